@@ -1,0 +1,1 @@
+"""Parametric gate-frame geometry, gmsh meshing, named regions and sensors."""

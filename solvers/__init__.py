@@ -1,0 +1,1 @@
+"""Heat conduction, thermoelasticity, beam theory and reduced models."""

@@ -1,0 +1,1 @@
+"""Conditions, sweeps, compensator, discrepancy workflow and the ``gatetherm`` CLI."""

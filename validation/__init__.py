@@ -1,0 +1,1 @@
+"""FE-vs-theory comparisons, verification studies, plots and reports."""
