@@ -16,7 +16,9 @@ from geometry.frame import FrameParams, MeshParams, TIE_SENSORS, tank_box, tie_d
 from geometry.mesh import FrameMesh
 from solvers.elasticity import ElasticSystem, assemble_elastic
 from solvers.fem import Field, to_skfem
-from solvers.heat import HeatSystem, ThermalParams, assemble_heat
+from skfem import FacetBasis, asm
+
+from solvers.heat import HeatSystem, ThermalParams, assemble_heat, film_load
 from solvers.material import FC300, Material
 
 log = logging.getLogger(__name__)
@@ -45,6 +47,13 @@ class ModelConfig:
     """Thermal contact conductance at the tie-bar joints, W/(m² K) (None: perfect contact)."""
     source: dict = field(default_factory=dict)
     """Volumetric heat sources by region name, W/m³."""
+    alpha_slope: float = 0.0
+    """Relative temperature slope of the expansion coefficient, α(T) = α(1 + s (T − T0)), 1/K."""
+
+
+def thermal_strain_measure(dT: np.ndarray, slope: float) -> np.ndarray:
+    """∫ α(T)/α dT from T0: the temperature rise that a constant α would need, K."""
+    return dT + 0.5 * slope * dT ** 2 if slope else dT
 
 
 def is_tie(region: str) -> bool:
@@ -88,22 +97,26 @@ class FrameModel:
     sensor_names: tuple[str, ...]
     probe: object
     weights: dict[str, np.ndarray]
+    surface_means: dict[str, np.ndarray]
+    """Weight vectors giving the area-mean temperature of the tank wall and the mounting face."""
 
     @property
     def dim(self) -> int:
         return self.fmesh.dim
 
     def temperatures(self, U: np.ndarray) -> dict[str, float]:
-        """Sensor temperatures (°C), θ_C as the mean of C1–C10, and the oil."""
+        """Sensor temperatures (°C), θ_C as the mean of C1–C10, tank oil, and the
+        area means of the tank wall and the mounting face."""
         vals = self.probe @ U[:-1]
         out = dict(zip(self.sensor_names, map(float, vals)))
         out["C"] = float(np.mean([out[c] for c in TIE_SENSORS]))
         out["oil"] = float(U[-1])
+        out.update({k: float(v @ U[:-1]) for k, v in self.surface_means.items()})
         return out
 
     def displacements(self, U: np.ndarray) -> dict[str, float]:
         """The outputs of :data:`OUTPUTS` in metres for the state ``U``."""
-        dT = U[:-1] - self.config.thermal.T0
+        dT = thermal_strain_measure(U[:-1] - self.config.thermal.T0, self.config.alpha_slope)
         return {k: float(w @ dT) for k, w in self.weights.items()}
 
     def displacement_field(self, U: np.ndarray) -> np.ndarray:
@@ -127,4 +140,9 @@ def build_model(cfg: ModelConfig, dim: int, fmesh: FrameMesh | None = None) -> F
     gx = {s: el.point_functional(fm.points[fm.sensors[s]], 0) for s in ("F_L", "F_R", "E_L", "E_R")}
     wx = {s: el.weights(g) for s, g in gx.items()}
     weights = {k: wx[a] - (wx[b] if b else 0.0) for k, (a, b) in OUTPUTS.items()}
-    return FrameModel(cfg, fm, mesh, heat, el, names, probe, weights)
+    means = {}
+    for key, bnd in (("wall", "tank_wall"), ("base", "mounting_face")):
+        fb = FacetBasis(mesh, heat.basis.elem, facets=mesh.boundaries[bnd])
+        a = asm(film_load, fb, h=1.0, t=f["thickness"].at(fb))
+        means[key] = a / a.sum()
+    return FrameModel(cfg, fm, mesh, heat, el, names, probe, weights, means)
