@@ -12,7 +12,7 @@ import logging
 import numpy as np
 
 from geometry.frame import (FrameParams, MeshParams, part_boxes, sensor_points,
-                            tank_box, validate)
+                            tank_box, validate, validate_mesh)
 from geometry.mesh import FrameMesh
 
 log = logging.getLogger(__name__)
@@ -51,7 +51,7 @@ def _add_box(occ, b, dim):
     return occ.addBox(b[0], b[2], b[4], b[1] - b[0], b[3] - b[2], b[5] - b[4])
 
 
-def _size_field(gmsh, p: FrameParams, mp: MeshParams, refine_curves):
+def _size_field(gmsh, size: float, mp: MeshParams, refine_curves):
     """Finer elements near the tank wall and the member joints."""
     f = gmsh.model.mesh.field
     dist = f.add("Distance")
@@ -60,10 +60,10 @@ def _size_field(gmsh, p: FrameParams, mp: MeshParams, refine_curves):
     f.setNumber(dist, "Sampling", 40)
     thr = f.add("Threshold")
     f.setNumber(thr, "InField", dist)
-    f.setNumber(thr, "SizeMin", mp.size * mp.refine)
-    f.setNumber(thr, "SizeMax", mp.size)
-    f.setNumber(thr, "DistMin", 0.5 * mp.size)
-    f.setNumber(thr, "DistMax", 3.0 * mp.size)
+    f.setNumber(thr, "SizeMin", size * mp.refine)
+    f.setNumber(thr, "SizeMax", size)
+    f.setNumber(thr, "DistMin", 0.5 * size)
+    f.setNumber(thr, "DistMax", 3.0 * size)
     f.setAsBackgroundMesh(thr)
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
@@ -73,6 +73,7 @@ def _size_field(gmsh, p: FrameParams, mp: MeshParams, refine_curves):
 def build_mesh(p: FrameParams, dim: int = 2, mesh: MeshParams = MeshParams()) -> FrameMesh:
     """Mesh the frame in ``dim`` = 2 (plane section) or 3 (solid) dimensions."""
     validate(p, dim)
+    validate_mesh(mesh)
     boxes = part_boxes(p, dim)
     tank = tank_box(p, dim)
     sensors = sensor_points(p, dim)
@@ -116,7 +117,9 @@ def build_mesh(p: FrameParams, dim: int = 2, mesh: MeshParams = MeshParams()) ->
             found = gmsh.model.getEntitiesInBoundingBox(
                 *(v - _TOL for v in xyz), *(v + _TOL for v in xyz), dim=0)
             point_of[name] = found[0][1]
-        _size_field(gmsh, p, mesh, refine)
+        _size_field(gmsh, mesh.size if dim == 2 else mesh.size_3d, mesh, refine)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fast, parallel Delaunay
+        gmsh.option.setNumber("General.NumThreads", 2)
         gmsh.model.mesh.generate(dim)
         return _extract(gmsh, dim, region_ents, facet_ents, point_of, p)
 

@@ -4,7 +4,8 @@ Coordinates: ``x`` horizontal from the outer (A) face of the tool-side column
 towards the workpiece side, ``y`` vertical up from the mounting face, ``z``
 depth (3-D only, front face at ``z = 0``). The paper gives no dimensions
 (its Fig. 2 is not in the text); the defaults are a bench-size cast-iron model
-whose figures are fitted in ``studies/data/paper.toml``.
+fitted to the paper's reported figures (``validation/calibrate_paper.py``);
+``studies/data/paper.toml`` repeats them explicitly.
 """
 from __future__ import annotations
 
@@ -20,21 +21,21 @@ Box = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, z0, z1
 class FrameParams:
     """Dimensions of the frame, all in metres (areas in m²)."""
 
-    h: float = 0.12
+    h: float = 0.20
     """Column width in x, the distance between sensor faces A and B, m."""
     depth: float = 0.12
     """Column depth in z (out-of-plane thickness of columns and arms in 2-D), m."""
-    column_height: float = 0.53
+    column_height: float = 0.79
     """Height of the column tops above the mounting face, m."""
-    l: float = 0.50
+    l: float = 0.76
     """Height of the cutting area (arm centreline, points E and F) above the mounting face, m."""
     l1: float = 0.25
     """Heated height of the tool-side column assumed by the beam theory, m."""
-    l4: float = 0.25
+    l4: float = 0.31
     """Height of the tie-bar centreline above the mounting face, m."""
     l_C: float = 0.40
     """Tie-bar length, the clear span between the inner column faces, m."""
-    A_C: float = 2.4e-3
+    A_C: float = 5.4e-4
     """Tie-bar cross-section, m²."""
     t_C: float = 0.04
     """Tie-bar height in the x-y plane, m (its depth is ``A_C / t_C``)."""
@@ -46,7 +47,7 @@ class FrameParams:
     """Gap between tool tip and workpiece tip, m."""
     tank_wall: float = 0.015
     """Wall thickness between the outer face A and the oil tank, m."""
-    tank_width: float = 0.05
+    tank_width: float = 0.038
     """Oil-tank extent in x, m."""
     tank_bottom: float = 0.02
     """Height of the tank floor above the mounting face, m."""
@@ -71,7 +72,9 @@ class MeshParams:
     """Mesh density controls."""
 
     size: float = 0.008
-    """Target element size away from refinement zones, m."""
+    """Target element size away from refinement zones in 2-D, m."""
+    size_3d: float = 0.009
+    """Target element size away from refinement zones in 3-D, m."""
     refine: float = 0.5
     """Element size at the tank wall and the member joints, as a fraction of ``size``."""
 
@@ -215,3 +218,15 @@ def validate(p: FrameParams, dim: int | None = None) -> FrameParams:
         raise InputError("A_C", f"tie-bar depth A_C/t_C = {tie_depth(p):g} m does not fit behind the arms "
                          f"({p.depth - p.arm_depth:g} m)", "raise t_C or lower A_C")
     return p
+
+
+def validate_mesh(m: MeshParams) -> MeshParams:
+    """Return ``m`` if its sizes are usable, else raise :class:`InputError`."""
+    if not m.size > 0:
+        raise InputError("mesh.size", f"must be positive, got {m.size}", "give an element size in metres")
+    if not m.size_3d > 0:
+        raise InputError("mesh.size_3d", f"must be positive, got {m.size_3d}", "give an element size in metres")
+    if not 0 < m.refine <= 1:
+        raise InputError("mesh.refine", f"must be in (0, 1], got {m.refine}",
+                         "give the refined size as a fraction of mesh.size")
+    return m

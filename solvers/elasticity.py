@@ -80,7 +80,9 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     lives on ``T_basis`` (same mesh). ``k_base`` (N/m³) replaces the clamp by
     an elastic foundation."""
     dim = mesh.dim()
-    vb = CellBasis(mesh, ElementVector(element(dim, order)), quadrature=T_basis.quadrature)
+    q = 2 * order - 1  # exact for the stiffness and the thermal load on affine simplices
+    vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
+    T_basis = CellBasis(mesh, T_basis.elem, intorder=q)
     lam, mu, b = moduli(E.values, nu.values, alpha.values, dim)
     t = thickness.at(vb)
     K = asm(stiffness, vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)

@@ -40,7 +40,7 @@ def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
     """Return ``solve(b)`` for the SPD matrix ``A``, set up once."""
     A = A.tocsr()
     if dim == 2 or A.shape[0] <= DIRECT_LIMIT_3D or near_null is None:
-        lu = splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A")
+        lu = splu(A.tocsc(), permc_spec="COLAMD")
         return lu.solve
     import pyamg
 

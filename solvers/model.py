@@ -7,6 +7,7 @@ weight vectors for displacements).
 from __future__ import annotations
 
 import logging
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,10 +24,8 @@ from solvers.material import FC300, Material
 
 log = logging.getLogger(__name__)
 
-#: Displacement outputs, each a difference or single x-displacement, m.
-OUTPUTS = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R"),
-           "ux_F_L": ("F_L", None), "ux_F_R": ("F_R", None),
-           "ux_E_L": ("E_L", None), "ux_E_R": ("E_R", None)}
+#: Displacement outputs: relative x-displacement (left minus right, m) of a sensor pair.
+OUTPUTS = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
 
 
 @dataclass(frozen=True)
@@ -45,6 +44,8 @@ class ModelConfig:
     """Foundation stiffness of the mounting face, N/m³ (None: clamped)."""
     joint_conductance: float | None = None
     """Thermal contact conductance at the tie-bar joints, W/(m² K) (None: perfect contact)."""
+    joint_stiffness: float | None = None
+    """Normal contact stiffness of the tie-bar joints per unit area, N/m³ (None: rigid contact)."""
     source: dict = field(default_factory=dict)
     """Volumetric heat sources by region name, W/m³."""
     alpha_slope: float = 0.0
@@ -70,6 +71,10 @@ def region_fields(cfg: ModelConfig, fm: FrameMesh, mesh) -> dict[str, Field]:
     if cfg.joint_conductance is not None:  # contact resistance in series with the end layer
         L = cfg.frame.joint_layer
         per_region["k"].update({r: L / (L / tie_m.k + 1.0 / cfg.joint_conductance)
+                                for r in ties if "joint" in r})
+    if cfg.joint_stiffness is not None:  # contact compliance in series with the end layer
+        L = cfg.frame.joint_layer
+        per_region["E"].update({r: L / (L / tie_m.E + 1.0 / cfg.joint_stiffness)
                                 for r in ties if "joint" in r})
     out = {name: Field.by_region(mesh, per_region[name], get(cfg.material))
            for name, get in props.items()}
@@ -99,6 +104,8 @@ class FrameModel:
     weights: dict[str, np.ndarray]
     surface_means: dict[str, np.ndarray]
     """Weight vectors giving the area-mean temperature of the tank wall and the mounting face."""
+    timings: dict[str, float] = field(default_factory=dict, compare=False)
+    """Seconds spent building: mesh, heat_assembly, elastic_setup, adjoint_solves."""
 
     @property
     def dim(self) -> int:
@@ -114,35 +121,49 @@ class FrameModel:
         out.update({k: float(v @ U[:-1]) for k, v in self.surface_means.items()})
         return out
 
+    def strain_measure(self, U: np.ndarray) -> np.ndarray:
+        return thermal_strain_measure(U[:-1] - self.config.thermal.T0, self.config.alpha_slope)
+
     def displacements(self, U: np.ndarray) -> dict[str, float]:
         """The outputs of :data:`OUTPUTS` in metres for the state ``U``."""
-        dT = thermal_strain_measure(U[:-1] - self.config.thermal.T0, self.config.alpha_slope)
+        dT = self.strain_measure(U)
         return {k: float(w @ dT) for k, w in self.weights.items()}
 
     def displacement_field(self, U: np.ndarray) -> np.ndarray:
         """Full displacement field (m) on the elastic basis: one elastic solve."""
-        return self.elastic.displacement(U[:-1] - self.config.thermal.T0)
+        return self.elastic.displacement(self.strain_measure(U))
 
 
 def build_model(cfg: ModelConfig, dim: int, fmesh: FrameMesh | None = None) -> FrameModel:
     """Mesh (unless ``fmesh`` is given) and assemble the frame model."""
+    clock = [time.perf_counter()]
+    timings = {}
+
+    def lap(name):
+        now = time.perf_counter()
+        timings[name] = now - clock[0]
+        clock[0] = now
+
     fm = fmesh or build_mesh(cfg.frame, dim, cfg.mesh)
+    lap("mesh")
     mesh = to_skfem(fm)
     f = region_fields(cfg, fm, mesh)
     src = f["source"] if cfg.source else None
     heat = assemble_heat(mesh, cfg.order, f["k"], f["rho_c"], f["thickness"], cfg.thermal,
                          oil_volume(cfg.frame, dim), source=src)
+    lap("heat_assembly")
     el = assemble_elastic(mesh, cfg.order, heat.basis, f["E"], f["nu"], f["alpha"],
                           f["thickness"], cfg.k_base)
+    lap("elastic_setup")
     names = tuple(fm.sensors)
     xyz = np.array([fm.points[fm.sensors[n]] for n in names]).T
     probe = heat.basis.probes(xyz).tocsr()
     gx = {s: el.point_functional(fm.points[fm.sensors[s]], 0) for s in ("F_L", "F_R", "E_L", "E_R")}
-    wx = {s: el.weights(g) for s, g in gx.items()}
-    weights = {k: wx[a] - (wx[b] if b else 0.0) for k, (a, b) in OUTPUTS.items()}
+    weights = {k: el.weights(gx[a] - gx[b]) for k, (a, b) in OUTPUTS.items()}
+    lap("adjoint_solves")
     means = {}
     for key, bnd in (("wall", "tank_wall"), ("base", "mounting_face")):
         fb = FacetBasis(mesh, heat.basis.elem, facets=mesh.boundaries[bnd])
         a = asm(film_load, fb, h=1.0, t=f["thickness"].at(fb))
         means[key] = a / a.sum()
-    return FrameModel(cfg, fm, mesh, heat, el, names, probe, weights, means)
+    return FrameModel(cfg, fm, mesh, heat, el, names, probe, weights, means, timings)

@@ -25,12 +25,27 @@ voltage-stroke loop is open by the hysteresis plus the dead band.
 The stack is mounted so that extension moves the tool away from the workpiece, which
 offsets the thermal approach: the displacement added to delta at the cutting area is
 ``-transmission * (x - x_bias)``, with ``x_bias`` the reset-state stroke at the bias voltage.
+
+Range (assumptions; the paper gives neither figure). Against the 32.34e6 N/m spring the
+stack gives 29.2 um, and from a 0 V reference it can only pull the tool away, while the
+paper compensated delta from about +44 um (approach) to about -16 um (apart, condition 3's
+60 um swing) and was left with +-7 um. The defaults therefore assume
+
+* ``transmission = 3``: the spring-shaped member is a flexure lever (the stack acts low in
+  the column, the tool sits higher), the smallest half-integer ratio for which
+  3 x 29.2 = 87.6 um covers that 60 um swing plus the +-7 um band on both sides (74 um);
+* ``bias_voltage_V = 50`` (one third of the 150 V range): zero compensation sits at
+  7.9 um of stroke, so the tool can be pushed 23.6 um towards the workpiece (>= 16 + 7) and
+  pulled 64.0 um away (>= 44 + 7), the 1 : 2.7 split of the paper's swing.
+
+The paper's reset strategy is kept: before each new voltage the drive returns to 0 V, which
+with a bias moves the tool briefly by ``transmission * x_bias`` towards the workpiece.
 """
 from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -64,10 +79,12 @@ class ActuatorParams:
     # Prandtl-Ishlinskii play thresholds r_i, V
     play_weights: tuple[float, ...] = (1.0, 0.25, 0.2, 0.15, 0.1)
     # relative play weights w_i, dimensionless (scaled by weights(); gives ~10 % open loop)
-    transmission: float = 1.0
-    # tool motion at the cutting area per unit of stroke, dimensionless
-    bias_voltage_V: float = 0.0
-    # voltage at which the compensation is zero, V (0 = paper: corrections away only)
+    transmission: float = 3.0
+    # tool motion at the cutting area per unit of stack stroke, dimensionless (assumed
+    # lever ratio of the spring-shaped member; see the module docstring)
+    bias_voltage_V: float = 50.0
+    # voltage at which the compensation is zero, V (assumed, one third of max_voltage_V so
+    # that the stroke works both ways; 0 = corrections away from the workpiece only)
     strategy: str = "reset"
     # "reset": return to 0 V before each new voltage (paper); "direct": step to it
 
@@ -165,6 +182,20 @@ def voltage_for(p: ActuatorParams, strokes_um) -> np.ndarray:
     return np.where(x > 0, np.interp(x + dead_band_um(p), loaded_stroke(p, knots), knots), 0.0)
 
 
+def stroke_range(p: ActuatorParams) -> tuple[float, float]:
+    """Reachable displacement at the cutting area (um), (most negative, most positive):
+    ``-transmission (x_max - x_bias)`` (away) .. ``transmission x_bias`` (towards)."""
+    x_bias = float(reset_curve(p, p.bias_voltage_V))
+    return -p.transmission * (float(reset_curve(p, p.max_voltage_V)) - x_bias), p.transmission * x_bias
+
+
+def saturated_commands(p: ActuatorParams, commands_um) -> np.ndarray:
+    """True where a displacement command (um) lies outside :func:`stroke_range` (1e-9 um slack)."""
+    lo, hi = stroke_range(p)
+    u = np.asarray(commands_um, float)
+    return (u < lo - 1e-9) | (u > hi + 1e-9)
+
+
 def apply_commands(p: ActuatorParams, commands_um) -> tuple[np.ndarray, np.ndarray]:
     """Voltages and achieved cutting-area displacements (um) for displacement commands (um).
 
@@ -173,12 +204,10 @@ def apply_commands(p: ActuatorParams, commands_um) -> tuple[np.ndarray, np.ndarr
     """
     u = np.asarray(commands_um, float)
     x_bias = float(reset_curve(p, p.bias_voltage_V))
-    lo = -p.transmission * (float(reset_curve(p, p.max_voltage_V)) - x_bias)
-    hi = p.transmission * x_bias
-    saturated = int(np.sum((u < lo - 1e-9) | (u > hi + 1e-9)))
+    saturated = int(np.sum(saturated_commands(p, u)))
     if saturated:
         log.warning("%d of %d piezo commands outside the reachable %.3g .. %.3g um; clipped",
-                    saturated, u.size, lo, hi)
+                    saturated, u.size, *stroke_range(p))
     volts = voltage_for(p, x_bias - u / p.transmission)
     return volts, -p.transmission * (sweep(p, volts) - x_bias)
 
@@ -194,3 +223,9 @@ def loop_width_um(p: ActuatorParams, steps: int = 30) -> float:
     """Open-loop width: largest stroke difference, descending minus ascending, at one voltage."""
     _, x = hysteresis_loop(p, steps)
     return float(np.max(np.abs(x[steps:][::-1] - x[: steps + 1])))
+
+
+def hysteresis_cost_um(p: ActuatorParams, steps: int = 30) -> float:
+    """What the hysteresis costs at the cutting area without the reset strategy, um:
+    transmission x the open-loop width of the direct-drive loop."""
+    return p.transmission * loop_width_um(replace(p, strategy="direct"), steps)

@@ -29,17 +29,27 @@ the start) and the hold is logged. No prediction exists for the first two sample
 
 The piezo command ``u = -delta_et`` is refreshed every ``update_interval_s`` from the
 first sample and held in between (0 before the first prediction).
+
+Coefficient sources (um/K): :func:`theory_coefficients` (beam theory of a model's frame),
+:func:`fe_coefficients_um` (FE load cases at the tips F), and
+``studies.regression.fit_coefficients`` (least squares on a run). Any other predictor
+(e.g. the static regression baseline) can drive the same loop via :func:`external_prediction`.
 """
 from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from geometry.errors import InputError
+from solvers import beam
 from studies import actuator as piezo
 from studies.timeseries import TimeSeries, rises, validate_complete
+
+if TYPE_CHECKING:
+    from solvers.model import FrameModel, ModelConfig
 
 log = logging.getLogger(__name__)
 
@@ -118,6 +128,32 @@ class ClosedLoop:
     # held displacement achieved at the cutting area, um
     delta_comp_um: np.ndarray
     # compensated delta = delta + stroke, um
+    saturated_updates: int = 0
+    # piezo updates whose command was outside the actuator's reach (clipped); 0 if ideal
+
+
+def beam_model(cfg: ModelConfig) -> beam.BeamModel:
+    """The beam model of a frame model: its l, l1, l4, h, l_C, A_C, column material E, alpha
+    with ``I = depth h^3 / 12`` (the tank cavity is ignored, as in the paper), tie-bar
+    material E_C, alpha_C."""
+    f, m = cfg.frame, cfg.material
+    tie = cfg.tie_material or m
+    return beam.BeamModel(l=f.l, l1=f.l1, l4=f.l4, h=f.h, EI=m.E * f.depth * f.h ** 3 / 12.0,
+                          alpha=m.alpha, l_C=f.l_C, A_C=f.A_C, E_C=tie.E, alpha_C=tie.alpha)
+
+
+def theory_coefficients(cfg: ModelConfig) -> tuple[float, float]:
+    """Beam-theory (K_i, K_C) of a frame model, um/K (eqs 22-24 via :func:`beam_model`)."""
+    ki, kc = beam.coefficients(beam_model(cfg))
+    return float(ki) * 1e6, float(kc) * 1e6
+
+
+def fe_coefficients_um(model: FrameModel) -> tuple[float, float]:
+    """(K_i, K_C) of an assembled FE model from the two load cases, read at the tips F, um/K."""
+    from solvers.reduced import fe_coefficients  # needs the FE stack; imported on use
+
+    c = fe_coefficients(model)
+    return c.Ki_F * 1e6, c.Kc_F * 1e6
 
 
 def extrapolate(previous, last):
@@ -199,31 +235,54 @@ def predict(ts: TimeSeries, Ki: float, Kc: float, params: CompensatorParams) -> 
         log.info("no first positive peak of delta recognised: R_i adapted over the whole run")
     if any(holds):
         log.info("near-zero denominators: R_i held at %d samples, R_C at %d", *holds)
+    return Prediction(grid.time_s, delta, delta_th, pred, R_i, R_C, held_commands(pred, params), peak,
+                      resampled)
+
+
+def held_commands(pred_um: np.ndarray, params: CompensatorParams) -> np.ndarray:
+    """Piezo commands on the grid: ``-pred`` at each update, held in between (0 before any)."""
     every = round(params.update_interval_s / params.sample_interval_s)
-    u = -np.nan_to_num(pred[(np.arange(n) // every) * every], nan=0.0)
-    return Prediction(grid.time_s, delta, delta_th, pred, R_i, R_C, u, peak, resampled)
+    return -np.nan_to_num(pred_um[(np.arange(len(pred_um)) // every) * every], nan=0.0)
 
 
-def compensate(ts: TimeSeries, Ki: float, Kc: float, params: CompensatorParams,
+def external_prediction(ts: TimeSeries, pred_um, params: CompensatorParams) -> Prediction:
+    """Wrap another predictor's delta (um, at ``ts``'s samples) for :func:`close_loop`;
+    it has no correction factors (R_i = R_C = NaN) and no theory term."""
+    grid, resampled = controller_grid(ts, params)
+    pred = np.asarray(pred_um, float)
+    pred = np.interp(grid.time_s, ts.time_s, pred) if resampled else pred
+    nan = np.full(len(pred), np.nan)
+    return Prediction(grid.time_s, grid["delta_um"], nan, pred, nan, nan, held_commands(pred, params),
+                      None, resampled)
+
+
+def close_loop(ts: TimeSeries, pr: Prediction, params: CompensatorParams,
                actuator: piezo.ActuatorParams | None = None) -> ClosedLoop:
-    """Closed loop: prediction, piezo drive (ideal if ``actuator`` is None), compensated delta."""
-    pr = predict(ts, Ki, Kc, params)
+    """Drive the piezo (ideal if ``actuator`` is None) with a prediction's held commands."""
     every = round(params.update_interval_s / params.sample_interval_s)
     updates = np.arange(0, len(pr.t_s), every)
     if actuator is None:
-        volts, stroke = np.full(updates.size, np.nan), pr.u_um[updates]
+        volts, stroke, saturated = np.full(updates.size, np.nan), pr.u_um[updates], 0
     else:
         volts, stroke = piezo.apply_commands(actuator, pr.u_um[updates])
+        saturated = int(np.sum(piezo.saturated_commands(actuator, pr.u_um[updates])))
     t = ts.time_s
     held = np.searchsorted(pr.t_s[updates], t + 1e-9 * params.sample_interval_s, side="right") - 1
     pred = np.interp(t, pr.t_s, pr.delta_pred_um) if pr.resampled else pr.delta_pred_um
     delta = ts["delta_um"]
     return ClosedLoop(pr, t, delta, pred, pr.u_um[updates][held], volts[held], stroke[held],
-                      delta + stroke[held])
+                      delta + stroke[held], saturated)
+
+
+def compensate(ts: TimeSeries, Ki: float, Kc: float, params: CompensatorParams,
+               actuator: piezo.ActuatorParams | None = None) -> ClosedLoop:
+    """Closed loop: prediction, piezo drive (ideal if ``actuator`` is None), compensated delta."""
+    return close_loop(ts, predict(ts, Ki, Kc, params), params, actuator)
 
 
 def summarize(loop: ClosedLoop, settle_s: float = 600.0) -> dict[str, float | None]:
-    """Summary figures (um; R dimensionless); bands skip the first ``settle_s`` seconds."""
+    """Summary figures (um; R dimensionless, None without factors); bands skip the first
+    ``settle_s`` seconds."""
     late = loop.t_s >= loop.t_s[0] + settle_s
     pr = loop.prediction
 
@@ -235,8 +294,9 @@ def summarize(loop: ClosedLoop, settle_s: float = 600.0) -> dict[str, float | No
         "swing_um": float(np.nanmax(loop.delta_um) - np.nanmin(loop.delta_um)),
         "prediction_error_band_um": band(loop.delta_um - loop.delta_pred_um),
         "residual_band_um": band(loop.delta_comp_um),
-        "R_i_final": float(pr.R_i[-1]),
-        "R_C_final": float(pr.R_C[-1]),
+        "R_i_final": float(pr.R_i[-1]) if np.isfinite(pr.R_i[-1]) else None,
+        "R_C_final": float(pr.R_C[-1]) if np.isfinite(pr.R_C[-1]) else None,
         "peak_time_s": None if pr.peak_index is None else float(pr.t_s[pr.peak_index]),
         "peak_delta_um": None if pr.peak_index is None else float(pr.delta_um[pr.peak_index]),
+        "piezo_saturated_updates": loop.saturated_updates,
     }

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from geometry.errors import InputError
 from geometry.frame import FrameParams, MeshParams, validate
+from solvers.effects import effects_from_table
 from solvers.heat import ThermalParams
 from solvers.material import Material
 from solvers.model import ModelConfig
@@ -31,6 +32,7 @@ class Config:
     supply: SupplyParams = SupplyParams()
     source: str = "defaults"
     effects: dict = field(default_factory=dict)
+    """Catalogue effects switched on, {name: value} (``[effects]``: ``NAME = {PARAM = VALUE}``)."""
 
 
 def _coerce(section: str, key: str, value, typ):
@@ -89,7 +91,7 @@ def parse_config(data: dict, source: str = "<dict>", base: Config | None = None)
         joint_conductance=(_coerce("model", "joint_conductance", model_table["joint_conductance"], float)
                            if "joint_conductance" in model_table else m.joint_conductance))
     supply = _build(SupplyParams, "supply", data.get("supply", {}), base.supply)
-    return Config(model, supply, source, {**base.effects, **data.get("effects", {})})
+    return Config(model, supply, source, {**base.effects, **effects_from_table(data.get("effects", {}))})
 
 
 def load_config(path: str | os.PathLike | None = None) -> Config:

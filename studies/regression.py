@@ -3,8 +3,11 @@
 * :func:`fit_coefficients`: K_i, K_C of ``delta = K_i (theta_A - theta_B) - K_C theta_C``
   (eq 21, no intercept), the "fit" source of the compensator's coefficients.
 * :func:`fit_regression` / :func:`apply_regression`: the industry baseline, a static
-  multiple linear regression of delta on the rises of theta_A, theta_B, theta_C and every
-  ``T_<name>_degC`` column, with intercept, fitted on one run and applied to another.
+  multiple linear regression of delta on temperature rises with intercept, fitted on one
+  run and applied to another. By default the regressors are theta_A, theta_B, theta_C and
+  every ``T_<name>_degC`` column, less any that is an exact linear combination of those
+  before it (e.g. the last tie-bar point, theta_C being the mean of C1..C10); a caller may
+  name them instead (e.g. :data:`THETAS`, the paper's three sensors).
 
 Rows with a missing value in any used column are left out of a fit (and logged).
 """
@@ -69,10 +72,27 @@ def _design(ts: TimeSeries, features) -> np.ndarray:
     return np.column_stack([np.ones(len(ts))] + [rises(ts, f) for f in features])
 
 
-def fit_regression(ts: TimeSeries) -> LinearModel:
-    """Fit the static multiple linear regression baseline on one run."""
-    features = regression_features(ts)
+def independent_features(ts: TimeSeries, features) -> tuple[str, ...]:
+    """``features`` in order, less those whose rise is (to round-off) a linear combination of
+    the intercept and the features kept before it; the dropped ones are logged."""
+    keep: list[str] = []
+    for name in features:
+        x = _design(ts, keep + [name])
+        x = x[np.isfinite(x).all(axis=1)]
+        if np.linalg.matrix_rank(x) == x.shape[1]:
+            keep.append(name)
+    if len(keep) < len(features):
+        log.info("regression: left out linearly dependent %s", ", ".join(f for f in features if f not in keep))
+    return tuple(keep)
+
+
+def fit_regression(ts: TimeSeries, features=None) -> LinearModel:
+    """Fit the static multiple linear regression baseline on one run; ``features`` are
+    temperature columns (default: :func:`regression_features`, dependent ones left out)."""
+    features = independent_features(ts, regression_features(ts)) if features is None else tuple(features)
     beta = _least_squares(_design(ts, features), ts["delta_um"], "regression baseline")
+    log.info("regression baseline on %d sensors: intercept %.4g um, coefficients %s um/K", len(features),
+             beta[0], ", ".join(f"{f} {b:.4g}" for f, b in zip(features, beta[1:])))
     return LinearModel(features, tuple(float(b) for b in beta[1:]), float(beta[0]))
 
 

@@ -5,8 +5,9 @@ import numpy as np
 import pytest
 
 from geometry.errors import InputError
-from studies.actuator import (ActuatorParams, apply_commands, dead_band_um, load_factor, loaded_stroke,
-                              loop_width_um, play, reset_curve, reset_state, step, sweep, voltage_for, weights)
+from studies.actuator import (ActuatorParams, apply_commands, dead_band_um, hysteresis_cost_um, load_factor,
+                              loaded_stroke, loop_width_um, play, reset_curve, reset_state, saturated_commands,
+                              step, stroke_range, sweep, voltage_for, weights)
 
 PRELOADED = ActuatorParams()
 UNLOADED = replace(PRELOADED, preload_N=0.0)
@@ -94,11 +95,32 @@ def test_apply_commands_reset_hits_targets_direct_does_not():
     assert err[3] < -1.0 and err[4] < -0.5  # falling: the descending branch moves the tool further
 
 
+def test_default_range_works_both_ways_and_covers_the_paper_swing():
+    # zero compensation at 50 V: x_bias = (150/231) * 62.4 V * load factor * 40/150 um/V - dead band
+    x_bias = 150 / 231 * 62.4 * load_factor(PRELOADED) * 40 / 150 - dead_band_um(PRELOADED)
+    assert float(reset_curve(PRELOADED, 50.0)) == pytest.approx(x_bias, rel=1e-14)
+    lo, hi = stroke_range(PRELOADED)
+    assert hi == pytest.approx(3 * x_bias, rel=1e-14) and hi == pytest.approx(23.64067, abs=1e-5)
+    assert lo == pytest.approx(-3 * (float(reset_curve(PRELOADED, 150.0)) - x_bias), rel=1e-14)
+    assert lo == pytest.approx(-63.94890, abs=1e-5)
+    # the paper's compensated range, +44 um approach .. -16 um apart, with its +-7 um band
+    assert lo < -(44 + 7) and hi > 16 + 7
+    assert hysteresis_cost_um(PRELOADED) == pytest.approx(3 * 3.04343, abs=1e-4)  # at the cutting area
+
+
 def test_apply_commands_saturates_and_transmits(caplog):
-    _, achieved = apply_commands(PRELOADED, [5.0, -40.0])
-    assert achieved[0] == 0.0  # cannot push the tool towards the workpiece from the 0 V reference
+    _, achieved = apply_commands(PRELOADED, [5.0, -40.0, 20.0])
+    np.testing.assert_allclose(achieved, [5.0, -40.0, 20.0], atol=1e-12)  # both ways from the bias
+    assert not caplog.text
+    commands = [30.0, -80.0, -10.0]
+    _, achieved = apply_commands(PRELOADED, commands)
+    np.testing.assert_allclose(achieved, [*stroke_range(PRELOADED)[::-1], -10.0], atol=1e-12)  # clipped
+    assert saturated_commands(PRELOADED, commands).tolist() == [True, True, False]
+    assert "2 of 3 piezo commands outside" in caplog.text
+    zero_ref = replace(PRELOADED, bias_voltage_V=0.0, transmission=1.0)
+    _, achieved = apply_commands(zero_ref, [5.0, -40.0])
+    assert achieved[0] == 0.0  # cannot push the tool towards the workpiece from a 0 V reference
     assert achieved[1] == pytest.approx(-29.19652, abs=1e-5)  # full stroke
-    assert "2 of 2 piezo commands outside" in caplog.text
     biased = replace(PRELOADED, bias_voltage_V=75.0, transmission=2.0)
     _, achieved = apply_commands(biased, [25.0, -32.0])
     np.testing.assert_allclose(achieved, [25.0, -32.0], atol=1e-12)

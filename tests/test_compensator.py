@@ -11,7 +11,7 @@ from studies import cli
 from studies.actuator import ActuatorParams
 from studies.compensator import (CompensatorParams, compensate, extrapolate, held_ratio, predict,
                                  summarize)
-from studies.regression import apply_regression, fit_coefficients, fit_regression
+from studies.regression import THETAS, apply_regression, fit_coefficients, fit_regression
 from studies.timeseries import TimeSeries, read_timeseries, write_timeseries
 
 EVERY_MIN = CompensatorParams(update_interval_s=60.0)
@@ -156,9 +156,17 @@ def test_closed_loop_with_actuator_and_summary():
     ideal = compensate(ts, 2.0, 1.0, CompensatorParams(), None)
     reset = compensate(ts, 2.0, 1.0, CompensatorParams(), ActuatorParams())
     direct = compensate(ts, 2.0, 1.0, CompensatorParams(), ActuatorParams(strategy="direct"))
-    ok = ideal.u_um <= 0  # the 0 V reference can only pull the tool away
-    np.testing.assert_allclose(reset.stroke_um[ok], ideal.stroke_um[ok], atol=1e-12)
-    assert np.all(reset.stroke_um[~ok] == 0) and np.all(np.isnan(ideal.voltage_V))
+    np.testing.assert_allclose(reset.stroke_um, ideal.stroke_um, atol=1e-12)
+    assert reset.saturated_updates == 0 and np.all(np.isnan(ideal.voltage_V))
+    apart = peaked(k, 1.2, 2.0)  # delta ends at -12 um: commands towards the workpiece
+    ideal_apart = compensate(apart, 2.0, 1.0, CompensatorParams(), None)
+    both = compensate(apart, 2.0, 1.0, CompensatorParams(), ActuatorParams())
+    np.testing.assert_allclose(both.stroke_um, ideal_apart.stroke_um, atol=1e-12)  # reach both ways
+    zero_ref = compensate(apart, 2.0, 1.0, CompensatorParams(), ActuatorParams(bias_voltage_V=0.0))
+    ok = ideal_apart.u_um <= 0  # a 0 V reference can only pull the tool away
+    np.testing.assert_allclose(zero_ref.stroke_um[ok], ideal_apart.stroke_um[ok], atol=1e-12)
+    assert np.all(zero_ref.stroke_um[~ok] == 0) and 10 < ideal_apart.u_um.max() < 23
+    assert zero_ref.saturated_updates == np.sum(ideal_apart.u_um[::5] > 0) > 10
     assert np.max(np.abs(direct.stroke_um - reset.stroke_um)) > 0.3  # hysteresis without reset
     s_ideal, s_direct = summarize(ideal), summarize(direct)
     d = ts["delta_um"]
@@ -186,6 +194,13 @@ def test_regression_baseline_fits_one_run_and_applies_to_another():
     np.testing.assert_allclose(apply_regression(fit, exact), exact["delta_um"], atol=1e-9)
     with pytest.raises(InputError, match="T_leg_degC"):
         apply_regression(model, peaked(k))
+    # theta_C is the mean of the tie-bar points: the last one adds nothing and is left out
+    c1 = 20 + 0.5 * k ** 0.8
+    tie = exact.with_columns(T_C1_degC=c1, T_C2_degC=2 * exact["theta_C_degC"] - c1)
+    assert fit_regression(tie).features == THETAS + ("T_leg_degC", "T_C1_degC")
+    three = fit_regression(tie, THETAS)  # the paper's sensors only: eq (21) with an intercept
+    assert three.features == THETAS
+    np.testing.assert_allclose(three.coefficients + (three.intercept_um,), (2, -2, -1, 1.5), atol=1e-9)
 
 
 # ---- the command line --------------------------------------------------------------------

@@ -28,7 +28,7 @@ TARGETS = {1: {"first_peak_um": 44.0, "first_peak_min": 15.0, "swing_um": 52.0},
 
 #: (section, field, lower, upper) of the fitted parameters.
 FREE = [("geometry", "l", 0.4, 1.0), ("geometry", "l4", 0.12, 0.5), ("geometry", "A_C", 2e-4, 4e-3),
-        ("geometry", "h", 0.08, 0.2), ("thermal", "h_oil_on", 50.0, 600.0),
+        ("geometry", "h", 0.10, 0.20), ("geometry", "tank_width", 0.02, 0.08), ("thermal", "h_oil_on", 50.0, 600.0),
         ("thermal", "h_oil_off", 5.0, 100.0), ("supply", "tau_heat", 300.0, 1800.0)]
 
 
@@ -43,7 +43,7 @@ def with_values(base, x):
         else:
             supply = dataclasses.replace(supply, **{name: v})
     frame = dataclasses.replace(frame, column_height=frame.l + 0.5 * frame.arm_thickness,
-                                tank_width=min(frame.tank_width, frame.h - frame.tank_wall - 0.04))
+                                tank_width=min(frame.tank_width, frame.h - frame.tank_wall - 0.03))
     model = dataclasses.replace(base.model, frame=frame, thermal=thermal)
     return dataclasses.replace(base, model=model, supply=supply)
 
@@ -97,8 +97,8 @@ def main() -> None:
     minimize(f, np.ones_like(x0), method="Nelder-Mead",
              options={"maxfev": args.evals, "initial_simplex": None, "xatol": 1e-3, "fatol": 1e-4})
     print("\n# best parameters")
-    for (sec, name, *_), v in zip(FREE, best[1]):
-        print(f"[{sec}] {name} = {v:.6g}")
+    for (sec, name, lo, hi), v in zip(FREE, best[1]):
+        print(f"[{sec}] {name} = {float(np.clip(v, lo, hi)):.6g}")
 
 
 if __name__ == "__main__":

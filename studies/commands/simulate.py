@@ -32,9 +32,9 @@ def register(sub) -> None:
 class Progress:
     """A one-line bar on a terminal; silent otherwise (logs stay clean)."""
 
-    def __init__(self, label: str, stream=sys.stderr):
-        self.label, self.stream = label, stream
-        self.on = stream.isatty()
+    def __init__(self, label: str, stream=None):
+        self.label, self.stream = label, stream or sys.stderr
+        self.on = self.stream.isatty()
 
     def __call__(self, i: int, n: int) -> None:
         if not self.on:

@@ -1,0 +1,49 @@
+"""Wall time of the paper's conditions at the default mesh, in parts, against targets.
+
+    python benchmarks/conditions.py [--dims 2 3] [--conditions 1 2 3]
+
+Prints, per dimension and condition: meshing, assembly, elastic set-up,
+adjoint solves, heat factorisations, time stepping (300 steps with δ every
+step) and the total, and the ratio of the total to the target
+(2-D: 15 s, 3-D: 90 s at ≥ 50 000 nodes; ratio < 1 meets it). Each condition
+builds its own model, as one ``gatetherm simulate`` run does (writing files
+and pictures is not included).
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+from solvers.heat import factorisation_seconds
+from solvers.model import build_model
+from studies.conditions import CONDITIONS, condition_drive
+from studies.config import load_config
+from studies.simulate import run_model, sample_times
+
+TARGET_S = {2: 15.0, 3: 90.0}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--dims", type=int, nargs="+", default=[2, 3])
+    ap.add_argument("--conditions", type=int, nargs="+", default=[1, 2, 3])
+    args = ap.parse_args()
+    cfg = load_config()
+    print(f"{'dim':>3} {'cond':>4} {'nodes':>7} {'mesh':>6} {'heat asm':>8} {'elastic':>8} "
+          f"{'adjoint':>8} {'factor':>7} {'steps':>6} {'total':>7} {'ratio':>6}")
+    for dim in args.dims:
+        for c in args.conditions:
+            t0 = time.perf_counter()
+            model = build_model(cfg.model, dim)
+            build, tm = time.perf_counter() - t0, model.timings
+            res = run_model(model, condition_drive(CONDITIONS[c], cfg.supply),
+                            sample_times(CONDITIONS[c].duration))
+            _, factor = factorisation_seconds(model.heat)
+            total = build + res.seconds
+            print(f"{dim:>3} {c:>4} {len(model.fmesh.points):>7} {tm['mesh']:>6.2f} {tm['heat_assembly']:>8.2f} "
+                  f"{tm['elastic_setup']:>8.2f} {tm['adjoint_solves']:>8.2f} {factor:>7.2f} "
+                  f"{res.seconds - factor:>6.2f} {total:>7.2f} {total / TARGET_S[dim]:>6.2f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,152 @@
+"""Hidden-effect study of the discrepancy workflow (issue 6).
+
+    python -m validation.hidden_effects --out DIR [--workers 2] [--quick]
+
+"Measured" runs are made by simulating a paper condition with one catalogue
+effect switched on at a seeded random strength (one draw in the lower and one
+in the upper third of its plausible range, log scale for positive
+parameters), on a finer mesh than the diagnosis uses (no inverse crime), then
+adding Gaussian sensor noise at the paper's resolution (0.1 µm, 0.05 K) and
+rounding to it. Each run is diagnosed blind from the baseline model. Also:
+noise-only runs, and runs with an effect outside the catalogue (a heat leak
+at the tie bar, thermocouples A/B mounted higher than the model assumes, a
+drop of the tank oil flow part-way through the run).
+
+Writes ``DIR/hidden_effects.md`` and ``DIR/hidden_effects.csv`` (one row per
+case: effect, strength, condition, named effect, verdict, runner-up, margin,
+held-out RMS of δ before/after, wall time) and prints the acceptance figures.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import io
+import logging
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from geometry.files import write_text_atomic
+from solvers.effects import CATALOGUE, ActiveEffects, apply_effects
+from solvers.heat import HeatSystem
+from solvers.model import build_model
+from studies.conditions import CONDITIONS, condition_drive
+from studies.config import Config, load_config
+from studies.discrepancy import Settings, diagnose
+from studies.replay import DELTA, resolution
+from studies.simulate import run_model, sample_times
+from studies.timeseries import FORMAT, TimeSeries
+
+log = logging.getLogger(__name__)
+
+#: The channels a rig of the paper records (no room temperature).
+MEASURED = ("time_s", "oil_degC", "pump", "theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
+TRUTH_MESH_FACTOR = 0.75
+"""Element size of the "measured" runs relative to the diagnosis mesh."""
+
+#: Effects outside the catalogue: name -> (parameter, unit, strengths tried).
+OUTSIDE = {
+    "tie_heat_leak": ("power", "W", (1.0, 2.0)),
+    "sensor_height": ("offset", "m", (0.04, -0.04)),
+    "flow_drop": ("fraction", "1", (0.3, 0.5)),
+}
+FLOW_DROP_AT_S = 2.5 * 3600.0
+"""When the oil flow drops in the ``flow_drop`` case, s."""
+
+
+@dataclass(frozen=True)
+class Case:
+    effect: str
+    """Catalogue name, an :data:`OUTSIDE` name, or "none" (noise only)."""
+    strength: float
+    condition: int
+    seed: int
+
+
+def draw_strengths(name: str, rng: np.random.Generator) -> tuple[float, float]:
+    """One strength in the lower and one in the upper third of the plausible range
+    (log scale for positive ranges; for a range through zero, |x| in 0.2–1 of the
+    upper end with a random sign)."""
+    e = CATALOGUE[name]
+    if e.log_scale:
+        a, b = np.log10(e.lo), np.log10(e.hi)
+        return tuple(float(10 ** rng.uniform(a + k * (b - a) / 3, a + (k + 1) * (b - a) / 3)) for k in (0, 2))
+    top = max(abs(e.lo), abs(e.hi))
+    mags = (rng.uniform(0.2, 0.45) * top, rng.uniform(0.6, 1.0) * top)
+    return tuple(float(m * rng.choice((-1.0, 1.0))) for m in mags)
+
+
+def _resumed(heat: HeatSystem, U0: np.ndarray) -> HeatSystem:
+    """``heat`` started from the state ``U0`` instead of a uniform temperature."""
+
+    @dataclass(frozen=True)
+    class Resumed(HeatSystem):
+        def initial(self, T0=None):
+            return U0.copy()
+
+    return Resumed(**{f.name: getattr(heat, f.name) for f in dataclasses.fields(heat) if f.name != "_lu"})
+
+
+def truth(config: Config, case: Case, dim: int = 2) -> dict[str, np.ndarray]:
+    """The noise-free columns of a case on the truth mesh."""
+    mesh = dataclasses.replace(config.model.mesh, size=config.model.mesh.size * TRUTH_MESH_FACTOR)
+    cfg = dataclasses.replace(config.model, mesh=mesh)
+    cond = CONDITIONS[case.condition]
+    drive = condition_drive(cond, config.supply)
+    times = sample_times(cond.duration)
+    if case.effect in CATALOGUE:
+        eff = ActiveEffects({case.effect: case.strength})
+        mcfg, drive = apply_effects(cfg, drive, eff, dim)
+        return eff.observe(run_model(build_model(mcfg, dim), drive, times).columns)
+    if case.effect == "tie_heat_leak":
+        from geometry.frame import part_boxes
+
+        x0, x1, y0, y1, z0, z1 = part_boxes(cfg.frame, dim)["tie_bar"]
+        cfg = dataclasses.replace(cfg, source={"tie_bar": -case.strength / ((x1 - x0) * (y1 - y0) * (z1 - z0))})
+    elif case.effect == "sensor_height":
+        cfg = dataclasses.replace(cfg, frame=cfg.frame.replace(sensor_height=cfg.frame.sensor_height + case.strength))
+    elif case.effect == "flow_drop":
+        k = int(np.searchsorted(times, FLOW_DROP_AT_S))
+        model = build_model(cfg, dim)
+        first = run_model(model, drive, times[:k + 1], keep_times=[times[k]])
+        low = dataclasses.replace(cfg.thermal, flow_rate=cfg.thermal.flow_rate * case.strength)
+        m2 = build_model(dataclasses.replace(cfg, thermal=low), dim, model.fmesh)
+        m2 = dataclasses.replace(m2, heat=_resumed(m2.heat, first.states[0][1]))
+        rest = run_model(m2, drive, times[k:]).columns
+        return {c: np.concatenate([first.columns[c][:k], rest[c]]) for c in rest}
+    elif case.effect != "none":
+        raise ValueError(f"unknown case effect {case.effect!r}")
+    return run_model(build_model(cfg, dim), drive, times).columns
+
+
+def measured(cols: dict[str, np.ndarray], seed: int, condition: int) -> TimeSeries:
+    """The rig's channels of ``cols`` with sensor noise at the resolution, rounded to it."""
+    rng = np.random.default_rng(seed)
+    out = {}
+    for c in MEASURED:
+        v = np.asarray(cols[c], dtype=float)
+        if c in ("theta_A_degC", "theta_B_degC", "theta_C_degC", DELTA):
+            r = resolution(c)
+            v = np.round((v + rng.normal(0.0, r, len(v))) / r) * r
+        out[c] = v
+    return TimeSeries(out, {"format": FORMAT, "source": "hidden-effect study", "condition": str(condition)})
+
+
+def run_case(case: Case, config: Config | None = None, settings: Settings = Settings(), mesh=None) -> dict:
+    """Make the measured run of ``case``, diagnose it blind, return the study row."""
+    config = config or load_config()
+    ts = measured(truth(config, case), case.seed, case.condition)
+    d = diagnose(config, ts, mesh=mesh, settings=settings)
+    s = d.summary()
+    before, after = s["rms_before_um"], s["rms_after_um"]
+    w_before = float(np.sqrt(np.mean([v ** 2 / resolution(c) ** 2 for c, v in s["rms_before"].items()])))
+    w_after = (float(np.sqrt(np.mean([v ** 2 / resolution(c) ** 2 for c, v in s["rms_after"].items()])))
+               if s["rms_after"] else None)
+    return {"effect": case.effect, "strength": case.strength, "condition": case.condition, "seed": case.seed,
+            "verdict": d.verdict, "named": d.named_effect, "runner_up": d.runner_up, "margin": d.margin,
+            "rms_before_um": before, "rms_after_um": after, "rms_w_before": w_before, "rms_w_after": w_after,
+            "fitted": s["fitted"], "runs": d.runs, "seconds": round(d.seconds, 1), "reason": d.reason}
