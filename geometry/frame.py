@@ -21,21 +21,21 @@ Box = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, z0, z1
 class FrameParams:
     """Dimensions of the frame, all in metres (areas in m²)."""
 
-    h: float = 0.20
+    h: float = 0.225
     """Column width in x, the distance between sensor faces A and B, m."""
     depth: float = 0.12
     """Column depth in z (out-of-plane thickness of columns and arms in 2-D), m."""
-    column_height: float = 0.79
+    column_height: float = 0.70
     """Height of the column tops above the mounting face, m."""
-    l: float = 0.76
+    l: float = 0.67
     """Height of the cutting area (arm centreline, points E and F) above the mounting face, m."""
     l1: float = 0.25
     """Heated height of the tool-side column assumed by the beam theory, m."""
-    l4: float = 0.31
+    l4: float = 0.34
     """Height of the tie-bar centreline above the mounting face, m."""
     l_C: float = 0.40
     """Tie-bar length, the clear span between the inner column faces, m."""
-    A_C: float = 5.4e-4
+    A_C: float = 5.9e-4
     """Tie-bar cross-section, m²."""
     t_C: float = 0.04
     """Tie-bar height in the x-y plane, m (its depth is ``A_C / t_C``)."""
@@ -45,9 +45,9 @@ class FrameParams:
     """Depth of the arms in z from the front face (3-D); the tie bar sits behind them, m."""
     gap: float = 0.02
     """Gap between tool tip and workpiece tip, m."""
-    tank_wall: float = 0.015
+    tank_wall: float = 0.0145
     """Wall thickness between the outer face A and the oil tank, m."""
-    tank_width: float = 0.038
+    tank_width: float = 0.026
     """Oil-tank extent in x, m."""
     tank_bottom: float = 0.02
     """Height of the tank floor above the mounting face, m."""

@@ -61,9 +61,9 @@ class ThermalParams:
     """Film coefficient of the free surfaces to room air (convection + linearised radiation), W/(m² K)."""
     h_base: float = 0.0
     """Film coefficient of the mounting face to a foundation at room temperature, W/(m² K)."""
-    h_oil_on: float = 121.0
+    h_oil_on: float = 260.0
     """Tank-wall film coefficient while the pump circulates the oil, W/(m² K)."""
-    h_oil_off: float = 25.7
+    h_oil_off: float = 28.0
     """Tank-wall film coefficient of standing oil, W/(m² K)."""
     oil_rho_c: float = 1.7e6
     """Volumetric heat capacity of the oil, J/(m³ K)."""
@@ -198,9 +198,9 @@ def march(sys: HeatSystem, drive: Drive, times: np.ndarray, theta: float = 1.0,
     for t0, t1 in zip(times[:-1], times[1:]):
         dt = float(t1 - t0)
         pump = bool(drive(0.5 * (t0 + t1)).pump)
-        K = sys.K(pump)
-        rhs = sys.M @ U / dt - (1 - theta) * (K @ U) \
-            + theta * sys.f(t1, drive, pump) + (1 - theta) * sys.f(t0, drive, pump)
+        rhs = sys.M @ U / dt + theta * sys.f(t1, drive, pump)
+        if theta < 1:
+            rhs += (1 - theta) * (sys.f(t0, drive, pump) - sys.K(pump) @ U)
         U = _solver(sys, dt, theta, pump).solve(rhs)
         yield float(t1), U
 

@@ -9,7 +9,7 @@ import sys
 from geometry.errors import InputError
 
 #: Sub-command modules under ``studies.commands``, in ``--help`` order.
-COMMAND_MODULES = ("mesh", "simulate", "beam", "compensate", "sweep", "validate")
+COMMAND_MODULES = ("mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -24,7 +24,7 @@ class SupplyParams:
 
     T_room: float = 20.0
     """Room temperature, also the oil temperature before heating, °C."""
-    tau_heat: float = 600.0
+    tau_heat: float = 650.0
     """Time constant of the supply oil approaching a higher set point (heater), s."""
     tau_cool: float = 600.0
     """Time constant of the supply oil approaching a lower set point (forced cooling), s."""

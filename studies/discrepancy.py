@@ -97,6 +97,9 @@ class Diagnosis:
     residual_after: dict[str, np.ndarray] | None
     runs: int
     seconds: float
+    has_ambient: bool = False
+    """The file recorded the room temperature (the model was driven by it)."""
+    margin_min: float = Settings.margin_min
 
     def summary(self) -> dict:
         """The ``diagnosis.json`` content."""
@@ -190,7 +193,7 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     log.info("diagnosis: %s (%s), %d model runs", verdict, reason, rep.runs)
     return Diagnosis(verdict, named, runner, margin, reason, adopted, base, tuple(ranked), channels, scale,
                      t, float(t[train][-1]), tuple(run_phases), tuple(findings), res0, after, rep.runs,
-                     time.perf_counter() - t0)
+                     time.perf_counter() - t0, rep.has_ambient, settings.margin_min)
 
 
 def adopted_config(config: Config, diag: Diagnosis) -> Config | None:

@@ -2,9 +2,12 @@
 
 A run is split into phases from its inputs (pump off, heating, oil steady,
 forced cooling). A residual is *significant* where its systematic part (a
-centred moving average over ``SMOOTH_S``) exceeds the sensor resolution; the
-sample-to-sample noise is estimated from first differences. All functions are
-pure and work on arrays in the channels' units.
+centred moving average over ``SMOOTH_S``) exceeds the sensor resolution with
+confidence: by more than ``Z`` standard errors of that average, the
+sample-to-sample noise being estimated from first differences (at least the
+rounding noise of the resolution, res/√12). A model error below the
+resolution, such as the FE discretisation error, is therefore not reported.
+All functions are pure and work on arrays in the channels' units.
 """
 from __future__ import annotations
 
@@ -20,6 +23,8 @@ OIL_RATE_K_PER_H = 2.0
 """Supply-oil rate that counts as heating or cooling rather than steady, K/h."""
 MIN_PHASE_S = 600.0
 """Shorter phases are merged into the one before, s."""
+Z = 3.0
+"""Standard errors of the moving average by which it must exceed the resolution."""
 
 
 @dataclass(frozen=True)
@@ -51,7 +56,9 @@ def phases(t: np.ndarray, oil: np.ndarray, pump: np.ndarray) -> list[Phase]:
     """Phases of a run from its (gap-free) inputs: "pump off", "heating",
     "forced cooling", "pump on, oil steady (N °C oil)"."""
     n = len(t)
-    rate = np.gradient(oil, t) * 3600.0 if n > 1 else np.zeros(n)
+    rate = np.append(np.diff(oil) / np.diff(t), 0.0) * 3600.0 if n > 1 else np.zeros(n)
+    if n > 1:  # the trend over the interval after each sample, like the pump state
+        rate[-1] = rate[-2]
     kinds = np.where(pump < 0.5, "pump off", np.where(rate > OIL_RATE_K_PER_H, "heating",
                      np.where(rate < -OIL_RATE_K_PER_H, "forced cooling", "pump on, oil steady")))
     cuts = [0] + [i for i in range(1, n) if kinds[i] != kinds[i - 1]] + [n]
@@ -77,18 +84,22 @@ def phases(t: np.ndarray, oil: np.ndarray, pump: np.ndarray) -> list[Phase]:
     return out
 
 
+def _window(t: np.ndarray, window_s: float) -> int:
+    """Half-width in samples of a moving average over about ``window_s``."""
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    return max(int(round(0.5 * window_s / dt)), 0)
+
+
 def smooth(t: np.ndarray, r: np.ndarray, window_s: float = SMOOTH_S) -> np.ndarray:
     """Centred moving average of ``r`` over about ``window_s`` (missing samples skipped)."""
-    dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
-    half = max(int(round(0.5 * window_s / dt)), 0)
+    half = _window(t, window_s)
     ok = np.isfinite(r)
     s = np.concatenate([[0.0], np.cumsum(np.where(ok, r, 0.0))])
     n = np.concatenate([[0], np.cumsum(ok)])
     i = np.arange(len(r))
     lo, hi = np.maximum(i - half, 0), np.minimum(i + half + 1, len(r))
     cnt = n[hi] - n[lo]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(cnt > 0, (s[hi] - s[lo]) / np.maximum(cnt, 1), np.nan)
+    return np.where(cnt > 0, (s[hi] - s[lo]) / np.maximum(cnt, 1), np.nan)
 
 
 def noise_sd(r: np.ndarray) -> float:
@@ -97,10 +108,17 @@ def noise_sd(r: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0)) if len(d) > 2 else 0.0
 
 
+def threshold(t: np.ndarray, r: np.ndarray, res: float) -> float:
+    """Level above which the moving average of ``r`` is significant: the resolution
+    plus ``Z`` standard errors of the average."""
+    noise = max(noise_sd(r), res / np.sqrt(12.0))
+    return res + Z * noise / np.sqrt(2 * _window(t, SMOOTH_S) + 1)
+
+
 def significant(t: np.ndarray, r: np.ndarray, res: float) -> np.ndarray:
-    """Samples where the systematic residual exceeds the resolution ``res``."""
+    """Samples where the systematic residual exceeds the resolution with confidence."""
     s = smooth(t, r)
-    return np.isfinite(s) & (np.abs(s) > res)
+    return np.isfinite(s) & (np.abs(s) > threshold(t, r, res))
 
 
 @dataclass(frozen=True)
@@ -138,7 +156,7 @@ def locate(t: np.ndarray, res: dict[str, np.ndarray], run_phases: list[Phase]) -
     out = []
     for c, r in res.items():
         s = smooth(t, r)
-        sig = np.isfinite(s) & (np.abs(s) > resolution(c))
+        sig = significant(t, r, resolution(c))
         for ph in run_phases:
             m = ph.mask(t) & np.isfinite(r)
             if not m.any():

@@ -215,11 +215,18 @@ def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = Tru
     return cfg, condition, tuple(sorted(effects.items())), skip
 
 
-def point_key(study: Study, overrides: dict[str, Any]) -> str:
-    """Hash of everything a point's result depends on (not of the study's name or plots)."""
-    blob = json.dumps({"base": dataclasses.asdict(dataclasses.replace(study.base, source="")),
-                       "dim": study.dim, "compute": sorted(study.compute), "fit": study.fit_frame,
-                       "overrides": overrides}, sort_keys=True, default=repr)
+def point_key(cfg: Config, dim: int, compute, condition, effects) -> str:
+    """Hash of everything a point's result depends on: the final model (without the
+    thermal and supply data when nothing is run), dimension, computations, condition, effects."""
+    model = dataclasses.asdict(cfg.model)
+    data = {"model": model, "supply": dataclasses.asdict(cfg.supply), "effects": cfg.effects}
+    if "run" not in compute:
+        for name in ("thermal", "source", "joint_conductance"):
+            model.pop(name, None)
+        data.pop("supply")
+        condition = None
+    blob = json.dumps({**data, "dim": dim, "compute": sorted(compute), "condition": condition,
+                       "effect_values": effects}, sort_keys=True, default=repr)
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
@@ -234,8 +241,8 @@ def plan(study: Study) -> list[Task]:
         if "run" in study.compute and cond is None:
             raise InputError("condition", "the 'run' computation needs a heating condition",
                              "add condition = [1, 2, 3] to [grid] or condition = 1 to [set]")
-        tasks.append(Task(point_key(study, overrides), params, cfg, study.dim, study.compute,
-                          cond, eff, skip))
+        key = point_key(cfg, study.dim, study.compute, cond, eff)
+        tasks.append(Task(key, params, cfg, study.dim, study.compute, cond, eff, skip))
     if tasks and all(t.skip for t in tasks):
         raise InputError(study.name, f"no point of the study can be built ({tasks[0].skip})",
                          "change the grid")

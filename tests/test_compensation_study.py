@@ -1,7 +1,8 @@
 """K sources, ``gatetherm compensate --condition``, the Fig. 5 plot and the compensation study.
 
-Everything runs on the default frame (FrameParams etc. defaults, not the shipped paper model,
-which is being recalibrated) meshed coarsely via a TOML file with ``[mesh] size = 0.02``.
+Everything runs on a frame of its own, pinned in a small TOML file (so that recalibrating
+the shipped paper model or the code defaults leaves these values alone) and meshed
+coarsely with ``[mesh] size = 0.02``.
 """
 import csv
 import dataclasses
@@ -26,10 +27,40 @@ from validation import compensation_study
 from validation.compensation_plots import plot_piezo_loops
 
 
+PINNED = """
+[mesh]
+size = 0.02
+
+[geometry]
+h = 0.18
+depth = 0.12
+column_height = 0.73
+l = 0.70
+l1 = 0.25
+l4 = 0.30
+l_C = 0.40
+A_C = 6e-4
+t_C = 0.04
+tank_wall = 0.015
+tank_width = 0.04
+tank_height = 0.21
+sensor_height = 0.125
+
+[thermal]
+h_air = 8.0
+h_oil_on = 150.0
+h_oil_off = 25.0
+
+[supply]
+tau_heat = 600.0
+tau_cool = 600.0
+"""
+
+
 @pytest.fixture(scope="module")
 def coarse_toml(tmp_path_factory):
     path = tmp_path_factory.mktemp("cfg") / "coarse.toml"
-    path.write_text("[mesh]\nsize = 0.02\n")
+    path.write_text(PINNED)
     return path
 
 
@@ -104,22 +135,24 @@ def test_cli_condition_simulates_and_compensates(tmp_path, coarse_toml, cfg, mod
     comp = read_timeseries(out / "compensated.csv")
     assert comp.metadata["condition"] == "2" and len(comp) == 301
     direct = run_model(model, condition_drive(CONDITIONS[2], cfg.supply), sample_times(5 * 3600))
-    np.testing.assert_allclose(comp["delta_um"], direct.columns["delta_um"], rtol=1e-9, atol=1e-9)
+    # the command meshes again and gmsh is not bit-reproducible: equal to ~1e-3 um, not to round-off
+    np.testing.assert_allclose(comp["delta_um"], direct.columns["delta_um"], rtol=1e-3, atol=0.01)
     np.testing.assert_array_equal(comp["delta_comp_um"], comp["delta_um"] + comp["u_piezo_um"])
-    assert summary["swing_um"] == pytest.approx(np.ptp(direct.columns["delta_um"]), rel=1e-9)
+    assert summary["swing_um"] == pytest.approx(np.ptp(comp["delta_um"]), rel=1e-15)
     assert "condition 2: K_i" in io_.out and "residual band" in io_.out
     # the same run from the file with the FE coefficients of the same model
     code, io_ = gatetherm("compensate", "--data", out / "compensated.csv", "--config", coarse_toml,
                           "--k-source", "fe", "--out", tmp_path / "fe", "--no-actuator")
     assert code == 0, io_.err
     fe = json.loads((tmp_path / "fe" / "summary.json").read_text())
-    assert fe["k_source"] == "fe" and (fe["Ki_um_per_K"], fe["Kc_um_per_K"]) == fe_coefficients_um(model)
+    assert fe["k_source"] == "fe"  # the command builds its own mesh: equal to ~1e-5
+    assert (fe["Ki_um_per_K"], fe["Kc_um_per_K"]) == pytest.approx(fe_coefficients_um(model), rel=3e-4)
     assert fe["swing_um"] == summary["swing_um"] and fe["piezo_saturated_updates"] == 0
 
 
 def test_cli_data_defaults_to_theory_of_the_paper_model(tmp_path, cfg, model, gatetherm):
     write_timeseries(tmp_path / "run.csv", simulated_series(model, cfg, 1))
-    code, io_ = gatetherm("compensate", "--data", tmp_path / "run.csv", "--out", tmp_path / "o")
+    code, io_ = gatetherm("compensate", "--data", tmp_path / "run.csv", "--out", tmp_path / "o", "--no-actuator")
     assert code == 0, io_.err
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["k_source"] == "theory" and summary["config"] == "gatetherm:paper.toml"
@@ -167,7 +200,8 @@ def test_study_table_structure(cfg, model, study):
     by = {(r.condition, r.predictor): r for r in rows}
     assert (by[1, "paper, K theory"].Ki_um_per_K, by[1, "paper, K theory"].Kc_um_per_K) == \
         theory_coefficients(cfg.model)
-    assert (by[1, "paper, K FE"].Ki_um_per_K, by[1, "paper, K FE"].Kc_um_per_K) == fe_coefficients_um(model)
+    assert (by[1, "paper, K FE"].Ki_um_per_K, by[1, "paper, K FE"].Kc_um_per_K) == \
+        pytest.approx(fe_coefficients_um(model), rel=3e-4)  # another build of the mesh
     for n in (1, 2, 3):
         same = [r for r in rows if r.condition == n]
         assert len({r.swing_um for r in same}) == 1
@@ -181,14 +215,16 @@ def test_study_table_structure(cfg, model, study):
     assert text.count("| ±6–7 |") == 18 and "- condition 3: yes (" in text
 
 
-# regression values, coarse default frame: (swing, prediction-error band, residual band,
-# residual band with 1-min updates, clipped updates)
+# regression values on the pinned coarse frame: (swing, prediction-error band, residual band,
+# residual band with 1-min updates, clipped updates). Two builds of one mesh differ by ~4e-5
+# (gmsh is not bit-reproducible), hence rel=3e-4; the all-sensor regression is too
+# ill-conditioned for regression values (its bands move by 10-50 % between builds).
 EXPECTED = {
-    (1, "paper, K theory"): (48.8583, 4.22373, 13.0026, 4.22373, 11),
-    (2, "paper, K FE"): (37.2369, 4.46063, 13.7053, 4.46063, 6),
-    (3, "paper, K fit (cond. 1)"): (42.4326, 4.26776, 13.1147, 7.85927, 5),
-    (2, "MLR θA θB θC (cond. 1)"): (37.2369, 2.20711, 14.4358, 2.66356, 6),
-    (3, "MLR θA θB θC (cond. 1), 1-min forecast"): (42.4326, 5.53383, 14.3391, 7.85927, 4),
+    (1, "paper, K theory"): (55.2296, 6.25439, 22.4210, 6.25439, 0),
+    (2, "paper, K FE"): (47.3038, 6.43560, 23.0646, 6.43560, 0),
+    (3, "paper, K fit (cond. 1)"): (61.3302, 6.08050, 21.7774, 6.08050, 0),
+    (3, "MLR θA θB θC (cond. 1)"): (61.3302, 2.12272, 22.8677, 2.12272, 1),
+    (2, "MLR θA θB θC (cond. 1), 1-min forecast"): (47.3038, 6.82289, 23.4004, 6.82289, 0),
 }
 
 
@@ -197,7 +233,7 @@ def test_study_regression_values(study, key):
     row = {(r.condition, r.predictor): r for r in study.rows}[key]
     got = (row.swing_um, row.prediction_error_band_um, row.residual_band_um, row.residual_band_1min_um,
            row.saturated_updates)
-    assert got == pytest.approx(EXPECTED[key], rel=1e-5)
+    assert got == pytest.approx(EXPECTED[key], rel=3e-4)
 
 
 def test_study_main_writes_figures_and_tables(tmp_path, coarse_toml, study, monkeypatch, capsys):

@@ -23,6 +23,8 @@ import csv
 import dataclasses
 import io
 import logging
+import multiprocessing
+import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
@@ -91,13 +93,15 @@ def _resumed(heat: HeatSystem, U0: np.ndarray) -> HeatSystem:
     return Resumed(**{f.name: getattr(heat, f.name) for f in dataclasses.fields(heat) if f.name != "_lu"})
 
 
-def truth(config: Config, case: Case, dim: int = 2) -> dict[str, np.ndarray]:
-    """The noise-free columns of a case on the truth mesh."""
-    mesh = dataclasses.replace(config.model.mesh, size=config.model.mesh.size * TRUTH_MESH_FACTOR)
+def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_MESH_FACTOR,
+          duration: float | None = None) -> dict[str, np.ndarray]:
+    """The noise-free columns of a case on the truth mesh (``mesh_factor`` × the model's
+    element size), over the condition's duration unless ``duration`` (s) is given."""
+    mesh = dataclasses.replace(config.model.mesh, size=config.model.mesh.size * mesh_factor)
     cfg = dataclasses.replace(config.model, mesh=mesh)
     cond = CONDITIONS[case.condition]
     drive = condition_drive(cond, config.supply)
-    times = sample_times(cond.duration)
+    times = sample_times(duration or cond.duration)
     if case.effect in CATALOGUE:
         eff = ActiveEffects({case.effect: case.strength})
         mcfg, drive = apply_effects(cfg, drive, eff, dim)
@@ -131,7 +135,7 @@ def measured(cols: dict[str, np.ndarray], seed: int, condition: int) -> TimeSeri
         v = np.asarray(cols[c], dtype=float)
         if c in ("theta_A_degC", "theta_B_degC", "theta_C_degC", DELTA):
             r = resolution(c)
-            v = np.round((v + rng.normal(0.0, r, len(v))) / r) * r
+            v = np.round(np.round((v + rng.normal(0.0, r, len(v))) / r) * r, 6)
         out[c] = v
     return TimeSeries(out, {"format": FORMAT, "source": "hidden-effect study", "condition": str(condition)})
 
@@ -150,3 +154,125 @@ def run_case(case: Case, config: Config | None = None, settings: Settings = Sett
             "verdict": d.verdict, "named": d.named_effect, "runner_up": d.runner_up, "margin": d.margin,
             "rms_before_um": before, "rms_after_um": after, "rms_w_before": w_before, "rms_w_after": w_after,
             "fitted": s["fitted"], "runs": d.runs, "seconds": round(d.seconds, 1), "reason": d.reason}
+
+
+def cases(seed: int = 6, conditions=(1, 2, 3), effects=tuple(CATALOGUE), noise_seeds: int = 2) -> list[Case]:
+    """The study: every effect at two strengths on every condition, noise-only runs
+    and the out-of-catalogue effects."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for name in effects:
+        for c in conditions:
+            out += [Case(name, s, c, int(rng.integers(1 << 31))) for s in draw_strengths(name, rng)]
+    for c in conditions:
+        out += [Case("none", 0.0, c, int(rng.integers(1 << 31))) for _ in range(noise_seeds)]
+        for name, (_, _, strengths) in OUTSIDE.items():
+            out += [Case(name, s, c, int(rng.integers(1 << 31))) for s in strengths]
+    return out
+
+
+def _worker(args):
+    case, mesh_size = args
+    logging.basicConfig(level=logging.WARNING)
+    config = load_config()
+    if mesh_size:
+        config = dataclasses.replace(config, model=dataclasses.replace(
+            config.model, mesh=dataclasses.replace(config.model.mesh, size=mesh_size)))
+    return run_case(case, config)
+
+
+def acceptance(rows: list[dict]) -> dict:
+    """The issue's acceptance figures."""
+    cat = [r for r in rows if r["effect"] in CATALOGUE]
+    hit = [r for r in cat if r["named"] == r["effect"]]
+    on_delta = [r for r in hit if r["effect"] != "thermocouple_lag"]
+    falls = [1 - r["rms_after_um"] / r["rms_before_um"] for r in on_delta]
+    lag = [1 - r["rms_w_after"] / r["rms_w_before"] for r in hit if r["effect"] == "thermocouple_lag"]
+    noise = [r for r in rows if r["effect"] == "none"]
+    outside = [r for r in rows if r["effect"] in OUTSIDE]
+    return {
+        "catalogue_cases": len(cat), "named_correctly": len(hit),
+        "named_fraction": len(hit) / max(len(cat), 1),
+        "wrong_names": sum(1 for r in cat if r["named"] not in (None, r["effect"])),
+        "delta_rms_fall_min": min(falls, default=float("nan")),
+        "delta_rms_fall_median": float(np.median(falls)) if falls else float("nan"),
+        "delta_rms_fall_ge_70pct": sum(f >= 0.7 for f in falls), "delta_cases": len(falls),
+        "lag_weighted_rms_fall_min": min(lag, default=float("nan")),
+        "noise_only": len(noise), "noise_only_named": sum(r["named"] is not None for r in noise),
+        "noise_only_verdicts": sorted({r["verdict"] for r in noise}),
+        "outside": len(outside), "outside_unexplained": sum(r["verdict"] == "unexplained" for r in outside),
+        "outside_verdicts": sorted({f"{r['effect']}:{r['verdict']}:{r['named']}" for r in outside}),
+        "seconds_max": max(r["seconds"] for r in rows), "seconds_median": float(np.median([r["seconds"] for r in rows])),
+    }
+
+
+COLUMNS = ("effect", "strength", "condition", "verdict", "named", "runner_up", "margin",
+           "rms_before_um", "rms_after_um", "rms_w_before", "rms_w_after", "seconds")
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def table_markdown(rows: list[dict], acc: dict) -> str:
+    head = ["effect", "strength", "cond.", "verdict", "named effect", "runner-up", "margin",
+            "δ RMS before (µm)", "δ RMS after (µm)", "weighted RMS before", "weighted RMS after", "time (s)"]
+    lines = ["# Hidden-effect study", "",
+             "Held-out window: last 40 % of each 5-h run. Weighted RMS: all channels, each in units of "
+             "its resolution (0.1 µm, 0.05 K). Strength in the effect's unit (see `gatetherm diagnose "
+             "--list-effects`); outside-catalogue cases: tie_heat_leak W, sensor_height m, flow_drop fraction.",
+             "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines += ["| " + " | ".join(_fmt(r[k]) for k in COLUMNS) + " |" for r in rows]
+    lines += ["", "## Acceptance", ""] + [f"- {k}: {_fmt(v)}" for k, v in acc.items()]
+    return "\n".join(lines) + "\n"
+
+
+def table_csv(rows: list[dict]) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(COLUMNS + ("fitted",))
+    for r in rows:
+        w.writerow([_fmt(r[k]) if r[k] is not None else "" for k in COLUMNS]
+                   + [";".join(f"{k}={v:.4g}" for k, v in r["fitted"].items())])
+    return buf.getvalue()
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", required=True, metavar="DIR")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seed", type=int, default=6)
+    ap.add_argument("--conditions", default="1,2,3")
+    ap.add_argument("--effects", default=",".join(CATALOGUE) + ",none," + ",".join(OUTSIDE),
+                    help="comma-separated catalogue/outside effects and 'none' (default: all)")
+    ap.add_argument("--mesh-size", type=float, help="diagnosis element size, m (default: the model's)")
+    args = ap.parse_args(argv)
+    logging.basicConfig(level=logging.WARNING)
+    wanted = set(args.effects.split(","))
+    todo = [c for c in cases(args.seed, tuple(int(x) for x in args.conditions.split(",")))
+            if c.effect in wanted]
+    t0 = time.perf_counter()
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")  # one thread per worker process
+    with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        rows = []
+        for row in pool.map(_worker, [(c, args.mesh_size) for c in todo]):
+            rows.append(row)
+            print("%-17s %-10.4g c%d -> %-18s %-17s margin %s  δ RMS %s -> %s  (%.0f s)" % (row["effect"],
+                        row["strength"], row["condition"], row["verdict"], row["named"], _fmt(row["margin"]),
+                  _fmt(row["rms_before_um"]), _fmt(row["rms_after_um"]), row["seconds"]), flush=True)
+    acc = {**acceptance(rows), "study_wall_time_s": round(time.perf_counter() - t0, 1)}
+    out = Path(args.out)
+    write_text_atomic(out / "hidden_effects.md", table_markdown(rows, acc))
+    write_text_atomic(out / "hidden_effects.csv", table_csv(rows))
+    for k, v in acc.items():
+        print(f"{k}: {_fmt(v)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -6,6 +6,7 @@ import os
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter, ScalarFormatter
 
 from geometry.files import atomic_path
 
@@ -47,7 +48,11 @@ def plot_xy(rows: list[dict], x: str, y: str, hue: str | None, path: str | os.Pa
         ax.plot(xs, ys, "o-", ms=3.5, color=f"C{i % 10}", label=f"{hue} = {h}" if hue else None)
     if hline is not None:
         ax.axhline(hline, color="0.4", lw=0.8, ls="--")
-    ax.set_xscale("log" if logx else "linear")
+    if logx:  # ticks at the data, in plain numbers
+        ax.set_xscale("log")
+        ax.set_xticks(sorted({p for r in rows if np.isfinite(p := _num(r.get(x)))}))
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_yscale("log" if logy else "linear")
     ax.set_xlabel(x)
     ax.set_ylabel(y)

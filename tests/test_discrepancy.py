@@ -1,0 +1,176 @@
+"""The discrepancy workflow: phases, significance, verdict rules, replay, model files,
+and a few representative blind diagnoses on a coarse mesh (the heavier ones are slow;
+the full hidden-effect study is ``python -m validation.hidden_effects``).
+
+The fast diagnoses make their "measured" data on the diagnosis mesh itself (an
+inverse crime, for speed); the study uses a finer truth mesh."""
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from geometry.frame import MeshParams
+from studies.calibrate import Fit
+from studies.cli import main
+from solvers.model import build_model
+from studies.conditions import CONDITIONS, condition_drive
+from studies.config import load_config
+from studies.discrepancy import Candidate, Settings, adopted_config, decide, diagnose
+from studies.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
+from studies.modelfile import config_toml
+from studies.simulate import run_model
+from studies.replay import Hypothesis, Replayer, compared_channels, residuals
+from studies.timeseries import write_timeseries
+from validation.hidden_effects import Case, measured, truth
+
+COARSE = MeshParams(size=0.02)
+HOUR = 3600.0
+
+
+@pytest.fixture(scope="module")
+def coarse_config():
+    cfg = load_config()
+    return dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, mesh=COARSE))
+
+
+def _measured(cfg, effect, strength, condition=1, seed=3):
+    case = Case(effect, strength, condition, seed)
+    return measured(truth(cfg, case, mesh_factor=1.0), seed, condition)
+
+
+def test_phases_from_inputs():
+    t = np.arange(0.0, 5 * HOUR + 1, 60.0)
+    oil = np.interp(t, [0, HOUR, 2 * HOUR, 3 * HOUR, 4 * HOUR, 5 * HOUR], [20, 30, 30, 30, 20, 20])
+    pump = np.where((t >= 2 * HOUR) & (t < 3 * HOUR), 0.0, 1.0)
+    pump[(t >= 4.5 * HOUR) & (t < 4.5 * HOUR + 300)] = 0.0  # a 5-min blip joins its neighbour
+    got = [(p.label, p.start_s / 60, p.end_s / 60) for p in phases(t, oil, pump)]
+    assert got == [("heating", 0, 60), ("pump on, oil steady (30 °C)", 60, 120), ("pump off", 120, 180),
+                   ("forced cooling", 180, 240), ("pump on, oil steady (20 °C)", 240, 300)]
+    last = phases(t, oil, pump)[-1]
+    assert last.closed and last.mask(t)[-1] and not phases(t, oil, pump)[0].mask(t)[60]
+
+
+def test_smoothing_noise_and_threshold():
+    t = np.arange(0.0, 300 * 60.0 + 1, 60.0)
+    ramp = 0.01 * t / 60
+    assert np.allclose(smooth(t, np.full_like(t, 2.5)), 2.5)
+    assert np.allclose(smooth(t, ramp)[8:-8], ramp[8:-8])  # a centred average keeps a line
+    assert noise_sd(ramp) == pytest.approx(0.0, abs=1e-12)
+    rng = np.random.default_rng(0)
+    assert noise_sd(rng.normal(0, 0.1, 20000)) == pytest.approx(0.1, rel=0.03)
+    # 15-min window at 1-min sampling: 17 samples; noise-free -> rounding noise res/sqrt(12)
+    assert threshold(t, ramp * 0, 0.1) == pytest.approx(0.1 * (1 + 3 / np.sqrt(12 * 17)), rel=1e-12)
+
+
+def test_locate_flags_only_the_disturbed_phase():
+    t = np.arange(0.0, 3 * HOUR + 1, 60.0)
+    ph = [Phase("a", 0, HOUR), Phase("b", HOUR, 2 * HOUR), Phase("c", 2 * HOUR, 3 * HOUR, closed=True)]
+    rng = np.random.default_rng(1)
+    r = rng.normal(0, 0.1, len(t)) + np.where((t > 1.2 * HOUR) & (t < 1.8 * HOUR), 0.6, 0.0)
+    found = {f.phase.label: f for f in locate(t, {"delta_um": r}, ph)}
+    assert [k for k, f in found.items() if f.significant] == ["b"]
+    assert "above the model" in found["b"].sentence() and "0.6" in found["b"].sentence()
+    assert "within resolution" in found["a"].sentence()
+    assert not significant(t, rng.normal(0, 0.1, len(t)), 0.1).any()
+
+
+def _cand(name, score, explains, k=1):
+    return Candidate(Fit(name, Hypothesis(), k, {}, {}, 0.0), score, {"delta_um": 0.1}, explains)
+
+
+def test_verdict_rules():
+    base = _cand("baseline", 5000.0, False, 0)
+    eff, other = _cand("piezo_heat", 500.0, True), _cand("stand_drift", 900.0, False)
+    recal = _cand("recalibration", 800.0, True, 4)
+    assert decide(base, [], False, 10.0)[0] == "no-discrepancy"
+    assert decide(base, [eff, recal, other], True, 10.0)[:4] == ("missing-effect", "piezo_heat", "recalibration", 300.0)
+    close = _cand("stand_drift", 505.0, True)
+    assert decide(base, [eff, close], True, 10.0)[:3] == ("unexplained", None, "stand_drift")
+    assert decide(base, [eff, close, recal], True, 10.0)[0] == "parameter-mismatch"
+    assert decide(base, [recal, other], True, 10.0)[:2] == ("parameter-mismatch", None)
+    none = decide(base, [_cand("piezo_heat", 600.0, False), other], True, 10.0)
+    assert none[:3] == ("unexplained", None, "piezo_heat") and "no candidate explains" in none[4]
+
+
+def test_replay_reproduces_a_simulation(coarse_config):
+    ts = _measured(coarse_config, "none", 0.0, condition=3)
+    rep = Replayer(coarse_config, ts.with_columns(ambient_degC=np.full(len(ts), 20.0)))
+    model = build_model(coarse_config.model, 2, rep.fmesh)  # the same mesh (gmsh may order nodes differently)
+    clean = run_model(model, condition_drive(CONDITIONS[3], coarse_config.supply), ts.time_s).columns
+    ts = ts.with_columns(**{c: clean[c] for c in ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")})
+    cols = rep.run()
+    channels = compared_channels(ts, cols)
+    assert channels == ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
+    assert max(np.abs(r).max() for r in residuals(ts, cols, channels).values()) < 1e-9
+    assert rep.has_ambient and rep.run() is not cols and rep.runs == 1  # second run from the cache
+
+
+def test_model_file_round_trip(tmp_path):
+    cfg = dataclasses.replace(load_config(), effects={"joint_compliance": 2.5e11, "ambient_drift": -0.3})
+    path = tmp_path / "model.toml"
+    path.write_text(config_toml(cfg, "a test"), encoding="utf-8")
+    back = load_config(path)
+    assert back.model == cfg.model and back.supply == cfg.supply and back.effects == cfg.effects
+
+
+def test_noise_only_is_no_discrepancy(coarse_config):
+    d = diagnose(coarse_config, _measured(coarse_config, "none", 0.0, seed=11))
+    assert (d.verdict, d.named_effect, d.runs) == ("no-discrepancy", None, 1)
+    assert d.summary()["rms_before_um"] == pytest.approx(0.1, rel=0.25)
+
+
+def test_names_a_hidden_effect(coarse_config):
+    ts = _measured(coarse_config, "piezo_heat", 3.0)
+    d = diagnose(coarse_config, ts, settings=Settings(effects=("piezo_heat", "stand_drift"), recalibrate=False))
+    s = d.summary()
+    assert (d.verdict, d.named_effect, d.runner_up) == ("missing-effect", "piezo_heat", "stand_drift")
+    assert s["fitted"]["piezo_heat.power"] == pytest.approx(3.0, rel=0.05)
+    assert s["uncertainty"]["piezo_heat.power"] < 0.1
+    assert s["rms_after_um"] < 0.3 * s["rms_before_um"]
+    assert adopted_config(coarse_config, d).effects == {"piezo_heat": s["fitted"]["piezo_heat.power"]}
+
+
+def test_list_effects_json(capsys):
+    assert main(["diagnose", "--list-effects", "--json"]) == 0
+    listed = json.loads(capsys.readouterr().out)
+    assert {"name", "params"} <= set(listed[0]) and len(listed) >= 6
+    assert main(["diagnose", "--data", "x.csv"]) == 2
+
+
+@pytest.mark.slow
+def test_parameter_mismatch(coarse_config):
+    th = coarse_config.model.thermal
+    wrong = dataclasses.replace(coarse_config, model=dataclasses.replace(
+        coarse_config.model, thermal=dataclasses.replace(th, h_oil_on=th.h_oil_on * 1.6)))
+    d = diagnose(coarse_config, _measured(wrong, "none", 0.0, condition=2))
+    assert (d.verdict, d.named_effect) == ("parameter-mismatch", None)
+    fit, sd = d.adopted.fit.values, d.adopted.fit.sigma
+    assert abs(fit["h_oil_on"] - 1.6 * th.h_oil_on) < max(3 * sd["h_oil_on"], 0.05 * th.h_oil_on)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("effect, strength", [("tie_heat_leak", 1.5), ("sensor_height", 0.04)])
+def test_outside_catalogue_is_unexplained(coarse_config, effect, strength):
+    d = diagnose(coarse_config, _measured(coarse_config, effect, strength))
+    assert (d.verdict, d.named_effect) == ("unexplained", None)
+
+
+@pytest.mark.slow
+def test_cli_end_to_end(coarse_config, tmp_path):
+    data = tmp_path / "run.csv"
+    write_timeseries(data, _measured(coarse_config, "stand_drift", 1.0, condition=2))
+    out = tmp_path / "diag"
+    assert main(["diagnose", "--data", str(data), "--out", str(out), "--mesh-size", "0.02",
+                 "--effects", "stand_drift,piezo_heat,compliant_base"]) == 0
+    s = json.loads((out / "diagnosis.json").read_text())
+    for key in ("named_effect", "verdict", "runner_up", "margin", "rms_before_um", "rms_after_um", "fitted"):
+        assert key in s
+    assert (s["verdict"], s["named_effect"]) == ("missing-effect", "stand_drift")
+    assert s["fitted"]["stand_drift.coefficient"] == pytest.approx(1.0, rel=0.05)
+    assert load_config(out / "model.toml").effects == {"stand_drift": s["fitted"]["stand_drift.coefficient"]}
+    report = (out / "report.md").read_text()
+    assert "missing-effect" in report and "before_after.png" in report
+    assert all((out / f).is_file() for f in ("residuals.png", "scores.png", "before_after.png"))
