@@ -118,8 +118,8 @@ def build_mesh(p: FrameParams, dim: int = 2, mesh: MeshParams = MeshParams()) ->
                 *(v - _TOL for v in xyz), *(v + _TOL for v in xyz), dim=0)
             point_of[name] = found[0][1]
         _size_field(gmsh, mesh.size if dim == 2 else mesh.size_3d, mesh, refine)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fast, parallel Delaunay
-        gmsh.option.setNumber("General.NumThreads", 2)
+        gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fast Delaunay
+        gmsh.option.setNumber("General.NumThreads", 1)  # threads make meshes differ run to run
         gmsh.model.mesh.generate(dim)
         return _extract(gmsh, dim, region_ents, facet_ents, point_of, p)
 

@@ -36,7 +36,7 @@ def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.nd
 
 
 def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
-               rtol: float = 1e-10) -> Callable[[np.ndarray], np.ndarray]:
+               rtol: float = 1e-9) -> Callable[[np.ndarray], np.ndarray]:
     """Return ``solve(b)`` for the SPD matrix ``A``, set up once."""
     A = A.tocsr()
     if dim == 2 or A.shape[0] <= DIRECT_LIMIT_3D or near_null is None:
@@ -44,7 +44,9 @@ def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
         return lu.solve
     import pyamg
 
-    ml = pyamg.smoothed_aggregation_solver(A, B=near_null, symmetry="symmetric",
+    # energy-minimising prolongation smoothing halves the CG iterations on the frame
+    # (28 against 53 at 53k DOFs) for about the same set-up time
+    ml = pyamg.smoothed_aggregation_solver(A, B=near_null, symmetry="symmetric", smooth="energy",
                                            strength=("symmetric", {"theta": 0.0}), max_coarse=500)
     log.info("AMG hierarchy: %d levels, operator complexity %.2f", len(ml.levels),
              ml.operator_complexity())

@@ -7,22 +7,24 @@ import pytest
 from geometry.build import build_mesh
 from geometry.frame import FrameParams, MeshParams
 
-COARSE = MeshParams(size=0.02)
+COARSE = MeshParams(size=0.02, size_3d=0.02)
 """Mesh density of the shared frame fixtures (about 1.6k triangles / 24k tetrahedra)."""
+FIXED = FrameParams(h=0.12, column_height=0.53, l=0.50, l4=0.25, A_C=2.4e-3, tank_wall=0.015, tank_width=0.05)
+"""A fixed frame (not the calibrated defaults), so that hand values in tests stay valid."""
 
 _ORDERS = pytest.StashKey[list]()
 
 
 @pytest.fixture(scope="session")
 def frame_2d():
-    """The default frame meshed in 2-D at :data:`COARSE`."""
-    return build_mesh(FrameParams(), 2, COARSE)
+    """The :data:`FIXED` frame meshed in 2-D at :data:`COARSE`."""
+    return build_mesh(FIXED, 2, COARSE)
 
 
 @pytest.fixture(scope="session")
 def frame_3d():
-    """The default frame meshed in 3-D at :data:`COARSE`."""
-    return build_mesh(FrameParams(), 3, COARSE)
+    """The :data:`FIXED` frame meshed in 3-D at :data:`COARSE`."""
+    return build_mesh(FIXED, 3, COARSE)
 
 
 @pytest.fixture

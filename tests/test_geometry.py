@@ -14,8 +14,7 @@ from geometry.errors import InputError
 from geometry.frame import FrameParams, MeshParams, sensor_points, tie_depth, validate, width
 from geometry.mesh import load_mesh, save_mesh
 
-P = FrameParams()
-COARSE = MeshParams(size=0.02)
+from conftest import COARSE, FIXED as P
 REGIONS = {"column_L", "column_R", "arm_L", "arm_R", "tie_bar", "tie_joint_L", "tie_joint_R"}
 BOUNDARIES = {"mounting_face", "tank_wall", "free_surface"}
 SENSORS = {"A", "B", *(f"C{i}" for i in range(1, 11)), "E_L", "E_R", "F_L", "F_R"}

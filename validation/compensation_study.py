@@ -226,9 +226,14 @@ def main(argv=None) -> int:
     ap.add_argument("--dim", type=int, choices=(2, 3), default=2)
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
-    logging.getLogger("studies.actuator").setLevel(logging.ERROR)  # clipping is in the table
     cfg = load_config(args.config)
-    st = study(cfg, args.dim)
+    quiet = logging.getLogger("studies.actuator")
+    level = quiet.level
+    quiet.setLevel(logging.ERROR)  # clipping is counted in the table; restored below
+    try:
+        st = study(cfg, args.dim)
+    finally:
+        quiet.setLevel(level)
     out = Path(args.out)
     for n, loops in st.loops.items():
         plot_condition_study(f"condition {n} ({cfg.source}, {args.dim}-D)", loops,
