@@ -77,8 +77,8 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     p.add_text(f"{title}\ndisplacement magnified ×{scale:.0f}", font_size=10)
     if grid.bounds[5] - grid.bounds[4] < 1e-12:
         p.view_xy()
-    else:
-        p.view_isometric()
+    else:  # y is up; seen from behind and above, so the tool side stays on the left
+        p.view_vector((0.35, 0.45, 1.0), viewup=(0.0, 1.0, 0.0))
     with atomic_path(path) as tmp:
         p.screenshot(str(tmp))
     p.close()
