@@ -130,10 +130,21 @@ def parse_effect(text: str) -> tuple[str, float]:
     if param and param != e.param:
         raise InputError("--effect", f"effect '{name}' has no parameter '{param}'", f"use {name}:{e.param}=VALUE")
     try:
-        return name, float(value)
+        number = float(value)
     except ValueError:
         raise InputError("--effect", f"'{text}' has no numeric value",
                          f"write {name}:{e.param}=VALUE in {e.unit}") from None
+    return name, _checked(e, number, "--effect")
+
+
+def _checked(e: Effect, value: float, where: str) -> float:
+    """``value`` if it is a finite number the effect's physics accepts (positive for
+    positive ranges), else InputError."""
+    if not np.isfinite(value) or (e.log_scale and value <= 0):
+        raise InputError(where, f"{e.name}.{e.param} = {value:g} is not physical",
+                         f"give a {'positive' if e.log_scale else 'finite'} value in {e.unit} "
+                         f"(plausible: {e.lo:g} … {e.hi:g})")
+    return value
 
 
 def parse_effect_options(items) -> ActiveEffects:
@@ -153,7 +164,7 @@ def effects_from_table(table: dict, section: str = "effects") -> dict[str, float
         value = params[e.param]
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(f"{where}.{e.param}", f"expected a number in {e.unit}, got {value!r}")
-        out[name] = float(value)
+        out[name] = _checked(e, float(value), f"{where}.{e.param}")
     return out
 
 

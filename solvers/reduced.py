@@ -5,8 +5,12 @@ temperature field and leave the rest to the FE: (a) θ_A − θ_B = 1 K, linear
 through the width of the tool-side column, zero mean, over the height l1;
 (b) +1 K uniform on the tie bar(s). Then K_i = δ_a and K_C = −δ_b, read at the
 column points E_L/E_R (the theory's assumption) and at the tips F_L/F_R.
-Since the displacement outputs are fixed weight vectors on the temperature,
-each load case costs one dot product.
+
+The temperature is put on the quadrature points of the loaded region only, as
+the theory does: a nodal field would also heat the nodes the region shares
+with its neighbour, leaking the load one element layer into the adjacent
+member (for a thin tie bar that heated sliver of column can dominate K_C, and
+it vanishes only as O(element size)). Each load case costs one elastic solve.
 """
 from __future__ import annotations
 
@@ -22,30 +26,6 @@ from solvers.fem import Field
 from solvers.model import FrameModel, is_tie, region_fields
 
 
-def _dofs_of(model: FrameModel, regions) -> np.ndarray:
-    basis, mesh = model.heat.basis, model.mesh
-    elems = np.concatenate([mesh.subdomains[r] for r in regions])
-    return np.unique(basis.element_dofs[:, elems])
-
-
-def gradient_case(model: FrameModel) -> np.ndarray:
-    """Load case (a): temperature rise (K) on the heat DOFs."""
-    p = model.config.frame
-    x, y = model.heat.basis.doflocs[0], model.heat.basis.doflocs[1]
-    dofs = _dofs_of(model, ["column_L"])
-    dofs = dofs[y[dofs] <= p.l1 + 1e-12]
-    T = np.zeros(model.heat.basis.N)
-    T[dofs] = 0.5 - x[dofs] / p.h
-    return T
-
-
-def tie_case(model: FrameModel) -> np.ndarray:
-    """Load case (b): +1 K on every tie-bar region."""
-    T = np.zeros(model.heat.basis.N)
-    T[_dofs_of(model, [r for r in model.fmesh.regions if is_tie(r)])] = 1.0
-    return T
-
-
 @dataclass(frozen=True)
 class Coefficients:
     """K_i and K_C (m/K) at the column points E and at the tips F."""
@@ -55,21 +35,6 @@ class Coefficients:
     Ki_F: float
     Kc_F: float
 
-
-def fe_coefficients(model: FrameModel) -> Coefficients:
-    """K_i, K_C of ``model`` from the two load cases."""
-    a, b = gradient_case(model), tie_case(model)
-    wE, wF = model.weights["delta_E"], model.weights["delta"]
-    return Coefficients(float(wE @ a), float(-(wE @ b)), float(wF @ a), float(-(wF @ b)))
-
-
-# --- Element-exact load cases ---------------------------------------------------------
-# The nodal load cases above set every DOF of the loaded region, including the nodes it
-# shares with its neighbours, so the load leaks one element layer into the adjacent
-# member. For a thin tie bar (large beta) that heated sliver of column bends the column
-# and can dominate K_C (it vanishes only as O(element size)). The variants below put the
-# temperature on the quadrature points of the loaded region only, as the theory does,
-# at the price of one elastic solve per load case instead of a dot product.
 
 @LinearForm
 def _thermal_rhs(v, w):
@@ -102,9 +67,8 @@ def _displacement(model: FrameModel, load: np.ndarray) -> np.ndarray:
     return u
 
 
-def exact_coefficients(model: FrameModel) -> Coefficients:
-    """K_i, K_C (m/K) of ``model`` from the load cases applied element-exactly:
-    (a) on the quadrature points of column_L at heights <= l1, (b) on the tie-bar regions."""
+def fe_coefficients(model: FrameModel) -> Coefficients:
+    """K_i, K_C (m/K) of ``model`` from the two load cases."""
     p = model.config.frame
     ties = [r for r in model.fmesh.regions if is_tie(r)]
     ua = _displacement(model, region_load(model, lambda X: (0.5 - X[0] / p.h) * (X[1] <= p.l1),

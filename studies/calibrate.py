@@ -102,7 +102,7 @@ def _thermal(params, nominal, z) -> dict[str, float]:
                      else getattr(nominal, p.name) + float(x)) for p, x in zip(params, z)}
 
 
-def fit_recalibration(obj: Objective, params=RECAL, max_nfev: int = 8) -> Fit:
+def fit_recalibration(obj: Objective, params=RECAL, max_nfev: int = 15) -> Fit:
     """Joint bounded least-squares fit of ``params`` on the objective's window."""
     nominal = obj.replayer.config.model.thermal
     bounds = np.array([np.log(p.bound) if p.kind == "log" else p.bound for p in params])
@@ -111,7 +111,7 @@ def fit_recalibration(obj: Objective, params=RECAL, max_nfev: int = 8) -> Fit:
         return obj.vector(Hypothesis.of(thermal=_thermal(params, nominal, z)))
 
     sol = least_squares(fun, np.zeros(len(params)), bounds=(-bounds, bounds), diff_step=0.01,
-                        x_scale=np.ones(len(params)), max_nfev=max_nfev, method="trf")
+                        x_scale=np.ones(len(params)), max_nfev=max_nfev, ftol=1e-4, method="trf")
     values = _thermal(params, nominal, sol.x)
     n = len(sol.fun)
     s2 = max(float(sol.fun @ sol.fun) / max(n - len(params), 1), 1.0)

@@ -50,7 +50,8 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
         L += ["", f"Runner-up: {d.runner_up}, margin {_num(d.margin)} (score units: χ² + k ln n)."]
     L += ["", "## 1. Replay", "",
           "The model was driven by the file's oil temperature and pump state"
-          + (" and room temperature" if d.has_ambient else " (room at the model's constant T_room)") + ". Noise scale per channel "
+          + (" and room temperature" if d.has_ambient else " (room at the model's constant T_room)")
+          + ". Noise scale per channel "
           "(the residual weight; at least the resolution 0.1 µm / 0.05 K): "
           + ", ".join(f"{label(c)} {_num(s, 2)} {unit(c)}" for c, s in d.scale.items()) + ".", "",
           "## 2. Locate", "",
@@ -64,8 +65,8 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
         cells = []
         for p in d.phases:
             f = next((f for f in d.findings if f.channel == c and f.phase == p), None)
-            cells.append("—" if f is None else
-                         f"{'**' if f.significant else ''}{f.peak / resolution(c):+.1f}×{'**' if f.significant else ''}")
+            bold = "**" if f is not None and f.significant else ""
+            cells.append("—" if f is None else f"{bold}{f.peak / resolution(c):+.1f}×{bold}")
         L.append(f"| {label(c)} | " + " | ".join(cells) + " |")
     L += ["", "Cells: largest systematic residual (measured − model) in units of the resolution; bold = significant."]
     if "residuals" in files:

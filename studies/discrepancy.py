@@ -134,28 +134,34 @@ def decide(base: Candidate, ranked: list[Candidate], discrepant: bool, margin_mi
     if not discrepant:
         return "no-discrepancy", None, None, None, "the baseline residual is within the sensor resolution"
     pool = sorted(ranked + [base], key=lambda c: c.score)
+    if len(pool) < 2:
+        return "unexplained", None, None, None, "no candidate was tried"
     best, second = pool[0], pool[1]
     margin = float(second.score - best.score)
     recal = next((c for c in ranked if c.name == "recalibration"), None)
-    if best.name not in ("recalibration", "baseline") and best.explains and margin >= margin_min:
+    is_effect = best.name not in ("recalibration", "baseline")
+    if is_effect and best.explains and margin >= margin_min:
         return ("missing-effect", best.name, second.name, margin,
                 f"{best.name} explains the held-out data and beats {second.name} by {margin:.1f}")
+    why_not = (f"{best.name} does not explain the held-out data" if not best.explains else
+               f"{best.name} beats {second.name} by only {margin:.1f} (< {margin_min:g})")
     if recal is not None and recal.explains:
-        gap = float(recal.score - best.score)
-        return ("parameter-mismatch", None, next(c.name for c in pool if c is not recal), gap,
+        runner = next(c for c in pool if c is not recal)
+        return ("parameter-mismatch", None, runner.name, float(runner.score - recal.score),
                 "recalibrating the existing parameters closes the gap"
-                + (f" (best effect {best.name} is only {gap:.1f} better)" if best is not recal else ""))
-    explaining = [c.name for c in ranked if c.explains]
-    reason = (f"{', '.join(explaining)} explain it about equally (margin {margin:.1f} < {margin_min:g})"
-              if explaining else f"no candidate explains the held-out residual (best: {best.name})")
-    return "unexplained", None, second.name if explaining else best.name, margin, reason
+                + (f"; no effect is established: {why_not}" if is_effect and best is not recal else ""))
+    if not any(c.explains for c in ranked):
+        return ("unexplained", None, best.name, margin,
+                f"no candidate explains the held-out residual (best: {best.name})")
+    return "unexplained", None, second.name, margin, f"no single effect is established: {why_not}"
 
 
 def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
              settings: Settings = Settings()) -> Diagnosis:
     """Run the whole workflow on a measured series ``ts``."""
     if not 0.2 <= settings.train_fraction <= 0.9:
-        raise InputError("--train-fraction", f"must be between 0.2 and 0.9, got {settings.train_fraction}")
+        raise InputError("--train-fraction", f"must be between 0.2 and 0.9, got {settings.train_fraction}",
+                         "e.g. 0.6: fit on the first 3 h of a 5-h run, score on the last 2 h")
     unknown = [e for e in settings.effects if e not in CATALOGUE]
     if unknown:
         raise InputError("--effects", f"unknown effect(s) {', '.join(unknown)}",

@@ -27,6 +27,7 @@ import hashlib
 import itertools
 import json
 import logging
+import threading
 import time
 from concurrent.futures import Executor, as_completed
 from dataclasses import dataclass
@@ -51,6 +52,8 @@ COMPUTE = {
 }
 PINHOLE = 0.003
 """Side of the cavity left by ``derived.tank_cavity = false``, m."""
+_GMSH = threading.Lock()
+"""gmsh is process-global: threaded workers (e.g. Dask's) mesh one point at a time."""
 
 
 @dataclass(frozen=True)
@@ -249,111 +252,17 @@ def plan(study: Study) -> list[Task]:
     return tasks
 
 
-# --- the study file -------------------------------------------------------------------
-
-def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
-    """``{"geometry": {"l4": v}}`` and ``{"geometry.l4": v}`` both give ``{"geometry.l4": v}``."""
-    out = {}
-    for key, value in table.items():
-        if isinstance(value, dict):
-            out.update(_flatten(value, f"{prefix}{key}."))
-        else:
-            out[f"{prefix}{key}"] = value
-    return out
-
-
-def _scalar(key: str, value):
-    if isinstance(value, (bool, int, float, str)):
-        return value
-    raise InputError(key, f"expected a number, true/false or a string, got {value!r}")
-
-
-def parse_study(data: dict, source: str = "<study>", base: Config | None = None) -> Study:
-    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the model it overrides)."""
-    from studies.config import load_config
-
-    known = {"study", "set", "grid", "plot"}
-    for key in data:
-        if key not in known:
-            raise InputError(key, "unknown table", f"known tables: {', '.join(sorted(known))}")
-    head = dict(data.get("study", {}))
-    for key in head:
-        if key not in ("name", "dim", "config", "compute", "fit_frame"):
-            raise InputError(f"study.{key}", "unknown key",
-                             "known keys: name, dim, config, compute, fit_frame")
-    dim = head.get("dim", 2)
-    if dim not in (2, 3) or isinstance(dim, bool):
-        raise InputError("study.dim", f"must be 2 or 3, got {dim!r}")
-    compute = head.get("compute", ["coefficients"])
-    if isinstance(compute, str):
-        compute = [compute]
-    for c in compute:
-        if c not in COMPUTE:
-            raise InputError("study.compute", f"unknown computation {c!r}", f"choose from {', '.join(COMPUTE)}")
-    fit = head.get("fit_frame", True)
-    if not isinstance(fit, bool):
-        raise InputError("study.fit_frame", f"expected true/false, got {fit!r}")
-    if base is None:
-        base = load_config(head.get("config"))
-    fixed = {k: _scalar(f"set.{k}", v) for k, v in _flatten(data.get("set", {})).items()}
-    grid = []
-    for key, values in _flatten(data.get("grid", {})).items():
-        if not isinstance(values, list) or not values:
-            raise InputError(f"grid.{key}", "expected a non-empty list of values", f'e.g. "{key}" = [1, 2]')
-        if key in fixed:
-            raise InputError(f"set.{key}", "is also swept in [grid]", "keep it in one of the two")
-        grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
-    if not grid:
-        raise InputError("grid", "no swept parameter", 'add e.g. "geometry.l4" = [0.2, 0.3] under [grid]')
-    columns = {k for k, _ in grid} | {"nodes"} | {c for k in compute for c in COMPUTE[k]}
-    plots = []
-    for i, spec in enumerate(data.get("plot", [])):
-        if not isinstance(spec, dict):
-            raise InputError(f"plot[{i + 1}]", "expected a table", "write [[plot]] with x, y and hue")
-        for key, value in spec.items():
-            if key not in ("x", "y", "hue"):
-                raise InputError(f"plot[{i + 1}].{key}", "unknown key", "known keys: x, y, hue")
-            if value not in columns:
-                raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",
-                                 f"choose from {', '.join(sorted(columns))}")
-        if "x" not in spec or "y" not in spec:
-            raise InputError(f"plot[{i + 1}]", "needs x and y")
-        plots.append(PlotSpec(spec["x"], spec["y"], spec.get("hue")))
-    return Study(str(head.get("name", source)), dim, base, tuple(fixed.items()), tuple(grid),
-                 tuple(compute), tuple(plots), fit)
-
-
-def load_study(path) -> Study:
-    """Read a STUDY.toml; a relative ``study.config`` is taken from the study file's folder."""
-    import tomllib
-    from pathlib import Path
-
-    from studies.config import load_config
-
-    p = Path(path)
-    if not p.is_file():
-        raise InputError("STUDY.toml", f"no such file '{path}'", "give a study file")
-    try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(str(p), f"not valid TOML ({err})") from None
-    data.setdefault("study", {}).setdefault("name", p.stem)
-    config = data["study"].pop("config", None)
-    base = load_config(None if config is None else p.parent / config)
-    return parse_study(data, str(p), base)
-
-
 # --- evaluation ---------------------------------------------------------------------------
 
 def _coefficients(model, cfg: Config) -> dict[str, float]:
     """FE (element-exact load cases, at E and at F) and beam-theory K_i, K_C in um/K, and normalised."""
     from solvers import beam
-    from solvers.reduced import exact_coefficients
+    from solvers.reduced import fe_coefficients
     from studies.compensator import theory_coefficients
 
     p, m = cfg.model.frame, cfg.model
     tie = m.tie_material or m.material
-    c = exact_coefficients(model)
+    c = fe_coefficients(model)
     ki_th, kc_th = theory_coefficients(m)
     ki_s = float(beam.ki_scale(m.material.alpha, p.l, p.h)) * 1e6
     kc_s = float(beam.kc_scale(tie.alpha, p.l_C)) * 1e6
@@ -385,16 +294,19 @@ def evaluate(task: Task) -> dict[str, Any]:
               "results": {}, "seconds": 0.0}
     if task.skip:
         return record
+    from geometry.build import build_mesh
     from solvers.effects import ActiveEffects, apply_effects
     from solvers.model import build_model
     from studies.conditions import CONDITIONS, condition_drive
 
     t0 = time.perf_counter()
-    eff = ActiveEffects(dict(task.effects))
+    eff = ActiveEffects({**task.config.effects, **dict(task.effects)})
     cond = CONDITIONS[task.condition] if task.condition else CONDITIONS[1]
     model_cfg, drive = apply_effects(task.config.model, condition_drive(cond, task.config.supply),
                                      eff, task.dim)
-    model = build_model(model_cfg, task.dim)
+    with _GMSH:
+        mesh = build_mesh(model_cfg.frame, task.dim, model_cfg.mesh)
+    model = build_model(model_cfg, task.dim, mesh)
     res: dict[str, Any] = {"nodes": int(len(model.fmesh.points))}
     if "coefficients" in task.compute:
         res.update(_coefficients(model, dataclasses.replace(task.config, model=model_cfg)))
@@ -406,37 +318,41 @@ def evaluate(task: Task) -> dict[str, Any]:
 
 def execute(tasks: list[Task], on_result: Callable[[dict], None], executor: Executor | None = None
             ) -> list[tuple[Task, BaseException]]:
-    """Evaluate ``tasks`` (serially without an executor) and hand every record to
-    ``on_result`` as soon as it is done; returns the points that failed, with the error."""
+    """Evaluate ``tasks`` (in this process without an executor) and hand every record to
+    ``on_result`` as soon as it is done; returns the points that failed, with the error
+    (the other points are still worth having)."""
     failed = []
+
+    def fail(t: Task, err: BaseException) -> None:
+        log.error("point %s failed: %s", dict(t.params), err)
+        failed.append((t, err))
+
     if executor is None:
         for t in tasks:
             try:
-                on_result(evaluate(t))
-            except InputError:
-                raise
-            except Exception as err:  # keep going: the other points are still worth having
-                log.error("point %s failed: %s", dict(t.params), err)
-                failed.append((t, err))
+                rec = evaluate(t)
+            except Exception as err:
+                fail(t, err)
+                continue
+            on_result(rec)
         return failed
     futures = {executor.submit(evaluate, t): t for t in tasks}
     for fut in as_completed(futures):
-        err = fut.exception()
-        if err is None:
+        if fut.exception() is None:
             on_result(fut.result())
         else:
-            log.error("point %s failed: %s", dict(futures[fut].params), err)
-            failed.append((futures[fut], err))
+            fail(futures[fut], fut.exception())
     return failed
 
 
 def table(tasks: list[Task], records: dict[str, dict]) -> tuple[list[str], list[dict]]:
-    """Columns and rows (grid order) of the tidy table: parameters, status, note, results.
-    Points without a record yet are rows with status "pending"."""
-    rows, result_cols = [], {}
+    """Columns and rows (grid order) of the tidy table: parameters, status, note, then the
+    results in the order of :data:`COMPUTE`. Points without a record are "pending" rows."""
+    rows = []
     for t in tasks:
         rec = records.get(t.key, {"status": "pending", "note": "", "results": {}})
         rows.append({**dict(t.params), "status": rec["status"], "note": rec["note"], **rec["results"]})
-        result_cols.update(dict.fromkeys(rec["results"]))
     params = [k for k, _ in tasks[0].params] if tasks else []
-    return params + ["status", "note"] + list(result_cols), rows
+    results = ["nodes"] + [c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]]
+    extra = [k for r in rows for k in r if k not in params and k not in results and k not in ("status", "note")]
+    return params + ["status", "note"] + results + list(dict.fromkeys(extra)), rows

@@ -36,14 +36,15 @@ def test_catalogue_entries():
 def test_parse_effect_and_table():
     assert parse_effect("piezo_heat:power=1.5") == ("piezo_heat", 1.5)
     assert parse_effect("stand_drift=2") == ("stand_drift", 2.0)
-    for bad in ("nope:x=1", "piezo_heat:watts=1", "piezo_heat:power=lots"):
+    for bad in ("nope:x=1", "piezo_heat:watts=1", "piezo_heat:power=lots", "joint_resistance=0",
+                "ambient_drift=nan"):
         with pytest.raises(InputError):
             parse_effect(bad)
     table = effects_table({"piezo_heat": 1.5, "ambient_drift": -0.25})
     assert table == {"piezo_heat": {"power": 1.5}, "ambient_drift": {"rate": -0.25}}
     assert effects_from_table(table) == {"piezo_heat": 1.5, "ambient_drift": -0.25}
     for bad in ({"nope": {"x": 1}}, {"piezo_heat": {"watts": 1}}, {"piezo_heat": 1.5},
-                {"piezo_heat": {"power": "high"}}):
+                {"piezo_heat": {"power": "high"}}, {"compliant_base": {"stiffness": -1e9}}):
         with pytest.raises(InputError):
             effects_from_table(bad)
 

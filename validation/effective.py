@@ -64,17 +64,16 @@ def condition_runs(cfg: Config, dim: int, model=None) -> tuple[object, dict[int,
 
 
 def effective_coefficients(cfg: Config, dim: int = 2, model=None) -> list[Source]:
-    """Theory, FE load cases (at F, element-exact and nodal) and least-squares fits
-    (per run and pooled), each scored on all three runs."""
-    from solvers.reduced import exact_coefficients, fe_coefficients
+    """Theory, FE load cases (at F) and least-squares fits (per run and pooled),
+    each scored on all three runs."""
+    from solvers.reduced import fe_coefficients
     from studies.compensator import theory_coefficients
     from studies.regression import fit_coefficients
 
     model, runs = condition_runs(cfg, dim, model)
-    exact, nodal = exact_coefficients(model), fe_coefficients(model)
+    fe = fe_coefficients(model)
     sources = [score("beam theory (eqs 22-24)", *theory_coefficients(cfg.model), runs),
-               score("FE load cases at F", exact.Ki_F * 1e6, exact.Kc_F * 1e6, runs),
-               score("FE load cases at F, nodal", nodal.Ki_F * 1e6, nodal.Kc_F * 1e6, runs)]
+               score("FE load cases at F", fe.Ki_F * 1e6, fe.Kc_F * 1e6, runs)]
     for c, cols in runs.items():
         sources.append(score(f"least squares, condition {c}", *fit_coefficients(_series(cols)), runs))
     pooled = {k: np.concatenate([runs[c][k] for c in CONDITIONS]) for k in runs[CONDITIONS[0]]}

@@ -1,6 +1,7 @@
 """Hidden-effect study of the discrepancy workflow (issue 6).
 
-    python -m validation.hidden_effects --out DIR [--workers 2] [--quick]
+    python -m validation.hidden_effects --out DIR [--workers 2] [--mesh-size M]
+                                        [--conditions 1,2,3] [--effects NAME,...]
 
 "Measured" runs are made by simulating a paper condition with one catalogue
 effect switched on at a seeded random strength (one draw in the lower and one
@@ -9,8 +10,10 @@ parameters), on a finer mesh than the diagnosis uses (no inverse crime), then
 adding Gaussian sensor noise at the paper's resolution (0.1 µm, 0.05 K) and
 rounding to it. Each run is diagnosed blind from the baseline model. Also:
 noise-only runs, and runs with an effect outside the catalogue (a heat leak
-at the tie bar, thermocouples A/B mounted higher than the model assumes, a
-drop of the tank oil flow part-way through the run).
+at the tie bar, thermocouples A/B mounted 40 mm higher or lower than the model
+assumes, a drop of the tank oil flow at 2.5 h), and runs made with a wrong
+existing parameter (tank-wall film with the pump on ×1.5, film to air ×0.6),
+for which "parameter-mismatch" is expected.
 
 Writes ``DIR/hidden_effects.md`` and ``DIR/hidden_effects.csv`` (one row per
 case: effect, strength, condition, named effect, verdict, runner-up, margin,
@@ -47,6 +50,8 @@ log = logging.getLogger(__name__)
 
 #: The channels a rig of the paper records (no room temperature).
 MEASURED = ("time_s", "oil_degC", "pump", "theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
+NOISE_RMS_UM = 0.1 * np.sqrt(1 + 1 / 12)
+"""RMS of the added δ noise: Gaussian at the resolution, then rounded to it, µm."""
 TRUTH_MESH_FACTOR = 0.75
 """Element size of the "measured" runs relative to the diagnosis mesh."""
 
@@ -58,6 +63,9 @@ OUTSIDE = {
 }
 FLOW_DROP_AT_S = 2.5 * 3600.0
 """When the oil flow drops in the ``flow_drop`` case, s."""
+#: Parameter mismatches (no missing effect; expected verdict "parameter-mismatch"):
+#: "mismatch:<ThermalParams field>" -> factors on the model's value.
+MISMATCH = {"mismatch:h_oil_on": (1.5,), "mismatch:h_air": (0.6,)}
 
 
 @dataclass(frozen=True)
@@ -113,6 +121,10 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
         cfg = dataclasses.replace(cfg, source={"tie_bar": -case.strength / ((x1 - x0) * (y1 - y0) * (z1 - z0))})
     elif case.effect == "sensor_height":
         cfg = dataclasses.replace(cfg, frame=cfg.frame.replace(sensor_height=cfg.frame.sensor_height + case.strength))
+    elif case.effect in MISMATCH:
+        field = case.effect.split(":")[1]
+        cfg = dataclasses.replace(cfg, thermal=dataclasses.replace(
+            cfg.thermal, **{field: getattr(cfg.thermal, field) * case.strength}))
     elif case.effect == "flow_drop":
         k = int(np.searchsorted(times, FLOW_DROP_AT_S))
         model = build_model(cfg, dim)
@@ -168,6 +180,9 @@ def cases(seed: int = 6, conditions=(1, 2, 3), effects=tuple(CATALOGUE), noise_s
         out += [Case("none", 0.0, c, int(rng.integers(1 << 31))) for _ in range(noise_seeds)]
         for name, (_, _, strengths) in OUTSIDE.items():
             out += [Case(name, s, c, int(rng.integers(1 << 31))) for s in strengths]
+    for c in conditions:
+        for name, factors in MISMATCH.items():
+            out += [Case(name, f, c, int(rng.integers(1 << 31))) for f in factors]
     return out
 
 
@@ -187,9 +202,13 @@ def acceptance(rows: list[dict]) -> dict:
     hit = [r for r in cat if r["named"] == r["effect"]]
     on_delta = [r for r in hit if r["effect"] != "thermocouple_lag"]
     falls = [1 - r["rms_after_um"] / r["rms_before_um"] for r in on_delta]
+    noise = NOISE_RMS_UM ** 2  # the part of the δ RMS no model can remove
+    excess = [1 - np.sqrt(max(r["rms_after_um"] ** 2 - noise, 0.0) / max(r["rms_before_um"] ** 2 - noise, 1e-30))
+              for r in on_delta]
     lag = [1 - r["rms_w_after"] / r["rms_w_before"] for r in hit if r["effect"] == "thermocouple_lag"]
     noise = [r for r in rows if r["effect"] == "none"]
     outside = [r for r in rows if r["effect"] in OUTSIDE]
+    mismatch = [r for r in rows if r["effect"] in MISMATCH]
     return {
         "catalogue_cases": len(cat), "named_correctly": len(hit),
         "named_fraction": len(hit) / max(len(cat), 1),
@@ -197,17 +216,21 @@ def acceptance(rows: list[dict]) -> dict:
         "delta_rms_fall_min": min(falls, default=float("nan")),
         "delta_rms_fall_median": float(np.median(falls)) if falls else float("nan"),
         "delta_rms_fall_ge_70pct": sum(f >= 0.7 for f in falls), "delta_cases": len(falls),
+        "delta_excess_rms_fall_min": min(excess, default=float("nan")),
         "lag_weighted_rms_fall_min": min(lag, default=float("nan")),
         "noise_only": len(noise), "noise_only_named": sum(r["named"] is not None for r in noise),
         "noise_only_verdicts": sorted({r["verdict"] for r in noise}),
         "outside": len(outside), "outside_unexplained": sum(r["verdict"] == "unexplained" for r in outside),
         "outside_verdicts": sorted({f"{r['effect']}:{r['verdict']}:{r['named']}" for r in outside}),
-        "seconds_max": max(r["seconds"] for r in rows), "seconds_median": float(np.median([r["seconds"] for r in rows])),
+        "mismatch": len(mismatch), "mismatch_recognised": sum(r["verdict"] == "parameter-mismatch" for r in mismatch),
+        "mismatch_verdicts": sorted({f"{r['effect']}:{r['verdict']}:{r['named']}" for r in mismatch}),
+        "seconds_max": max(r["seconds"] for r in rows),
+        "seconds_median": float(np.median([r["seconds"] for r in rows])),
     }
 
 
 COLUMNS = ("effect", "strength", "condition", "verdict", "named", "runner_up", "margin",
-           "rms_before_um", "rms_after_um", "rms_w_before", "rms_w_after", "seconds")
+           "rms_before_um", "rms_after_um", "rms_w_before", "rms_w_after", "seconds", "reason")
 
 
 def _fmt(v) -> str:
@@ -220,7 +243,8 @@ def _fmt(v) -> str:
 
 def table_markdown(rows: list[dict], acc: dict) -> str:
     head = ["effect", "strength", "cond.", "verdict", "named effect", "runner-up", "margin",
-            "δ RMS before (µm)", "δ RMS after (µm)", "weighted RMS before", "weighted RMS after", "time (s)"]
+            "δ RMS before (µm)", "δ RMS after (µm)", "weighted RMS before", "weighted RMS after", "time (s)",
+            "reason"]
     lines = ["# Hidden-effect study", "",
              "Held-out window: last 40 % of each 5-h run. Weighted RMS: all channels, each in units of "
              "its resolution (0.1 µm, 0.05 K). Strength in the effect's unit (see `gatetherm diagnose "
@@ -247,7 +271,7 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=6)
     ap.add_argument("--conditions", default="1,2,3")
-    ap.add_argument("--effects", default=",".join(CATALOGUE) + ",none," + ",".join(OUTSIDE),
+    ap.add_argument("--effects", default=",".join([*CATALOGUE, "none", *OUTSIDE, *MISMATCH]),
                     help="comma-separated catalogue/outside effects and 'none' (default: all)")
     ap.add_argument("--mesh-size", type=float, help="diagnosis element size, m (default: the model's)")
     args = ap.parse_args(argv)

@@ -13,13 +13,114 @@ import io
 import json
 import logging
 import os
+import sys
 import tomllib
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from geometry.errors import InputError
 from geometry.files import write_text_atomic
 
+if TYPE_CHECKING:
+    from studies.config import Config
+    from studies.sweep import Study
+
 log = logging.getLogger(__name__)
+
+SCHEDULER_TIMEOUT_S = 20.0
+"""How long to try to reach a Dask scheduler, s."""
+
+
+# --- the study file ---------------------------------------------------------------------
+
+def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
+    """``{"geometry": {"l4": v}}`` and ``{"geometry.l4": v}`` both give ``{"geometry.l4": v}``."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
+def _scalar(key: str, value):
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    raise InputError(key, f"expected a number, true/false or a string, got {value!r}")
+
+
+def parse_study(data: dict, source: str = "<study>", base: Config | None = None) -> Study:
+    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the model it overrides)."""
+    from studies.config import load_config
+    from studies.sweep import COMPUTE, PlotSpec, Study
+
+    known = {"study", "set", "grid", "plot"}
+    for key in data:
+        if key not in known:
+            raise InputError(key, "unknown table", f"known tables: {', '.join(sorted(known))}")
+    head = dict(data.get("study", {}))
+    for key in head:
+        if key not in ("name", "dim", "config", "compute", "fit_frame"):
+            raise InputError(f"study.{key}", "unknown key",
+                             "known keys: name, dim, config, compute, fit_frame")
+    dim = head.get("dim", 2)
+    if dim not in (2, 3) or isinstance(dim, bool):
+        raise InputError("study.dim", f"must be 2 or 3, got {dim!r}")
+    compute = head.get("compute", ["coefficients"])
+    if isinstance(compute, str):
+        compute = [compute]
+    for c in compute:
+        if c not in COMPUTE:
+            raise InputError("study.compute", f"unknown computation {c!r}", f"choose from {', '.join(COMPUTE)}")
+    fit = head.get("fit_frame", True)
+    if not isinstance(fit, bool):
+        raise InputError("study.fit_frame", f"expected true/false, got {fit!r}")
+    if base is None:
+        base = load_config(head.get("config"))
+    fixed = {k: _scalar(f"set.{k}", v) for k, v in _flatten(data.get("set", {})).items()}
+    grid = []
+    for key, values in _flatten(data.get("grid", {})).items():
+        if not isinstance(values, list) or not values:
+            raise InputError(f"grid.{key}", "expected a non-empty list of values", f'e.g. "{key}" = [1, 2]')
+        if key in fixed:
+            raise InputError(f"set.{key}", "is also swept in [grid]", "keep it in one of the two")
+        grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
+    if not grid:
+        raise InputError("grid", "no swept parameter", 'add e.g. "geometry.l4" = [0.2, 0.3] under [grid]')
+    columns = {k for k, _ in grid} | {"nodes"} | {c for k in compute for c in COMPUTE[k]}
+    plots = []
+    for i, spec in enumerate(data.get("plot", [])):
+        if not isinstance(spec, dict):
+            raise InputError(f"plot[{i + 1}]", "expected a table", "write [[plot]] with x, y and hue")
+        for key, value in spec.items():
+            if key not in ("x", "y", "hue"):
+                raise InputError(f"plot[{i + 1}].{key}", "unknown key", "known keys: x, y, hue")
+            if value not in columns:
+                raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",
+                                 f"choose from {', '.join(sorted(columns))}")
+        if "x" not in spec or "y" not in spec:
+            raise InputError(f"plot[{i + 1}]", "needs x and y")
+        plots.append(PlotSpec(spec["x"], spec["y"], spec.get("hue")))
+    return Study(str(head.get("name", source)), dim, base, tuple(fixed.items()), tuple(grid),
+                 tuple(compute), tuple(plots), fit)
+
+
+def load_study(path) -> Study:
+    """Read a STUDY.toml; a relative ``study.config`` is taken from the study file's folder."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("STUDY.toml", f"no such file '{path}'", "give a study file")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(str(p), f"not valid TOML ({err})") from None
+    from studies.config import load_config
+
+    data.setdefault("study", {}).setdefault("name", p.stem)
+    config = data["study"].pop("config", None)
+    base = load_config(None if config is None else p.parent / config)
+    return parse_study(data, str(p), base)
 
 
 def register(sub) -> None:
@@ -51,7 +152,7 @@ def executor(workers: int, scheduler: str | None, n_tasks: int):
             raise InputError("--scheduler", "dask.distributed is not installed",
                              "pip install 'dask[distributed]' or leave --scheduler out") from None
         try:
-            client = Client(scheduler, timeout=20)
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
         except (OSError, TimeoutError, ValueError) as err:
             raise InputError("--scheduler", f"cannot connect to {scheduler} ({err})",
                              "give the address of a running Dask scheduler") from None
@@ -113,6 +214,7 @@ def run_studies(jobs, workers: int, scheduler: str | None, progress=None):
     from studies.sweep import execute
 
     done = [store.load(t.key for t in tasks) for tasks, store in jobs]
+    keys = [{t.key for t in tasks} for tasks, _ in jobs]
     todo, owner = [], {}
     for i, (tasks, store) in enumerate(jobs):
         for t in tasks:
@@ -126,9 +228,10 @@ def run_studies(jobs, workers: int, scheduler: str | None, progress=None):
         i = owner[rec["key"]]
         jobs[i][1].save(rec)
         done[i][rec["key"]] = rec
-        for j, (tasks, store) in enumerate(jobs):  # same point in another study: share it
-            if j != i and rec["key"] in {t.key for t in tasks}:
-                store.save(rec)
+        for j, (_, store) in enumerate(jobs):  # the same point in another study: share it
+            if j != i and rec["key"] in keys[j]:
+                if store.dir != jobs[i][1].dir:
+                    store.save(rec)
                 done[j][rec["key"]] = rec
         n_done[0] += 1
         if progress:
@@ -140,7 +243,7 @@ def run_studies(jobs, workers: int, scheduler: str | None, progress=None):
 
 
 def run(args) -> int:
-    from studies.sweep import load_study, plan, table
+    from studies.sweep import plan, table
 
     study = load_study(args.study)
     tasks = plan(study)
@@ -156,15 +259,16 @@ def run(args) -> int:
         {"name": study.name, "dim": study.dim, "config": study.base.source, "compute": list(study.compute),
          "set": dict(study.fixed), "grid": {k: list(v) for k, v in study.grid}}, indent=2) + "\n")
     n_skip = sum(r["status"] == "skipped" for r in rows)
-    print(f"wrote {out / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} computed, "
+    print(f"wrote {out / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} done, "
           f"{n_skip} skipped (frame cannot be built), {len(failed)} failed")
     if not args.no_plots and study.plots:
         from validation.sweep_plots import plot_xy
 
         for spec in study.plots:
             path = out / f"{spec.y}_vs_{spec.x}{'_by_' + spec.hue if spec.hue else ''}.png".replace("/", "_")
-            plot_xy(rows, spec.x, spec.y, spec.hue, path, study.name)
+            others = [k for k, _ in study.grid if k not in (spec.x, spec.hue)]
+            plot_xy(rows, spec.x, spec.y, spec.hue, path, study.name, lines_by=others)
             print(f"wrote {path}")
     for t, err in failed:
-        print(f"failed: {dict(t.params)}: {err}")
+        print(f"gatetherm: point {dict(t.params)} failed: {err}", file=sys.stderr)
     return 1 if failed else 0
