@@ -37,14 +37,14 @@ class Config:
 
 def _coerce(section: str, key: str, value, typ):
     where = f"{section}.{key}"
-    if typ is bool or typ == "bool":
+    if typ is bool:
         if not isinstance(value, bool):
             raise InputError(where, f"expected true/false, got {value!r}")
         return value
-    if typ in (float, "float", "float | None", int, "int"):
+    if typ in (float, int):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(where, f"expected a number, got {value!r}")
-        return int(value) if typ in (int, "int") else float(value)
+        return int(value) if typ is int else float(value)
     return value
 
 

@@ -79,7 +79,7 @@ def run(args) -> int:
     t_built = time.perf_counter()
     times = sample_times(duration)
     every = max(args.fields_every, 1.0) * 60.0
-    keep = [t for t in times if (t % every < 1e-6) or t % 300.0 < 1e-6]
+    keep = [t for t in times if t % every < 1e-6 or t % 300.0 < 1e-6]  # fields, and picture candidates
     res = run_model(model, drive, times, keep, Progress(f"condition {args.condition or 'file'}"))
     cols = effects.observe(res.columns)
     figs = delta_figures(cols["time_s"], cols["delta_um"])
