@@ -103,3 +103,14 @@ def test_simulate_bad_input(tmp_path, capsys, argv, needle):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and needle in err
     assert not (tmp_path / "o").exists()
+
+
+def test_simulate_applies_effects_of_the_model_file(tmp_path):
+    """A model file written by 'diagnose' switches its effects on in 'simulate'."""
+    cfg = tmp_path / "m.toml"
+    cfg.write_text(COARSE + "[effects]\nstand_drift = {coefficient = 2.0}\n")
+    assert main(["simulate", "--condition", "1", "--config", str(cfg), "--out", str(tmp_path / "e"),
+                 "--no-pictures"]) == 0
+    s = json.loads((tmp_path / "e" / "summary.json").read_text())
+    assert s["effects"] == {"stand_drift": 2.0}
+    assert s["first_peak_um"] > REGRESSION["first_peak_um"] + 1.0

@@ -64,10 +64,10 @@ def resolve_drive(args, cfg):
 
 def run(args) -> int:
     from studies.config import load_config
-    from solvers.effects import apply_effects, parse_effect_options
+    from solvers.effects import ActiveEffects, apply_effects, parse_effect_options
 
     cfg = load_config(args.config)
-    effects = parse_effect_options(args.effect)
+    effects = ActiveEffects({**cfg.effects, **parse_effect_options(args.effect).values})  # file, then CLI
     drive, label, duration = resolve_drive(args, cfg)
     out = Path(args.out)
     t_start = time.perf_counter()
