@@ -156,7 +156,6 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
         remap = -np.ones(len(points), dtype=np.int64)
         remap[used] = np.arange(len(used))
         points, cells = points[used], remap[cells]
-        regions = regions
         boundaries = {k: remap[v] for k, v in boundaries.items()}
         sensors = {k: int(remap[v]) for k, v in sensors.items()}
     log.info("meshed %d-D frame: %d nodes, %d elements", dim, len(points), len(cells))

@@ -11,7 +11,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from geometry.errors import InputError
@@ -20,7 +19,7 @@ from studies import sweep
 from studies.cli import main
 from studies.commands import sweep as sweep_command
 from studies.commands.sweep import parse_study
-from studies.config import Config, parse_config
+from studies.config import parse_config
 
 #: A fully specified frame (independent of the shipped paper model, which is recalibrated).
 MODEL = {

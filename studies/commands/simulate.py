@@ -79,11 +79,12 @@ def run(args) -> int:
     t_built = time.perf_counter()
     times = sample_times(duration)
     every = max(args.fields_every, 1.0) * 60.0
-    keep = [t for t in times if t % every < 1e-6 or t % 300.0 < 1e-6]  # fields, and picture candidates
+    field_times = {float(t) for t in times if t % every < 1e-6}
+    keep = sorted(field_times | {float(t) for t in times if t % 300.0 < 1e-6})  # + picture candidates
     res = run_model(model, drive, times, keep, Progress(f"condition {args.condition or 'file'}"))
     cols = effects.observe(res.columns)
     figs = delta_figures(cols["time_s"], cols["delta_um"])
-    _write_outputs(args, cfg, model, res, cols, figs, label, out)
+    _write_outputs(args, cfg, model, res, cols, figs, label, out, field_times)
     summary = {**figs, "wall_time_s": round(time.perf_counter() - t_start, 2),
                "build_s": round(t_built - t_start, 2), "march_s": round(res.seconds, 2),
                "dim": args.dim, "nodes": len(model.fmesh.points), "elements": len(model.fmesh.cells),
@@ -98,7 +99,7 @@ def run(args) -> int:
     return 0
 
 
-def _write_outputs(args, cfg, model, res, cols, figs, label, out: Path) -> None:
+def _write_outputs(args, cfg, model, res, cols, figs, label, out: Path, field_times) -> None:
     from studies.output import pyvista_grid, write_fields
     from studies.timeseries import FORMAT, TimeSeries, write_timeseries
 
@@ -107,8 +108,7 @@ def _write_outputs(args, cfg, model, res, cols, figs, label, out: Path) -> None:
     if args.condition:
         meta["condition"] = str(args.condition)
     write_timeseries(out / "timeseries.csv", TimeSeries(cols, meta))
-    every = max(args.fields_every, 1.0) * 60.0
-    states = [(t, U) for t, U in res.states if t % every < 1e-6]
+    states = [(t, U) for t, U in res.states if t in field_times]
     write_fields(model, states, out / "fields")
     if args.no_pictures:
         return
