@@ -1,17 +1,21 @@
 """Transient heat conduction in the frame, coupled to a lumped oil tank.
 
-Unknowns are the nodal temperatures of the solid (°C) followed by one oil
-temperature. Per unit of the 2-D out-of-plane thickness ``t`` (``t = 1`` in
-3-D) the weak form is
+Unknowns are the nodal temperatures of the solid (°C) followed by the tank oil
+temperature and, if the supply hose has a heat capacity, the hose temperature.
+Per unit of the 2-D out-of-plane thickness ``t`` (``t = 1`` in 3-D) the weak form is
 
     ∫ t ρc Ṫ v + ∫ t k ∇T·∇v + Σ_Γ ∫ t h_Γ (T − T_amb) v + ∫ h_s (T − T_amb) v
         + ∫_wall t h_oil (T − T_oil) v = ∫ t q v
-    C_oil Ṫ_oil + ∫_wall t h_oil (T_oil − T) + G (T_oil − T_supply) = 0
+    C_oil Ṫ_oil + ∫_wall t h_oil (T_oil − T) + G (T_oil − T_in) = 0
+    C_hose Ṫ_hose + G (T_hose − T_supply) + UA_hose (T_hose − T_amb) = 0
 
 with ``h_s`` the out-of-plane loss (2 h_air for the front and back faces of a
 2-D section), ``h_oil`` and the pump conductance ``G = ρc_oil Q`` following the
-pump state. Integrated with the θ-method; each distinct (dt, pump) matrix is
-factorised once.
+pump state, and ``T_in`` the oil reaching the tank: ``T_hose`` (``T_supply``
+without a hose). The hose is one well-mixed lump, the simplest model of the oil
+that stands and cools in it while the pump is off and reaches the tank first
+when it restarts. Integrated with the θ-method (:class:`TimeScheme`); each
+distinct (θ dt, pump) matrix is factorised once.
 """
 from __future__ import annotations
 
@@ -71,6 +75,13 @@ class ThermalParams:
     """Oil flow through the tank while the pump runs, m³/s."""
     out_of_plane: bool = True
     """2-D only: the front and back faces of the section lose heat with ``h_air``."""
+    hose_capacity: float = 1800.0
+    """Heat capacity of the supply hose from the oil unit to the tank, its oil and its wall,
+    J/K (0: no hose). Default: 2 m of 13 mm-bore rubber hose, 0.27 L of oil (450 J/K) and
+    0.68 kg of rubber (1360 J/K)."""
+    hose_loss: float = 0.9
+    """Heat loss of the supply hose to the room, W/K. Default: 2 m of 23 mm outer diameter,
+    8 W/(m² K) outside, 5 mm of rubber (k = 0.2 W/(m K))."""
 
 
 class Inputs(NamedTuple):
@@ -88,8 +99,24 @@ Drive = Callable[[float], Inputs]
 
 
 @dataclass(frozen=True)
+class TimeScheme:
+    """The θ-method with Rannacher start-up at input switches."""
+
+    theta: float = 0.5
+    """1: backward Euler; 0.5: Crank–Nicolson (second order)."""
+    restart: int = 4
+    """Steps into which each of the ``restart_intervals`` intervals after a pump switch (and
+    at the start) is divided; for θ < 1 the very first of them is two backward-Euler half
+    steps, which damp the stiff modes the switch excites (oil, wall film) instead of
+    letting CN ring. 1: no grading."""
+    restart_intervals: int = 3
+    """How many intervals after a switch are divided."""
+
+
+@dataclass(frozen=True)
 class HeatSystem:
-    """Assembled operators; the last unknown is the oil temperature."""
+    """Assembled operators; the unknowns are the solid's (``n_solid``), then the tank
+    oil, then the hose (if ``params.hose_capacity > 0``)."""
 
     basis: CellBasis
     M: sp.csr_matrix
@@ -98,12 +125,23 @@ class HeatSystem:
     f_amb: np.ndarray
     f_src: np.ndarray
     params: ThermalParams
+    n_solid: int
     _lu: dict = field(default_factory=dict, compare=False, repr=False)
     """Cache of conductance matrices and factorisations, keyed by what they depend on."""
 
     @property
     def n(self) -> int:
         return self.M.shape[0]
+
+    @property
+    def oil(self) -> int:
+        """Index of the tank-oil unknown."""
+        return self.n_solid
+
+    @property
+    def inlet(self) -> int:
+        """Index of the unknown the supplied oil enters: the hose, or the tank without one."""
+        return self.n - 1
 
     def coefficients(self, pump: bool) -> tuple[float, float]:
         """(tank-wall film coefficient, pump conductance in W/K) for a pump state."""
@@ -115,14 +153,15 @@ class HeatSystem:
         key = ("K", pump)
         if key not in self._lu:
             h, G = self.coefficients(pump)
-            e = sp.csr_matrix(([G], ([self.n - 1], [self.n - 1])), shape=(self.n, self.n))
+            o, i = self.oil, self.inlet  # G (T_oil − T_in) and G T_in, summed if the same unknown
+            e = sp.csr_matrix(([G, -G, G], ([o, o, i], [o, i, i])), shape=(self.n, self.n))
             self._lu[key] = (self.K0 + h * self.K_wall + e).tocsr()
         return self._lu[key]
 
     def f(self, t: float, drive: Drive, pump: bool) -> np.ndarray:
         u = drive(t)
         out = self.f_amb * u.T_amb + self.f_src
-        out[-1] += self.coefficients(pump)[1] * u.T_supply
+        out[self.inlet] += self.coefficients(pump)[1] * u.T_supply
         return out
 
     def initial(self, T0: float | None = None) -> np.ndarray:
@@ -163,20 +202,27 @@ def assemble_heat(mesh, order: int, k: Field, rho_c: Field, thickness: Field,
     A_ww = asm(film, wb, h=1.0, t=tw)
     c = asm(film_load, wb, h=1.0, t=tw)
     K_wall = sp.bmat([[A_ww, -c[:, None]], [-c[None, :], np.array([[c.sum()]])]]).tocsr()
-    M = sp.block_diag([M, np.array([[params.oil_rho_c * oil_volume]])]).tocsr()
-    K0 = sp.block_diag([K, sp.csr_matrix((1, 1))]).tocsr()
+    caps, loss = [params.oil_rho_c * oil_volume], [0.0]
+    if params.hose_capacity > 0:
+        caps, loss = caps + [params.hose_capacity], loss + [params.hose_loss]
+        K_wall = sp.block_diag([K_wall, sp.csr_matrix((1, 1))]).tocsr()
+    M = sp.block_diag([M, sp.diags(caps)]).tocsr()
+    K0 = sp.block_diag([K, sp.diags(loss)]).tocsr()
+    f_amb, f_src = np.concatenate([f_amb, loss]), np.concatenate([f_src, np.zeros(len(caps))])
     log.info("heat system: %d unknowns (P%d), wall area %.4g m²", M.shape[0], order, c.sum())
-    return HeatSystem(basis, M, K0, K_wall, np.append(f_amb, 0.0), np.append(f_src, 0.0), params)
+    return HeatSystem(basis, M, K0, K_wall, f_amb, f_src, params, basis.N)
 
 
-def _solver(sys: HeatSystem, dt: float, theta: float, pump: bool):
-    key = (round(dt, 9), theta, pump)
+def _solve(sys: HeatSystem, dt: float, theta: float, pump: bool, rhs: np.ndarray) -> np.ndarray:
+    """Solve ``(M/dt + θ K) U = rhs`` with the factor of ``M/(θ dt) + K``, which backward
+    Euler over dt/2 and Crank–Nicolson over dt share."""
+    key = (round(theta * dt, 9), pump)
     if key not in sys._lu:
         t0 = time.perf_counter()
-        A = (sys.M / dt + theta * sys.K(pump)).tocsc()
+        A = (sys.M / (theta * dt) + sys.K(pump)).tocsc()
         sys._lu[key] = (splu(A, permc_spec="COLAMD"), time.perf_counter() - t0)
-        log.debug("factorised heat matrix for dt=%g s, pump=%s in %.2f s", dt, pump, sys._lu[key][1])
-    return sys._lu[key][0]
+        log.debug("factorised heat matrix for θdt=%g s, pump=%s in %.2f s", theta * dt, pump, sys._lu[key][1])
+    return sys._lu[key][0].solve(rhs / theta)
 
 
 def factorisation_seconds(sys: HeatSystem) -> tuple[int, float]:
@@ -185,23 +231,47 @@ def factorisation_seconds(sys: HeatSystem) -> tuple[int, float]:
     return len(lus), sum(s for _, s in lus)
 
 
-def march(sys: HeatSystem, drive: Drive, times: np.ndarray, theta: float = 1.0,
+def theta_step(sys: HeatSystem, drive: Drive, U: np.ndarray, t0: float, t1: float, theta: float,
+               pump: bool) -> np.ndarray:
+    """One θ-method step from ``U`` at ``t0`` to ``t1`` with the pump state ``pump``."""
+    dt = t1 - t0
+    rhs = sys.M @ U / dt + theta * sys.f(t1, drive, pump)
+    if theta < 1:
+        rhs += (1 - theta) * (sys.f(t0, drive, pump) - sys.K(pump) @ U)
+    return _solve(sys, dt, theta, pump, rhs)
+
+
+def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple[float, float, float]]:
+    """The (start, end, θ) steps of the interval ``t0``..``t1``, the ``since``-th after a
+    switch (0: the first): one θ step, or ``scheme.restart`` steps, the very first of them
+    two backward-Euler half steps if θ < 1."""
+    if since >= scheme.restart_intervals or scheme.restart <= 1:
+        return [(t0, t1, scheme.theta)]
+    s = np.linspace(t0, t1, scheme.restart + 1)
+    steps = [(a, b, scheme.theta) for a, b in zip(s[:-1], s[1:])]
+    if scheme.theta < 1 and since == 0:
+        mid = 0.5 * (s[0] + s[1])
+        steps[:1] = [(s[0], mid, 1.0), (mid, s[1], 1.0)]
+    return [(float(a), float(b), th) for a, b, th in steps]
+
+
+def march(sys: HeatSystem, drive: Drive, times: np.ndarray, scheme: TimeScheme = TimeScheme(),
           U0: np.ndarray | None = None) -> Iterator[tuple[float, np.ndarray]]:
     """Yield ``(t, U)`` at every entry of ``times``, starting with the initial state.
 
-    ``theta`` = 1 is backward Euler, 0.5 Crank–Nicolson. The pump state of an
-    interval is read at its midpoint, so a switch at a sample time takes effect
-    for the whole following interval.
+    The pump state of an interval is read at its midpoint, so a switch at a sample
+    time takes effect for the whole following interval; that interval (and the
+    first) is refined as :class:`TimeScheme` says.
     """
     U = sys.initial() if U0 is None else np.array(U0, dtype=float)
     yield float(times[0]), U
+    last, since = None, 0
     for t0, t1 in zip(times[:-1], times[1:]):
-        dt = float(t1 - t0)
         pump = bool(drive(0.5 * (t0 + t1)).pump)
-        rhs = sys.M @ U / dt + theta * sys.f(t1, drive, pump)
-        if theta < 1:
-            rhs += (1 - theta) * (sys.f(t0, drive, pump) - sys.K(pump) @ U)
-        U = _solver(sys, dt, theta, pump).solve(rhs)
+        since = 0 if pump != last else since + 1
+        for a, b, theta in substeps(float(t0), float(t1), scheme, since):
+            U = theta_step(sys, drive, U, a, b, theta, pump)
+        last = pump
         yield float(t1), U
 
 
@@ -215,8 +285,8 @@ def energy_step(sys: HeatSystem, U0: np.ndarray, U1: np.ndarray, t0: float, t1: 
     pump = bool(drive(0.5 * (t0 + t1)).pump)
     h, _ = sys.coefficients(pump)
     Um = theta * U1 + (1 - theta) * U0
-    solid = np.ones(sys.n)
-    solid[-1] = 0.0
+    solid = np.zeros(sys.n)
+    solid[:sys.n_solid] = 1.0
     f_amb = theta * drive(t1).T_amb + (1 - theta) * drive(t0).T_amb
     return {
         "wall": -dt * h * float(solid @ (sys.K_wall @ Um)),

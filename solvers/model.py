@@ -112,17 +112,19 @@ class FrameModel:
         return self.fmesh.dim
 
     def temperatures(self, U: np.ndarray) -> dict[str, float]:
-        """Sensor temperatures (°C), θ_C as the mean of C1–C10, tank oil, and the
-        area means of the tank wall and the mounting face."""
-        vals = self.probe @ U[:-1]
-        out = dict(zip(self.sensor_names, map(float, vals)))
+        """Sensor temperatures (°C), θ_C as the mean of C1–C10, tank oil, supply hose
+        (``hose``, if modelled), and the area means of the tank wall and the mounting face."""
+        T = U[:self.heat.n_solid]
+        out = dict(zip(self.sensor_names, map(float, self.probe @ T)))
         out["C"] = float(np.mean([out[c] for c in TIE_SENSORS]))
-        out["oil"] = float(U[-1])
-        out.update({k: float(v @ U[:-1]) for k, v in self.surface_means.items()})
+        out["oil"] = float(U[self.heat.oil])
+        if self.heat.inlet != self.heat.oil:
+            out["hose"] = float(U[self.heat.inlet])
+        out.update({k: float(v @ T) for k, v in self.surface_means.items()})
         return out
 
     def strain_measure(self, U: np.ndarray) -> np.ndarray:
-        return thermal_strain_measure(U[:-1] - self.config.thermal.T0, self.config.alpha_slope)
+        return thermal_strain_measure(U[:self.heat.n_solid] - self.config.thermal.T0, self.config.alpha_slope)
 
     def displacements(self, U: np.ndarray) -> dict[str, float]:
         """The outputs of :data:`OUTPUTS` in metres for the state ``U``."""

@@ -13,7 +13,7 @@ from solvers.model import FrameModel
 
 def nodal_fields(model: FrameModel, U: np.ndarray) -> dict[str, np.ndarray]:
     """Temperature (°C) and displacement (m, 3 components) at the mesh nodes."""
-    T = U[:-1][model.heat.basis.nodal_dofs[0]]
+    T = U[:model.heat.n_solid][model.heat.basis.nodal_dofs[0]]
     u_dofs = model.displacement_field(U)
     u = np.zeros((len(T), 3))
     u[:, : model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T

@@ -37,7 +37,6 @@ import numpy as np
 
 from geometry.files import write_text_atomic
 from solvers.effects import CATALOGUE, ActiveEffects, apply_effects
-from solvers.heat import HeatSystem
 from solvers.model import build_model
 from studies.conditions import CONDITIONS, condition_drive
 from studies.config import Config, load_config
@@ -90,17 +89,6 @@ def draw_strengths(name: str, rng: np.random.Generator) -> tuple[float, float]:
     return tuple(float(m * rng.choice((-1.0, 1.0))) for m in mags)
 
 
-def _resumed(heat: HeatSystem, U0: np.ndarray) -> HeatSystem:
-    """``heat`` started from the state ``U0`` instead of a uniform temperature."""
-
-    @dataclass(frozen=True)
-    class Resumed(HeatSystem):
-        def initial(self, T0=None):
-            return U0.copy()
-
-    return Resumed(**{f.name: getattr(heat, f.name) for f in dataclasses.fields(heat) if f.name != "_lu"})
-
-
 def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_MESH_FACTOR,
           duration: float | None = None) -> dict[str, np.ndarray]:
     """The noise-free columns of a case on the truth mesh (``mesh_factor`` × the model's
@@ -131,8 +119,7 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
         first = run_model(model, drive, times[:k + 1], keep_times=[times[k]])
         low = dataclasses.replace(cfg.thermal, flow_rate=cfg.thermal.flow_rate * case.strength)
         m2 = build_model(dataclasses.replace(cfg, thermal=low), dim, model.fmesh)
-        m2 = dataclasses.replace(m2, heat=_resumed(m2.heat, first.states[0][1]))
-        rest = run_model(m2, drive, times[k:]).columns
+        rest = run_model(m2, drive, times[k:], U0=first.states[0][1]).columns
         return {c: np.concatenate([first.columns[c][:k], rest[c]]) for c in rest}
     elif case.effect != "none":
         raise ValueError(f"unknown case effect {case.effect!r}")

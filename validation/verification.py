@@ -22,7 +22,7 @@ from skfem.helpers import dot
 
 from solvers.elasticity import assemble_elastic, moduli, stiffness, thermal_load
 from solvers.fem import Field, element
-from solvers.heat import (HeatSystem, Inputs, ThermalParams, assemble_heat, capacity, conduction,
+from solvers.heat import (HeatSystem, Inputs, ThermalParams, TimeScheme, assemble_heat, capacity, conduction,
                           energy_step, film, film_load, march)
 
 _EDGE = 1e-9
@@ -271,12 +271,13 @@ class HarmonicDrive:
 def unit_heat_system(n: int = 4, order: int = 1) -> HeatSystem:
     """A small real heat system in unit-free numbers: the unit square (n × n cells),
     k = ρc = 1, tank wall x = 0, mounting face y = 0, free surface elsewhere,
-    out-of-plane loss on; with the pump on (n = 4, P1) its modes decay at 4 to 510 per s."""
+    out-of-plane loss on, and a supply hose (capacity 0.25, loss 0.5); with the pump on
+    (n = 4, P1) its modes decay at 4 to 510 per s."""
     s = np.linspace(0.0, 1.0, n + 1)
     m = rectangle(s, s, {"left": "tank_wall", "bottom": "mounting_face",
                          "right": "free_surface", "top": "free_surface"})
     p = ThermalParams(T0=20.0, h_air=1.0, h_base=0.5, h_oil_on=5.0, h_oil_off=1.0,
-                      oil_rho_c=1.0, flow_rate=2.0)
+                      oil_rho_c=1.0, flow_rate=2.0, hose_capacity=0.25, hose_loss=0.5)
     return assemble_heat(m, order, *_const(m, 1.0, 1.0, 1.0), p, oil_volume=0.5)
 
 
@@ -293,37 +294,42 @@ def exact_response(sys: HeatSystem, drive: HarmonicDrive, times: np.ndarray,
 
     Each mode obeys ``y' + λ y = a + c cos ωt``; its solution is
     ``y_p(t) + e^{−λ(t − t0)} (y(t0) − y_p(t0))`` with
-    ``y_p = a/λ + (ω sin ωt + λ cos ωt) c/(λ² + ω²)``.
+    ``y_p = a/λ + (ω sin ωt + λ cos ωt) c/(λ² + ω²)``. With a hose ``K`` is not
+    symmetric (the flow runs one way): the modes are the general eigenvectors and
+    ``y(t0) = φ⁻¹ U(t0)``.
     """
     M, w = sys.M.toarray(), drive.omega
-    oil = np.zeros(sys.n)
-    oil[-1] = 1.0
+    inlet = np.zeros(sys.n)
+    inlet[sys.inlet] = 1.0
     modes = {}
     U = sys.initial() if U0 is None else np.array(U0, float)
     out = [U]
     for t0, t1 in zip(times[:-1], times[1:]):
         pump = drive.pump(0.5 * (t0 + t1))
         if pump not in modes:
-            lam, phi = scipy.linalg.eigh(sys.K(pump).toarray(), M)
+            lam, phi = scipy.linalg.eig(sys.K(pump).toarray(), M)
+            lam, phi = lam.real, phi.real  # real: the hose feeds the symmetric solid-oil block one way
             G = sys.coefficients(pump)[1]
-            a = sys.f_amb * drive.amb0 + sys.f_src + G * drive.sup0 * oil
-            c = sys.f_amb * drive.amb1 + G * drive.sup1 * oil
-            modes[pump] = lam, phi, phi.T @ a, phi.T @ c / (lam ** 2 + w ** 2)
-        lam, phi, a, c = modes[pump]
+            a = sys.f_amb * drive.amb0 + sys.f_src + G * drive.sup0 * inlet
+            c = sys.f_amb * drive.amb1 + G * drive.sup1 * inlet
+            inv = np.linalg.inv(phi)
+            Minv = inv @ np.linalg.inv(M)
+            modes[pump] = lam, phi, inv, Minv @ a, Minv @ c / (lam ** 2 + w ** 2)
+        lam, phi, inv, a, c = modes[pump]
         yp = lambda t: a / lam + (w * np.sin(w * t) + lam * np.cos(w * t)) * c  # noqa: E731
-        U = phi @ (yp(t1) + np.exp(-lam * (t1 - t0)) * (phi.T @ (M @ U) - yp(t0)))
+        U = phi @ (yp(t1) + np.exp(-lam * (t1 - t0)) * (inv @ U - yp(t0)))
         out.append(U)
     return np.array(out)
 
 
-def time_errors(sys: HeatSystem, drive: HarmonicDrive, t_end: float, steps, theta: float,
+def time_errors(sys: HeatSystem, drive: HarmonicDrive, t_end: float, steps, scheme: TimeScheme,
                 U0: np.ndarray | None = None, final_only: bool = False):
     """(dt in s, error in K) per step count in ``steps``: the max over nodes of
     |U − exact|, maximised over all step times or taken at ``t_end`` only (``final_only``)."""
     dts, errs = [], []
     for n in steps:
         times = np.linspace(0.0, t_end, n + 1)
-        U = np.array([u for _, u in march(sys, drive, times, theta, U0)])
+        U = np.array([u for _, u in march(sys, drive, times, scheme, U0)])
         e = np.abs(U - exact_response(sys, drive, times, U0)).max(axis=1)
         dts.append(t_end / n)
         errs.append(float(e[-1] if final_only else e.max()))
@@ -341,46 +347,53 @@ def slab_film_series(xi, fo: float, biot: float, terms: int = 200) -> np.ndarray
     return np.cos(np.multiply.outer(np.asarray(xi, float), lam)) @ (C * np.exp(-lam ** 2 * fo))
 
 
-def slab_film_error(order: int = 2, nx: int = 20, dt: float = 2.0, theta: float = 0.5,
+def slab_film_error(order: int = 2, nx: int = 20, dt: float = 2.0, scheme: TimeScheme = TimeScheme(),
                     t_end: float = 1200.0, L: float = 0.1, h: float = 500.0,
                     k: float = 48.0, rho_c: float = 3.6975e6, every: float = 60.0) -> float:
     """Max |θ_FE − θ_series| (θ = (T − T_amb)/(T_i − T_amb)) over the nodes and the
     times ``every``, ``2 every``, … ≤ ``t_end`` (s) of a strip ``L × L/20`` (m) at
     ``T_i``, cooled by a film ``h`` (W/(m² K)) on its mounting face x = 0 and
     insulated elsewhere, built by :func:`solvers.heat.assemble_heat` and marched by
-    :func:`solvers.heat.march`. For θ < 1 the first ``dt`` is two backward-Euler
-    steps (the film switched on at t = 0 is a shock that CN would not damp)."""
+    :func:`solvers.heat.march` (whose start-up damps the shock of the film switched
+    on at t = 0)."""
     T_i, T_amb = 20.0, 60.0
     m = rectangle(np.linspace(0.0, L, nx + 1), [0.0, L / 20], {
         "left": "mounting_face", "right": "tank_wall", "top": "free_surface", "bottom": "free_surface"})
     params = ThermalParams(T0=T_i, h_air=0.0, h_base=h, h_oil_on=0.0, h_oil_off=0.0, flow_rate=0.0)
     sys = assemble_heat(m, order, *_const(m, k, rho_c, 1.0), params, oil_volume=1e-6)
     drive = lambda t: Inputs(T_i, False, T_amb)  # noqa: E731
-    times, U0 = np.arange(0.0, t_end + 0.5 * dt, dt), None
-    if theta < 1:
-        *_, (_, U0) = march(sys, drive, np.linspace(0.0, dt, 3), 1.0)
-        times = times[1:]
+    times = np.arange(0.0, t_end + 0.5 * dt, dt)
     xi = (L - sys.basis.doflocs[0]) / L
     err = 0.0
-    for t, U in march(sys, drive, times, theta, U0):
+    for t, U in march(sys, drive, times, scheme):
         if t >= every and abs(t / every - round(t / every)) < 1e-9:
             exact = slab_film_series(xi, k / rho_c * t / L ** 2, h * L / k)
-            err = max(err, float(np.abs((U[:-1] - T_amb) / (T_i - T_amb) - exact).max()))
+            err = max(err, float(np.abs((U[:sys.n_solid] - T_amb) / (T_i - T_amb) - exact).max()))
     return err
 
 
 def energy_balance(sys: HeatSystem, drive, times: np.ndarray, theta: float) -> dict[str, np.ndarray]:
-    """Per-step heat (J) over a march: the terms of :func:`solvers.heat.energy_step`
-    (solid: ``wall + source = stored + lost``) and the oil's own account, ``supply``
-    brought by the pump flow and ``oil_stored``, so that ``supply = oil_stored + wall``."""
-    states = list(march(sys, drive, times, theta))
+    """Per-step heat (J) over a θ-method march without start-up grading: the terms of
+    :func:`solvers.heat.energy_step` (solid: ``wall + source = stored + lost``), the
+    oil's own account (``supply`` brought by the flow, ``supply = oil_stored + wall``)
+    and, with a hose, the hose's (``hose_in = hose_stored + hose_lost``; enthalpy flows
+    G (T_supply − T_hose) into the hose, G (T_hose − T_oil) into the tank)."""
+    states = list(march(sys, drive, times, TimeScheme(theta, restart=1)))
+    o, i = sys.oil, sys.inlet
     out: dict[str, list[float]] = {}
     for (t0, U0), (t1, U1) in zip(states[:-1], states[1:]):
-        G = sys.coefficients(bool(drive(0.5 * (t0 + t1)).pump))[1]
-        T_sup = theta * drive(t1).T_supply + (1 - theta) * drive(t0).T_supply
+        dt, G = t1 - t0, sys.coefficients(bool(drive(0.5 * (t0 + t1)).pump))[1]
+        Um = theta * U1 + (1 - theta) * U0
+        u = {k: theta * getattr(drive(t1), k) + (1 - theta) * getattr(drive(t0), k) for k in ("T_supply", "T_amb")}
         terms = {**energy_step(sys, U0, U1, t0, t1, drive, theta),
-                 "supply": (t1 - t0) * G * (T_sup - theta * U1[-1] - (1 - theta) * U0[-1]),
-                 "oil_stored": sys.M[-1, -1] * (U1[-1] - U0[-1])}
+                 "oil_stored": sys.M[o, o] * (U1[o] - U0[o])}
+        if i == o:
+            terms["supply"] = dt * G * (u["T_supply"] - Um[o])
+        else:
+            terms["supply"] = dt * G * (Um[i] - Um[o])
+            terms["hose_in"] = dt * G * (u["T_supply"] - Um[i])
+            terms["hose_lost"] = dt * sys.params.hose_loss * (Um[i] - u["T_amb"])
+            terms["hose_stored"] = sys.M[i, i] * (U1[i] - U0[i])
         for key, v in terms.items():
             out.setdefault(key, []).append(float(v))
     return {key: np.array(v) for key, v in out.items()}
