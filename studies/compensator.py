@@ -128,6 +128,8 @@ class ClosedLoop:
     # held displacement achieved at the cutting area, um
     delta_comp_um: np.ndarray
     # compensated delta = delta + stroke, um
+    update_t_s: np.ndarray
+    # times of the piezo updates, s: each sets the command to -delta_et of that instant
     saturated_updates: int = 0
     # piezo updates whose command was outside the actuator's reach (clipped); 0 if ideal
 
@@ -271,7 +273,7 @@ def close_loop(ts: TimeSeries, pr: Prediction, params: CompensatorParams,
     pred = np.interp(t, pr.t_s, pr.delta_pred_um) if pr.resampled else pr.delta_pred_um
     delta = ts["delta_um"]
     return ClosedLoop(pr, t, delta, pred, pr.u_um[updates][held], volts[held], stroke[held],
-                      delta + stroke[held], saturated)
+                      delta + stroke[held], pr.t_s[updates], saturated)
 
 
 def compensate(ts: TimeSeries, Ki: float, Kc: float, params: CompensatorParams,
@@ -282,9 +284,13 @@ def compensate(ts: TimeSeries, Ki: float, Kc: float, params: CompensatorParams,
 
 def summarize(loop: ClosedLoop, settle_s: float = 600.0) -> dict[str, float | None]:
     """Summary figures (um; R dimensionless, None without factors); bands skip the first
-    ``settle_s`` seconds."""
+    ``settle_s`` seconds. ``residual_at_updates_um`` is the compensated delta only at the
+    update instants, for which each command was predicted: the paper's reading (its
+    compensation result minus its prediction error is "the mechanism's error"), while
+    ``residual_band_um`` also counts the drift while a command is held."""
     late = loop.t_s >= loop.t_s[0] + settle_s
     pr = loop.prediction
+    at = loop.update_t_s[loop.update_t_s >= loop.t_s[0] + settle_s]
 
     def band(x):
         x = np.abs(x[late])
@@ -294,6 +300,8 @@ def summarize(loop: ClosedLoop, settle_s: float = 600.0) -> dict[str, float | No
         "swing_um": float(np.nanmax(loop.delta_um) - np.nanmin(loop.delta_um)),
         "prediction_error_band_um": band(loop.delta_um - loop.delta_pred_um),
         "residual_band_um": band(loop.delta_comp_um),
+        "residual_at_updates_um": float(np.max(np.abs(np.interp(at, loop.t_s, loop.delta_comp_um))))
+        if at.size else None,
         "R_i_final": float(pr.R_i[-1]) if np.isfinite(pr.R_i[-1]) else None,
         "R_C_final": float(pr.R_C[-1]) if np.isfinite(pr.R_C[-1]) else None,
         "peak_time_s": None if pr.peak_index is None else float(pr.t_s[pr.peak_index]),

@@ -220,11 +220,11 @@ def test_study_table_structure(cfg, model, study):
 # (gmsh is not bit-reproducible), hence rel=3e-4; the all-sensor regression is too
 # ill-conditioned for regression values (its bands move by 10-50 % between builds).
 EXPECTED = {
-    (1, "paper, K theory"): (55.2296, 6.25439, 22.4210, 6.25439, 0),
-    (2, "paper, K FE"): (47.3038, 6.43560, 23.0646, 6.43560, 0),
-    (3, "paper, K fit (cond. 1)"): (61.3302, 6.08050, 21.7774, 6.08050, 0),
-    (3, "MLR θA θB θC (cond. 1)"): (61.3302, 2.12272, 22.8677, 2.12272, 1),
-    (2, "MLR θA θB θC (cond. 1), 1-min forecast"): (47.3038, 6.82289, 23.4004, 6.82289, 0),
+    (1, "paper, K theory"): (55.7106, 4.66092, 21.3687, 4.66092, 0),
+    (2, "paper, K FE"): (47.1894, 4.79228, 22.1107, 4.79228, 0),
+    (3, "paper, K fit (cond. 1)"): (61.3944, 4.60845, 20.7123, 4.60845, 0),
+    (3, "MLR θA θB θC (cond. 1)"): (61.3944, 2.04152, 21.7875, 2.04152, 1),
+    (2, "MLR θA θB θC (cond. 1), 1-min forecast"): (47.1894, 5.55267, 22.4095, 5.55267, 0),
 }
 
 

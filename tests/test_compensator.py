@@ -176,6 +176,10 @@ def test_closed_loop_with_actuator_and_summary():
     assert s_ideal["prediction_error_band_um"] == pytest.approx(
         np.max(np.abs(d - ideal.delta_pred_um)[late]), rel=1e-15)
     assert s_direct["residual_band_um"] > s_ideal["residual_band_um"]
+    at = late & (k % 5 == 0)  # at an update the ideal stroke cancels the prediction made for it
+    assert s_ideal["residual_at_updates_um"] == pytest.approx(
+        np.max(np.abs(d - ideal.delta_pred_um)[at]), rel=1e-12)
+    assert s_ideal["residual_at_updates_um"] <= s_ideal["prediction_error_band_um"]
     assert s_ideal["peak_time_s"] == 17 * 60.0 and s_ideal["R_i_final"] == ideal.prediction.R_i[-1]
 
 

@@ -88,7 +88,7 @@ def test_simulate_condition_1_coarse(tmp_path, capsys):
     assert m.point_data["T"].max() > 30.0 and np.abs(m.point_data["u"]).max() > 1e-6
 
 
-REGRESSION = {"first_peak_um": 47.73, "first_peak_min": 13.0, "swing_um": 50.70}  # measured 2026-11-22
+REGRESSION = {"first_peak_um": 48.00, "first_peak_min": 13.0, "swing_um": 51.07}  # measured 2026-11-22 (CN, hose)
 
 
 @pytest.mark.parametrize("argv, needle", [

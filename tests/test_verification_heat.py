@@ -108,6 +108,8 @@ def test_frame_energy_balance(frame_model, theta):
     oil = e["supply"] - e["oil_stored"] - e["wall"]
     hose = e["hose_in"] - e["hose_stored"] - e["hose_lost"]
     total = max(abs(v.sum()) for v in e.values())
+    print(f"theta={theta}: largest relative imbalance per step, solid / oil / hose: "
+          + " / ".join(f"{np.abs(a / scale).max():.2g}" for a in (solid, oil, hose)))
     for account in (solid, oil, hose):
         assert np.abs(account / scale).max() < 1e-8
         assert abs(account.sum()) < 1e-8 * total

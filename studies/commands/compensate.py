@@ -148,5 +148,6 @@ def run(args: argparse.Namespace) -> int:
           f"{'piezo_loops.png, ' if actuator else ''}summary.json")
     print(f"{what}: K_i {ki:.4g}, K_C {kc:.4g} um/K ({source}); swing {summary['swing_um']:.2f} um, "
           f"prediction error band {_um(summary['prediction_error_band_um'])}, "
-          f"residual band {_um(summary['residual_band_um'])}")
+          f"residual band {_um(summary['residual_band_um'])} "
+          f"({_um(summary['residual_at_updates_um'])} at the update instants)")
     return 0
