@@ -10,9 +10,9 @@ import pytest
 from geometry.frame import MeshParams
 from solvers.heat import Inputs, TimeScheme
 from solvers.model import ModelConfig, build_model
-from validation.verification import (HarmonicDrive, energy_balance, heat_mms_error, observed_order,
-                                     slab_film_error, spatial_study, steady_state, time_errors,
-                                     unit_heat_system)
+from validation.verification import heat_mms_error, observed_order, spatial_study
+from validation.verification_time import (HarmonicDrive, energy_balance, slab_film_error, steady_state,
+                                          time_errors, unit_heat_system)
 
 
 # (dimension, element order, refinement levels): unit square refined n times (h = 2^-n),
