@@ -141,3 +141,20 @@ def test_default_scheme_resolves_pump_switches(frame_2d):
     print(f"max |δ - δ_ref|: default {np.abs(default - ref).max():.3f} µm, BE 60 s {np.abs(be - ref).max():.3f} µm")
     assert np.abs(default - ref).max() < 0.1
     assert np.abs(be - ref).max() > 1.0
+
+
+def test_supply_hose_hand_values(frame_2d):
+    """The hose is fed by the supply only (one-way), so condition 1 gives it hand values:
+    after an hour with the pump on it holds (G·40 + UA·20)/(G + UA) °C (G = ρc·Q), and an
+    hour after the pump stops it has relaxed towards the room as exp(−UA t / C_hose)."""
+    from studies.conditions import CONDITIONS, SupplyParams, condition_drive
+    from studies.simulate import run_model, sample_times
+
+    model = build_model(ModelConfig(), 2, fmesh=frame_2d)
+    p = model.config.thermal
+    cols = run_model(model, condition_drive(CONDITIONS[1], SupplyParams()), sample_times(7200.0)).columns
+    G, UA = p.oil_rho_c * p.flow_rate, p.hose_loss
+    on = cols["T_hose_degC"][60]
+    assert on == pytest.approx((G * 40.0 + UA * 20.0) / (G + UA), abs=1e-9)
+    off = 20.0 + (on - 20.0) * np.exp(-UA * 3600.0 / p.hose_capacity)
+    assert cols["T_hose_degC"][120] == pytest.approx(off, abs=5e-3)  # CN over 60-s steps
