@@ -6,7 +6,8 @@ import pytest
 
 from studies import design as ds
 from studies.config import parse_config
-from studies.sweep import evaluate, plan
+from studies.sweep import plan
+from studies.sweep_evaluate import evaluate
 
 GEOMETRY = dict(h=0.15, depth=0.12, column_height=0.63, l=0.6, l1=0.25, l4=0.3, l_C=0.4, A_C=6e-4, t_C=0.04,
                 arm_thickness=0.06, arm_depth=0.06, gap=0.02, tank_wall=0.015, tank_width=0.05,

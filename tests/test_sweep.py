@@ -15,7 +15,7 @@ import pytest
 
 from geometry.errors import InputError
 from solvers import beam
-from studies import sweep
+from studies import sweep, sweep_evaluate
 from studies.cli import main
 from studies.commands import sweep as sweep_command
 from studies.commands.sweep import parse_study
@@ -169,8 +169,8 @@ def test_sweep_writes_one_row_per_point_and_resumes(study_dir, monkeypatch):
     assert len(points) == 4
     points[0].unlink()
     calls = []
-    real = sweep.evaluate
-    monkeypatch.setattr(sweep, "evaluate", lambda t: calls.append(t.key) or real(t))
+    real = sweep_evaluate.evaluate
+    monkeypatch.setattr(sweep_evaluate, "evaluate", lambda t: calls.append(t.key) or real(t))
     assert main(["sweep", str(study_dir / "study.toml"), "--out", str(out), "--workers", "1"]) == 0
     assert calls == [points[0].stem]
     assert (out / "table.csv").read_text() == first

@@ -211,7 +211,7 @@ def write_table(path: Path, columns: list[str], rows: list[dict]) -> None:
 def run_studies(jobs, workers: int, scheduler: str | None, progress=None):
     """Evaluate the unfinished points of several ``(tasks, store)`` jobs in one pool.
     Returns ``(records per job, failures)``."""
-    from studies.sweep import execute
+    from studies.sweep_evaluate import execute
 
     done = [store.load(t.key for t in tasks) for tasks, store in jobs]
     keys = [{t.key for t in tasks} for tasks, _ in jobs]

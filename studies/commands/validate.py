@@ -94,6 +94,7 @@ def run_beam(args) -> int:
     from solvers.beam import normalised
     from studies.config import load_config
     from validation import beam_vs_fe as bv
+    from validation import beam_vs_fe_report as bv_report
     from validation.beam_plots import plot_ki_kc
     from validation.effective import effective_coefficients, table_rows
     from validation.sweep_plots import plot_xy
@@ -114,8 +115,8 @@ def run_beam(args) -> int:
     write_table(out / "errors.csv", *_rows(errors))
     gaps = [e for e in errors if e["gap"] or not e["within_tolerance"]]
     write_text_atomic(out / "errors.md", "# K_i, K_C: FE against the beam theory\n\n"
-                      + bv.md_table(bv.summary_by_beta(errors)) + "\n\n## Gaps\n\n"
-                      + (bv.md_table(gaps) if gaps else "none") + "\n")
+                      + bv_report.md_table(bv_report.summary_by_beta(errors)) + "\n\n## Gaps\n\n"
+                      + (bv_report.md_table(gaps) if gaps else "none") + "\n")
     slender = bv.series_rows([r for rs in rows["slenderness"] for r in rs], "l_over_h")
     tie = bv.series_rows([r for rs in rows["tie_height"] for r in rs], "geometry.t_C")
     for series, x, name in ((slender, "l_over_h", "slenderness"), (tie, "geometry.t_C", "tie_height")):
@@ -136,8 +137,8 @@ def run_beam(args) -> int:
     timing = {"points": points, "wall s": round(time.perf_counter() - t0, 1),
               "CPU s": round(_cpu_seconds() - c0, 1), "workers": args.scheduler or args.workers}
     cfg = next(t.config for t in plans["sweep"][0] if not t.skip)
-    text = bv.report(dim, cfg, base.source, errors, errors_nt, skipped, zc_fe, zc_th, slender, tie,
-                     conv, effective, timing)
+    text = bv_report.report(dim, cfg, base.source, errors, errors_nt, skipped, zc_fe, zc_th, slender, tie,
+                            conv, effective, timing)
     write_text_atomic(out / "report.md", text)
     write_text_atomic(out / "summary.json", json.dumps({
         **timing, "within_tolerance": sum(e["within_tolerance"] for e in errors), "values": len(errors),
