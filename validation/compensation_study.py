@@ -194,7 +194,8 @@ def markdown(st: Study) -> str:
               f"min, swing {f['swing_um']:.2f} µm" for n, f in st.figures.items()]
     cols = ("cond.", "predictor", "K_i µm/K", "K_C µm/K", "swing before µm", "pred. error band µm",
             "at min", "error band off switches µm", "residual band µm", "residual off switches µm",
-            "residual at update instants µm", "residual, 1-min updates µm", "no-reset stroke error µm", "clipped updates", "paper µm")
+            "residual at update instants µm", "residual, 1-min updates µm", "no-reset stroke error µm",
+            "clipped updates", "paper µm")
     lines += ["", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in st.rows:
         vals = asdict(r)
