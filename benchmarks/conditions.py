@@ -14,11 +14,11 @@ from __future__ import annotations
 import argparse
 import time
 
-from solvers.heat import factorisation_seconds
-from solvers.model import build_model
-from studies.conditions import CONDITIONS, condition_drive
-from studies.config import load_config
-from studies.simulate import run_model, sample_times
+from gatetherm.solvers.heat import factorisation_seconds
+from gatetherm.solvers.model import build_model
+from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.studies.run.config import load_config
+from gatetherm.studies.run.simulate import run_model, sample_times
 
 TARGET_S = {2: 15.0, 3: 90.0}
 

@@ -11,9 +11,9 @@ import logging
 
 import numpy as np
 
-from geometry.frame import (FrameParams, MeshParams, part_boxes, sensor_points,
+from gatetherm.geometry.frame import (FrameParams, MeshParams, part_boxes, sensor_points,
                             tank_box, validate, validate_mesh)
-from geometry.mesh import FrameMesh
+from gatetherm.geometry.mesh import FrameMesh
 
 log = logging.getLogger(__name__)
 _TOL = 1e-7

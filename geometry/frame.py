@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
-from geometry.errors import InputError
+from gatetherm import InputError
 
 Box = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, z0, z1
 

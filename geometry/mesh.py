@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geometry.errors import InputError
-from geometry.files import atomic_path
+from gatetherm import InputError
+from gatetherm import atomic_path
 
 _CELL = {2: "triangle", 3: "tetra"}
 _FACET = {2: "line", 3: "triangle"}

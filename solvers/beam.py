@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from geometry.errors import InputError
+from gatetherm import InputError
 
 
 @dataclass(frozen=True)

@@ -13,10 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geometry.errors import InputError
-from geometry.frame import part_boxes
-from solvers.heat import Drive, Inputs
-from solvers.model import ModelConfig
+from gatetherm import InputError
+from gatetherm.geometry.frame import part_boxes
+from gatetherm.solvers.heat import Drive, Inputs
+from gatetherm.solvers.model import ModelConfig
 
 
 @dataclass(frozen=True)

@@ -17,9 +17,9 @@ import scipy.sparse as sp
 from skfem import BilinearForm, CellBasis, ElementVector, FacetBasis, asm
 from skfem.helpers import ddot, div, dot, sym_grad
 
-from solvers.fem import Field, element
-from solvers.linsolve import rigid_body_modes, spd_solver
-from solvers.material import lame, lame_plane_stress, thermal_stress_modulus
+from gatetherm.solvers.fem import Field, element
+from gatetherm.solvers.linsolve import rigid_body_modes, spd_solver
+from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
 
 log = logging.getLogger(__name__)
 

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from geometry.mesh import FrameMesh
+from gatetherm.geometry.mesh import FrameMesh
 
 _MESH = {2: skfem.MeshTri, 3: skfem.MeshTet}
 _ELEM = {(2, 1): skfem.ElementTriP1, (2, 2): skfem.ElementTriP2,

@@ -30,7 +30,7 @@ from scipy.sparse.linalg import splu
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
-from solvers.fem import Field, element
+from gatetherm.solvers.fem import Field, element
 
 log = logging.getLogger(__name__)
 

@@ -12,15 +12,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from geometry.build import build_mesh
-from geometry.frame import FrameParams, MeshParams, TIE_SENSORS, tank_box, tie_depth
-from geometry.mesh import FrameMesh
-from solvers.elasticity import ElasticSystem, assemble_elastic
-from solvers.fem import Field, to_skfem
+from gatetherm.geometry.build import build_mesh
+from gatetherm.geometry.frame import FrameParams, MeshParams, TIE_SENSORS, tank_box, tie_depth
+from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic
+from gatetherm.solvers.fem import Field, to_skfem
 from skfem import FacetBasis, asm
 
-from solvers.heat import HeatSystem, ThermalParams, assemble_heat, film_load
-from solvers.material import FC300, Material
+from gatetherm.solvers.heat import HeatSystem, ThermalParams, assemble_heat, film_load
+from gatetherm.solvers.material import FC300, Material
 
 log = logging.getLogger(__name__)
 

@@ -21,9 +21,9 @@ import numpy as np
 from skfem import CellBasis, LinearForm, asm
 from skfem.helpers import div
 
-from solvers.elasticity import moduli
-from solvers.fem import Field
-from solvers.model import FrameModel, is_tie, region_fields
+from gatetherm.solvers.elasticity import moduli
+from gatetherm.solvers.fem import Field
+from gatetherm.solvers.model import FrameModel, is_tie, region_fields
 
 
 @dataclass(frozen=True)

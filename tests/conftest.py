@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from geometry.build import build_mesh
-from geometry.frame import FrameParams, MeshParams
+from gatetherm.geometry.build import build_mesh
+from gatetherm.geometry.frame import FrameParams, MeshParams
 
 COARSE = MeshParams(size=0.02, size_3d=0.02)
 """Mesh density of the shared frame fixtures (about 1.6k triangles / 24k tetrahedra)."""

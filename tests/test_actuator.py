@@ -4,8 +4,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from geometry.errors import InputError
-from studies.actuator import (ActuatorParams, apply_commands, dead_band_um, hysteresis_cost_um, load_factor,
+from gatetherm import InputError
+from gatetherm.studies.control.actuator import (ActuatorParams, apply_commands, dead_band_um, hysteresis_cost_um, load_factor,
                               loaded_stroke, loop_width_um, play, reset_curve, reset_state, saturated_commands,
                               step, stroke_range, sweep, voltage_for, weights)
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, minimize_scalar
 
-from geometry.errors import InputError
-from solvers import beam
-from solvers.beam import BeamModel, coefficients, delta, normalised, tie_force
+from gatetherm import InputError
+from gatetherm.solvers import beam
+from gatetherm.solvers.beam import BeamModel, coefficients, delta, normalised, tie_force
 
 BETAS = (0.01, 0.03, 0.1, 0.3, 1.0)
 
@@ -240,7 +240,7 @@ def test_model_rejects_bad_fields(field, value):
 @pytest.fixture
 def cli(monkeypatch):
     """``studies.cli`` with only the beam command, independent of the other command modules."""
-    from studies import cli
+    from gatetherm.studies import cli
 
     assert "beam" in cli.COMMAND_MODULES
     monkeypatch.setattr(cli, "COMMAND_MODULES", ("beam",))
@@ -269,7 +269,7 @@ def test_cli_bad_input(cli, capsys, args, option):
 
 
 def test_plots_written(tmp_path):
-    from validation.beam_plots import plot_ki_kc
+    from gatetherm.validation.plots.beam import plot_ki_kc
 
     a = np.linspace(0.5, 5.0, 200)
     theory = {b: normalised(a, b) for b in BETAS}

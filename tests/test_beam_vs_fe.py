@@ -8,13 +8,13 @@ import dataclasses
 import numpy as np
 import pytest
 
-from solvers import beam
-from solvers.model import build_model
-from solvers.reduced import fe_coefficients
-from studies.compensator import theory_coefficients
-from studies.config import parse_config
-from studies.sweep import configure, plan
-from validation import beam_vs_fe as bv
+from gatetherm.solvers import beam
+from gatetherm.solvers.model import build_model
+from gatetherm.solvers.reduced import fe_coefficients
+from gatetherm.studies.control.compensator import theory_coefficients
+from gatetherm.studies.run.config import parse_config
+from gatetherm.studies.sweeps.sweep import configure, plan
+from gatetherm.validation import beam_vs_fe as bv
 
 GEOMETRY = dict(h=0.1, depth=0.12, column_height=0.63, l=0.6, l1=0.3, l4=0.3, l_C=0.4, A_C=1e-3, t_C=0.04,
                 arm_thickness=0.06, arm_depth=0.06, gap=0.02, tank_wall=0.01, tank_width=0.03,
@@ -139,7 +139,7 @@ def test_slender_frame_without_cavity_matches_the_theory():
 @pytest.mark.slow
 def test_validate_beam_2d_meets_the_acceptance(tmp_path):
     """The whole `gatetherm validate beam --dim 2` (about 3 min on 2 cores)."""
-    from studies.cli import main
+    from gatetherm.studies.cli import main
 
     assert main(["validate", "beam", "--dim", "2", "--out", str(tmp_path), "--workers", "2"]) == 0
     with open(tmp_path / "beam_vs_fe.csv", newline="") as fh:

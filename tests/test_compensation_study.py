@@ -12,19 +12,19 @@ import json
 import numpy as np
 import pytest
 
-from solvers import beam
-from solvers.model import build_model
-from solvers.reduced import fe_coefficients
-from studies import cli
-from studies.actuator import ActuatorParams, dead_band_um
-from studies.commands.compensate import K_SOURCES, simulated_series
-from studies.compensator import fe_coefficients_um, theory_coefficients
-from studies.conditions import CONDITIONS, condition_drive
-from studies.config import load_config
-from studies.simulate import run_model, sample_times
-from studies.timeseries import read_timeseries, write_timeseries
-from validation import compensation_study
-from validation.compensation_plots import plot_piezo_loops
+from gatetherm.solvers import beam
+from gatetherm.solvers.model import build_model
+from gatetherm.solvers.reduced import fe_coefficients
+from gatetherm.studies import cli
+from gatetherm.studies.control.actuator import ActuatorParams, dead_band_um
+from gatetherm.studies.cli.compensate import K_SOURCES, simulated_series
+from gatetherm.studies.control.compensator import fe_coefficients_um, theory_coefficients
+from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.studies.run.config import load_config
+from gatetherm.studies.run.simulate import run_model, sample_times
+from gatetherm.studies.run.timeseries import read_timeseries, write_timeseries
+from gatetherm.validation import compensation_study
+from gatetherm.validation.plots.compensation import plot_piezo_loops
 
 
 PINNED = """

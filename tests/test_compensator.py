@@ -6,13 +6,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from geometry.errors import InputError
-from studies import cli
-from studies.actuator import ActuatorParams
-from studies.compensator import (CompensatorParams, compensate, extrapolate, held_ratio, predict,
+from gatetherm import InputError
+from gatetherm.studies import cli
+from gatetherm.studies.control.actuator import ActuatorParams
+from gatetherm.studies.control.compensator import (CompensatorParams, compensate, extrapolate, held_ratio, predict,
                                  summarize)
-from studies.regression import THETAS, apply_regression, fit_coefficients, fit_regression
-from studies.timeseries import TimeSeries, read_timeseries, write_timeseries
+from gatetherm.studies.control.regression import THETAS, apply_regression, fit_coefficients, fit_regression
+from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
 
 EVERY_MIN = CompensatorParams(update_interval_s=60.0)
 # 6 samples, 1 min apart: rises dA = 3k, dB = 0.5k, dC = k, so delta = 2(dA - dB) - dC = 4k exactly
@@ -73,7 +73,7 @@ def test_near_zero_denominators_hold_the_last_factor(caplog):
     assert held_ratio(3.0, 1.5, 1.7, 1.0, (0.5, 1.5)) == (1.5, False)
     # phase 1: delta_th = 0, 3, 0.5, 4, 6 -> R_i(4) keeps R_i(3) = 3.3/3
     ts = series(np.arange(5) * 60.0, [0, 1.5, 0.25, 2, 3], np.zeros(5), np.zeros(5), [0, 3.3, 3.5, 4.8, 6.0])
-    with caplog.at_level(logging.DEBUG, logger="studies.compensator"):
+    with caplog.at_level(logging.DEBUG, logger="gatetherm.studies.control.compensator"):
         pr = predict(ts, 2.0, 1.0, EVERY_MIN)
     np.testing.assert_allclose(pr.R_i, [1, 1, 1.1, 1.1, 1.2], rtol=1e-15)
     assert "|delta_th| = 0.5 um at or below threshold, R_i held" in caplog.text

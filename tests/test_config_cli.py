@@ -6,10 +6,10 @@ import meshio
 import numpy as np
 import pytest
 
-from studies.cli import main
-from studies.config import Config, load_config, parse_config
-from geometry.errors import InputError
-from studies.timeseries import read_timeseries
+from gatetherm.studies.cli import main
+from gatetherm.studies.run.config import Config, load_config, parse_config
+from gatetherm import InputError
+from gatetherm.studies.run.timeseries import read_timeseries
 
 GROUPS = {"column_L", "column_R", "arm_L", "arm_R", "tie_bar", "tie_joint_L", "tie_joint_R",
           "mounting_face", "tank_wall", "free_surface", "A", "B", "E_L", "E_R", "F_L", "F_R",

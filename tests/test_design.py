@@ -4,10 +4,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from studies import design as ds
-from studies.config import parse_config
-from studies.sweep import plan
-from studies.sweep_evaluate import evaluate
+from gatetherm.studies.sweeps import design as ds
+from gatetherm.studies.run.config import parse_config
+from gatetherm.studies.sweeps.sweep import plan
+from gatetherm.studies.sweeps.evaluate import evaluate
 
 GEOMETRY = dict(h=0.15, depth=0.12, column_height=0.63, l=0.6, l1=0.25, l4=0.3, l_C=0.4, A_C=6e-4, t_C=0.04,
                 arm_thickness=0.06, arm_depth=0.06, gap=0.02, tank_wall=0.015, tank_width=0.05,
@@ -73,7 +73,7 @@ def test_validate_design_2d(tmp_path):
     """The whole `gatetherm validate design` on the paper model (a few minutes on 2 cores)."""
     import csv
 
-    from studies.cli import main
+    from gatetherm.studies.cli import main
 
     assert main(["validate", "design", "--out", str(tmp_path), "--workers", "2"]) == 0
     with open(tmp_path / "second_tie_bar.csv", newline="") as fh:

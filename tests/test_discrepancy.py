@@ -12,19 +12,19 @@ import json
 import numpy as np
 import pytest
 
-from geometry.frame import MeshParams
-from studies.calibrate import Fit
-from studies.cli import main
-from solvers.model import build_model
-from studies.conditions import CONDITIONS, condition_drive
-from studies.config import load_config
-from studies.discrepancy import Candidate, Settings, adopted_config, decide, diagnose
-from studies.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
-from studies.modelfile import config_toml
-from studies.simulate import run_model
-from studies.replay import Hypothesis, Replayer, compared_channels, residuals
-from studies.timeseries import write_timeseries
-from validation.hidden_effects import Case, measured, truth
+from gatetherm.geometry.frame import MeshParams
+from gatetherm.studies.diagnosis.calibrate import Fit
+from gatetherm.studies.cli import main
+from gatetherm.solvers.model import build_model
+from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.studies.run.config import load_config
+from gatetherm.studies.diagnosis.discrepancy import Candidate, Settings, adopted_config, decide, diagnose
+from gatetherm.studies.diagnosis.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
+from gatetherm.studies.run.modelfile import config_toml
+from gatetherm.studies.run.simulate import run_model
+from gatetherm.studies.diagnosis.replay import Hypothesis, Replayer, compared_channels, residuals
+from gatetherm.studies.run.timeseries import write_timeseries
+from gatetherm.validation.hidden_effects import Case, measured, truth
 
 COARSE = MeshParams(size=0.02)
 HOUR = 3600.0

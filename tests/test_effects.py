@@ -8,17 +8,17 @@ import json
 import numpy as np
 import pytest
 
-from geometry.errors import InputError
-from solvers.effects import (CATALOGUE, ActiveEffects, apply_effects, catalogue_json, effects_from_table,
+from gatetherm import InputError
+from gatetherm.solvers.effects import (CATALOGUE, ActiveEffects, apply_effects, catalogue_json, effects_from_table,
                              effects_table, first_order_lag, parse_effect)
-from solvers.fem import to_skfem
-from solvers.heat import Inputs
-from solvers.model import ModelConfig, build_model, region_fields
-from studies.conditions import CONDITIONS, condition_drive
-from studies.config import load_config, parse_config
-from studies.simulate import run_model, sample_times
+from gatetherm.solvers.fem import to_skfem
+from gatetherm.solvers.heat import Inputs
+from gatetherm.solvers.model import ModelConfig, build_model, region_fields
+from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.studies.run.config import load_config, parse_config
+from gatetherm.studies.run.simulate import run_model, sample_times
 
-from geometry.frame import MeshParams
+from gatetherm.geometry.frame import MeshParams
 
 COARSE = MeshParams(size=0.02)
 

@@ -8,11 +8,11 @@ import gmsh
 import numpy as np
 import pytest
 
-import geometry.build
-from geometry.build import build_mesh
-from geometry.errors import InputError
-from geometry.frame import FrameParams, MeshParams, sensor_points, tie_depth, validate, width
-from geometry.mesh import load_mesh, save_mesh
+import gatetherm.geometry.build
+from gatetherm.geometry.build import build_mesh
+from gatetherm import InputError
+from gatetherm.geometry.frame import FrameParams, MeshParams, sensor_points, tie_depth, validate, width
+from gatetherm.geometry.mesh import load_mesh, save_mesh
 
 from conftest import COARSE, FIXED as P
 REGIONS = {"column_L", "column_R", "arm_L", "arm_R", "tie_bar", "tie_joint_L", "tie_joint_R"}
@@ -132,7 +132,7 @@ def test_gmsh_finalised_when_build_raises(monkeypatch):
     def fail(*args, **kwargs):
         assert gmsh.isInitialized()
         raise RuntimeError("extraction failed")
-    monkeypatch.setattr(geometry.build, "_extract", fail)
+    monkeypatch.setattr(gatetherm.geometry.build, "_extract", fail)
     with pytest.raises(RuntimeError, match="extraction failed"):
         build_mesh(P, 2, COARSE)
     assert not gmsh.isInitialized()

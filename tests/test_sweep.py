@@ -13,13 +13,13 @@ from pathlib import Path
 
 import pytest
 
-from geometry.errors import InputError
-from solvers import beam
-from studies import sweep, sweep_evaluate
-from studies.cli import main
-from studies.commands import sweep as sweep_command
-from studies.commands.sweep import parse_study
-from studies.config import parse_config
+from gatetherm import InputError
+from gatetherm.solvers import beam
+from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
+from gatetherm.studies.cli import main
+from gatetherm.studies.cli import sweep as sweep_command
+from gatetherm.studies.cli.sweep import parse_study
+from gatetherm.studies.run.config import parse_config
 
 #: A fully specified frame (independent of the shipped paper model, which is recalibrated).
 MODEL = {
@@ -205,10 +205,9 @@ def test_killed_sweep_restarts_to_the_same_table(study_dir):
     study = study_dir / "study.toml"
     study.write_text(STUDY.replace('"derived.beta" = [0.1]', '"derived.beta" = [0.03, 0.3]'))
     out = study_dir / "killed"
-    cmd = [sys.executable, "-m", "studies.cli", "sweep", str(study), "--out", str(out), "--workers", "1",
+    cmd = [sys.executable, "-m", "gatetherm.studies.cli", "sweep", str(study), "--out", str(out), "--workers", "1",
            "--no-plots"]
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
     while len(_stored(out)) < 2 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.01)
@@ -217,7 +216,7 @@ def test_killed_sweep_restarts_to_the_same_table(study_dir):
     assert 2 <= len(_stored(out)) < 8 and not (out / "table.csv").exists()
     for p in _stored(out):  # every stored result is whole (a stray temporary .name is never read)
         assert json.loads(p.read_text())["key"] == p.stem
-    assert subprocess.run(cmd, env=env, capture_output=True).returncode == 0
+    assert subprocess.run(cmd, capture_output=True).returncode == 0
     assert main(["sweep", str(study), "--out", str(study_dir / "clean"), "--workers", "1", "--no-plots"]) == 0
     assert (out / "table.csv").read_text() == (study_dir / "clean" / "table.csv").read_text()
     assert len(_stored(out)) == 8

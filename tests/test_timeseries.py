@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from geometry.errors import InputError
-from studies.timeseries import (FORMAT, INPUT_COLUMNS, OUTPUT_COLUMNS, TimeSeries, read_timeseries,
+from gatetherm import InputError
+from gatetherm.studies.run.timeseries import (FORMAT, INPUT_COLUMNS, OUTPUT_COLUMNS, TimeSeries, read_timeseries,
                                 rises, validate_complete, write_timeseries)
 
 HEADER = "time_s,oil_degC,pump,theta_A_degC,theta_B_degC,theta_C_degC,delta_um"

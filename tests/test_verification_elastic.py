@@ -9,9 +9,9 @@ import pytest
 from skfem import MeshTet, MeshTri
 from skfem.models.elasticity import plane_stress as skfem_plane_stress
 
-from solvers.elasticity import moduli
-from solvers.material import lame, lame_plane_stress, thermal_stress_modulus
-from validation.verification import (clamped_bar_tip, dofs_where, elastic_mms_error, spatial_study,
+from gatetherm.solvers.elasticity import moduli
+from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
+from gatetherm.validation.verification import (clamped_bar_tip, dofs_where, elastic_mms_error, spatial_study,
                                      thermoelastic_solve)
 
 E, NU, ALPHA = 1.2e11, 0.26, 1.05e-5

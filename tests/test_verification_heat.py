@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from geometry.frame import MeshParams
-from solvers.heat import Inputs, TimeScheme
-from solvers.model import ModelConfig, build_model
-from validation.verification import heat_mms_error, observed_order, spatial_study
-from validation.verification_time import (HarmonicDrive, energy_balance, slab_film_error, steady_state,
+from gatetherm.geometry.frame import MeshParams
+from gatetherm.solvers.heat import Inputs, TimeScheme
+from gatetherm.solvers.model import ModelConfig, build_model
+from gatetherm.validation.verification import heat_mms_error, observed_order, spatial_study
+from gatetherm.validation.verification_time import (HarmonicDrive, energy_balance, slab_film_error, steady_state,
                                           time_errors, unit_heat_system)
 
 
@@ -129,8 +129,8 @@ def test_default_scheme_resolves_pump_switches(frame_2d):
     3.75 s to better than the 0.1 µm δ sensor resolution at every sample (0.062 µm
     observed), while backward Euler at 60 s, which under-resolves the rise of several
     µm/min after each pump restart, misses by over 1 µm (2.6 µm observed)."""
-    from studies.conditions import CONDITIONS, SupplyParams, condition_drive
-    from studies.simulate import run_model, sample_times
+    from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+    from gatetherm.studies.run.simulate import run_model, sample_times
 
     model = build_model(ModelConfig(), 2, fmesh=frame_2d)
     drive, times = condition_drive(CONDITIONS[2], SupplyParams()), sample_times(5 * 3600.0)
@@ -147,8 +147,8 @@ def test_supply_hose_hand_values(frame_2d):
     """The hose is fed by the supply only (one-way), so condition 1 gives it hand values:
     after an hour with the pump on it holds (G·40 + UA·20)/(G + UA) °C (G = ρc·Q), and an
     hour after the pump stops it has relaxed towards the room as exp(−UA t / C_hose)."""
-    from studies.conditions import CONDITIONS, SupplyParams, condition_drive
-    from studies.simulate import run_model, sample_times
+    from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+    from gatetherm.studies.run.simulate import run_model, sample_times
 
     model = build_model(ModelConfig(), 2, fmesh=frame_2d)
     p = model.config.thermal

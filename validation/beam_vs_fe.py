@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from geometry.frame import MeshParams
-from studies.config import Config
-from studies.sweep import Study
+from gatetherm.geometry.frame import MeshParams
+from gatetherm.studies.run.config import Config
+from gatetherm.studies.sweeps.sweep import Study
 
 SLENDERNESS = 8.0
 """l/h of the study frame."""
@@ -119,7 +119,7 @@ def shear_coefficients(cfg: Config) -> tuple[float, float]:
 
 def collect(tasks, records) -> list[dict]:
     """Table rows of the points (studies.sweep.table) plus the shear-corrected theory (um/K)."""
-    from studies.sweep import table
+    from gatetherm.studies.sweeps.sweep import table
 
     _, rows = table(tasks, records)
     for t, r in zip(tasks, rows):

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from studies.config import Config
-from validation.beam_vs_fe import (A_VALUES, ABS_TOL_UM, ELEMENTS_ACROSS, GAP_REL, PARTS, REL_TOL, SLENDERNESS,
+from gatetherm.studies.run.config import Config
+from gatetherm.validation.beam_vs_fe import (A_VALUES, ABS_TOL_UM, ELEMENTS_ACROSS, GAP_REL, PARTS, REL_TOL, SLENDERNESS,
                                    agreement, cavity_stiffness_ratio)
 
 

@@ -15,10 +15,10 @@ import dataclasses
 import numpy as np
 from scipy.optimize import minimize
 
-from solvers.model import build_model
-from studies.conditions import CONDITIONS, condition_drive
-from studies.config import load_config
-from studies.simulate import delta_figures, run_model, sample_times
+from gatetherm.solvers.model import build_model
+from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.studies.run.config import load_config
+from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
 
 #: The paper's figures (section 4.2): cond. 1 and 2 first peak (µm), its time (min),
 #: swing (µm); cond. 3 second positive peak ≈ cond. 2's first peak − 5 µm, swing.

@@ -38,14 +38,14 @@ from pathlib import Path
 
 import numpy as np
 
-from geometry.files import write_text_atomic
-from studies import actuator as piezo
-from studies.commands.compensate import simulated_series
-from studies.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction, extrapolate,
+from gatetherm import write_text_atomic
+from gatetherm.studies.control import actuator as piezo
+from gatetherm.studies.cli.compensate import simulated_series
+from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction, extrapolate,
                                  fe_coefficients_um, predict, summarize, theory_coefficients)
-from studies.conditions import condition
-from studies.regression import THETAS, LinearModel, apply_regression, fit_coefficients, fit_regression
-from studies.simulate import delta_figures
+from gatetherm.studies.run.conditions import condition
+from gatetherm.studies.control.regression import THETAS, LinearModel, apply_regression, fit_coefficients, fit_regression
+from gatetherm.studies.run.simulate import delta_figures
 
 log = logging.getLogger(__name__)
 
@@ -141,7 +141,7 @@ def _row(number: int, label: str, ts, predictor, params, actuator) -> tuple[Row,
 def study(cfg, dim: int = 2, conditions=(1, 2, 3), params: CompensatorParams = CompensatorParams(),
           actuator: piezo.ActuatorParams = piezo.ActuatorParams()) -> Study:
     """Simulate ``conditions`` on ``cfg``'s model and compensate each with every predictor."""
-    from solvers.model import build_model
+    from gatetherm.solvers.model import build_model
 
     model = build_model(cfg.model, dim)
     runs = {n: simulated_series(model, cfg, n) for n in sorted(set(conditions) | {FIT_ON})}
@@ -222,8 +222,8 @@ def table_csv(st: Study) -> str:
 
 
 def main(argv=None) -> int:
-    from studies.config import load_config
-    from validation.compensation_plots import plot_condition_study, plot_piezo_loops
+    from gatetherm.studies.run.config import load_config
+    from gatetherm.validation.plots.compensation import plot_condition_study, plot_piezo_loops
 
     ap = argparse.ArgumentParser(prog="python -m validation.compensation_study", description=__doc__.split("\n")[0])
     ap.add_argument("--out", required=True, metavar="DIR")
@@ -232,7 +232,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     cfg = load_config(args.config)
-    quiet = logging.getLogger("studies.actuator")
+    quiet = logging.getLogger("gatetherm.studies.control.actuator")
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # clipping is counted in the table; restored below
     try:

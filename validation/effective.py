@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from studies.config import Config
+from gatetherm.studies.run.config import Config
 
 log = logging.getLogger(__name__)
 
@@ -36,7 +36,7 @@ class Source:
 
 
 def _series(cols):
-    from studies.timeseries import TimeSeries
+    from gatetherm.studies.run.timeseries import TimeSeries
 
     return TimeSeries({k: cols[k] for k in ("time_s", "theta_A_degC", "theta_B_degC", "theta_C_degC",
                                             "delta_um")})
@@ -54,9 +54,9 @@ def score(name: str, ki: float, kc: float, runs: dict[int, dict]) -> Source:
 
 def condition_runs(cfg: Config, dim: int, model=None) -> tuple[object, dict[int, dict]]:
     """The model and its run columns for conditions 1-3."""
-    from solvers.model import build_model
-    from studies.conditions import CONDITIONS as ALL, condition_drive
-    from studies.simulate import run_model, sample_times
+    from gatetherm.solvers.model import build_model
+    from gatetherm.studies.run.conditions import CONDITIONS as ALL, condition_drive
+    from gatetherm.studies.run.simulate import run_model, sample_times
 
     model = model or build_model(cfg.model, dim)
     return model, {c: run_model(model, condition_drive(ALL[c], cfg.supply),
@@ -66,9 +66,9 @@ def condition_runs(cfg: Config, dim: int, model=None) -> tuple[object, dict[int,
 def effective_coefficients(cfg: Config, dim: int = 2, model=None) -> list[Source]:
     """Theory, FE load cases (at F) and least-squares fits (per run and pooled),
     each scored on all three runs."""
-    from solvers.reduced import fe_coefficients
-    from studies.compensator import theory_coefficients
-    from studies.regression import fit_coefficients
+    from gatetherm.solvers.reduced import fe_coefficients
+    from gatetherm.studies.control.compensator import theory_coefficients
+    from gatetherm.studies.control.regression import fit_coefficients
 
     model, runs = condition_runs(cfg, dim, model)
     fe = fe_coefficients(model)

@@ -35,15 +35,15 @@ from pathlib import Path
 
 import numpy as np
 
-from geometry.files import write_text_atomic
-from solvers.effects import CATALOGUE, ActiveEffects, apply_effects
-from solvers.model import build_model
-from studies.conditions import CONDITIONS, condition_drive
-from studies.config import Config, load_config
-from studies.discrepancy import Settings, diagnose
-from studies.replay import DELTA, resolution
-from studies.simulate import run_model, sample_times
-from studies.timeseries import FORMAT, TimeSeries
+from gatetherm import write_text_atomic
+from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
+from gatetherm.solvers.model import build_model
+from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.studies.run.config import Config, load_config
+from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
+from gatetherm.studies.diagnosis.replay import DELTA, resolution
+from gatetherm.studies.run.simulate import run_model, sample_times
+from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
 
 log = logging.getLogger(__name__)
 
@@ -103,7 +103,7 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
         mcfg, drive = apply_effects(cfg, drive, eff, dim)
         return eff.observe(run_model(build_model(mcfg, dim), drive, times).columns)
     if case.effect == "tie_heat_leak":
-        from geometry.frame import part_boxes
+        from gatetherm.geometry.frame import part_boxes
 
         x0, x1, y0, y1, z0, z1 = part_boxes(cfg.frame, dim)["tie_bar"]
         cfg = dataclasses.replace(cfg, source={"tie_bar": -case.strength / ((x1 - x0) * (y1 - y0) * (z1 - z0))})

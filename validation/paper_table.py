@@ -14,7 +14,7 @@ import argparse
 import json
 from pathlib import Path
 
-from studies.cli import main as gatetherm
+from gatetherm.studies.cli import main as gatetherm
 
 #: (condition, summary key, paper value, label); cond. 3's peak is its second positive one.
 PAPER = [(1, "first_peak_um", 44.0, "first peak [µm]"), (1, "first_peak_min", 15.0, "time of peak [min]"),

@@ -18,9 +18,9 @@ from skfem import (CellBasis, ElementVector, FacetBasis, Functional, LinearForm,
                    MeshTri, asm, condense)
 from skfem.helpers import dot
 
-from solvers.elasticity import assemble_elastic, moduli, stiffness, thermal_load
-from solvers.fem import Field, element
-from solvers.heat import capacity, conduction, film, film_load
+from gatetherm.solvers.elasticity import assemble_elastic, moduli, stiffness, thermal_load
+from gatetherm.solvers.fem import Field, element
+from gatetherm.solvers.heat import capacity, conduction, film, film_load
 
 _EDGE = 1e-9
 """Relative coordinate tolerance for picking mesh sides, 1."""

@@ -13,8 +13,8 @@ import scipy.linalg
 from scipy.optimize import brentq
 from scipy.sparse.linalg import spsolve
 
-from solvers.heat import HeatSystem, Inputs, ThermalParams, TimeScheme, assemble_heat, energy_step, march
-from validation.verification import uniform_fields, rectangle
+from gatetherm.solvers.heat import HeatSystem, Inputs, ThermalParams, TimeScheme, assemble_heat, energy_step, march
+from gatetherm.validation.verification import uniform_fields, rectangle
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,131 @@
+"""Replay a measured run through a model and line the outputs up with the measurement.
+
+The model is driven by the file's own inputs (oil, pump, ambient when present)
+at the file's sample times; every measured output channel that the model also
+produces is compared. A :class:`Replayer` meshes the frame once and re-assembles
+only when a hypothesis changes the model itself, so the hundred-odd runs of a
+diagnosis cost well under a second each with the 2-D model.
+
+Residuals are *measured minus model*, in the channel's unit, and are judged
+against the sensor resolution: 0.1 µm for displacements, 0.05 K for
+thermocouples (/work/shared/paper-model.md).
+"""
+from __future__ import annotations
+
+import dataclasses
+import logging
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+
+from gatetherm.geometry.build import build_mesh
+from gatetherm import InputError
+from gatetherm.geometry.frame import MeshParams
+from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
+from gatetherm.solvers.model import build_model
+from gatetherm.studies.run.conditions import table_drive
+from gatetherm.studies.run.config import Config
+from gatetherm.studies.run.simulate import run_model
+from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, TimeSeries
+
+log = logging.getLogger(__name__)
+
+#: Sensor resolution by column-unit suffix: differential transformer 0.1 µm, thermocouples 0.05 K.
+RESOLUTION = {"_um": 0.1, "_degC": 0.05}
+DELTA = "delta_um"
+#: Columns that are inputs or compensation, never compared.
+NOT_COMPARED = ("time_s", "oil_degC", "pump", "ambient_degC", "u_piezo_um")
+
+
+def resolution(column: str) -> float:
+    """Resolution of a channel (its unit: µm or K)."""
+    return next(r for suffix, r in RESOLUTION.items() if column.endswith(suffix))
+
+
+def unit(column: str) -> str:
+    return "µm" if column.endswith("_um") else "K"
+
+
+def label(column: str) -> str:
+    """Short readable channel name: δ, θ_A, T_C3 …"""
+    if column == DELTA:
+        return "δ"
+    stem = column.removesuffix("_degC").removesuffix("_um")
+    return stem.replace("theta_", "θ_")
+
+
+def compared_channels(ts: TimeSeries, model_columns) -> tuple[str, ...]:
+    """Measured output channels the model also produces: δ, θ_A, θ_B, θ_C, then
+    further sensors in file order; at least one sample each."""
+    first = [c for c in OUTPUT_COLUMNS if c in ts]
+    rest = [c for c in ts.names if c not in first and c not in NOT_COMPARED
+            and c.endswith(tuple(RESOLUTION))]
+    out = tuple(c for c in first + rest if c in model_columns and np.isfinite(ts[c]).any())
+    if not out:
+        raise InputError("--data", "no output channel the model can replay",
+                         f"give at least one of {', '.join(OUTPUT_COLUMNS)}")
+    return out
+
+
+@dataclass(frozen=True)
+class Hypothesis:
+    """What a candidate explanation changes in the model: thermal parameters
+    (fields of ``ThermalParams``) and catalogue effects ({name: value})."""
+
+    thermal: tuple[tuple[str, float], ...] = ()
+    effects: tuple[tuple[str, float], ...] = ()
+
+    @classmethod
+    def of(cls, thermal: dict | None = None, effects: dict | None = None) -> "Hypothesis":
+        return cls(tuple(sorted((thermal or {}).items())), tuple(sorted((effects or {}).items())))
+
+
+class Replayer:
+    """Runs ``config`` through the inputs of the measured series ``ts``."""
+
+    def __init__(self, config: Config, ts: TimeSeries, dim: int = 2, mesh: MeshParams | None = None,
+                 cache: int = 3):
+        amb = ts["ambient_degC"] if "ambient_degC" in ts else None
+        self.config = config
+        self.dim = dim
+        self.times = np.asarray(ts.time_s - ts.time_s[0], dtype=float)
+        self.drive = table_drive(self.times, ts["oil_degC"], ts["pump"], amb, config.supply.T_room)
+        self.has_ambient = amb is not None
+        self.mesh = mesh or config.model.mesh
+        self.fmesh = build_mesh(config.model.frame, dim, self.mesh)
+        self.runs = 0
+        self._models: OrderedDict = OrderedDict()
+        self._raw: OrderedDict = OrderedDict()
+        self._cache = cache
+
+    def _lru(self, store: OrderedDict, key, make):
+        if key in store:
+            store.move_to_end(key)
+            return store[key]
+        value = store[key] = make()
+        while len(store) > self._cache:
+            store.popitem(last=False)
+        return value
+
+    def run(self, hyp: Hypothesis = Hypothesis()) -> dict[str, np.ndarray]:
+        """Output columns (data-format names and units) of the model under ``hyp``."""
+        base = self.config.model
+        thermal = dataclasses.replace(base.thermal, **dict(hyp.thermal))
+        cfg = dataclasses.replace(base, thermal=thermal, mesh=self.mesh)
+        eff = ActiveEffects({**self.config.effects, **dict(hyp.effects)})
+        mcfg, drive = apply_effects(cfg, self.drive, eff, self.dim)
+        drive_key = tuple((k, v) for k, v in sorted(eff.values.items()) if CATALOGUE[k].acts_on == "drive")
+        key = (repr(mcfg), drive_key)
+
+        def simulate():
+            model = self._lru(self._models, repr(mcfg), lambda: build_model(mcfg, self.dim, self.fmesh))
+            self.runs += 1
+            return run_model(model, drive, self.times).columns
+
+        return eff.observe(self._lru(self._raw, key, simulate))
+
+
+def residuals(ts: TimeSeries, cols: dict[str, np.ndarray], channels) -> dict[str, np.ndarray]:
+    """Measured minus model per channel (NaN where the measurement is missing)."""
+    return {c: np.asarray(ts[c], dtype=float) - cols[c] for c in channels}

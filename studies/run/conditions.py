@@ -1,0 +1,139 @@
+"""The oil-supply schedules of the paper's experiments, and schedules from files.
+
+A condition is data: the supply unit's initial oil temperature and a list of
+segments, each with a start time, the pump state and the controller set point.
+The supply oil approaches the set point with a first-order lag (its heater or
+the forced cooling of condition 3), which is what makes condition 2 start from
+20 °C oil. The tank itself (oil mass, wall film) is part of the FE model.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gatetherm import InputError
+from gatetherm.solvers.heat import Drive, Inputs
+
+HOUR = 3600.0
+
+
+@dataclass(frozen=True)
+class SupplyParams:
+    """The oil temperature controller feeding the tank."""
+
+    T_room: float = 20.0
+    """Room temperature, also the oil temperature before heating, °C."""
+    tau_heat: float = 650.0
+    """Time constant of the supply oil approaching a higher set point (heater), s."""
+    tau_cool: float = 600.0
+    """Time constant of the supply oil approaching a lower set point (forced cooling), s."""
+
+
+@dataclass(frozen=True)
+class Segment:
+    """From ``start`` on: pump state and set point."""
+
+    start: float
+    """Start time, s."""
+    pump: bool
+    """Oil circulation through the tank on."""
+    set_point: float
+    """Controller set point, °C."""
+
+
+@dataclass(frozen=True)
+class Condition:
+    """An experiment schedule."""
+
+    name: str
+    segments: tuple[Segment, ...]
+    T_supply0: float | None
+    """Supply oil temperature at t = 0, °C (None: the room temperature)."""
+    duration: float = 5 * HOUR
+    """Length of the run, s."""
+
+
+def _alternating(T0: float | None, name: str) -> Condition:
+    return Condition(name, tuple(Segment(k * HOUR, k % 2 == 0, 40.0) for k in range(5)), T0)
+
+
+CONDITIONS: dict[int, Condition] = {
+    1: _alternating(40.0, "oil pre-heated to 40 °C; pump on at 0, then OFF/ON/OFF/ON hourly"),
+    2: _alternating(None, "heater and pump start at 0 from 20 °C oil; then pump OFF/ON/OFF/ON hourly"),
+    3: Condition("as 2; oil forced to 20 °C at 1 h, 40 °C again at 2 h; pump off 3–4 h",
+                 (Segment(0, True, 40.0), Segment(HOUR, True, 20.0), Segment(2 * HOUR, True, 40.0),
+                  Segment(3 * HOUR, False, 40.0), Segment(4 * HOUR, True, 40.0)), None),
+}
+
+
+def condition(number: int) -> Condition:
+    if number not in CONDITIONS:
+        raise InputError("--condition", f"no condition {number}",
+                         f"choose one of {', '.join(map(str, CONDITIONS))} or give a schedule file")
+    return CONDITIONS[number]
+
+
+def supply_temperature(cond: Condition, sp: SupplyParams, t: np.ndarray) -> np.ndarray:
+    """Supply oil temperature (°C) at times ``t`` (s): exact first-order response
+    to the piecewise-constant set point."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    out = np.empty_like(t)
+    T = sp.T_room if cond.T_supply0 is None else cond.T_supply0
+    ends = [s.start for s in cond.segments[1:]] + [np.inf]
+    for seg, end in zip(cond.segments, ends):
+        tau = sp.tau_heat if seg.set_point >= T else sp.tau_cool
+        on = (t >= seg.start) & (t < end)
+        out[on] = seg.set_point + (T - seg.set_point) * np.exp(-(t[on] - seg.start) / tau)
+        if np.isfinite(end):
+            T = seg.set_point + (T - seg.set_point) * np.exp(-(end - seg.start) / tau)
+    return out
+
+
+def pump_state(cond: Condition, t: float) -> bool:
+    return next(s.pump for s in reversed(cond.segments) if t >= s.start)
+
+
+def condition_drive(cond: Condition, sp: SupplyParams) -> Drive:
+    """The model input for a paper condition."""
+
+    def drive(t: float) -> Inputs:
+        return Inputs(float(supply_temperature(cond, sp, t)[0]), pump_state(cond, t), sp.T_room)
+
+    return drive
+
+
+@dataclass(frozen=True)
+class TableDrive:
+    """Inputs from a recorded schedule: oil and ambient interpolated linearly
+    (missing samples skipped), pump held from the last sample."""
+
+    time: np.ndarray
+    oil: np.ndarray
+    pump: np.ndarray
+    ambient: np.ndarray
+
+    def __call__(self, t: float) -> Inputs:
+        i = max(int(np.searchsorted(self.time, t, side="right")) - 1, 0)
+        return Inputs(float(np.interp(t, self.time, self.oil)), bool(self.pump[i] > 0.5),
+                      float(np.interp(t, self.time, self.ambient)))
+
+
+def table_drive(time, oil, pump, ambient=None, T_room: float = 20.0) -> TableDrive:
+    """Build a :class:`TableDrive`, filling missing samples channel by channel;
+    without an ambient column the room stays at ``T_room`` (°C)."""
+    time = np.asarray(time, dtype=float)
+
+    def filled(name, v, hold=False):
+        v = np.asarray(v, dtype=float)
+        ok = np.isfinite(v)
+        if not ok.any():
+            raise InputError(name, "has no values", "fill the column or leave it out")
+        if hold:  # last known value, the first known one before it
+            idx = np.maximum.accumulate(np.where(ok, np.arange(len(v)), 0))
+            v = np.where(ok[idx], v[idx], v[ok][0])
+            return v
+        return np.interp(time, time[ok], v[ok])
+
+    amb = np.full_like(time, T_room) if ambient is None else filled("ambient_degC", ambient)
+    return TableDrive(time, filled("oil_degC", oil), filled("pump", pump, hold=True), amb)

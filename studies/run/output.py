@@ -1,0 +1,54 @@
+"""Writers for a run directory: fields for ParaView, summary JSON, picture input."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from gatetherm import atomic_path, write_text_atomic
+from gatetherm.geometry.mesh import to_meshio
+from gatetherm.solvers.model import FrameModel
+
+
+def nodal_fields(model: FrameModel, U: np.ndarray) -> dict[str, np.ndarray]:
+    """Temperature (°C) and displacement (m, 3 components) at the mesh nodes."""
+    T = U[:model.heat.n_solid][model.heat.basis.nodal_dofs[0]]
+    u_dofs = model.displacement_field(U)
+    u = np.zeros((len(T), 3))
+    u[:, : model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
+    return {"T": T, "u": u}
+
+
+def write_fields(model: FrameModel, states, out: Path) -> list[Path]:
+    """One ``.vtu`` per saved state (arrays ``T``, ``u``) and a ``fields.pvd``
+    collection that ParaView opens as a time series."""
+    import meshio
+
+    out.mkdir(parents=True, exist_ok=True)
+    written, entries = [], []
+    for t, U in states:
+        name = f"fields_{int(round(t / 60)):04d}min.vtu"
+        with atomic_path(out / name) as tmp:
+            meshio.write(tmp, to_meshio(model.fmesh, nodal_fields(model, U)), file_format="vtu")
+        entries.append(f'    <DataSet timestep="{t:g}" file="{name}"/>')
+        written.append(out / name)
+    pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+           + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
+    write_text_atomic(out / "fields.pvd", pvd)
+    return written + [out / "fields.pvd"]
+
+
+def pyvista_grid(model: FrameModel, U: np.ndarray):
+    """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``."""
+    import pyvista as pv
+
+    mm = to_meshio(model.fmesh, nodal_fields(model, U))
+    cell_type = "tetra" if model.dim == 3 else "triangle"
+    grid = pv.from_meshio(mm)
+    keep = np.flatnonzero(grid.celltypes == {"tetra": 10, "triangle": 5}[cell_type])
+    return grid.extract_cells(keep)
+
+
+def write_json(path: Path, data: dict) -> None:
+    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")

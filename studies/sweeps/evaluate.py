@@ -1,0 +1,113 @@
+"""Evaluating sweep points: the FE and beam-theory coefficients or a heating run of one
+:class:`~studies.sweep.Task`, and running many tasks in this process or on an executor.
+
+studies/sweep.py turns a study into tasks and the records into a table.
+"""
+from __future__ import annotations
+
+import dataclasses
+import logging
+import threading
+import time
+from concurrent.futures import Executor, as_completed
+from typing import Any, Callable
+
+import numpy as np
+
+from gatetherm.studies.run.config import Config
+from gatetherm.studies.sweeps.sweep import Task
+
+log = logging.getLogger(__name__)
+_GMSH = threading.Lock()
+"""gmsh is process-global: threaded workers (e.g. Dask's) mesh one point at a time."""
+
+
+def _coefficients(model, cfg: Config) -> dict[str, float]:
+    """FE (element-exact load cases, at E and at F) and beam-theory K_i, K_C in um/K, and normalised."""
+    from gatetherm.solvers import beam
+    from gatetherm.solvers.reduced import fe_coefficients
+    from gatetherm.studies.control.compensator import theory_coefficients
+
+    p, m = cfg.model.frame, cfg.model
+    tie = m.tie_material or m.material
+    c = fe_coefficients(model)
+    ki_th, kc_th = theory_coefficients(m)
+    ki_s = float(beam.ki_scale(m.material.alpha, p.l, p.h)) * 1e6
+    kc_s = float(beam.kc_scale(tie.alpha, p.l_C)) * 1e6
+    out = {"Ki_E_fe": c.Ki_E * 1e6, "Kc_E_fe": c.Kc_E * 1e6, "Ki_F_fe": c.Ki_F * 1e6,
+           "Kc_F_fe": c.Kc_F * 1e6, "Ki_theory": ki_th, "Kc_theory": kc_th}
+    out.update({"Ki_norm_fe": out["Ki_E_fe"] / ki_s, "Kc_norm_fe": out["Kc_E_fe"] / kc_s,
+                "Ki_norm_theory": ki_th / ki_s, "Kc_norm_theory": kc_th / kc_s,
+                "Ki_scale": ki_s, "Kc_scale": kc_s, "l_over_l4": p.l / p.l4, "l_over_h": p.l / p.h,
+                "beta": float(beam.beta(p.depth * p.h ** 3 / 12.0 * m.material.E / tie.E, p.l_C,
+                                        p.A_C, p.l))})
+    return out
+
+
+def _run(model, task: Task, drive, effects) -> dict[str, float | None]:
+    from gatetherm.studies.run.conditions import CONDITIONS
+    from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
+
+    cols = effects.observe(run_model(model, drive, sample_times(CONDITIONS[task.condition].duration)).columns)
+    d = cols["delta_um"]
+    dab = cols["theta_A_degC"] - cols["theta_B_degC"]
+    return {**delta_figures(cols["time_s"], d), "delta_max_um": float(d.max()),
+            "delta_min_um": float(d.min()), "theta_AB_max_K": float(np.max(dab - dab[0])),
+            "theta_C_end_K": float(cols["theta_C_degC"][-1] - cols["theta_C_degC"][0])}
+
+
+def evaluate(task: Task) -> dict[str, Any]:
+    """The result record of one point: key, params, status, note, results, seconds."""
+    record = {"key": task.key, "params": dict(task.params), "status": "skipped", "note": task.skip,
+              "results": {}, "seconds": 0.0}
+    if task.skip:
+        return record
+    from gatetherm.geometry.build import build_mesh
+    from gatetherm.solvers.effects import ActiveEffects, apply_effects
+    from gatetherm.solvers.model import build_model
+    from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+
+    t0 = time.perf_counter()
+    eff = ActiveEffects({**task.config.effects, **dict(task.effects)})
+    cond = CONDITIONS[task.condition] if task.condition else CONDITIONS[1]
+    model_cfg, drive = apply_effects(task.config.model, condition_drive(cond, task.config.supply),
+                                     eff, task.dim)
+    with _GMSH:
+        mesh = build_mesh(model_cfg.frame, task.dim, model_cfg.mesh)
+    model = build_model(model_cfg, task.dim, mesh)
+    res: dict[str, Any] = {"nodes": int(len(model.fmesh.points))}
+    if "coefficients" in task.compute:
+        res.update(_coefficients(model, dataclasses.replace(task.config, model=model_cfg)))
+    if "run" in task.compute:
+        res.update(_run(model, task, drive, eff))
+    record.update(status="ok", results=res, seconds=round(time.perf_counter() - t0, 3))
+    return record
+
+
+def execute(tasks: list[Task], on_result: Callable[[dict], None], executor: Executor | None = None
+            ) -> list[tuple[Task, BaseException]]:
+    """Evaluate ``tasks`` (in this process without an executor) and hand every record to
+    ``on_result`` as soon as it is done; returns the points that failed, with the error
+    (the other points are still worth having)."""
+    failed = []
+
+    def fail(t: Task, err: BaseException) -> None:
+        log.error("point %s failed: %s", dict(t.params), err)
+        failed.append((t, err))
+
+    if executor is None:
+        for t in tasks:
+            try:
+                rec = evaluate(t)
+            except Exception as err:
+                fail(t, err)
+                continue
+            on_result(rec)
+        return failed
+    futures = {executor.submit(evaluate, t): t for t in tasks}
+    for fut in as_completed(futures):
+        if fut.exception() is None:
+            on_result(fut.result())
+        else:
+            fail(futures[fut], fut.exception())
+    return failed

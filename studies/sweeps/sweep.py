@@ -1,0 +1,258 @@
+"""Parametric sweeps: a grid of model parameters, evaluated point by point.
+
+A study is data: a base model, fixed overrides (``set``), a grid whose cartesian
+product gives the points, the dimension, and what to compute at each point.
+Parameter keys are
+
+* ``<section>.<field>`` for the model-file sections ``geometry``, ``mesh``, ``material``,
+  ``material.tie_bar``, ``thermal``, ``supply`` and ``model`` (see studies/config.py);
+* ``condition``: the paper's condition 1-3 (for the ``run`` computation);
+* ``effect.<name>``: a catalogue effect (solvers/effects.py) in its unit;
+* ``derived.<name>``: the parameters of :data:`DERIVED`, applied after the direct
+  overrides in the table's order (e.g. ``derived.beta`` sets ``A_C`` from eq (26)).
+
+With ``fit_frame`` (default on), the column is raised to hold every tie bar
+(``column_height >= l4 + t_C/2``) and, in 3-D, ``t_C`` is raised until the tie-bar
+depth ``A_C/t_C`` fits behind the arms. A point whose frame still cannot be built
+(e.g. a 2-D tie bar overlapping the arms) is a "skipped" row, not an error.
+
+Every point has a key, a hash of everything its result depends on, so results
+can be stored per point and a stopped sweep resumes without recomputing
+anything finished (studies/commands/sweep.py does the files and the processes).
+Evaluating the points is in studies/sweep_evaluate.py.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from gatetherm import InputError
+from gatetherm.geometry.frame import FrameParams, tie_depth, tie_heights, validate
+from gatetherm.studies.run.config import Config, parse_config
+
+SECTIONS = ("geometry", "mesh", "material", "material.tie_bar", "thermal", "supply", "model")
+#: What a point can compute, with the result columns each adds (besides "nodes").
+COMPUTE = {
+    "coefficients": ("Ki_E_fe", "Kc_E_fe", "Ki_F_fe", "Kc_F_fe", "Ki_theory", "Kc_theory",
+                     "Ki_norm_fe", "Kc_norm_fe", "Ki_norm_theory", "Kc_norm_theory", "Ki_scale",
+                     "Kc_scale", "l_over_l4", "l_over_h", "beta"),
+    "run": ("first_peak_um", "first_peak_min", "second_peak_um", "swing_um", "delta_max_um",
+            "delta_min_um", "theta_AB_max_K", "theta_C_end_K"),
+}
+PINHOLE = 0.003
+"""Side of the cavity left by ``derived.tank_cavity = false``, m."""
+
+
+@dataclass(frozen=True)
+class PlotSpec:
+    """One figure of a study: ``y`` against ``x``, one line per value of ``hue``."""
+
+    x: str
+    y: str
+    hue: str | None = None
+
+
+@dataclass(frozen=True)
+class Study:
+    """A parametric study (the STUDY.toml file mirrors it)."""
+
+    name: str
+    dim: int
+    base: Config
+    fixed: tuple[tuple[str, Any], ...]
+    """Overrides applied at every point, (key, value)."""
+    grid: tuple[tuple[str, tuple], ...]
+    """Swept keys with their values, in file order; the points are the cartesian product."""
+    compute: tuple[str, ...]
+    plots: tuple[PlotSpec, ...] = ()
+    fit_frame: bool = True
+    """Raise the column (and the 3-D tie-bar height t_C) so that every tie bar fits."""
+
+
+@dataclass(frozen=True)
+class Task:
+    """Everything one point needs, picklable for worker processes."""
+
+    key: str
+    params: tuple[tuple[str, Any], ...]
+    """The grid values of this point (its table columns)."""
+    config: Config
+    dim: int
+    compute: tuple[str, ...]
+    condition: int | None
+    effects: tuple[tuple[str, float], ...]
+    skip: str = ""
+    """Why the frame cannot be built ("" = buildable)."""
+
+
+# --- derived parameters ---------------------------------------------------------------
+
+def _l_over_h(cfg: Config, v: float) -> dict:
+    p = cfg.model.frame
+    s = p.l / v / p.h
+    return {"h": p.l / v, "tank_wall": p.tank_wall * s, "tank_width": p.tank_width * s}
+
+
+def _beta(cfg: Config, v: float) -> dict:
+    p, m = cfg.model.frame, cfg.model
+    E_C = (m.tie_material or m.material).E
+    I = p.depth * p.h ** 3 / 12.0
+    return {"A_C": 3.0 * m.material.E * I * p.l_C / (v * E_C * p.l ** 3)}
+
+
+def _tank_cavity(cfg: Config, v: bool) -> dict:
+    p = cfg.model.frame
+    if v:
+        return {}
+    return {"tank_wall": 0.5 * (p.h - PINHOLE), "tank_width": PINHOLE, "tank_height": PINHOLE,
+            "tank_depth": min(PINHOLE, p.tank_depth)}
+
+
+#: name -> (doc, type, function(config, value) -> geometry changes), applied in this order.
+DERIVED: dict[str, tuple[str, type, Callable[[Config, Any], dict]]] = {
+    "l_over_h": ("column slenderness: h = l/value, tank_wall and tank_width scaled with h",
+                 float, _l_over_h),
+    "l1_over_l": ("heated height: l1 = value * l", float, lambda c, v: {"l1": v * c.model.frame.l}),
+    "l_over_l4": ("tie-bar height: l4 = l/value", float, lambda c, v: {"l4": c.model.frame.l / v}),
+    "beta": ("stiffness ratio of eq (26): A_C = 3 E I l_C / (beta E_C l^3), I = depth h^3/12",
+             float, _beta),
+    "tank_cavity": (f"false: the tank becomes a {PINHOLE * 1e3:g} mm pinhole at mid-width", bool,
+                    _tank_cavity),
+}
+
+
+def fit_frame(p: FrameParams, dim: int) -> FrameParams:
+    """Raise ``t_C`` (3-D, tie bar behind the arms) and ``column_height`` so that the tie bars fit."""
+    room = p.depth - p.arm_depth
+    if dim == 3 and tie_depth(p) > room:
+        p = dataclasses.replace(p, t_C=p.A_C / room * (1.0 + 1e-9))
+    top = max(p.l + 0.5 * p.arm_thickness, *(y + 0.5 * p.t_C for y in tie_heights(p)))
+    return dataclasses.replace(p, column_height=max(p.column_height, top))
+
+
+# --- from keys to a model -------------------------------------------------------------
+
+def _number(key: str, value, typ: type):
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise InputError(key, f"expected true/false, got {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+        raise InputError(key, f"expected a number, got {value!r}")
+    return typ(value)
+
+
+def _nest(flat: dict[str, Any]) -> dict:
+    out: dict = {}
+    for key, value in flat.items():
+        *head, last = key.split(".")
+        node = out
+        for part in head:
+            node = node.setdefault(part, {})
+        node[last] = value
+    return out
+
+
+def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = True):
+    """``(config, condition, effects, skip)`` of one point; bad keys raise InputError."""
+    from gatetherm.solvers.effects import CATALOGUE
+    from gatetherm.studies.run.conditions import CONDITIONS
+
+    sections, geometry, derived, effects, condition = {}, {}, {}, {}, None
+    fields = {f.name for f in dataclasses.fields(FrameParams)}
+    for key, value in overrides.items():
+        head, _, name = key.rpartition(".")
+        if key == "condition":
+            condition = _number(key, value, int)
+            if condition not in CONDITIONS:
+                raise InputError(key, f"no condition {condition}", f"choose from {sorted(CONDITIONS)}")
+        elif head == "geometry":
+            if name not in fields:
+                raise InputError(key, "unknown key", f"known keys: {', '.join(sorted(fields))}")
+            geometry[name] = _number(key, value, float)
+        elif head == "derived":
+            if name not in DERIVED:
+                raise InputError(key, "unknown derived parameter", f"known: {', '.join(DERIVED)}")
+            derived[name] = _number(key, value, DERIVED[name][1])
+        elif head == "effect":
+            if name not in CATALOGUE:
+                raise InputError(key, "unknown effect", f"known: {', '.join(CATALOGUE)}")
+            effects[name] = _number(key, value, float)
+        elif head in SECTIONS:
+            sections[key] = value
+        else:
+            raise InputError(key, "unknown parameter", "use <section>.<field> with a section of "
+                             f"{', '.join(SECTIONS)}, or condition, effect.<name>, derived.<name>")
+    cfg = parse_config(_nest(sections), base.source, base) if sections else base
+
+    def with_frame(c: Config, changes: dict) -> Config:
+        frame = dataclasses.replace(c.model.frame, **changes)
+        return dataclasses.replace(c, model=dataclasses.replace(c.model, frame=frame))
+
+    cfg = with_frame(cfg, geometry)
+    for name, (_, typ, rule) in DERIVED.items():
+        if name in derived:
+            if typ is float and not derived[name] > 0:
+                raise InputError(f"derived.{name}", f"must be > 0, got {derived[name]}")
+            cfg = with_frame(cfg, rule(cfg, derived[name]))
+    if fit:
+        cfg = with_frame(cfg, dataclasses.asdict(fit_frame(cfg.model.frame, dim)))
+    try:
+        validate(cfg.model.frame, dim)
+        skip = ""
+    except InputError as err:
+        skip = str(err)
+    return cfg, condition, tuple(sorted(effects.items())), skip
+
+
+def point_key(cfg: Config, dim: int, compute, condition, effects) -> str:
+    """Hash of everything a point's result depends on: the final model (without the
+    thermal and supply data when nothing is run), dimension, computations, condition, effects."""
+    model = dataclasses.asdict(cfg.model)
+    data = {"model": model, "supply": dataclasses.asdict(cfg.supply), "effects": cfg.effects}
+    if "run" not in compute:
+        for name in ("thermal", "source", "joint_conductance"):
+            model.pop(name, None)
+        data.pop("supply")
+        condition = None
+    blob = json.dumps({**data, "dim": dim, "compute": sorted(compute), "condition": condition,
+                       "effect_values": effects}, sort_keys=True, default=repr)
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+def plan(study: Study) -> list[Task]:
+    """The points of ``study`` in grid order (last key varying fastest); bad keys raise."""
+    keys = [k for k, _ in study.grid]
+    tasks = []
+    for values in itertools.product(*(v for _, v in study.grid)):
+        params = tuple(zip(keys, values))
+        overrides = {**dict(study.fixed), **dict(params)}
+        cfg, cond, eff, skip = configure(study.base, overrides, study.dim, study.fit_frame)
+        if "run" in study.compute and cond is None:
+            raise InputError("condition", "the 'run' computation needs a heating condition",
+                             "add condition = [1, 2, 3] to [grid] or condition = 1 to [set]")
+        key = point_key(cfg, study.dim, study.compute, cond, eff)
+        tasks.append(Task(key, params, cfg, study.dim, study.compute, cond, eff, skip))
+    if tasks and all(t.skip for t in tasks):
+        raise InputError(study.name, f"no point of the study can be built ({tasks[0].skip})",
+                         "change the grid")
+    return tasks
+
+
+def table(tasks: list[Task], records: dict[str, dict]) -> tuple[list[str], list[dict]]:
+    """Columns and rows (grid order) of the tidy table: parameters, status, note, then the
+    results in the order of :data:`COMPUTE`. Points without a record are "pending" rows."""
+    rows = []
+    for t in tasks:
+        rec = records.get(t.key, {"status": "pending", "note": "", "results": {}})
+        rows.append({**dict(t.params), "status": rec["status"], "note": rec["note"], **rec["results"]})
+    params = [k for k, _ in tasks[0].params] if tasks else []
+    results = ["nodes"] + [c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]]
+    extra = [k for r in rows for k in r if k not in params and k not in results and k not in ("status", "note")]
+    return params + ["status", "note"] + results + list(dict.fromkeys(extra)), rows

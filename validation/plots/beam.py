@@ -1,0 +1,55 @@
+"""Fig. 7 / Fig. 8 analogues: normalised K_i and K_C against l/l4, theory curves and FE markers."""
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from gatetherm import atomic_path
+
+KI_LABEL = r"$K_i\,/\,(3\alpha l^2/8h)$  ($l_1 = l/2$)"
+KC_LABEL = r"$K_C\,/\,(\alpha l_C)$  ($l_1 = l/2$)"
+A_LABEL = r"$l/l_4$"
+A_RANGE = (0.5, 5.0)
+
+
+def _plot_one(theory_a, curves: Mapping, fe_points: Mapping | None, ylabel: str,
+              zero_line: bool, path: str | os.PathLike) -> None:
+    """One figure: a theory line per beta and FE markers of the same colour; atomic PNG."""
+    fig = Figure(figsize=(6.0, 4.2))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    a = np.asarray(theory_a, dtype=float)
+    for i, (b, y) in enumerate(sorted(curves.items())):
+        colour = f"C{i}"
+        ax.plot(a, np.asarray(y, dtype=float), color=colour, label=rf"theory, $\beta$ = {b:g}")
+        if fe_points and b in fe_points:
+            fa, fy = fe_points[b]
+            ax.plot(fa, fy, "o", color=colour, mfc="none", label=rf"FE, $\beta$ = {b:g}")
+    if zero_line:
+        ax.axhline(0.0, color="0.4", lw=0.8, ls="--")
+    ax.set_xlim(*A_RANGE)
+    ax.set_xlabel(A_LABEL)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize="small", ncol=2)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
+
+
+def plot_ki_kc(theory_a, theory: Mapping, fe: Mapping | None,
+               path_ki: str | os.PathLike, path_kc: str | os.PathLike) -> None:
+    """Draw the Fig. 7 (``K_i``) and Fig. 8 (``K_C``) analogues to two PNG files.
+
+    ``theory_a``: the l/l4 values of the theory curves; ``theory``: beta -> (Ki_norm, Kc_norm)
+    arrays over ``theory_a``; ``fe``: beta -> (a, Ki_norm, Kc_norm) FE results or None.
+    """
+    fe = fe or {}
+    _plot_one(theory_a, {b: v[0] for b, v in theory.items()},
+              {b: (v[0], v[1]) for b, v in fe.items()}, KI_LABEL, True, path_ki)
+    _plot_one(theory_a, {b: v[1] for b, v in theory.items()},
+              {b: (v[0], v[2]) for b, v in fe.items()}, KC_LABEL, False, path_kc)

@@ -1,0 +1,136 @@
+"""Plots of sweep tables: y against x, one line per value of a hue column."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+from gatetherm import atomic_path
+
+
+def new_axes(figsize=(6.0, 4.2)):
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot()
+
+
+def save(fig, path: str | os.PathLike) -> None:
+    """Tight layout and an atomic PNG."""
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
+
+
+def _num(v) -> float:
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return np.nan
+
+
+def plot_xy(rows: list[dict], x: str, y: str, hue: str | None, path: str | os.PathLike,
+            title: str = "", logx: bool = False, hline: float | None = None, lines_by=()) -> None:
+    """Lines with markers of ``y`` over ``x`` (rows without a number left out): one colour per
+    ``hue`` value, one line per combination of the ``lines_by`` columns (other swept
+    parameters; line styles tell them apart, the legend names them)."""
+    fig, ax = new_axes()
+    hues = list(dict.fromkeys(r.get(hue) for r in rows)) if hue else [None]
+    others = list(dict.fromkeys(tuple(r.get(k) for k in lines_by) for r in rows))
+    styles = ["-", "--", ":", "-."]
+    for i, h in enumerate(hues):
+        for j, o in enumerate(others):
+            grp = [r for r in rows if (not hue or r.get(hue) == h) and tuple(r.get(k) for k in lines_by) == o]
+            pts = [p for p in sorted((_num(r.get(x)), _num(r.get(y))) for r in grp) if np.isfinite(p).all()]
+            if not pts:
+                continue
+            label = ", ".join([f"{hue} = {h}"] * bool(hue) + [f"{k} = {v}" for k, v in zip(lines_by, o)])
+            ax.plot(*zip(*pts), "o", ls=styles[j % len(styles)], ms=3.5, color=f"C{i % 10}", label=label or None)
+    if hline is not None:
+        ax.axhline(hline, color="0.4", lw=0.8, ls="--")
+    if logx:  # ticks at the data, in plain numbers
+        ax.set_xscale("log")
+        ax.set_xticks(sorted({p for r in rows if np.isfinite(p := _num(r.get(x)))}))
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    ax.set_title(title, fontsize="medium")
+    ax.grid(True, lw=0.3)
+    if hue or lines_by:
+        ax.legend(fontsize="x-small", ncol=2 if len(hues) * len(others) > 6 else 1)
+    save(fig, path)
+
+
+# --- the design study (studies/design.py) ---------------------------------------------------
+
+def plot_positions(rows: list[dict], marks: dict[str, float], path: str | os.PathLike, title: str = "") -> None:
+    """Swing of delta per condition (and the worst) over the tie-bar height, with the FE
+    K_i, K_C at the tips below; vertical lines at ``marks`` (label -> l4)."""
+    fig = Figure(figsize=(6.4, 6.4))
+    FigureCanvasAgg(fig)
+    ax, bx = fig.subplots(2, 1, sharex=True)
+    ok = [r for r in rows if r.get("status") == "ok"]
+    conds = sorted({r["condition"] for r in ok})
+    worst: dict = {}
+    for i, c in enumerate(conds):
+        pts = sorted((r["geometry.l4"], r["swing_um"]) for r in ok if r["condition"] == c)
+        ax.plot(*zip(*pts), "o-", ms=3, color=f"C{i}", label=f"condition {c}")
+        for l4, s in pts:
+            worst[l4] = max(worst.get(l4, -np.inf), s)
+    ax.plot(*zip(*sorted(worst.items())), "k--", lw=1, label="worst of 1-3")
+    coef = sorted({(r["geometry.l4"], r["Ki_F_fe"], r["Kc_F_fe"]) for r in ok})
+    bx.plot([c[0] for c in coef], [c[1] for c in coef], "o-", ms=3, color="C3", label="$K_i$ (FE, tips)")
+    bx.plot([c[0] for c in coef], [c[2] for c in coef], "s-", ms=3, color="C4", label="$K_C$ (FE, tips)")
+    for j, (label, x) in enumerate(marks.items()):
+        for a in (ax, bx):
+            a.axvline(x, color="0.3", lw=0.8, ls=(0, (4, 2 + 2 * j)))
+        ax.annotate(label, (x, ax.get_ylim()[1]), fontsize="small", rotation=90, va="top", ha="right")
+    ax.set_ylabel(r"5-h swing of $\delta$ (µm)")
+    bx.set_ylabel("µm/K")
+    bx.set_xlabel(r"tie-bar height $l_4$ (m)")
+    for a in (ax, bx):
+        a.grid(True, lw=0.3)
+        a.legend(fontsize="small")
+    ax.set_title(title, fontsize="medium")
+    save(fig, path)
+
+
+def plot_second(summary: list[dict], path: str | os.PathLike, title: str = "") -> None:
+    """Worst swing over conditions 1-3 against the second tie bar's height, one line per
+    first-bar height; the level without a second bar dashed."""
+    fig, ax = new_axes()
+    for i, l4 in enumerate(sorted({r["l4"] for r in summary})):
+        rs = [r for r in summary if r["l4"] == l4]
+        ref = [r["worst_swing_um"] for r in rs if r["l4_2"] == 0.0]
+        pts = sorted((r["l4_2"], r["worst_swing_um"]) for r in rs if r["l4_2"] > 0)
+        ax.plot(*zip(*pts), "o-", color=f"C{i}", label=f"$l_4$ = {l4:.3g} m, second bar at $l_{{4,2}}$")
+        if ref:
+            ax.axhline(ref[0], color=f"C{i}", ls="--", lw=1, label=f"$l_4$ = {l4:.3g} m, one bar")
+    ax.set_xlabel(r"second tie-bar height $l_{4,2}$ (m)")
+    ax.set_ylabel(r"worst 5-h swing of $\delta$, conditions 1-3 (µm)")
+    ax.set_ylim(bottom=0)
+    ax.grid(True, lw=0.3)
+    ax.legend(fontsize="small")
+    ax.set_title(title, fontsize="medium")
+    save(fig, path)
+
+
+def plot_histories(histories: dict[str, dict[int, tuple]], path: str | os.PathLike) -> None:
+    """delta(t) per condition (one panel each), one line per design (label -> condition -> (t_s, delta_um))."""
+    conds = sorted(next(iter(histories.values())))
+    fig = Figure(figsize=(6.4, 2.3 * len(conds)))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(conds), 1, sharex=True)
+    for ax, c in zip(np.atleast_1d(axes), conds):
+        for i, (label, runs) in enumerate(histories.items()):
+            t, d = runs[c]
+            ax.plot(np.asarray(t) / 3600.0, d, color=f"C{i}", label=label)
+        ax.axhline(0.0, color="0.5", lw=0.6)
+        ax.set_ylabel(rf"$\delta$ (µm), cond. {c}")
+        ax.grid(True, lw=0.3)
+    np.atleast_1d(axes)[0].legend(fontsize="x-small")
+    np.atleast_1d(axes)[-1].set_xlabel("time (h)")
+    save(fig, path)
