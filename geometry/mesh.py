@@ -30,7 +30,9 @@ class FrameMesh:
     regions: dict[str, np.ndarray]
     boundaries: dict[str, np.ndarray]
     sensors: dict[str, int]
-    meta: dict[str, float] = field(default_factory=dict)
+    meta: dict = field(default_factory=dict, compare=False)
+    """What the mesh was made from, when known: ``{"frame": FrameParams}`` for a mesh built
+    by :func:`gatetherm.geometry.build.build_mesh` (not kept in files)."""
 
     def sensor_xyz(self, name: str) -> np.ndarray:
         return self.points[self.sensors[name]]

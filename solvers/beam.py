@@ -14,11 +14,16 @@ to µm. "No tie bar" is ``A_C = 0``: then ``k_C = 0``, ``1/D = 0`` exactly, so
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from gatetherm import InputError
+
+if TYPE_CHECKING:
+    from gatetherm.geometry.frame import FrameParams
+    from gatetherm.solvers.model import ModelConfig
 
 
 @dataclass(frozen=True)
@@ -26,25 +31,25 @@ class BeamModel:
     """Geometry and materials of the beam model; any field may be an array (sweeps)."""
 
     l: ArrayLike
-    # height of the cutting area (points E) above the column mounting face, m
+    """Height of the cutting area (points E) above the column mounting face, m."""
     l1: ArrayLike
-    # heated height of the heat-source column, from the mounting face, m (0 < l1 <= l)
+    """Heated height of the heat-source column, from the mounting face, m (0 < l1 <= l)."""
     l4: ArrayLike
-    # height of the tie bar above the mounting face, m
+    """Height of the tie bar above the mounting face, m."""
     h: ArrayLike
-    # column width, distance from A to B, m
+    """Column width, distance from A to B, m."""
     EI: ArrayLike
-    # column bending stiffness (both columns), N m^2
+    """Column bending stiffness (both columns), N m^2."""
     alpha: ArrayLike
-    # column linear expansion coefficient, 1/K
+    """Column linear expansion coefficient, 1/K."""
     l_C: ArrayLike
-    # tie-bar length, m
+    """Tie-bar length, m."""
     A_C: ArrayLike
-    # tie-bar cross-section, m^2 (0 = no tie bar)
+    """Tie-bar cross-section, m^2 (0 = no tie bar)."""
     E_C: ArrayLike
-    # tie-bar Young's modulus, Pa
+    """Tie-bar Young's modulus, Pa."""
     alpha_C: ArrayLike
-    # tie-bar linear expansion coefficient, 1/K
+    """Tie-bar linear expansion coefficient, 1/K."""
 
     def __post_init__(self):
         for name in ("l", "l1", "l4", "h", "EI", "l_C", "E_C"):
@@ -175,3 +180,38 @@ def denormalise(ki_norm: ArrayLike, kc_norm: ArrayLike, alpha: ArrayLike, l: Arr
                 h: ArrayLike, l_C: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Inverse of :func:`normalised` (same material): ``(K_i, K_C)`` in m/K."""
     return np.asarray(ki_norm) * ki_scale(alpha, l, h), np.asarray(kc_norm) * kc_scale(alpha, l_C)
+
+
+# --- the bridge from a frame model to the beam theory ------------------------------------------
+
+def column_I(frame: FrameParams) -> float:
+    """Second moment of area of a full column section, ``depth h^3 / 12`` in m^4 (the tank
+    cavity is ignored, as in the paper)."""
+    return frame.depth * frame.h ** 3 / 12.0
+
+
+def beam_model(cfg: ModelConfig) -> BeamModel:
+    """The beam model of a frame model: its l, l1, l4, h, l_C, A_C, column material E, alpha
+    with :func:`column_I`, tie-bar material E_C, alpha_C."""
+    f, m = cfg.frame, cfg.material
+    tie = cfg.tie_material or m
+    return BeamModel(l=f.l, l1=f.l1, l4=f.l4, h=f.h, EI=m.E * column_I(f), alpha=m.alpha, l_C=f.l_C,
+                     A_C=f.A_C, E_C=tie.E, alpha_C=tie.alpha)
+
+
+def theory_coefficients(cfg: ModelConfig) -> tuple[float, float]:
+    """Beam-theory (K_i, K_C) of a frame model, um/K (eqs 22-24 via :func:`beam_model`)."""
+    ki, kc = coefficients(beam_model(cfg))
+    return float(ki) * 1e6, float(kc) * 1e6
+
+
+def frame_beta(cfg: ModelConfig) -> float:
+    """Eq (26) for a frame model, with the column-to-tie-bar modulus ratio (1 for one material)."""
+    f, tie = cfg.frame, cfg.tie_material or cfg.material
+    return float(beta(column_I(f) * cfg.material.E / tie.E, f.l_C, f.A_C, f.l))
+
+
+def beta_area(cfg: ModelConfig, value: float) -> float:
+    """The tie-bar section ``A_C`` (m^2) that gives eq (26)'s ``beta = value`` on a frame model."""
+    f, tie = cfg.frame, cfg.tie_material or cfg.material
+    return 3.0 * cfg.material.E * column_I(f) * f.l_C / (value * tie.E * f.l ** 3)

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Iterator, NamedTuple
 
 import numpy as np
@@ -116,7 +116,8 @@ class TimeScheme:
 @dataclass(frozen=True)
 class HeatSystem:
     """Assembled operators; the unknowns are the solid's (``n_solid``), then the tank
-    oil, then the hose (if ``params.hose_capacity > 0``)."""
+    oil, then the hose (if ``params.hose_capacity > 0``). Immutable: the factorisations
+    of its step matrices live in a :class:`HeatSolver`."""
 
     basis: CellBasis
     M: sp.csr_matrix
@@ -126,8 +127,6 @@ class HeatSystem:
     f_src: np.ndarray
     params: ThermalParams
     n_solid: int
-    _lu: dict = field(default_factory=dict, compare=False, repr=False)
-    """Cache of conductance matrices and factorisations, keyed by what they depend on."""
 
     @property
     def n(self) -> int:
@@ -149,14 +148,11 @@ class HeatSystem:
         return (p.h_oil_on, p.oil_rho_c * p.flow_rate) if pump else (p.h_oil_off, 0.0)
 
     def K(self, pump: bool) -> sp.csr_matrix:
-        """Conductance matrix for a pump state (cached: it changes only with the pump)."""
-        key = ("K", pump)
-        if key not in self._lu:
-            h, G = self.coefficients(pump)
-            o, i = self.oil, self.inlet  # G (T_oil − T_in) and G T_in, summed if the same unknown
-            e = sp.csr_matrix(([G, -G, G], ([o, o, i], [o, i, i])), shape=(self.n, self.n))
-            self._lu[key] = (self.K0 + h * self.K_wall + e).tocsr()
-        return self._lu[key]
+        """Conductance matrix for a pump state."""
+        h, G = self.coefficients(pump)
+        o, i = self.oil, self.inlet  # G (T_oil − T_in) and G T_in, summed if the same unknown
+        e = sp.csr_matrix(([G, -G, G], ([o, o, i], [o, i, i])), shape=(self.n, self.n))
+        return (self.K0 + h * self.K_wall + e).tocsr()
 
     def f(self, t: float, drive: Drive, pump: bool) -> np.ndarray:
         u = drive(t)
@@ -166,6 +162,42 @@ class HeatSystem:
 
     def initial(self, T0: float | None = None) -> np.ndarray:
         return np.full(self.n, self.params.T0 if T0 is None else T0)
+
+
+class HeatSolver:
+    """Step solves of one :class:`HeatSystem`: the conductance matrix of each pump state
+    and the factor of each distinct (θ dt, pump) step matrix, made on first use and kept
+    (four per paper condition: 60-s and 15-s steps, pump on and off)."""
+
+    def __init__(self, system: HeatSystem):
+        self.system = system
+        self._K: dict[bool, sp.csr_matrix] = {}
+        self._lu: dict[tuple[float, bool], object] = {}
+        self.factor_seconds = 0.0
+        """Seconds spent factorising so far."""
+
+    def K(self, pump: bool) -> sp.csr_matrix:
+        if pump not in self._K:
+            self._K[pump] = self.system.K(pump)
+        return self._K[pump]
+
+    @property
+    def factorisations(self) -> int:
+        """How many step matrices were factorised so far."""
+        return len(self._lu)
+
+    def solve(self, dt: float, theta: float, pump: bool, rhs: np.ndarray) -> np.ndarray:
+        """Solve ``(M/dt + θ K) U = rhs`` with the factor of ``M/(θ dt) + K``, which backward
+        Euler over dt/2 and Crank–Nicolson over dt share."""
+        key = (round(theta * dt, 9), pump)
+        if key not in self._lu:
+            t0 = time.perf_counter()
+            A = (self.system.M / (theta * dt) + self.K(pump)).tocsc()
+            self._lu[key] = splu(A, permc_spec="COLAMD")
+            seconds = time.perf_counter() - t0
+            self.factor_seconds += seconds
+            log.debug("factorised heat matrix for θdt=%g s, pump=%s in %.2f s", theta * dt, pump, seconds)
+        return self._lu[key].solve(rhs / theta)
 
 
 def assemble_heat(mesh, order: int, k: Field, rho_c: Field, thickness: Field,
@@ -213,32 +245,14 @@ def assemble_heat(mesh, order: int, k: Field, rho_c: Field, thickness: Field,
     return HeatSystem(basis, M, K0, K_wall, f_amb, f_src, params, basis.N)
 
 
-def _solve(sys: HeatSystem, dt: float, theta: float, pump: bool, rhs: np.ndarray) -> np.ndarray:
-    """Solve ``(M/dt + θ K) U = rhs`` with the factor of ``M/(θ dt) + K``, which backward
-    Euler over dt/2 and Crank–Nicolson over dt share."""
-    key = (round(theta * dt, 9), pump)
-    if key not in sys._lu:
-        t0 = time.perf_counter()
-        A = (sys.M / (theta * dt) + sys.K(pump)).tocsc()
-        sys._lu[key] = (splu(A, permc_spec="COLAMD"), time.perf_counter() - t0)
-        log.debug("factorised heat matrix for θdt=%g s, pump=%s in %.2f s", theta * dt, pump, sys._lu[key][1])
-    return sys._lu[key][0].solve(rhs / theta)
-
-
-def factorisation_seconds(sys: HeatSystem) -> tuple[int, float]:
-    """How many heat matrices were factorised so far, and the seconds it took."""
-    lus = [v for k, v in sys._lu.items() if k[0] != "K"]
-    return len(lus), sum(s for _, s in lus)
-
-
-def theta_step(sys: HeatSystem, drive: Drive, U: np.ndarray, t0: float, t1: float, theta: float,
+def theta_step(solver: HeatSolver, drive: Drive, U: np.ndarray, t0: float, t1: float, theta: float,
                pump: bool) -> np.ndarray:
     """One θ-method step from ``U`` at ``t0`` to ``t1`` with the pump state ``pump``."""
-    dt = t1 - t0
+    sys, dt = solver.system, t1 - t0
     rhs = sys.M @ U / dt + theta * sys.f(t1, drive, pump)
     if theta < 1:
-        rhs += (1 - theta) * (sys.f(t0, drive, pump) - sys.K(pump) @ U)
-    return _solve(sys, dt, theta, pump, rhs)
+        rhs += (1 - theta) * (sys.f(t0, drive, pump) - solver.K(pump) @ U)
+    return solver.solve(dt, theta, pump, rhs)
 
 
 def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple[float, float, float]]:
@@ -255,22 +269,26 @@ def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple
     return [(float(a), float(b), th) for a, b, th in steps]
 
 
-def march(sys: HeatSystem, drive: Drive, times: np.ndarray, scheme: TimeScheme = TimeScheme(),
+def march(system: HeatSystem | HeatSolver, drive: Drive, times: np.ndarray, scheme: TimeScheme = TimeScheme(),
           U0: np.ndarray | None = None) -> Iterator[tuple[float, np.ndarray]]:
     """Yield ``(t, U)`` at every entry of ``times``, starting with the initial state.
+
+    Pass a :class:`HeatSolver` to reuse its factorisations across runs; a bare
+    :class:`HeatSystem` gets a solver of its own for this run.
 
     The pump state of an interval is read at its midpoint, so a switch at a sample
     time takes effect for the whole following interval; that interval (and the
     first) is refined as :class:`TimeScheme` says.
     """
-    U = sys.initial() if U0 is None else np.array(U0, dtype=float)
+    solver = system if isinstance(system, HeatSolver) else HeatSolver(system)
+    U = solver.system.initial() if U0 is None else np.array(U0, dtype=float)
     yield float(times[0]), U
     last, since = None, 0
     for t0, t1 in zip(times[:-1], times[1:]):
         pump = bool(drive(0.5 * (t0 + t1)).pump)
         since = 0 if pump != last else since + 1
         for a, b, theta in substeps(float(t0), float(t1), scheme, since):
-            U = theta_step(sys, drive, U, a, b, theta, pump)
+            U = theta_step(solver, drive, U, a, b, theta, pump)
         last = pump
         yield float(t1), U
 

@@ -6,6 +6,7 @@ weight vectors for displacements).
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass, field
@@ -13,17 +14,21 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gatetherm.geometry.build import build_mesh
-from gatetherm.geometry.frame import FrameParams, MeshParams, TIE_SENSORS, tank_box, tie_depth
+from gatetherm import InputError
+from gatetherm.geometry.frame import (FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth,
+                                      width)
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic
 from gatetherm.solvers.fem import Field, to_skfem
 from skfem import FacetBasis, asm
 
-from gatetherm.solvers.heat import HeatSystem, ThermalParams, assemble_heat, film_load
+from gatetherm.solvers.heat import HeatSystem, ThermalParams, TimeScheme, assemble_heat, film_load
 from gatetherm.solvers.material import FC300, Material
 
 log = logging.getLogger(__name__)
 
+GEOMETRY_FREE = ("l1",)
+"""FrameParams fields the mesh does not depend on (the beam theory's heated height)."""
 #: Displacement outputs: relative x-displacement (left minus right, m) of a sensor pair.
 OUTPUTS = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
 
@@ -48,13 +53,8 @@ class ModelConfig:
     """Normal contact stiffness of the tie-bar joints per unit area, N/m³ (None: rigid contact)."""
     source: dict = field(default_factory=dict)
     """Volumetric heat sources by region name, W/m³."""
-    alpha_slope: float = 0.0
-    """Relative temperature slope of the expansion coefficient, α(T) = α(1 + s (T − T0)), 1/K."""
-
-
-def thermal_strain_measure(dT: np.ndarray, slope: float) -> np.ndarray:
-    """∫ α(T)/α dT from T0: the temperature rise that a constant α would need, K."""
-    return dT + 0.5 * slope * dT ** 2 if slope else dT
+    scheme: TimeScheme = TimeScheme()
+    """Time stepping of the heat equation."""
 
 
 def is_tie(region: str) -> bool:
@@ -123,21 +123,53 @@ class FrameModel:
         out.update({k: float(v @ T) for k, v in self.surface_means.items()})
         return out
 
-    def strain_measure(self, U: np.ndarray) -> np.ndarray:
-        return thermal_strain_measure(U[:self.heat.n_solid] - self.config.thermal.T0, self.config.alpha_slope)
+    def rise(self, U: np.ndarray) -> np.ndarray:
+        """Temperature rise of the solid above the stress-free T0, K."""
+        return U[:self.heat.n_solid] - self.config.thermal.T0
 
     def displacements(self, U: np.ndarray) -> dict[str, float]:
         """The outputs of :data:`OUTPUTS` in metres for the state ``U``."""
-        dT = self.strain_measure(U)
+        dT = self.rise(U)
         return {k: float(w @ dT) for k, w in self.weights.items()}
 
     def displacement_field(self, U: np.ndarray) -> np.ndarray:
         """Full displacement field (m) on the elastic basis: one elastic solve."""
-        return self.elastic.displacement(self.strain_measure(U))
+        return self.elastic.displacement(self.rise(U))
+
+
+def check_mesh(fm: FrameMesh, p: FrameParams, dim: int) -> FrameMesh:
+    """``fm`` if it is a mesh of the frame ``p`` in ``dim`` dimensions, else InputError naming
+    the first field (a mesh built here) or region (a mesh read from a file) that differs."""
+    if fm.dim != dim:
+        raise InputError("--dim", f"the mesh is {fm.dim}-D, the model {dim}-D", "mesh and model must agree")
+    built = fm.meta.get("frame")
+    if built is not None:
+        for f in dataclasses.fields(p):
+            if f.name not in GEOMETRY_FREE and getattr(built, f.name) != getattr(p, f.name):
+                raise InputError(f"geometry.{f.name}", f"the mesh was built with {getattr(built, f.name)!r}, the "
+                                 f"model says {getattr(p, f.name)!r}", "mesh the model's own geometry")
+        return fm
+    tol = 1e-6 * max(width(p), p.column_height)
+    boxes = {**part_boxes(p, dim), "tank_wall": tank_box(p, dim)}
+    for name, box in boxes.items():
+        where = fm.regions.get(name) if name != "tank_wall" else None
+        if name == "tank_wall":
+            nodes = np.unique(fm.boundaries.get(name, np.zeros((0, dim), int)))
+        else:
+            nodes = np.unique(fm.cells[where]) if where is not None else np.zeros(0, int)
+        if nodes.size == 0:
+            raise InputError(f"mesh region {name}", "missing from the mesh", "mesh the model's own geometry")
+        lo, hi = fm.points[nodes].min(axis=0), fm.points[nodes].max(axis=0)
+        want = np.array(box[:2 * dim]).reshape(dim, 2)
+        if not (np.allclose(lo, want[:, 0], atol=tol) and np.allclose(hi, want[:, 1], atol=tol)):
+            raise InputError(f"mesh region {name}", f"spans {np.round(lo, 6).tolist()}..{np.round(hi, 6).tolist()} m, "
+                             f"the model's geometry puts it at {want[:, 0].tolist()}..{want[:, 1].tolist()} m",
+                             "mesh the model's own geometry")
+    return fm
 
 
 def build_model(cfg: ModelConfig, dim: int, fmesh: FrameMesh | None = None) -> FrameModel:
-    """Mesh (unless ``fmesh`` is given) and assemble the frame model."""
+    """Mesh (unless ``fmesh`` is given, which must be a mesh of ``cfg.frame``) and assemble the frame model."""
     clock = [time.perf_counter()]
     timings = {}
 
@@ -146,7 +178,7 @@ def build_model(cfg: ModelConfig, dim: int, fmesh: FrameMesh | None = None) -> F
         timings[name] = now - clock[0]
         clock[0] = now
 
-    fm = fmesh or build_mesh(cfg.frame, dim, cfg.mesh)
+    fm = build_mesh(cfg.frame, dim, cfg.mesh) if fmesh is None else check_mesh(fmesh, cfg.frame, dim)
     lap("mesh")
     mesh = to_skfem(fm)
     f = region_fields(cfg, fm, mesh)

@@ -67,6 +67,12 @@ def _displacement(model: FrameModel, load: np.ndarray) -> np.ndarray:
     return u
 
 
+def tip_coefficients_um(model: FrameModel) -> tuple[float, float]:
+    """(K_i, K_C) of ``model`` from the two load cases, read at the tips F, um/K."""
+    c = fe_coefficients(model)
+    return c.Ki_F * 1e6, c.Kc_F * 1e6
+
+
 def fe_coefficients(model: FrameModel) -> Coefficients:
     """K_i, K_C (m/K) of ``model`` from the two load cases."""
     p = model.config.frame

@@ -11,7 +11,7 @@ import pytest
 from gatetherm.solvers import beam
 from gatetherm.solvers.model import build_model
 from gatetherm.solvers.reduced import fe_coefficients
-from gatetherm.studies.control.compensator import theory_coefficients
+from gatetherm.solvers.beam import theory_coefficients
 from gatetherm.studies.run.config import parse_config
 from gatetherm.studies.sweeps.sweep import configure, plan
 from gatetherm.validation import beam_vs_fe as bv

@@ -18,7 +18,8 @@ from gatetherm.solvers.reduced import fe_coefficients
 from gatetherm.studies import cli
 from gatetherm.studies.control.actuator import ActuatorParams, dead_band_um
 from gatetherm.studies.cli.compensate import K_SOURCES, simulated_series
-from gatetherm.studies.control.compensator import fe_coefficients_um, theory_coefficients
+from gatetherm.solvers.beam import theory_coefficients
+from gatetherm.solvers.reduced import tip_coefficients_um
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config
 from gatetherm.studies.run.simulate import run_model, sample_times
@@ -112,11 +113,11 @@ def test_theory_coefficients_are_the_beam_theory_of_the_frame(cfg):
 
 def test_fe_coefficients_are_the_load_cases_at_the_tips(cfg, model):
     c = fe_coefficients(model)
-    assert fe_coefficients_um(model) == (c.Ki_F * 1e6, c.Kc_F * 1e6)
+    assert tip_coefficients_um(model) == (c.Ki_F * 1e6, c.Kc_F * 1e6)
     built = []
-    assert K_SOURCES["fe"](None, cfg, lambda: built.append(1) or model) == fe_coefficients_um(model)
+    assert K_SOURCES["fe"](None, cfg, lambda: built.append(1) or model) == tip_coefficients_um(model)
     assert built == [1]  # the model is asked for only when the FE source is used
-    ki, kc = fe_coefficients_um(model)
+    ki, kc = tip_coefficients_um(model)
     assert ki > 0 and kc > 0  # heat-side bending approaches, a warmer tie bar pushes apart
 
 
@@ -146,7 +147,7 @@ def test_cli_condition_simulates_and_compensates(tmp_path, coarse_toml, cfg, mod
     assert code == 0, io_.err
     fe = json.loads((tmp_path / "fe" / "summary.json").read_text())
     assert fe["k_source"] == "fe"  # the command builds its own mesh: equal to ~1e-5
-    assert (fe["Ki_um_per_K"], fe["Kc_um_per_K"]) == pytest.approx(fe_coefficients_um(model), rel=3e-4)
+    assert (fe["Ki_um_per_K"], fe["Kc_um_per_K"]) == pytest.approx(tip_coefficients_um(model), rel=3e-4)
     assert fe["swing_um"] == summary["swing_um"] and fe["piezo_saturated_updates"] == 0
 
 
@@ -201,7 +202,7 @@ def test_study_table_structure(cfg, model, study):
     assert (by[1, "paper, K theory"].Ki_um_per_K, by[1, "paper, K theory"].Kc_um_per_K) == \
         theory_coefficients(cfg.model)
     assert (by[1, "paper, K FE"].Ki_um_per_K, by[1, "paper, K FE"].Kc_um_per_K) == \
-        pytest.approx(fe_coefficients_um(model), rel=3e-4)  # another build of the mesh
+        pytest.approx(tip_coefficients_um(model), rel=3e-4)  # another build of the mesh
     for n in (1, 2, 3):
         same = [r for r in rows if r.condition == n]
         assert len({r.swing_um for r in same}) == 1

@@ -20,7 +20,7 @@ from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config
 from gatetherm.studies.diagnosis.discrepancy import Candidate, Settings, adopted_config, decide, diagnose
 from gatetherm.studies.diagnosis.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
-from gatetherm.studies.run.modelfile import config_toml
+from gatetherm.studies.run.config import config_toml
 from gatetherm.studies.run.simulate import run_model
 from gatetherm.studies.diagnosis.replay import Hypothesis, Replayer, compared_channels, residuals
 from gatetherm.studies.run.timeseries import write_timeseries

@@ -17,6 +17,7 @@ from gatetherm.solvers.model import ModelConfig, build_model, region_fields
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config, parse_config
 from gatetherm.studies.run.simulate import run_model, sample_times
+from conftest import FIXED_MODEL
 
 from gatetherm.geometry.frame import MeshParams
 
@@ -78,7 +79,7 @@ def test_observation_and_drive_effects():
 
 
 def test_model_effects_map_to_model_fields(frame_2d):
-    cfg = ModelConfig()
+    cfg = FIXED_MODEL
     eff = ActiveEffects({"joint_resistance": 500.0, "joint_compliance": 2e11, "compliant_base": 1e10,
                          "base_conduction": 100.0, "piezo_heat": 2.0})
     m, _ = apply_effects(cfg, condition_drive(CONDITIONS[1], load_config().supply), eff, 2)

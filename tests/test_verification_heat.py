@@ -4,12 +4,15 @@ balance of the real frame model. The observed orders are printed in the session
 summary ("observed convergence orders")."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from gatetherm.geometry.frame import MeshParams
 from gatetherm.solvers.heat import Inputs, TimeScheme
 from gatetherm.solvers.model import ModelConfig, build_model
+from conftest import FIXED_MODEL
 from gatetherm.validation.verification import heat_mms_error, observed_order, spatial_study
 from gatetherm.validation.verification_time import (HarmonicDrive, energy_balance, slab_film_error, steady_state,
                                           time_errors, unit_heat_system)
@@ -92,7 +95,7 @@ def _frame_drive(t: float) -> Inputs:
 
 @pytest.fixture(scope="module")
 def frame_model(frame_2d):
-    return build_model(ModelConfig(mesh=MeshParams(size=0.02), source={"arm_L": SOURCE}), 2, fmesh=frame_2d)
+    return build_model(dataclasses.replace(FIXED_MODEL, source={"arm_L": SOURCE}), 2, fmesh=frame_2d)
 
 
 @pytest.mark.parametrize("theta", [1.0, 0.5])
@@ -132,7 +135,7 @@ def test_default_scheme_resolves_pump_switches(frame_2d):
     from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
     from gatetherm.studies.run.simulate import run_model, sample_times
 
-    model = build_model(ModelConfig(), 2, fmesh=frame_2d)
+    model = build_model(FIXED_MODEL, 2, fmesh=frame_2d)
     drive, times = condition_drive(CONDITIONS[2], SupplyParams()), sample_times(5 * 3600.0)
     fine = run_model(model, drive, sample_times(5 * 3600.0, 3.75), scheme=TimeScheme(0.5, 1))
     ref = fine.columns["delta_um"][::16]
@@ -150,7 +153,7 @@ def test_supply_hose_hand_values(frame_2d):
     from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
     from gatetherm.studies.run.simulate import run_model, sample_times
 
-    model = build_model(ModelConfig(), 2, fmesh=frame_2d)
+    model = build_model(FIXED_MODEL, 2, fmesh=frame_2d)
     p = model.config.thermal
     cols = run_model(model, condition_drive(CONDITIONS[1], SupplyParams()), sample_times(7200.0)).columns
     G, UA = p.oil_rho_c * p.flow_rate, p.hose_loss

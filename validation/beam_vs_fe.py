@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from gatetherm.geometry.frame import MeshParams
+from gatetherm.solvers.beam import column_I
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.sweeps.sweep import Study
 
@@ -99,7 +100,7 @@ def shear_coefficients(cfg: Config) -> tuple[float, float]:
     p, m = cfg.model.frame, cfg.model
     tie = m.tie_material or m.material
     E, G = m.material.E, m.material.E / (2.0 * (1.0 + m.material.nu))
-    EI, GA = E * p.depth * p.h ** 3 / 12.0, SHEAR_FACTOR * G * p.depth * p.h
+    EI, GA = E * column_I(p), SHEAR_FACTOR * G * p.depth * p.h
 
     def u(y):  # free thermal displacement per K of theta_A - theta_B
         k = m.material.alpha / p.h

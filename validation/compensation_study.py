@@ -41,8 +41,10 @@ import numpy as np
 from gatetherm import write_text_atomic
 from gatetherm.studies.control import actuator as piezo
 from gatetherm.studies.cli.compensate import simulated_series
-from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction, extrapolate,
-                                 fe_coefficients_um, predict, summarize, theory_coefficients)
+from gatetherm.solvers.beam import theory_coefficients
+from gatetherm.solvers.reduced import tip_coefficients_um
+from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction,
+                                                   extrapolate, predict, summarize)
 from gatetherm.studies.run.conditions import condition
 from gatetherm.studies.control.regression import THETAS, LinearModel, apply_regression, fit_coefficients, fit_regression
 from gatetherm.studies.run.simulate import delta_figures
@@ -149,7 +151,7 @@ def study(cfg, dim: int = 2, conditions=(1, 2, 3), params: CompensatorParams = C
     full = fit_regression(runs[FIT_ON])
     predictors = {
         "paper, K theory": theory_coefficients(cfg.model),
-        "paper, K FE": fe_coefficients_um(model),
+        "paper, K FE": tip_coefficients_um(model),
         f"paper, K fit (cond. {FIT_ON})": fit_coefficients(runs[FIT_ON]),
         f"MLR θA θB θC (cond. {FIT_ON})": Baseline(baseline),
         f"MLR θA θB θC (cond. {FIT_ON}), 1-min forecast": Baseline(baseline, True),

@@ -67,7 +67,7 @@ def effective_coefficients(cfg: Config, dim: int = 2, model=None) -> list[Source
     """Theory, FE load cases (at F) and least-squares fits (per run and pooled),
     each scored on all three runs."""
     from gatetherm.solvers.reduced import fe_coefficients
-    from gatetherm.studies.control.compensator import theory_coefficients
+    from gatetherm.solvers.beam import theory_coefficients
     from gatetherm.studies.control.regression import fit_coefficients
 
     model, runs = condition_runs(cfg, dim, model)

@@ -26,8 +26,9 @@ from gatetherm import InputError
 from gatetherm import write_text_atomic
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.cli.mesh import add_model_options
-from gatetherm.studies.control.compensator import (NEEDED, CompensatorParams, compensate, fe_coefficients_um, summarize,
-                                 theory_coefficients)
+from gatetherm.solvers.beam import theory_coefficients
+from gatetherm.solvers.reduced import tip_coefficients_um
+from gatetherm.studies.control.compensator import NEEDED, CompensatorParams, compensate, summarize
 from gatetherm.studies.control.regression import fit_coefficients
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, read_timeseries, validate_complete, write_timeseries
 
@@ -37,7 +38,7 @@ log = logging.getLogger(__name__)
 #: name -> f(series, config, model) -> (Ki, Kc), ``model()`` building the FE model on first use.
 K_SOURCES = {
     "theory": lambda ts, cfg, model: theory_coefficients(cfg.model),
-    "fe": lambda ts, cfg, model: fe_coefficients_um(model()),
+    "fe": lambda ts, cfg, model: tip_coefficients_um(model()),
     "fit": lambda ts, cfg, model: fit_coefficients(ts),
 }
 DEFAULT_K_SOURCE = "theory"

@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
 def _write(args, cfg, diag, adopted, out: Path) -> None:
     from gatetherm import write_text_atomic
     from gatetherm.studies.diagnosis.report import report_markdown
-    from gatetherm.studies.run.modelfile import config_toml
+    from gatetherm.studies.run.config import config_toml
     from gatetherm.studies.run.output import write_json
     from gatetherm.validation.plots.discrepancy import plot_before_after, plot_residuals, plot_scores
 

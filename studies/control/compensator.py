@@ -30,8 +30,8 @@ the start) and the hold is logged. No prediction exists for the first two sample
 The piezo command ``u = -delta_et`` is refreshed every ``update_interval_s`` from the
 first sample and held in between (0 before the first prediction).
 
-Coefficient sources (um/K): :func:`theory_coefficients` (beam theory of a model's frame),
-:func:`fe_coefficients_um` (FE load cases at the tips F), and
+Coefficient sources (um/K): ``gatetherm.solvers.beam.theory_coefficients`` (beam theory of a
+model's frame), ``gatetherm.solvers.reduced.tip_coefficients_um`` (FE load cases at the tips F), and
 ``studies.regression.fit_coefficients`` (least squares on a run). Any other predictor
 (e.g. the static regression baseline) can drive the same loop via :func:`external_prediction`.
 """
@@ -39,17 +39,12 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.solvers import beam
 from gatetherm.studies.control import actuator as piezo
 from gatetherm.studies.run.timeseries import TimeSeries, rises, validate_complete
-
-if TYPE_CHECKING:
-    from gatetherm.solvers.model import FrameModel, ModelConfig
 
 log = logging.getLogger(__name__)
 
@@ -132,30 +127,6 @@ class ClosedLoop:
     # times of the piezo updates, s: each sets the command to -delta_et of that instant
     saturated_updates: int = 0
     # piezo updates whose command was outside the actuator's reach (clipped); 0 if ideal
-
-
-def beam_model(cfg: ModelConfig) -> beam.BeamModel:
-    """The beam model of a frame model: its l, l1, l4, h, l_C, A_C, column material E, alpha
-    with ``I = depth h^3 / 12`` (the tank cavity is ignored, as in the paper), tie-bar
-    material E_C, alpha_C."""
-    f, m = cfg.frame, cfg.material
-    tie = cfg.tie_material or m
-    return beam.BeamModel(l=f.l, l1=f.l1, l4=f.l4, h=f.h, EI=m.E * f.depth * f.h ** 3 / 12.0,
-                          alpha=m.alpha, l_C=f.l_C, A_C=f.A_C, E_C=tie.E, alpha_C=tie.alpha)
-
-
-def theory_coefficients(cfg: ModelConfig) -> tuple[float, float]:
-    """Beam-theory (K_i, K_C) of a frame model, um/K (eqs 22-24 via :func:`beam_model`)."""
-    ki, kc = beam.coefficients(beam_model(cfg))
-    return float(ki) * 1e6, float(kc) * 1e6
-
-
-def fe_coefficients_um(model: FrameModel) -> tuple[float, float]:
-    """(K_i, K_C) of an assembled FE model from the two load cases, read at the tips F, um/K."""
-    from gatetherm.solvers.reduced import fe_coefficients  # needs the FE stack; imported on use
-
-    c = fe_coefficients(model)
-    return c.Ki_F * 1e6, c.Kc_F * 1e6
 
 
 def extrapolate(previous, last):

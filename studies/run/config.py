@@ -1,9 +1,15 @@
-"""TOML model files: ``[geometry]``, ``[mesh]``, ``[material]`` (with an
-optional ``[material.tie_bar]``), ``[thermal]``, ``[supply]`` and ``[model]``,
-each mirroring a parameter dataclass. Unknown keys and wrong types are errors."""
+"""TOML model files, read and written from one schema.
+
+Each section of a model file mirrors one parameter dataclass (:data:`SCHEMA`); unknown
+keys and wrong types are errors. ``[effects]`` switches on catalogue effects as
+``NAME = {PARAM = VALUE}``. :func:`config_toml` writes a file that :func:`load_config`
+reads back to the same :class:`Config`.
+"""
 from __future__ import annotations
 
 import dataclasses
+import logging
+import math
 import os
 import tomllib
 import types
@@ -13,15 +19,16 @@ from importlib import resources
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.geometry.frame import FrameParams, MeshParams, validate
-from gatetherm.solvers.effects import effects_from_table
-from gatetherm.solvers.heat import ThermalParams
+from gatetherm.geometry.frame import FrameParams, MeshParams, validate, validate_mesh
+from gatetherm.solvers.effects import effects_from_table, effects_table
+from gatetherm.solvers.heat import ThermalParams, TimeScheme
 from gatetherm.solvers.material import Material
 from gatetherm.solvers.model import ModelConfig
 from gatetherm.studies.run.conditions import SupplyParams
 
+log = logging.getLogger(__name__)
+
 PAPER_TOML = "paper.toml"
-_MODEL_KEYS = ("order", "k_base", "joint_conductance")
 
 
 @dataclass(frozen=True)
@@ -31,12 +38,53 @@ class Config:
     model: ModelConfig = ModelConfig()
     supply: SupplyParams = SupplyParams()
     source: str = "defaults"
+    """Where the configuration came from (a file path, or ``gatetherm:paper.toml``)."""
     effects: dict = field(default_factory=dict)
     """Catalogue effects switched on, {name: value} (``[effects]``: ``NAME = {PARAM = VALUE}``)."""
 
 
-def _coerce(section: str, key: str, value, typ):
-    where = f"{section}.{key}"
+@dataclass(frozen=True)
+class Section:
+    """One table of the model file and the dataclass it mirrors."""
+
+    name: str
+    """TOML table name, e.g. ``"material.tie_bar"``."""
+    path: tuple[str, ...]
+    """Attribute path of the dataclass in :class:`Config`."""
+    cls: type
+    keys: tuple[str, ...] | None = None
+    """Fields the file may set (None: all)."""
+
+
+SCHEMA = (
+    Section("geometry", ("model", "frame"), FrameParams),
+    Section("mesh", ("model", "mesh"), MeshParams),
+    Section("material", ("model", "material"), Material),
+    Section("material.tie_bar", ("model", "tie_material"), Material),
+    Section("thermal", ("model", "thermal"), ThermalParams),
+    Section("supply", ("supply",), SupplyParams),
+    Section("model", ("model",), ModelConfig, ("order", "k_base", "joint_conductance", "joint_stiffness")),
+    Section("model.scheme", ("model", "scheme"), TimeScheme),
+)
+"""The model file, section by section, in the order :func:`config_toml` writes it."""
+SECTION_NAMES = tuple(s.name for s in SCHEMA) + ("effects",)
+
+
+def _get(obj, path):
+    for name in path:
+        obj = getattr(obj, name)
+    return obj
+
+
+def _set(obj, path, value):
+    if not path:
+        return value
+    return dataclasses.replace(obj, **{path[0]: _set(getattr(obj, path[0]), path[1:], value)})
+
+
+def _coerce(where: str, value, typ):
+    if isinstance(typ, types.UnionType):  # "float | None": a number (None is "not set")
+        typ = next(a for a in typing.get_args(typ) if a is not type(None))
     if typ is bool:
         if not isinstance(value, bool):
             raise InputError(where, f"expected true/false, got {value!r}")
@@ -44,54 +92,53 @@ def _coerce(section: str, key: str, value, typ):
     if typ in (float, int):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(where, f"expected a number, got {value!r}")
+        if typ is int and value != int(value):
+            raise InputError(where, f"expected a whole number, got {value!r}")
         return int(value) if typ is int else float(value)
-    return value
+    raise InputError(where, "cannot be set in a model file")
 
 
-def _build(cls, section: str, table: dict, base=None):
-    hints = typing.get_type_hints(cls)
-    known = {f.name for f in dataclasses.fields(cls)}
-    out = {}
+def _section_table(data: dict, name: str) -> dict:
+    node = data
+    for part in name.split("."):
+        node = node.get(part, {}) if isinstance(node, dict) else {}
+    if not isinstance(node, dict):
+        raise InputError(name, "expected a table", f"write [{name}] with key = value lines")
+    return {k: v for k, v in node.items() if not any(s.name == f"{name}.{k}" for s in SCHEMA)}
+
+
+def _apply(sec: Section, table: dict, current):
+    """``current`` (an instance of ``sec.cls``) with the keys of ``table`` applied."""
+    hints = typing.get_type_hints(sec.cls)
+    known = sec.keys or tuple(f.name for f in dataclasses.fields(sec.cls))
+    changes = {}
     for key, value in table.items():
         if key not in known:
-            raise InputError(f"{section}.{key}", "unknown key",
-                             f"known keys: {', '.join(sorted(known))}")
-        typ = hints[key]
-        if isinstance(typ, types.UnionType):
-            typ = float
-        out[key] = _coerce(section, key, value, typ)
-    return dataclasses.replace(base or cls(), **out)
+            raise InputError(f"{sec.name}.{key}", "unknown key", f"known keys: {', '.join(sorted(known))}")
+        changes[key] = _coerce(f"{sec.name}.{key}", value, hints[key])
+    return dataclasses.replace(current, **changes) if changes else current
 
 
 def parse_config(data: dict, source: str = "<dict>", base: Config | None = None) -> Config:
     """Build a :class:`Config` from a parsed TOML document (overlaying ``base``)."""
-    base = base or Config()
-    sections = {"geometry", "mesh", "material", "thermal", "supply", "model", "effects"}
+    cfg = base or Config()
     for key in data:
-        if key not in sections:
-            raise InputError(key, "unknown section", f"known sections: {', '.join(sorted(sections))}")
-    m = base.model
-    material_table = dict(data.get("material", {}))
-    tie_table = material_table.pop("tie_bar", None)
-    frame = _build(FrameParams, "geometry", data.get("geometry", {}), m.frame)
-    model_table = data.get("model", {})
-    for key in model_table:
-        if key not in _MODEL_KEYS:
-            raise InputError(f"model.{key}", "unknown key", f"known keys: {', '.join(_MODEL_KEYS)}")
-    order = _coerce("model", "order", model_table.get("order", m.order), int)
-    if order not in (1, 2):
-        raise InputError("model.order", f"must be 1 or 2, got {order}")
-    material = _build(Material, "material", material_table, m.material)
-    model = dataclasses.replace(
-        m, frame=validate(frame), mesh=_build(MeshParams, "mesh", data.get("mesh", {}), m.mesh),
-        material=material,
-        tie_material=_build(Material, "material.tie_bar", tie_table, material) if tie_table else m.tie_material,
-        thermal=_build(ThermalParams, "thermal", data.get("thermal", {}), m.thermal), order=order,
-        k_base=_coerce("model", "k_base", model_table["k_base"], float) if "k_base" in model_table else m.k_base,
-        joint_conductance=(_coerce("model", "joint_conductance", model_table["joint_conductance"], float)
-                           if "joint_conductance" in model_table else m.joint_conductance))
-    supply = _build(SupplyParams, "supply", data.get("supply", {}), base.supply)
-    return Config(model, supply, source, {**base.effects, **effects_from_table(data.get("effects", {}))})
+        if key not in SECTION_NAMES and not any(s.name.startswith(f"{key}.") for s in SCHEMA):
+            raise InputError(key, "unknown section", f"known sections: {', '.join(SECTION_NAMES)}")
+    for sec in SCHEMA:
+        table = _section_table(data, sec.name)
+        current = _get(cfg, sec.path)
+        if current is None:  # the tie bar's own material starts from the column material
+            if not table:
+                continue
+            current = _get(cfg, ("model", "material"))
+        cfg = _set(cfg, sec.path, _apply(sec, table, current))
+    validate(cfg.model.frame)
+    validate_mesh(cfg.model.mesh)
+    if cfg.model.order not in (1, 2):
+        raise InputError("model.order", f"must be 1 or 2, got {cfg.model.order}")
+    effects = {**cfg.effects, **effects_from_table(data.get("effects", {}))}
+    return dataclasses.replace(cfg, source=source, effects=effects)
 
 
 def load_config(path: str | os.PathLike | None = None) -> Config:
@@ -109,3 +156,34 @@ def load_config(path: str | os.PathLike | None = None) -> Config:
     except tomllib.TOMLDecodeError as err:
         raise InputError(source, f"not valid TOML ({err})") from None
     return parse_config(data, source)
+
+
+def _value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            raise ValueError(f"cannot write {v} to TOML")
+        return repr(v)
+    raise TypeError(f"cannot write {type(v).__name__} to a model file")
+
+
+def config_toml(cfg: Config, header: str = "") -> str:
+    """The model file of ``cfg``; ``header`` lines become TOML comments. Volumetric
+    sources (``ModelConfig.source``) have no key: they come from effects."""
+    if cfg.model.source != ModelConfig().source:
+        log.warning("model file: volumetric sources not written (they are set by [effects])")
+    lines = [f"# {h}" for h in header.splitlines()] + ([""] if header else [])
+    for sec in SCHEMA:
+        obj = _get(cfg, sec.path)
+        if obj is None:
+            continue
+        keys = sec.keys or tuple(f.name for f in dataclasses.fields(sec.cls))
+        rows = [f"{k} = {_value(getattr(obj, k))}" for k in keys if getattr(obj, k) is not None]
+        lines += [f"[{sec.name}]", *rows, ""]
+    if cfg.effects:
+        lines += ["[effects]"] + [f"{name} = {{ {p} = {_value(v)} }}"
+                                  for name, table in effects_table(cfg.effects).items() for p, v in table.items()]
+    return "\n".join(lines).rstrip("\n") + "\n"

@@ -26,12 +26,11 @@ def _coefficients(model, cfg: Config) -> dict[str, float]:
     """FE (element-exact load cases, at E and at F) and beam-theory K_i, K_C in um/K, and normalised."""
     from gatetherm.solvers import beam
     from gatetherm.solvers.reduced import fe_coefficients
-    from gatetherm.studies.control.compensator import theory_coefficients
 
     p, m = cfg.model.frame, cfg.model
     tie = m.tie_material or m.material
     c = fe_coefficients(model)
-    ki_th, kc_th = theory_coefficients(m)
+    ki_th, kc_th = beam.theory_coefficients(m)
     ki_s = float(beam.ki_scale(m.material.alpha, p.l, p.h)) * 1e6
     kc_s = float(beam.kc_scale(tie.alpha, p.l_C)) * 1e6
     out = {"Ki_E_fe": c.Ki_E * 1e6, "Kc_E_fe": c.Kc_E * 1e6, "Ki_F_fe": c.Ki_F * 1e6,
@@ -39,8 +38,7 @@ def _coefficients(model, cfg: Config) -> dict[str, float]:
     out.update({"Ki_norm_fe": out["Ki_E_fe"] / ki_s, "Kc_norm_fe": out["Kc_E_fe"] / kc_s,
                 "Ki_norm_theory": ki_th / ki_s, "Kc_norm_theory": kc_th / kc_s,
                 "Ki_scale": ki_s, "Kc_scale": kc_s, "l_over_l4": p.l / p.l4, "l_over_h": p.l / p.h,
-                "beta": float(beam.beta(p.depth * p.h ** 3 / 12.0 * m.material.E / tie.E, p.l_C,
-                                        p.A_C, p.l))})
+                "beta": beam.frame_beta(m)})
     return out
 
 

@@ -34,6 +34,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry.frame import FrameParams, tie_depth, tie_heights, validate
+from gatetherm.solvers.beam import beta_area
 from gatetherm.studies.run.config import Config, parse_config
 
 SECTIONS = ("geometry", "mesh", "material", "material.tie_bar", "thermal", "supply", "model")
@@ -100,10 +101,7 @@ def _l_over_h(cfg: Config, v: float) -> dict:
 
 
 def _beta(cfg: Config, v: float) -> dict:
-    p, m = cfg.model.frame, cfg.model
-    E_C = (m.tie_material or m.material).E
-    I = p.depth * p.h ** 3 / 12.0
-    return {"A_C": 3.0 * m.material.E * I * p.l_C / (v * E_C * p.l ** 3)}
+    return {"A_C": beta_area(cfg.model, v)}
 
 
 def _tank_cavity(cfg: Config, v: bool) -> dict:
