@@ -18,6 +18,16 @@ log = logging.getLogger(__name__)
 
 DIRECT_LIMIT_3D = 30_000
 """Largest 3-D system (DOFs) solved by sparse LU."""
+RTOL = 1e-9
+"""Relative residual at which AMG-preconditioned CG stops."""
+MAXITER = 500
+"""Iterations after which AMG-preconditioned CG gives up (and raises)."""
+SETTINGS = {"direct_limit_3d": DIRECT_LIMIT_3D, "rtol": RTOL, "maxiter": MAXITER}
+"""What the solution depends on, for digests of the numerical scheme."""
+
+
+class SolverError(RuntimeError):
+    """An iterative solve did not converge."""
 
 
 def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.ndarray:
@@ -36,7 +46,7 @@ def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.nd
 
 
 def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
-               rtol: float = 1e-9) -> Callable[[np.ndarray], np.ndarray]:
+               rtol: float = RTOL) -> Callable[[np.ndarray], np.ndarray]:
     """Return ``solve(b)`` for the SPD matrix ``A``, set up once."""
     A = A.tocsr()
     if dim == 2 or A.shape[0] <= DIRECT_LIMIT_3D or near_null is None:
@@ -53,8 +63,12 @@ def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
 
     def solve(b: np.ndarray) -> np.ndarray:
         res: list[float] = []
-        x = ml.solve(b, tol=rtol, accel="cg", maxiter=500, residuals=res)
-        log.debug("AMG-CG: %d iterations, residual %.2e", len(res) - 1, res[-1] / max(res[0], 1e-300))
+        x = ml.solve(b, tol=rtol, accel="cg", maxiter=MAXITER, residuals=res)
+        rel = float(np.linalg.norm(b - A @ x) / max(np.linalg.norm(b), 1e-300))
+        log.debug("AMG-CG: %d iterations, relative residual %.2e", len(res) - 1, rel)
+        if not rel <= 10 * rtol:
+            raise SolverError(f"AMG-CG did not converge: relative residual {rel:.2e} after {len(res) - 1} "
+                              f"iterations (tolerance {rtol:g})")
         return x
 
     return solve

@@ -7,6 +7,8 @@ weight vectors for displacements).
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import json
 import logging
 import time
 from dataclasses import dataclass, field
@@ -18,6 +20,7 @@ from gatetherm import InputError
 from gatetherm.geometry.frame import (FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth,
                                       width)
 from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.solvers import linsolve
 from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic
 from gatetherm.solvers.fem import Field, to_skfem
 from skfem import FacetBasis, asm
@@ -26,6 +29,14 @@ from gatetherm.solvers.heat import HeatSystem, ThermalParams, TimeScheme, assemb
 from gatetherm.solvers.material import FC300, Material
 
 log = logging.getLogger(__name__)
+
+def scheme_digest(cfg: ModelConfig) -> str:
+    """Eight hex digits naming the numerical scheme: element order, time stepping and the
+    linear solvers' settings (not the physics)."""
+    blob = json.dumps({"order": cfg.order, "time": dataclasses.asdict(cfg.scheme), "linear": linsolve.SETTINGS},
+                      sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:8]
+
 
 GEOMETRY_FREE = ("l1",)
 """FrameParams fields the mesh does not depend on (the beam theory's heated height)."""

@@ -17,7 +17,9 @@ from gatetherm.solvers.model import build_model
 from gatetherm.solvers.reduced import fe_coefficients
 from gatetherm.studies import cli
 from gatetherm.studies.control.actuator import ActuatorParams, dead_band_um
-from gatetherm.studies.cli.compensate import K_SOURCES, simulated_series
+from gatetherm.studies.cli.compensate import K_SOURCES
+from gatetherm.studies.run.scenario import condition_schedule, run_scenario
+from gatetherm.studies.run.timeseries import FORMAT
 from gatetherm.solvers.beam import theory_coefficients
 from gatetherm.solvers.reduced import tip_coefficients_um
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
@@ -152,7 +154,8 @@ def test_cli_condition_simulates_and_compensates(tmp_path, coarse_toml, cfg, mod
 
 
 def test_cli_data_defaults_to_theory_of_the_paper_model(tmp_path, cfg, model, gatetherm):
-    write_timeseries(tmp_path / "run.csv", simulated_series(model, cfg, 1))
+    run = run_scenario(cfg, 2, condition_schedule(1, cfg), mesh=model.fmesh)
+    write_timeseries(tmp_path / "run.csv", run.series({"format": FORMAT}))
     code, io_ = gatetherm("compensate", "--data", tmp_path / "run.csv", "--out", tmp_path / "o", "--no-actuator")
     assert code == 0, io_.err
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
@@ -239,7 +242,7 @@ def test_study_regression_values(study, key):
 
 def test_study_main_writes_figures_and_tables(tmp_path, coarse_toml, study, monkeypatch, capsys):
     monkeypatch.setattr(compensation_study, "study", lambda cfg, dim: study)  # computed above already
-    assert compensation_study.main(["--out", str(tmp_path), "--config", str(coarse_toml)]) == 0
+    assert cli.main(["validate", "compensation", "--out", str(tmp_path), "--config", str(coarse_toml)]) == 0
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == ["compensation_table.csv", "compensation_table.md", "fig14_condition1.png",
                      "fig15_condition2.png", "fig16_condition3.png", "piezo_loops.png"]

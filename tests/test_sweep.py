@@ -17,8 +17,8 @@ from gatetherm import InputError
 from gatetherm.solvers import beam
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
 from gatetherm.studies.cli import main
-from gatetherm.studies.cli import sweep as sweep_command
-from gatetherm.studies.cli.sweep import parse_study
+from gatetherm.studies.sweeps import runner as sweep_runner
+from gatetherm.studies.sweeps.studyfile import parse_study
 from gatetherm.studies.run.config import parse_config
 
 #: A fully specified frame (independent of the shipped paper model, which is recalibrated).
@@ -194,7 +194,7 @@ def test_dask_cluster_on_loopback(study_dir):
 
 def test_unreachable_scheduler_is_an_input_error(study_dir, capsys, monkeypatch):
     pytest.importorskip("distributed")
-    monkeypatch.setattr(sweep_command, "SCHEDULER_TIMEOUT_S", 1.0)
+    monkeypatch.setattr(sweep_runner, "SCHEDULER_TIMEOUT_S", 1.0)
     code = main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "x"),
                  "--scheduler", "tcp://127.0.0.1:9", "--no-plots"])
     assert code == 2 and capsys.readouterr().err.startswith("gatetherm: error: --scheduler:")

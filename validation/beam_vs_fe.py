@@ -10,7 +10,7 @@ element-exact load cases of solvers/reduced.py read at E (and at F).
 Controlled series explain the gaps: the same sweep without the tank cavity, a
 slenderness series ``l/h``, a tie-bar height series ``t_C`` and a mesh series; and
 :func:`shear_coefficients` adds the columns' shear compliance to the beam theory.
-Numbers only; studies/commands/validate.py runs the studies and writes the files, and
+Numbers only; validation/beam_study.py runs the studies and writes the files, and
 validation/beam_vs_fe_report.py turns the rows into report.md.
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The report.md text of ``gatetherm validate beam``: markdown tables, the per-beta summary,
 the slenderness-series acceptance and the report itself, from the rows of validation/beam_vs_fe.py.
-Text only; studies/commands/validate.py writes the files.
+Text only; validation/beam_study.py writes the files.
 """
 from __future__ import annotations
 

@@ -1,24 +1,25 @@
 """How the default paper model was fitted: free dimensions and film coefficients
 chosen so that the 2-D model reproduces the paper's reported figures.
 
-    python -m validation.calibrate_paper [--evals N]
+    gatetherm validate calibrate --out DIR [--evals N]
 
-prints the objective per evaluation and the best parameter set as TOML lines to
+prints the objective at each improvement and the best parameter set as TOML lines to
 paste into ``studies/data/paper.toml``. It is a record of the procedure, not
 part of any run; it takes a few minutes.
 """
 from __future__ import annotations
 
-import argparse
 import dataclasses
+import logging
 
 import numpy as np
 from scipy.optimize import minimize
 
-from gatetherm.solvers.model import build_model
-from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config
-from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
+from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.studies.run.simulate import delta_figures
+
+log = logging.getLogger(__name__)
 
 #: The paper's figures (section 4.2): cond. 1 and 2 first peak (µm), its time (min),
 #: swing (µm); cond. 3 second positive peak ≈ cond. 2's first peak − 5 µm, swing.
@@ -53,12 +54,11 @@ def with_values(base, x):
 
 
 def figures(cfg, dim: int = 2) -> dict[int, dict]:
-    model = build_model(cfg.model, dim)
-    out = {}
+    cache, out = ScenarioCache(), {}
     for c in TARGETS:
-        r = run_model(model, condition_drive(CONDITIONS[c], cfg.supply), sample_times(18000))
-        out[c] = delta_figures(r.columns["time_s"], r.columns["delta_um"])
-        out[c]["wall_rise_10min"] = float(r.columns["T_tank_wall_degC"][10] - r.columns["T_tank_wall_degC"][0])
+        cols = run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache).columns
+        out[c] = delta_figures(cols["time_s"], cols["delta_um"])
+        out[c]["wall_rise_10min"] = float(cols["T_tank_wall_degC"][10] - cols["T_tank_wall_degC"][0])
     return out
 
 
@@ -72,14 +72,12 @@ def misfit(figs: dict[int, dict]) -> float:
     return err + WALL_WEIGHT * ((figs[1]["wall_rise_10min"] - WALL_RISE_10MIN) / WALL_RISE_10MIN) ** 2
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--evals", type=int, default=150)
-    ap.add_argument("--mesh-size", type=float, default=0.012)
-    args = ap.parse_args()
+def calibrate(evals: int = 150, mesh_size: float = 0.012, on_better=None) -> list[str]:
+    """Nelder–Mead on :func:`misfit` from the shipped model; ``on_better(line)`` hears of
+    each improvement. Returns the best parameters as ``[section] name = value`` lines."""
     base = load_config()
     base = dataclasses.replace(base, model=dataclasses.replace(
-        base.model, mesh=dataclasses.replace(base.model.mesh, size=args.mesh_size)))
+        base.model, mesh=dataclasses.replace(base.model.mesh, size=mesh_size)))
     get = {"geometry": base.model.frame, "thermal": base.model.thermal, "supply": base.supply}
     x0 = np.array([getattr(get[s], n) for s, n, *_ in FREE])
     scale = x0.copy()
@@ -90,22 +88,16 @@ def main() -> None:
         try:
             figs = figures(with_values(base, x))
         except Exception as err:  # an infeasible frame (e.g. overlapping parts)
-            print("infeasible:", err)
+            log.info("infeasible: %s", err)
             return 10.0
         m = misfit(figs)
         if m < best[0]:
             best[:] = [m, x]
-            print(f"misfit {m:.4f}", {c: {k: round(v, 1) for k, v in d.items() if v is not None}
-                                      for c, d in figs.items()},
-                  {n: float(np.clip(v, lo, hi)) for (_, n, lo, hi), v in zip(FREE, x)}, flush=True)
+            if on_better:
+                on_better(f"misfit {m:.4f} {({c: {k: round(v, 1) for k, v in d.items() if v is not None} for c, d in figs.items()})} "
+                          f"{({n: float(np.clip(v, lo, hi)) for (_, n, lo, hi), v in zip(FREE, x)})}")
         return m
 
     minimize(f, np.ones_like(x0), method="Nelder-Mead",
-             options={"maxfev": args.evals, "initial_simplex": None, "xatol": 1e-3, "fatol": 1e-4})
-    print("\n# best parameters")
-    for (sec, name, lo, hi), v in zip(FREE, best[1]):
-        print(f"[{sec}] {name} = {float(np.clip(v, lo, hi)):.6g}")
-
-
-if __name__ == "__main__":
-    main()
+             options={"maxfev": evals, "initial_simplex": None, "xatol": 1e-3, "fatol": 1e-4})
+    return [f"[{sec}] {name} = {float(np.clip(v, lo, hi)):.6g}" for (sec, name, lo, hi), v in zip(FREE, best[1])]

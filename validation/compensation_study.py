@@ -1,6 +1,6 @@
-"""Closed-loop compensation study on FE data (issue 5; the paper's Figs. 14-16 and its +-6-7 um).
+"""Closed-loop compensation study on FE data (the paper's Figs. 14-16 and its +-6-7 um).
 
-    python -m validation.compensation_study --out DIR [--config FILE.toml] [--dim 2]
+    gatetherm validate compensation --out DIR [--config FILE.toml] [--dim 2]
 
 Conditions 1-3 are simulated on the model (default: the shipped paper model in 2-D) and
 each run is compensated by
@@ -29,7 +29,6 @@ and DIR/piezo_loops.png, and prints the markdown.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import io
 import logging
@@ -40,7 +39,6 @@ import numpy as np
 
 from gatetherm import write_text_atomic
 from gatetherm.studies.control import actuator as piezo
-from gatetherm.studies.cli.compensate import simulated_series
 from gatetherm.solvers.beam import theory_coefficients
 from gatetherm.solvers.reduced import tip_coefficients_um
 from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction,
@@ -143,10 +141,14 @@ def _row(number: int, label: str, ts, predictor, params, actuator) -> tuple[Row,
 def study(cfg, dim: int = 2, conditions=(1, 2, 3), params: CompensatorParams = CompensatorParams(),
           actuator: piezo.ActuatorParams = piezo.ActuatorParams()) -> Study:
     """Simulate ``conditions`` on ``cfg``'s model and compensate each with every predictor."""
-    from gatetherm.solvers.model import build_model
+    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+    from gatetherm.studies.run.timeseries import FORMAT
 
-    model = build_model(cfg.model, dim)
-    runs = {n: simulated_series(model, cfg, n) for n in sorted(set(conditions) | {FIT_ON})}
+    cache = ScenarioCache()
+    sims = {n: run_scenario(cfg, dim, condition_schedule(n, cfg), cache=cache)
+            for n in sorted(set(conditions) | {FIT_ON})}
+    runs = {n: s.series({"format": FORMAT, "condition": str(n)}) for n, s in sims.items()}
+    model = sims[FIT_ON].model
     baseline = fit_regression(runs[FIT_ON], THETAS)
     full = fit_regression(runs[FIT_ON])
     predictors = {
@@ -223,35 +225,23 @@ def table_csv(st: Study) -> str:
     return buf.getvalue()
 
 
-def main(argv=None) -> int:
-    from gatetherm.studies.run.config import load_config
+def write_compensation_study(out: Path, cfg, dim: int = 2) -> str:
+    """Run the study, write the figures, ``compensation_table.md`` and ``.csv``; returns the markdown."""
     from gatetherm.validation.plots.compensation import plot_condition_study, plot_piezo_loops
 
-    ap = argparse.ArgumentParser(prog="python -m validation.compensation_study", description=__doc__.split("\n")[0])
-    ap.add_argument("--out", required=True, metavar="DIR")
-    ap.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
-    ap.add_argument("--dim", type=int, choices=(2, 3), default=2)
-    args = ap.parse_args(argv)
-    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
-    cfg = load_config(args.config)
     quiet = logging.getLogger("gatetherm.studies.control.actuator")
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # clipping is counted in the table; restored below
     try:
-        st = study(cfg, args.dim)
+        st = study(cfg, dim)
     finally:
         quiet.setLevel(level)
-    out = Path(args.out)
+    out = Path(out)
     for n, loops in st.loops.items():
-        plot_condition_study(f"condition {n} ({cfg.source}, {args.dim}-D)", loops,
+        plot_condition_study(f"condition {n} ({cfg.source}, {dim}-D)", loops,
                              out / FIGURES.get(n, f"condition{n}.png"), PAPER_BAND_UM)
     plot_piezo_loops(piezo.ActuatorParams(), out / "piezo_loops.png")
     write_text_atomic(out / "compensation_table.csv", table_csv(st))
     text = markdown(st)
     write_text_atomic(out / "compensation_table.md", text)
-    print(text, end="")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    return text

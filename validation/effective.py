@@ -52,25 +52,23 @@ def score(name: str, ki: float, kc: float, runs: dict[int, dict]) -> Source:
     return Source(name, float(ki), float(kc), rms, worst)
 
 
-def condition_runs(cfg: Config, dim: int, model=None) -> tuple[object, dict[int, dict]]:
+def condition_runs(cfg: Config, dim: int) -> tuple[object, dict[int, dict]]:
     """The model and its run columns for conditions 1-3."""
-    from gatetherm.solvers.model import build_model
-    from gatetherm.studies.run.conditions import CONDITIONS as ALL, condition_drive
-    from gatetherm.studies.run.simulate import run_model, sample_times
+    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 
-    model = model or build_model(cfg.model, dim)
-    return model, {c: run_model(model, condition_drive(ALL[c], cfg.supply),
-                                sample_times(ALL[c].duration)).columns for c in CONDITIONS}
+    cache = ScenarioCache()
+    runs = {c: run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache) for c in CONDITIONS}
+    return runs[CONDITIONS[0]].model, {c: r.columns for c, r in runs.items()}
 
 
-def effective_coefficients(cfg: Config, dim: int = 2, model=None) -> list[Source]:
+def effective_coefficients(cfg: Config, dim: int = 2) -> list[Source]:
     """Theory, FE load cases (at F) and least-squares fits (per run and pooled),
     each scored on all three runs."""
     from gatetherm.solvers.reduced import fe_coefficients
     from gatetherm.solvers.beam import theory_coefficients
     from gatetherm.studies.control.regression import fit_coefficients
 
-    model, runs = condition_runs(cfg, dim, model)
+    model, runs = condition_runs(cfg, dim)
     fe = fe_coefficients(model)
     sources = [score("beam theory (eqs 22-24)", *theory_coefficients(cfg.model), runs),
                score("FE load cases at F", fe.Ki_F * 1e6, fe.Kc_F * 1e6, runs)]

@@ -1,7 +1,7 @@
 """Hidden-effect study of the discrepancy workflow (issue 6).
 
-    python -m validation.hidden_effects --out DIR [--workers 2] [--mesh-size M]
-                                        [--conditions 1,2,3] [--effects NAME,...]
+    gatetherm validate hidden-effects --out DIR [--workers 2] [--mesh-size M]
+                                      [--conditions 1,2,3] [--effects NAME,...]
 
 "Measured" runs are made by simulating a paper condition with one catalogue
 effect switched on at a seeded random strength (one draw in the lower and one
@@ -21,7 +21,6 @@ held-out RMS of δ before/after, wall time) and prints the acceptance figures.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import dataclasses
 import io
@@ -36,13 +35,12 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import write_text_atomic
-from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
-from gatetherm.solvers.model import build_model
-from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+from gatetherm.solvers.effects import CATALOGUE
 from gatetherm.studies.run.config import Config, load_config
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
 from gatetherm.studies.diagnosis.replay import DELTA, resolution
-from gatetherm.studies.run.simulate import run_model, sample_times
+from gatetherm.studies.run.scenario import condition_schedule, run_scenario
+from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
 
 log = logging.getLogger(__name__)
@@ -95,13 +93,15 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
     element size), over the condition's duration unless ``duration`` (s) is given."""
     mesh = dataclasses.replace(config.model.mesh, size=config.model.mesh.size * mesh_factor)
     cfg = dataclasses.replace(config.model, mesh=mesh)
-    cond = CONDITIONS[case.condition]
-    drive = condition_drive(cond, config.supply)
-    times = sample_times(duration or cond.duration)
+    sched = condition_schedule(case.condition, config)
+    if duration:
+        sched = dataclasses.replace(sched, times=sample_times(duration))
+
+    def run(model_cfg, schedule=sched, **kw):
+        return run_scenario(dataclasses.replace(config, model=model_cfg), dim, schedule, **kw)
+
     if case.effect in CATALOGUE:
-        eff = ActiveEffects({case.effect: case.strength})
-        mcfg, drive = apply_effects(cfg, drive, eff, dim)
-        return eff.observe(run_model(build_model(mcfg, dim), drive, times).columns)
+        return run(cfg, effects={case.effect: case.strength}).columns
     if case.effect == "tie_heat_leak":
         from gatetherm.geometry.frame import part_boxes
 
@@ -114,16 +114,16 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
         cfg = dataclasses.replace(cfg, thermal=dataclasses.replace(
             cfg.thermal, **{field: getattr(cfg.thermal, field) * case.strength}))
     elif case.effect == "flow_drop":
+        times = sched.times
         k = int(np.searchsorted(times, FLOW_DROP_AT_S))
-        model = build_model(cfg, dim)
-        first = run_model(model, drive, times[:k + 1], keep_times=[times[k]])
+        first = run(cfg, dataclasses.replace(sched, times=times[:k + 1]), keep_times=[times[k]])
         low = dataclasses.replace(cfg.thermal, flow_rate=cfg.thermal.flow_rate * case.strength)
-        m2 = build_model(dataclasses.replace(cfg, thermal=low), dim, model.fmesh)
-        rest = run_model(m2, drive, times[k:], U0=first.states[0][1]).columns
+        rest = run(dataclasses.replace(cfg, thermal=low), dataclasses.replace(sched, times=times[k:]),
+                   mesh=first.model.fmesh, U0=first.result.states[0][1]).columns
         return {c: np.concatenate([first.columns[c][:k], rest[c]]) for c in rest}
     elif case.effect != "none":
         raise ValueError(f"unknown case effect {case.effect!r}")
-    return run_model(build_model(cfg, dim), drive, times).columns
+    return run(cfg).columns
 
 
 def measured(cols: dict[str, np.ndarray], seed: int, condition: int) -> TimeSeries:
@@ -252,38 +252,33 @@ def table_csv(rows: list[dict]) -> str:
     return buf.getvalue()
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", required=True, metavar="DIR")
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--seed", type=int, default=6)
-    ap.add_argument("--conditions", default="1,2,3")
-    ap.add_argument("--effects", default=",".join([*CATALOGUE, "none", *OUTSIDE, *MISMATCH]),
-                    help="comma-separated catalogue/outside effects and 'none' (default: all)")
-    ap.add_argument("--mesh-size", type=float, help="diagnosis element size, m (default: the model's)")
-    args = ap.parse_args(argv)
-    logging.basicConfig(level=logging.WARNING)
-    wanted = set(args.effects.split(","))
-    todo = [c for c in cases(args.seed, tuple(int(x) for x in args.conditions.split(",")))
-            if c.effect in wanted]
+ALL_CASES = (*CATALOGUE, "none", *OUTSIDE, *MISMATCH)
+"""Every kind of case of the study, by name."""
+
+
+def row_line(row: dict) -> str:
+    """One line of progress for a finished case."""
+    return ("%-17s %-10.4g c%d -> %-18s %-17s margin %s  δ RMS %s -> %s  (%.0f s)"
+            % (row["effect"], row["strength"], row["condition"], row["verdict"], row["named"], _fmt(row["margin"]),
+               _fmt(row["rms_before_um"]), _fmt(row["rms_after_um"]), row["seconds"]))
+
+
+def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=(1, 2, 3), wanted=ALL_CASES,
+                         mesh_size: float | None = None, on_row=None) -> dict:
+    """Run the study on ``workers`` processes, write ``hidden_effects.md`` and ``.csv``;
+    returns the acceptance figures. ``on_row(row)`` is called as each case finishes."""
+    todo = [c for c in cases(seed, tuple(conditions)) if c.effect in set(wanted)]
     t0 = time.perf_counter()
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")  # one thread per worker process
-    with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        rows = []
-        for row in pool.map(_worker, [(c, args.mesh_size) for c in todo]):
+    rows = []
+    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        for row in pool.map(_worker, [(c, mesh_size) for c in todo]):
             rows.append(row)
-            print("%-17s %-10.4g c%d -> %-18s %-17s margin %s  δ RMS %s -> %s  (%.0f s)" % (row["effect"],
-                        row["strength"], row["condition"], row["verdict"], row["named"], _fmt(row["margin"]),
-                  _fmt(row["rms_before_um"]), _fmt(row["rms_after_um"]), row["seconds"]), flush=True)
+            if on_row:
+                on_row(row)
     acc = {**acceptance(rows), "study_wall_time_s": round(time.perf_counter() - t0, 1)}
-    out = Path(args.out)
+    out = Path(out)
     write_text_atomic(out / "hidden_effects.md", table_markdown(rows, acc))
     write_text_atomic(out / "hidden_effects.csv", table_csv(rows))
-    for k, v in acc.items():
-        print(f"{k}: {_fmt(v)}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    return {k: _fmt(v) for k, v in acc.items()}

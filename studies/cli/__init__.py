@@ -8,7 +8,7 @@ import sys
 
 from gatetherm import InputError
 
-#: Sub-command modules under ``studies.commands``, in ``--help`` order.
+#: Sub-command modules of this package, in ``--help`` order.
 COMMAND_MODULES = ("mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose")
 
 

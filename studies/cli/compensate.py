@@ -16,21 +16,18 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import functools
 import json
 import logging
 import math
 from pathlib import Path
 
-from gatetherm import InputError
-from gatetherm import write_text_atomic
-from gatetherm.studies.control.actuator import ActuatorParams
-from gatetherm.studies.cli.mesh import add_model_options
+from gatetherm import InputError, write_text_atomic
 from gatetherm.solvers.beam import theory_coefficients
-from gatetherm.solvers.reduced import tip_coefficients_um
+from gatetherm.studies.cli.options import add_model_options
+from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import NEEDED, CompensatorParams, compensate, summarize
 from gatetherm.studies.control.regression import fit_coefficients
-from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, read_timeseries, validate_complete, write_timeseries
+from gatetherm.studies.run.timeseries import FORMAT, read_timeseries, validate_complete, write_timeseries
 
 log = logging.getLogger(__name__)
 
@@ -38,10 +35,16 @@ log = logging.getLogger(__name__)
 #: name -> f(series, config, model) -> (Ki, Kc), ``model()`` building the FE model on first use.
 K_SOURCES = {
     "theory": lambda ts, cfg, model: theory_coefficients(cfg.model),
-    "fe": lambda ts, cfg, model: tip_coefficients_um(model()),
+    "fe": lambda ts, cfg, model: _tips(model()),
     "fit": lambda ts, cfg, model: fit_coefficients(ts),
 }
 DEFAULT_K_SOURCE = "theory"
+
+
+def _tips(model) -> tuple[float, float]:
+    from gatetherm.solvers.reduced import tip_coefficients_um  # the FE stack, imported on use
+
+    return tip_coefficients_um(model)
 
 
 def register(subparsers) -> None:
@@ -83,17 +86,6 @@ def coefficients(args: argparse.Namespace, ts, cfg, model) -> tuple[float, float
     return (*K_SOURCES[source](ts, cfg, model), source)
 
 
-def simulated_series(model, cfg, number: int) -> TimeSeries:
-    """Condition ``number`` simulated on ``model`` (driven by ``cfg.supply``), 1-min samples."""
-    from gatetherm.studies.cli.simulate import resolve_drive
-    from gatetherm.studies.run.simulate import run_model, sample_times
-
-    drive, label, duration = resolve_drive(argparse.Namespace(schedule=None, condition=number), cfg)
-    res = run_model(model, drive, sample_times(duration))
-    return TimeSeries(res.columns, {"format": FORMAT, "source": "gatetherm compensate", "schedule": label,
-                                    "dim": str(model.dim), "config": cfg.source, "condition": str(number)})
-
-
 def _um(value) -> str:
     return "n/a" if value is None else f"{value:.2f} um"
 
@@ -101,6 +93,7 @@ def _um(value) -> str:
 def run(args: argparse.Namespace) -> int:
     from gatetherm.studies.run.conditions import condition
     from gatetherm.studies.run.config import load_config
+    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, prepare, run_scenario
 
     if not (math.isfinite(args.interval_min) and args.interval_min > 0):
         raise InputError("--interval-min", f"must be > 0, got {args.interval_min}", "e.g. --interval-min 5")
@@ -110,15 +103,17 @@ def run(args: argparse.Namespace) -> int:
     params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
     cfg = load_config(args.config)
 
-    @functools.cache
-    def model():
-        from gatetherm.solvers.model import build_model
+    cache = ScenarioCache()
 
-        return build_model(cfg.model, args.dim)
+    def model():  # the FE model with the model file's effects, built on first use
+        return prepare(cfg, args.dim, condition_schedule(args.condition or 1, cfg).drive, cache=cache).model
 
     if args.condition is not None:
         condition(args.condition)  # a bad number fails before the model is built
-        ts, what = simulated_series(model(), cfg, args.condition), f"condition {args.condition}"
+        sim = run_scenario(cfg, args.dim, condition_schedule(args.condition, cfg), cache=cache)
+        ts = sim.series({"format": FORMAT, "source": "gatetherm compensate", "schedule": sim.schedule.label,
+                         "dim": str(args.dim), "config": cfg.source, "condition": str(args.condition)})
+        what = f"condition {args.condition}"
     else:
         ts, what = read_timeseries(args.data), str(args.data)
         validate_complete(ts, NEEDED, source=args.data)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.solvers.effects import CATALOGUE, catalogue_json
-from gatetherm.studies.cli.mesh import add_model_options
+from gatetherm.studies.cli.options import add_model_options
 
 log = logging.getLogger(__name__)
 

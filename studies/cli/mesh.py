@@ -1,17 +1,11 @@
 """``gatetherm mesh``: build the frame mesh and write it as .msh and .vtu."""
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.mesh import save_mesh
-
-
-def add_model_options(p: argparse.ArgumentParser, dims=(2, 3)) -> None:
-    """``--dim`` and ``--config``, shared by the commands that build a model."""
-    p.add_argument("--dim", type=int, choices=dims, default=2, help="2-D section or 3-D solid (default 2)")
-    p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
+from gatetherm.studies.cli.options import add_model_options
 
 
 def register(sub) -> None:

@@ -3,18 +3,18 @@
 The model is driven by the file's own inputs (oil, pump, ambient when present)
 at the file's sample times; every measured output channel that the model also
 produces is compared. A :class:`Replayer` meshes the frame once and re-assembles
-only when a hypothesis changes the model itself, so the hundred-odd runs of a
-diagnosis cost well under a second each with the 2-D model.
+only when a hypothesis changes the model itself, and reruns the model only when a
+hypothesis changes the model or the drive (sensor-side effects act on a kept run), so
+the hundred-odd runs of a diagnosis cost well under a second each with the 2-D model.
 
 Residuals are *measured minus model*, in the channel's unit, and are judged
 against the sensor resolution: 0.1 µm for displacements, 0.05 K for
-thermocouples (/work/shared/paper-model.md).
+thermocouples (the paper's sensors).
 """
 from __future__ import annotations
 
 import dataclasses
 import logging
-from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,11 +22,8 @@ import numpy as np
 from gatetherm.geometry.build import build_mesh
 from gatetherm import InputError
 from gatetherm.geometry.frame import MeshParams
-from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
-from gatetherm.solvers.model import build_model
-from gatetherm.studies.run.conditions import table_drive
 from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.simulate import run_model
+from gatetherm.studies.run.scenario import ScenarioCache, run_scenario, series_schedule
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, TimeSeries
 
 log = logging.getLogger(__name__)
@@ -82,48 +79,33 @@ class Hypothesis:
 
 
 class Replayer:
-    """Runs ``config`` through the inputs of the measured series ``ts``."""
+    """Runs ``config`` through the inputs of the measured series ``ts`` (the scenario
+    path, one mesh and one :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all
+    hypotheses)."""
 
     def __init__(self, config: Config, ts: TimeSeries, dim: int = 2, mesh: MeshParams | None = None,
                  cache: int = 3):
-        amb = ts["ambient_degC"] if "ambient_degC" in ts else None
-        self.config = config
+        self.config = dataclasses.replace(config, model=dataclasses.replace(
+            config.model, mesh=mesh or config.model.mesh))
         self.dim = dim
-        self.times = np.asarray(ts.time_s - ts.time_s[0], dtype=float)
-        self.drive = table_drive(self.times, ts["oil_degC"], ts["pump"], amb, config.supply.T_room)
-        self.has_ambient = amb is not None
-        self.mesh = mesh or config.model.mesh
-        self.fmesh = build_mesh(config.model.frame, dim, self.mesh)
-        self.runs = 0
-        self._models: OrderedDict = OrderedDict()
-        self._raw: OrderedDict = OrderedDict()
-        self._cache = cache
+        self.schedule = series_schedule(ts, config, "measured inputs")
+        self.times = self.schedule.times
+        self.drive = self.schedule.drive
+        self.has_ambient = "ambient_degC" in ts
+        self.fmesh = build_mesh(self.config.model.frame, dim, self.config.model.mesh)
+        self.cache = ScenarioCache(self.fmesh, cache)
 
-    def _lru(self, store: OrderedDict, key, make):
-        if key in store:
-            store.move_to_end(key)
-            return store[key]
-        value = store[key] = make()
-        while len(store) > self._cache:
-            store.popitem(last=False)
-        return value
+    @property
+    def runs(self) -> int:
+        """Model runs made so far."""
+        return self.cache.runs
 
     def run(self, hyp: Hypothesis = Hypothesis()) -> dict[str, np.ndarray]:
         """Output columns (data-format names and units) of the model under ``hyp``."""
-        base = self.config.model
-        thermal = dataclasses.replace(base.thermal, **dict(hyp.thermal))
-        cfg = dataclasses.replace(base, thermal=thermal, mesh=self.mesh)
-        eff = ActiveEffects({**self.config.effects, **dict(hyp.effects)})
-        mcfg, drive = apply_effects(cfg, self.drive, eff, self.dim)
-        drive_key = tuple((k, v) for k, v in sorted(eff.values.items()) if CATALOGUE[k].acts_on == "drive")
-        key = (repr(mcfg), drive_key)
-
-        def simulate():
-            model = self._lru(self._models, repr(mcfg), lambda: build_model(mcfg, self.dim, self.fmesh))
-            self.runs += 1
-            return run_model(model, drive, self.times).columns
-
-        return eff.observe(self._lru(self._raw, key, simulate))
+        model = self.config.model
+        cfg = dataclasses.replace(self.config, model=dataclasses.replace(
+            model, thermal=dataclasses.replace(model.thermal, **dict(hyp.thermal))))
+        return run_scenario(cfg, self.dim, self.schedule, dict(hyp.effects), cache=self.cache).columns
 
 
 def residuals(ts: TimeSeries, cols: dict[str, np.ndarray], channels) -> dict[str, np.ndarray]:

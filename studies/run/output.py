@@ -1,4 +1,4 @@
-"""Writers for a run directory: fields for ParaView, summary JSON, picture input."""
+"""Writers for a run directory: the time series, fields for ParaView, summary JSON, picture input."""
 from __future__ import annotations
 
 import json
@@ -52,3 +52,18 @@ def pyvista_grid(model: FrameModel, U: np.ndarray):
 
 def write_json(path: Path, data: dict) -> None:
     write_text_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+
+
+def write_run(out: Path, run, metadata: dict[str, str], field_times) -> None:
+    """``out/timeseries.csv`` (what the sensors report) and the fields at ``field_times``
+    (``out/fields``) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`."""
+    from gatetherm.studies.run.timeseries import FORMAT, write_timeseries
+
+    write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
+    write_fields(run.model, [(t, U) for t, U in run.result.states if t in field_times], out / "fields")
+
+
+def deformed_grid(run, t_pic: float):
+    """(time, pyvista grid with T and u) of the kept state nearest ``t_pic`` (s)."""
+    t, U = min(run.result.states, key=lambda s: abs(s[0] - t_pic))
+    return t, pyvista_grid(run.model, U)

@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 from scipy.signal import find_peaks
 
-from gatetherm.solvers.heat import Drive, TimeScheme, march
+from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, march
 from gatetherm.solvers.model import FrameModel
 
 log = logging.getLogger(__name__)
@@ -38,14 +38,17 @@ def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
 
 
 def run_model(model: FrameModel, drive: Drive, times: np.ndarray, keep_times=(),
-              on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme = TimeScheme(),
-              U0: np.ndarray | None = None) -> RunResult:
-    """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0);
-    keep full states at ``keep_times``."""
+              on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
+              U0: np.ndarray | None = None, solver: HeatSolver | None = None) -> RunResult:
+    """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0)
+    with ``scheme`` (default: the model's); keep full states at ``keep_times``. A
+    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs."""
     keep = {float(t) for t in keep_times}
     rows, states = [], []
     t0 = _time.perf_counter()
-    for i, (t, U) in enumerate(march(model.heat, drive, np.asarray(times, float), scheme, U0)):
+    scheme = model.config.scheme if scheme is None else scheme
+    steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
+    for i, (t, U) in enumerate(steps):
         u = drive(t)
         temps = model.temperatures(U)
         disp = model.displacements(U)

@@ -125,15 +125,12 @@ def with_frame(cfg: Config, **changes) -> Config:
 
 def histories(designs: dict[str, Config], dim: int) -> dict[str, dict[int, tuple]]:
     """delta(t) (s, um) of each design (label -> model) for conditions 1-3."""
-    from gatetherm.solvers.model import build_model
-    from gatetherm.studies.run.conditions import CONDITIONS as ALL, condition_drive
-    from gatetherm.studies.run.simulate import run_model, sample_times
+    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 
     out = {}
     for label, cfg in designs.items():
-        model = build_model(cfg.model, dim)
-        runs = (run_model(model, condition_drive(ALL[c], cfg.supply), sample_times(ALL[c].duration)).columns
-                for c in CONDITIONS)
+        cache = ScenarioCache()
+        runs = (run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache).columns for c in CONDITIONS)
         out[label] = {c: (r["time_s"], r["delta_um"]) for c, r in zip(CONDITIONS, runs)}
     return out
 

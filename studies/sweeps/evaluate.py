@@ -14,6 +14,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+import gatetherm
+from gatetherm.solvers.model import scheme_digest
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.sweeps.sweep import Task
 
@@ -42,11 +44,9 @@ def _coefficients(model, cfg: Config) -> dict[str, float]:
     return out
 
 
-def _run(model, task: Task, drive, effects) -> dict[str, float | None]:
-    from gatetherm.studies.run.conditions import CONDITIONS
-    from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
+def _run(cols: dict) -> dict[str, float | None]:
+    from gatetherm.studies.run.simulate import delta_figures
 
-    cols = effects.observe(run_model(model, drive, sample_times(CONDITIONS[task.condition].duration)).columns)
     d = cols["delta_um"]
     dab = cols["theta_A_degC"] - cols["theta_B_degC"]
     return {**delta_figures(cols["time_s"], d), "delta_max_um": float(d.max()),
@@ -57,27 +57,27 @@ def _run(model, task: Task, drive, effects) -> dict[str, float | None]:
 def evaluate(task: Task) -> dict[str, Any]:
     """The result record of one point: key, params, status, note, results, seconds."""
     record = {"key": task.key, "params": dict(task.params), "status": "skipped", "note": task.skip,
-              "results": {}, "seconds": 0.0}
+              "results": {}, "seconds": 0.0, "version": gatetherm.__version__,
+              "scheme": scheme_digest(task.config.model)}
     if task.skip:
         return record
     from gatetherm.geometry.build import build_mesh
-    from gatetherm.solvers.effects import ActiveEffects, apply_effects
-    from gatetherm.solvers.model import build_model
-    from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
+    from gatetherm.studies.run.scenario import condition_schedule, prepare, run_scenario
 
     t0 = time.perf_counter()
-    eff = ActiveEffects({**task.config.effects, **dict(task.effects)})
-    cond = CONDITIONS[task.condition] if task.condition else CONDITIONS[1]
-    model_cfg, drive = apply_effects(task.config.model, condition_drive(cond, task.config.supply),
-                                     eff, task.dim)
+    cfg, dim, effects = task.config, task.dim, dict(task.effects)
+    schedule = condition_schedule(task.condition or 1, cfg)
     with _GMSH:
-        mesh = build_mesh(model_cfg.frame, task.dim, model_cfg.mesh)
-    model = build_model(model_cfg, task.dim, mesh)
-    res: dict[str, Any] = {"nodes": int(len(model.fmesh.points))}
-    if "coefficients" in task.compute:
-        res.update(_coefficients(model, dataclasses.replace(task.config, model=model_cfg)))
+        mesh = build_mesh(cfg.model.frame, dim, cfg.model.mesh)
+    res: dict[str, Any] = {}
     if "run" in task.compute:
-        res.update(_run(model, task, drive, eff))
+        run = run_scenario(cfg, dim, schedule, effects, mesh=mesh)
+        model, res = run.model, _run(run.columns)
+    else:
+        model = prepare(cfg, dim, schedule.drive, effects, mesh=mesh).model
+    if "coefficients" in task.compute:
+        res.update(_coefficients(model, dataclasses.replace(cfg, model=model.config)))
+    res["nodes"] = int(len(model.fmesh.points))
     record.update(status="ok", results=res, seconds=round(time.perf_counter() - t0, 3))
     return record
 

@@ -18,7 +18,7 @@ depth ``A_C/t_C`` fits behind the arms. A point whose frame still cannot be buil
 
 Every point has a key, a hash of everything its result depends on, so results
 can be stored per point and a stopped sweep resumes without recomputing
-anything finished (studies/commands/sweep.py does the files and the processes).
+anything finished (studies/sweeps/runner.py does the files and the processes).
 Evaluating the points is in studies/sweep_evaluate.py.
 """
 from __future__ import annotations
@@ -34,7 +34,9 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry.frame import FrameParams, tie_depth, tie_heights, validate
+import gatetherm
 from gatetherm.solvers.beam import beta_area
+from gatetherm.solvers.model import scheme_digest
 from gatetherm.studies.run.config import Config, parse_config
 
 SECTIONS = ("geometry", "mesh", "material", "material.tie_bar", "thermal", "supply", "model")
@@ -46,6 +48,9 @@ COMPUTE = {
     "run": ("first_peak_um", "first_peak_min", "second_peak_um", "swing_um", "delta_max_um",
             "delta_min_um", "theta_AB_max_K", "theta_C_end_K"),
 }
+MADE_BY = ("version", "scheme")
+"""Table columns naming what computed a point: gatetherm version and scheme digest
+(:func:`~gatetherm.solvers.model.scheme_digest`), both part of the point key."""
 PINHOLE = 0.003
 """Side of the cavity left by ``derived.tank_cavity = false``, m."""
 
@@ -210,12 +215,14 @@ def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = Tru
 
 
 def point_key(cfg: Config, dim: int, compute, condition, effects) -> str:
-    """Hash of everything a point's result depends on: the final model (without the
-    thermal and supply data when nothing is run), dimension, computations, condition, effects."""
+    """Hash of everything a point's result depends on: the gatetherm version, the numerical
+    scheme, the final model (without the thermal and supply data when nothing is run),
+    dimension, computations, condition, effects."""
     model = dataclasses.asdict(cfg.model)
-    data = {"model": model, "supply": dataclasses.asdict(cfg.supply), "effects": cfg.effects}
+    data = {"model": model, "supply": dataclasses.asdict(cfg.supply), "effects": cfg.effects,
+            "version": gatetherm.__version__, "scheme": scheme_digest(cfg.model)}
     if "run" not in compute:
-        for name in ("thermal", "source", "joint_conductance"):
+        for name in ("thermal", "source", "joint_conductance", "scheme"):
             model.pop(name, None)
         data.pop("supply")
         condition = None
@@ -249,8 +256,9 @@ def table(tasks: list[Task], records: dict[str, dict]) -> tuple[list[str], list[
     rows = []
     for t in tasks:
         rec = records.get(t.key, {"status": "pending", "note": "", "results": {}})
-        rows.append({**dict(t.params), "status": rec["status"], "note": rec["note"], **rec["results"]})
+        made = {k: rec.get(k, "") for k in MADE_BY}
+        rows.append({**dict(t.params), "status": rec["status"], "note": rec["note"], **rec["results"], **made})
     params = [k for k, _ in tasks[0].params] if tasks else []
     results = ["nodes"] + [c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]]
-    extra = [k for r in rows for k in r if k not in params and k not in results and k not in ("status", "note")]
-    return params + ["status", "note"] + results + list(dict.fromkeys(extra)), rows
+    extra = [k for r in rows for k in r if k not in params + results + ["status", "note", *MADE_BY]]
+    return params + ["status", "note"] + results + list(dict.fromkeys(extra)) + list(MADE_BY), rows

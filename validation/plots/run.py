@@ -82,3 +82,20 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     with atomic_path(path) as tmp:
         p.screenshot(str(tmp))
     p.close()
+
+
+def plot_run(run, figs: dict, out, title: str) -> None:
+    """``oil_temperatures.png`` (Fig. 10), ``response.png`` (Figs. 11–13) and ``deformed.png``
+    (at the first peak of δ, else at 1 h) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`
+    whose kept states include that time."""
+    from pathlib import Path
+
+    from gatetherm.studies.run.output import deformed_grid
+
+    out = Path(out)
+    plot_oil(run.columns, out / "oil_temperatures.png", title)
+    plot_response(run.columns, out / "response.png", title)
+    t, grid = deformed_grid(run, (figs["first_peak_min"] or 60.0) * 60.0)
+    umax = float(np.abs(grid["u"]).max()) or 1.0
+    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
+    render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 60:.0f} min", scale)

@@ -1,0 +1,37 @@
+"""Options shared by several commands, and the terminal progress bar."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+
+def add_model_options(p: argparse.ArgumentParser, dims=(2, 3)) -> None:
+    """``--dim`` and ``--config``, shared by the commands that build a model."""
+    p.add_argument("--dim", type=int, choices=dims, default=2, help="2-D section or 3-D solid (default 2)")
+    p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
+
+
+def add_parallel_options(p: argparse.ArgumentParser) -> None:
+    """``--workers`` and ``--scheduler``, shared by the commands that run many points."""
+    p.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
+                   help="local worker processes (default: the CPU count; 1 = in this process)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run the points on an existing Dask cluster, e.g. tcp://10.0.0.5:8786")
+
+
+class Progress:
+    """A one-line bar on a terminal; silent otherwise (logs stay clean)."""
+
+    def __init__(self, label: str, stream=None):
+        self.label, self.stream = label, stream or sys.stderr
+        self.on = self.stream.isatty()
+
+    def __call__(self, i: int, n: int) -> None:
+        if not self.on:
+            return
+        k = int(30 * i / n)
+        self.stream.write(f"\r{self.label} [{'#' * k}{'.' * (30 - k)}] {i}/{n}")
+        if i == n:
+            self.stream.write("\n")
+        self.stream.flush()

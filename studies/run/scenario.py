@@ -1,0 +1,162 @@
+"""The one scenario path: apply effects → build (or reuse) the model → run → observe.
+
+Every command and study runs a model through :func:`run_scenario` (or, when it needs
+the assembled model without a run, :func:`prepare`), so that the effects of a model
+file act the same everywhere. What drives a run is a :class:`Schedule`: a paper
+condition, a schedule file, or the inputs of a measured series.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from collections import OrderedDict
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import numpy as np
+
+from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
+from gatetherm.solvers.heat import Drive, HeatSolver
+from gatetherm.solvers.model import FrameModel, ModelConfig, build_model
+from gatetherm.studies.run.conditions import condition, condition_drive, table_drive
+from gatetherm.studies.run.config import Config
+from gatetherm.studies.run.simulate import RunResult, run_model, sample_times
+from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, read_timeseries
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """What drives a run and when it is sampled."""
+
+    drive: Drive
+    """Model inputs (supply oil, pump, room) as a function of time, s from the start."""
+    times: np.ndarray
+    """Sample times, s from the start (the first is 0)."""
+    label: str
+    """What the schedule is, for file metadata and reports."""
+    condition: int | None = None
+    """The paper's condition number, if it is one."""
+
+
+def condition_schedule(number: int, cfg: Config, step_s: float = 60.0) -> Schedule:
+    """The paper's condition ``number`` driven by ``cfg``'s supply unit, sampled every ``step_s``."""
+    cond = condition(number)
+    return Schedule(condition_drive(cond, cfg.supply), sample_times(cond.duration, step_s),
+                    f"condition {number}: {cond.name}", number)
+
+
+def series_schedule(ts: TimeSeries, cfg: Config, label: str) -> Schedule:
+    """The inputs of a series (oil, pump, room if recorded), sampled at its own times."""
+    t = np.asarray(ts.time_s - ts.time_s[0], dtype=float)
+    amb = ts["ambient_degC"] if "ambient_degC" in ts else None
+    return Schedule(table_drive(t, ts["oil_degC"], ts["pump"], amb, cfg.supply.T_room), t, label)
+
+
+def file_schedule(path, cfg: Config, step_s: float = 60.0) -> Schedule:
+    """A schedule file (data format, input columns), sampled every ``step_s`` over its length."""
+    s = series_schedule(read_timeseries(path, required=INPUT_COLUMNS), cfg, f"schedule {path}")
+    return Schedule(s.drive, sample_times(float(s.times[-1]), step_s), s.label)
+
+
+class ScenarioCache:
+    """Assembled models with their heat solvers (factorisations), and finished runs, by
+    what they depend on; the least recently used are dropped beyond ``size``. A study that
+    runs one frame many times (a diagnosis) passes one cache to every :func:`run_scenario`."""
+
+    def __init__(self, fmesh: FrameMesh | None = None, size: int = 3):
+        self.fmesh = fmesh
+        """The mesh every model of the cache is built on (None: each meshes its own frame)."""
+        self.size = size
+        self.runs = 0
+        """Model runs made (cache misses)."""
+        self._models: OrderedDict = OrderedDict()
+        self._results: OrderedDict = OrderedDict()
+
+    def _lru(self, store: OrderedDict, key, make):
+        if key in store:
+            store.move_to_end(key)
+            return store[key]
+        value = store[key] = make()
+        while len(store) > self.size:
+            store.popitem(last=False)
+        return value
+
+    def model(self, cfg: ModelConfig, dim: int) -> tuple[FrameModel, HeatSolver]:
+        def make():
+            model = build_model(cfg, dim, self.fmesh)
+            return model, HeatSolver(model.heat)
+        return self._lru(self._models, (repr(cfg), dim), make)
+
+    def result(self, key, make: Callable[[], RunResult]) -> RunResult:
+        def counted():
+            self.runs += 1
+            return make()
+        return self._lru(self._results, key, counted)
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A model ready to run: effects applied and assembled."""
+
+    model: FrameModel
+    solver: HeatSolver
+    drive: Drive
+    """The schedule's drive with the drive-side effects applied."""
+    effects: ActiveEffects
+    """The model file's effects, then the caller's."""
+
+
+def prepare(config: Config, dim: int, drive: Drive, effects: Mapping[str, float] | None = None, *,
+            cache: ScenarioCache | None = None, mesh: FrameMesh | None = None) -> Prepared:
+    """Apply the effects of ``config`` and ``effects`` (these win) and build or reuse the model."""
+    eff = ActiveEffects({**config.effects, **dict(effects or {})})
+    model_cfg, drive = apply_effects(config.model, drive, eff, dim)
+    if cache is not None:
+        model, solver = cache.model(model_cfg, dim)
+    else:
+        model = build_model(model_cfg, dim, mesh)
+        solver = HeatSolver(model.heat)
+    return Prepared(model, solver, drive, eff)
+
+
+@dataclass(frozen=True)
+class ScenarioRun:
+    """A finished scenario."""
+
+    columns: dict[str, np.ndarray]
+    """What the sensors report, in the data format (observation-side effects applied)."""
+    result: RunResult
+    """The model's own columns, kept states and march time."""
+    model: FrameModel
+    effects: ActiveEffects
+    schedule: Schedule
+    seconds: float
+    """Wall time of prepare and run, s."""
+
+    def series(self, metadata: dict[str, str]) -> TimeSeries:
+        return TimeSeries(self.columns, metadata)
+
+
+def run_scenario(config: Config, dim: int, schedule: Schedule, effects: Mapping[str, float] | None = None, *,
+                 cache: ScenarioCache | None = None, mesh: FrameMesh | None = None, keep_times=(),
+                 on_step: Callable[[int, int], None] | None = None, U0: np.ndarray | None = None) -> ScenarioRun:
+    """Run ``config`` (its model and its effects, plus ``effects``) in ``dim`` dimensions
+    through ``schedule``; keep full states at ``keep_times``. With a ``cache`` the model,
+    its factorisations and (for a plain run from the initial state) the run itself are reused."""
+    t0 = time.perf_counter()
+    p = prepare(config, dim, schedule.drive, effects, cache=cache, mesh=mesh)
+
+    def run() -> RunResult:
+        return run_model(p.model, p.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver)
+
+    if cache is not None and U0 is None and not keep_times:
+        drive_side = tuple(sorted((k, v) for k, v in p.effects.values.items() if CATALOGUE[k].acts_on == "drive"))
+        key = (repr(p.model.config), dim, drive_side, schedule.label, schedule.times.tobytes())
+        result = cache.result(key, run)
+    else:
+        result = run()
+    return ScenarioRun(p.effects.observe(result.columns), result, p.model, p.effects, schedule,
+                       time.perf_counter() - t0)

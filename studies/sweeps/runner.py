@@ -1,0 +1,137 @@
+"""Running sweep points: in this process, on local worker processes or on a Dask
+cluster; one JSON file per finished point (``DIR/points/<key>.json``, written atomically,
+so a restarted sweep recomputes nothing finished and never reads a half-written result),
+and the tidy table re-assembled from them."""
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import logging
+from pathlib import Path
+
+from gatetherm import InputError, write_text_atomic
+
+log = logging.getLogger(__name__)
+
+SCHEDULER_TIMEOUT_S = 20.0
+"""How long to try to reach a Dask scheduler, s."""
+
+
+@contextlib.contextmanager
+def executor(workers: int, scheduler: str | None, n_tasks: int):
+    """A concurrent.futures executor for the points, or None to run them in this process."""
+    if scheduler:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise InputError("--scheduler", "dask.distributed is not installed",
+                             "pip install 'dask[distributed]' or leave --scheduler out") from None
+        try:
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as err:
+            raise InputError("--scheduler", f"cannot connect to {scheduler} ({err})",
+                             "give the address of a running Dask scheduler") from None
+        try:
+            yield client.get_executor()
+        finally:
+            client.close()
+        return
+    if workers < 1:
+        raise InputError("--workers", f"must be >= 1, got {workers}")
+    if workers == 1 or n_tasks <= 1:
+        yield None
+        return
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=min(workers, n_tasks)) as ex:
+        yield ex
+
+
+class PointStore:
+    """One JSON file per finished point under ``root/points``."""
+
+    def __init__(self, root: Path):
+        self.dir = Path(root) / "points"
+
+    def load(self, keys) -> dict[str, dict]:
+        out = {}
+        for key in keys:
+            path = self.dir / f"{key}.json"
+            if path.is_file():
+                try:
+                    out[key] = json.loads(path.read_text(encoding="utf-8"))
+                except (json.JSONDecodeError, UnicodeDecodeError):
+                    log.warning("unreadable point file %s: it will be recomputed", path)
+        return out
+
+    def save(self, record: dict) -> None:
+        write_text_atomic(self.dir / f"{record['key']}.json", json.dumps(record, indent=1, sort_keys=True) + "\n")
+
+
+def _cell(v) -> str:
+    if v is None:
+        return ""
+    return repr(float(v)) if isinstance(v, float) else str(v)
+
+
+def write_table(path: Path, columns: list[str], rows: list[dict]) -> None:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(columns)
+    for r in rows:
+        w.writerow([_cell(r.get(c)) for c in columns])
+    write_text_atomic(path, buf.getvalue())
+
+
+def run_studies(jobs, workers: int, scheduler: str | None, progress=None):
+    """Evaluate the unfinished points of several ``(tasks, store)`` jobs in one pool.
+    Returns ``(records per job, failures)``."""
+    from gatetherm.studies.sweeps.evaluate import execute
+
+    done = [store.load(t.key for t in tasks) for tasks, store in jobs]
+    keys = [{t.key for t in tasks} for tasks, _ in jobs]
+    todo, owner = [], {}
+    for i, (tasks, store) in enumerate(jobs):
+        for t in tasks:
+            if t.key not in done[i] and t.key not in owner:
+                todo.append(t)
+                owner[t.key] = i
+    n_done = [0]
+    log.info("%d points to compute, %d already done", len(todo), sum(map(len, done)))
+
+    def finished(rec: dict) -> None:
+        i = owner[rec["key"]]
+        jobs[i][1].save(rec)
+        done[i][rec["key"]] = rec
+        for j, (_, store) in enumerate(jobs):  # the same point in another study: share it
+            if j != i and rec["key"] in keys[j]:
+                if store.dir != jobs[i][1].dir:
+                    store.save(rec)
+                done[j][rec["key"]] = rec
+        n_done[0] += 1
+        if progress:
+            progress(n_done[0], len(todo))
+
+    with executor(workers, scheduler, len(todo)) as ex:
+        failed = execute(todo, finished, ex)
+    return done, failed
+
+
+class PointsFailed(Exception):
+    """Some points raised; the finished ones are stored, a rerun retries the rest."""
+
+
+def run_points(named_studies: dict, out: Path, workers: int, scheduler: str | None, progress=None):
+    """Plan and run every study (one shared point store under ``out``); the task lists per
+    study name and the records by key. Raises :class:`PointsFailed` after storing what finished."""
+    from gatetherm.studies.sweeps.sweep import plan
+
+    plans = {name: [plan(s) for s in studies] for name, studies in named_studies.items()}
+    jobs = [(tasks, PointStore(out)) for lst in plans.values() for tasks in lst]
+    done, failed = run_studies(jobs, workers, scheduler, progress)
+    if failed:
+        raise PointsFailed("; ".join(f"{dict(t.params)}: {err}" for t, err in failed[:3])
+                           + f" ({len(failed)} points failed; rerun to retry them)")
+    return plans, {k: v for d in done for k, v in d.items()}

@@ -1,0 +1,104 @@
+"""The study file (STUDY.toml) of ``gatetherm sweep``: ``[study]`` (name, dim, config,
+compute, fit_frame), ``[set]``, ``[grid]`` and ``[[plot]]`` tables into a
+:class:`~gatetherm.studies.sweeps.sweep.Study`."""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from gatetherm import InputError
+
+if TYPE_CHECKING:
+    from gatetherm.studies.run.config import Config
+    from gatetherm.studies.sweeps.sweep import Study
+
+
+def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
+    """``{"geometry": {"l4": v}}`` and ``{"geometry.l4": v}`` both give ``{"geometry.l4": v}``."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(_flatten(value, f"{prefix}{key}."))
+        else:
+            out[f"{prefix}{key}"] = value
+    return out
+
+
+def _scalar(key: str, value):
+    if isinstance(value, (bool, int, float, str)):
+        return value
+    raise InputError(key, f"expected a number, true/false or a string, got {value!r}")
+
+
+def parse_study(data: dict, source: str = "<study>", base: Config | None = None) -> Study:
+    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the model it overrides)."""
+    from gatetherm.studies.run.config import load_config
+    from gatetherm.studies.sweeps.sweep import COMPUTE, PlotSpec, Study
+
+    known = {"study", "set", "grid", "plot"}
+    for key in data:
+        if key not in known:
+            raise InputError(key, "unknown table", f"known tables: {', '.join(sorted(known))}")
+    head = dict(data.get("study", {}))
+    for key in head:
+        if key not in ("name", "dim", "config", "compute", "fit_frame"):
+            raise InputError(f"study.{key}", "unknown key",
+                             "known keys: name, dim, config, compute, fit_frame")
+    dim = head.get("dim", 2)
+    if dim not in (2, 3) or isinstance(dim, bool):
+        raise InputError("study.dim", f"must be 2 or 3, got {dim!r}")
+    compute = head.get("compute", ["coefficients"])
+    if isinstance(compute, str):
+        compute = [compute]
+    for c in compute:
+        if c not in COMPUTE:
+            raise InputError("study.compute", f"unknown computation {c!r}", f"choose from {', '.join(COMPUTE)}")
+    fit = head.get("fit_frame", True)
+    if not isinstance(fit, bool):
+        raise InputError("study.fit_frame", f"expected true/false, got {fit!r}")
+    if base is None:
+        base = load_config(head.get("config"))
+    fixed = {k: _scalar(f"set.{k}", v) for k, v in _flatten(data.get("set", {})).items()}
+    grid = []
+    for key, values in _flatten(data.get("grid", {})).items():
+        if not isinstance(values, list) or not values:
+            raise InputError(f"grid.{key}", "expected a non-empty list of values", f'e.g. "{key}" = [1, 2]')
+        if key in fixed:
+            raise InputError(f"set.{key}", "is also swept in [grid]", "keep it in one of the two")
+        grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
+    if not grid:
+        raise InputError("grid", "no swept parameter", 'add e.g. "geometry.l4" = [0.2, 0.3] under [grid]')
+    columns = {k for k, _ in grid} | {"nodes"} | {c for k in compute for c in COMPUTE[k]}
+    plots = []
+    for i, spec in enumerate(data.get("plot", [])):
+        if not isinstance(spec, dict):
+            raise InputError(f"plot[{i + 1}]", "expected a table", "write [[plot]] with x, y and hue")
+        for key, value in spec.items():
+            if key not in ("x", "y", "hue"):
+                raise InputError(f"plot[{i + 1}].{key}", "unknown key", "known keys: x, y, hue")
+            if value not in columns:
+                raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",
+                                 f"choose from {', '.join(sorted(columns))}")
+        if "x" not in spec or "y" not in spec:
+            raise InputError(f"plot[{i + 1}]", "needs x and y")
+        plots.append(PlotSpec(spec["x"], spec["y"], spec.get("hue")))
+    return Study(str(head.get("name", source)), dim, base, tuple(fixed.items()), tuple(grid),
+                 tuple(compute), tuple(plots), fit)
+
+
+def load_study(path) -> Study:
+    """Read a STUDY.toml; a relative ``study.config`` is taken from the study file's folder."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("STUDY.toml", f"no such file '{path}'", "give a study file")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(str(p), f"not valid TOML ({err})") from None
+    from gatetherm.studies.run.config import load_config
+
+    data.setdefault("study", {}).setdefault("name", p.stem)
+    config = data["study"].pop("config", None)
+    base = load_config(None if config is None else p.parent / config)
+    return parse_study(data, str(p), base)
