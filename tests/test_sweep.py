@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+import gatetherm
+
 from gatetherm import InputError
 from gatetherm.solvers import beam
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
@@ -176,15 +178,49 @@ def test_sweep_writes_one_row_per_point_and_resumes(study_dir, monkeypatch):
     assert (out / "table.csv").read_text() == first
 
 
+def _recomputed(study_dir, monkeypatch, out) -> list[str]:
+    calls = []
+    real = sweep_evaluate.evaluate
+    monkeypatch.setattr(sweep_evaluate, "evaluate", lambda t: calls.append(t.key) or real(t))
+    assert main(["sweep", str(study_dir / "study.toml"), "--out", str(out), "--workers", "1", "--no-plots"]) == 0
+    monkeypatch.setattr(sweep_evaluate, "evaluate", real)
+    return calls
+
+
+def test_a_new_scheme_or_version_recomputes_the_points(study_dir, monkeypatch):
+    """Points made with one time scheme or gatetherm version are not reused by another:
+    the key holds both, and the table says which made each row."""
+    out = study_dir / "out"
+    study = study_dir / "study.toml"
+    study.write_text(STUDY.replace('compute = ["coefficients"]', 'compute = ["run"]')
+                     .replace('"derived.l_over_l4" = [0.6, 1.0, 2.0, 3.0]', '"derived.l_over_l4" = [2.0]')
+                     .replace("[set]", "[set]\ncondition = 1").replace('y = "Ki_norm_fe"', 'y = "swing_um"'))
+    assert len(_recomputed(study_dir, monkeypatch, out)) == 1
+    assert _recomputed(study_dir, monkeypatch, out) == []  # nothing changed: nothing recomputed
+    before = _table(out / "table.csv")[0]
+    assert before["version"] == gatetherm.__version__ and len(before["scheme"]) == 8
+    model = study_dir / "model.toml"
+    model.write_text(model.read_text() + "\n[model.scheme]\ntheta = 1.0\nrestart = 1\n")
+    assert len(_recomputed(study_dir, monkeypatch, out)) == 1
+    after = _table(out / "table.csv")[0]
+    assert after["scheme"] != before["scheme"] and after["swing_um"] != before["swing_um"]
+    monkeypatch.setattr(gatetherm, "__version__", "99.0")
+    assert len(_recomputed(study_dir, monkeypatch, out)) == 1
+    assert _table(out / "table.csv")[0]["version"] == "99.0"
+
+
 def test_process_pool_gives_the_same_table(study_dir):
-    main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "a"), "--workers", "1", "--no-plots"])
-    main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "b"), "--workers", "2", "--no-plots"])
+    assert main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "a"), "--workers", "1",
+                 "--no-plots"]) == 0
+    assert main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "b"), "--workers", "2",
+                 "--no-plots"]) == 0
     assert (study_dir / "a" / "table.csv").read_text() == (study_dir / "b" / "table.csv").read_text()
 
 
 def test_dask_cluster_on_loopback(study_dir):
     distributed = pytest.importorskip("distributed")
-    main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "a"), "--workers", "1", "--no-plots"])
+    assert main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "a"), "--workers", "1",
+                 "--no-plots"]) == 0
     with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, host="127.0.0.1",
                                   protocol="tcp://", dashboard_address=None) as cluster:
         assert main(["sweep", str(study_dir / "study.toml"), "--out", str(study_dir / "d"),

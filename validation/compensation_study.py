@@ -69,17 +69,17 @@ class Row:
     swing_um: float
     prediction_error_band_um: float
     worst_error_min: float
-    # time of the largest |delta - delta_et| after the first 10 min, min
+    """Time of the largest |delta - delta_et| after the first 10 min, min."""
     error_band_off_switch_um: float
     residual_band_um: float
     residual_band_off_switch_um: float
     residual_at_updates_um: float
-    # largest |compensated delta| at the 5-min update instants only (the paper's reading)
+    """Largest |compensated delta| at the 5-min update instants only (the paper's reading)."""
     residual_band_1min_um: float
     no_reset_error_um: float
-    # largest |stroke without reset - stroke with reset| after the first 10 min: the hysteresis
+    """Largest |stroke without reset - stroke with reset| after the first 10 min: the hysteresis."""
     saturated_updates: int
-    # clipped piezo updates of the main (5-min, reset) loop, of the run's total
+    """Clipped piezo updates of the main (5-min, reset) loop, of the run's total."""
     updates: int
 
 
@@ -87,11 +87,11 @@ class Row:
 class Study:
     rows: tuple[Row, ...]
     loops: dict[int, dict[str, ClosedLoop]]
-    # condition -> predictor -> main closed loop (for the figures)
+    """Condition -> predictor -> main closed loop (for the figures)."""
     figures: dict[int, dict]
-    # condition -> delta_figures of the uncompensated run
+    """Condition -> delta_figures of the uncompensated run."""
     header: dict[str, str]
-    # model, coefficient and actuator facts for the report
+    """Model, coefficient and actuator facts for the report."""
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,7 @@ class Baseline:
 
     model: LinearModel
     forecast: bool = False
-    # True: delta_et(n) from the temperatures extrapolated from n-2, n-1 (eq 33)
+    """True: delta_et(n) from the temperatures extrapolated from n-2, n-1 (eq 33)."""
 
 
 def _prediction(ts, predictor, params: CompensatorParams):

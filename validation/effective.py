@@ -26,13 +26,13 @@ class Source:
 
     name: str
     Ki: float
-    # um/K
+    """Um/K."""
     Kc: float
-    # um/K
+    """Um/K."""
     rms_um: dict[int, float]
-    # condition -> RMS of delta - (Ki dtheta_AB - Kc theta_C) over the run, um
+    """Condition -> RMS of delta - (Ki dtheta_AB - Kc theta_C) over the run, um."""
     max_um: dict[int, float]
-    # condition -> largest |delta - prediction| over the run, um
+    """Condition -> largest |delta - prediction| over the run, um."""
 
 
 def _series(cols):

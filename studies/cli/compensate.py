@@ -55,7 +55,7 @@ def register(subparsers) -> None:
         "adaptive correction factors R_i, R_C and drive the piezo with -delta_et.",
     )
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument("--data", metavar="FILE.csv", help="time-series file (data-format.md)")
+    src.add_argument("--data", metavar="FILE.csv", help="time-series file (docs/data-format.md)")
     src.add_argument("--condition", type=int, metavar="N",
                      help="simulate the paper's condition 1, 2 or 3 on the model and compensate it")
     add_model_options(p)

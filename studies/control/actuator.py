@@ -61,32 +61,32 @@ class ActuatorParams:
     """Piezo stack (Tokin NLA-10x10x36-like) in its spring member; defaults documented inline."""
 
     free_stroke_um_per_V: float = 40.0 / 150.0
-    # free (unloaded) stroke per volt on the reset curve, um/V: 40 um at 150 V (assumed
-    # for a 36 mm stack; the paper gives no figure)
+    """Free (unloaded) stroke per volt on the reset curve, um/V: 40 um at 150 V (assumed for a 36
+    mm stack; the paper gives no figure)."""
     max_voltage_V: float = 150.0
-    # drive voltage limit, V; the stroke limits follow from it (0 V .. max_voltage_V)
+    """Drive voltage limit, V; the stroke limits follow from it (0 V .. max_voltage_V)."""
     stack_stiffness_N_per_m: float = 87.5e6
-    # stack stiffness, N/m: assumed 3500 N blocked force / 40 um free stroke
+    """Stack stiffness, N/m: assumed 3500 N blocked force / 40 um free stroke."""
     spring_stiffness_N_per_m: float = 32.34e6
-    # stiffness of the spring member the stack works against, N/m (paper)
+    """Stiffness of the spring member the stack works against, N/m (paper)."""
     preload_N: float = 580.0
-    # static preload on the stack, N (paper: 580 N; 0 = the unloaded case of Fig. 5)
+    """Static preload on the stack, N (paper: 580 N; 0 = the unloaded case of Fig. 5)."""
     dead_band_unloaded_um: float = 3.0
-    # seating gap of the unloaded stack, um (assumed)
+    """Seating gap of the unloaded stack, um (assumed)."""
     seating_force_N: float = 100.0
-    # preload that shrinks the seating gap by a factor e, N (assumed)
+    """Preload that shrinks the seating gap by a factor e, N (assumed)."""
     play_thresholds_V: tuple[float, ...] = (0.0, 8.0, 16.0, 24.0, 32.0)
-    # Prandtl-Ishlinskii play thresholds r_i, V
+    """Prandtl-Ishlinskii play thresholds r_i, V."""
     play_weights: tuple[float, ...] = (1.0, 0.25, 0.2, 0.15, 0.1)
-    # relative play weights w_i, dimensionless (scaled by weights(); gives ~10 % open loop)
+    """Relative play weights w_i, dimensionless (scaled by weights(); gives ~10 % open loop)."""
     transmission: float = 3.0
-    # tool motion at the cutting area per unit of stack stroke, dimensionless (assumed
-    # lever ratio of the spring-shaped member; see the module docstring)
+    """Tool motion at the cutting area per unit of stack stroke, dimensionless (assumed lever ratio
+    of the spring-shaped member; see the module docstring)."""
     bias_voltage_V: float = 50.0
-    # voltage at which the compensation is zero, V (assumed, one third of max_voltage_V so
-    # that the stroke works both ways; 0 = corrections away from the workpiece only)
+    """Voltage at which the compensation is zero, V (assumed, one third of max_voltage_V so that
+    the stroke works both ways; 0 = corrections away from the workpiece only)."""
     strategy: str = "reset"
-    # "reset": return to 0 V before each new voltage (paper); "direct": step to it
+    """"reset": return to 0 V before each new voltage (paper); "direct": step to it."""
 
     def __post_init__(self):
         if self.strategy not in STRATEGIES:
@@ -108,9 +108,9 @@ class ActuatorState:
     """Memory of the rate-independent model."""
 
     plays_V: tuple[float, ...]
-    # play-operator outputs z_i, V
+    """Play-operator outputs z_i, V."""
     gap_um: float
-    # play output of the seating gap (stroke domain), um
+    """Play output of the seating gap (stroke domain), um."""
 
 
 def weights(p: ActuatorParams) -> np.ndarray:

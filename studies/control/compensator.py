@@ -56,19 +56,19 @@ class CompensatorParams:
     """Settings of the prediction and compensation procedure."""
 
     sample_interval_s: float = 60.0
-    # controller sampling period, s (paper: 1 min); other data are resampled linearly
+    """Controller sampling period, s (paper: 1 min); other data are resampled linearly."""
     update_interval_s: float = 300.0
-    # piezo command refresh period, s, a whole multiple of sample_interval_s (paper: 5 min)
+    """Piezo command refresh period, s, a whole multiple of sample_interval_s (paper: 5 min)."""
     min_theory_um: float = 1.0
-    # hold R_i when |delta_th| is at or below this, um (10 x the 0.1 um sensor resolution)
+    """Hold R_i when |delta_th| is at or below this, um (10 x the 0.1 um sensor resolution)."""
     min_tie_bar_um: float = 1.0
-    # hold R_C when |K_C theta_C| is at or below this, um
+    """Hold R_C when |K_C theta_C| is at or below this, um."""
     peak_drop_um: float = 0.0
-    # drop below the running maximum of delta that confirms the first peak, um (paper: 0)
+    """Drop below the running maximum of delta that confirms the first peak, um (paper: 0)."""
     r_limits: tuple[float, float] | None = None
-    # clip range of R_i and R_C, dimensionless; None = no clipping (paper)
+    """Clip range of R_i and R_C, dimensionless; None = no clipping (paper)."""
     settle_s: float = 600.0
-    # summary bands ignore the first settle_s of the run, s (10 min)
+    """Summary bands ignore the first settle_s of the run, s (10 min)."""
 
     def __post_init__(self):
         ratio = self.update_interval_s / self.sample_interval_s if self.sample_interval_s > 0 else 0
@@ -84,23 +84,23 @@ class Prediction:
     """The procedure on the controller's sampling grid."""
 
     t_s: np.ndarray
-    # sample times, s
+    """Sample times, s."""
     delta_um: np.ndarray
-    # measured (uncompensated) delta_ex, um
+    """Measured (uncompensated) delta_ex, um."""
     delta_th_um: np.ndarray
-    # beam-theory delta_th (21), um
+    """Beam-theory delta_th (21), um."""
     delta_pred_um: np.ndarray
-    # predicted delta_et for each sample, made one sample earlier, um (NaN for the first two)
+    """Predicted delta_et for each sample, made one sample earlier, um (NaN for the first two)."""
     R_i: np.ndarray
-    # correction factor used for each sample's prediction, dimensionless
+    """Correction factor used for each sample's prediction, dimensionless."""
     R_C: np.ndarray
-    # tie-bar correction factor used for each sample's prediction, dimensionless
+    """Tie-bar correction factor used for each sample's prediction, dimensionless."""
     u_um: np.ndarray
-    # piezo command held between updates, -delta_et at the update instants, um
+    """Piezo command held between updates, -delta_et at the update instants, um."""
     peak_index: int | None
-    # grid index j of the first positive peak of delta, None if not recognised
+    """Grid index j of the first positive peak of delta, None if not recognised."""
     resampled: bool
-    # True if the input was linearly resampled onto the grid
+    """True if the input was linearly resampled onto the grid."""
 
 
 @dataclass(frozen=True)
@@ -108,25 +108,25 @@ class ClosedLoop:
     """Compensation evaluated at the input's own sample times."""
 
     prediction: Prediction
-    # the procedure on the controller grid
+    """The procedure on the controller grid."""
     t_s: np.ndarray
-    # input sample times, s
+    """Input sample times, s."""
     delta_um: np.ndarray
-    # uncompensated delta, um
+    """Uncompensated delta, um."""
     delta_pred_um: np.ndarray
-    # prediction, linearly interpolated from the grid where resampled, um
+    """Prediction, linearly interpolated from the grid where resampled, um."""
     u_um: np.ndarray
-    # held command, um
+    """Held command, um."""
     voltage_V: np.ndarray
-    # held piezo voltage, V (NaN for the ideal actuator)
+    """Held piezo voltage, V (NaN for the ideal actuator)."""
     stroke_um: np.ndarray
-    # held displacement achieved at the cutting area, um
+    """Held displacement achieved at the cutting area, um."""
     delta_comp_um: np.ndarray
-    # compensated delta = delta + stroke, um
+    """Compensated delta = delta + stroke, um."""
     update_t_s: np.ndarray
-    # times of the piezo updates, s: each sets the command to -delta_et of that instant
+    """Times of the piezo updates, s: each sets the command to -delta_et of that instant."""
     saturated_updates: int = 0
-    # piezo updates whose command was outside the actuator's reach (clipped); 0 if ideal
+    """Piezo updates whose command was outside the actuator's reach (clipped); 0 if ideal."""
 
 
 def extrapolate(previous, last):

@@ -33,11 +33,11 @@ class LinearModel:
     """``delta = intercept + sum_i coefficients[i] * rise(features[i])``."""
 
     features: tuple[str, ...]
-    # temperature columns whose rises are the regressors
+    """Temperature columns whose rises are the regressors."""
     coefficients: tuple[float, ...]
-    # one per feature, um/K
+    """One per feature, um/K."""
     intercept_um: float
-    # constant term, um
+    """Constant term, um."""
 
 
 def _least_squares(x: np.ndarray, y: np.ndarray, what: str) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The gatetherm time-series file (/work/shared/data-format.md, version 1).
+"""The gatetherm time-series file (docs/data-format.md, version 1).
 
 One CSV format for simulated and measured runs: ``# key: value`` metadata lines,
 one header row, then numbers; an empty field is a missing sample (NaN).
@@ -36,9 +36,9 @@ class TimeSeries:
     """A run: equally long float columns (NaN = missing) in file order, and metadata."""
 
     columns: dict[str, np.ndarray]
-    # column name -> values in the column's unit (s, degC, um, 0/1); read-only copies
+    """Column name -> values in the column's unit (s, degC, um, 0/1); read-only copies."""
     metadata: dict[str, str] = field(default_factory=dict)
-    # '# key: value' lines of the file, e.g. {"format": FORMAT, "condition": "2"}
+    """'# key: value' lines of the file, e.g. {"format": FORMAT, "condition": "2"}."""
 
     def __post_init__(self):
         cols = {}
@@ -124,7 +124,7 @@ def _parse_value(text: str, where: str) -> float:
 
 
 def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS) -> TimeSeries:
-    """Read and validate a time-series CSV; see the module docstring and data-format.md."""
+    """Read and validate a time-series CSV; see the module docstring and docs/data-format.md."""
     path = Path(path)
     with open(path, encoding="utf-8", newline="") as fh:
         lines = fh.read().splitlines()

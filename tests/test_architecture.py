@@ -1,0 +1,78 @@
+"""The layers: geometry → solvers → studies → validation → CLI, never back.
+
+Every import of every module (top level and inside functions) is read from the source;
+a module may import gatetherm modules of its own layer or earlier ones only. Numerics
+(geometry, solvers) import no plotting library.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+#: Source folder -> package it installs as (pyproject.toml's package-dir).
+FOLDERS = {"core": "gatetherm", "geometry": "gatetherm.geometry", "solvers": "gatetherm.solvers",
+           "studies": "gatetherm.studies", "validation": "gatetherm.validation"}
+LAYERS = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.validation",
+          "gatetherm.studies.cli")
+PLOTTING = ("matplotlib", "pyvista", "vtk", "vtkmodules")
+
+
+def layer(module: str) -> int:
+    """Index in :data:`LAYERS` of the longest layer prefix of ``module``."""
+    best = max((p for p in LAYERS if module == p or module.startswith(p + ".")), key=len)
+    return LAYERS.index(best)
+
+
+def modules() -> dict[str, Path]:
+    out = {}
+    for folder, package in FOLDERS.items():
+        for path in (ROOT / folder).rglob("*.py"):
+            parts = path.relative_to(ROOT / folder).with_suffix("").parts
+            parts = parts[:-1] if parts[-1] == "__init__" else parts
+            out[".".join((package, *parts))] = path
+    return out
+
+
+def imports(path: Path) -> set[str]:
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.add(node.module)
+            found |= {f"{node.module}.{a.name}" for a in node.names}  # "from pkg import module"
+    return found
+
+
+MODULES = modules()
+
+
+def test_every_package_folder_is_mapped():
+    assert {"gatetherm.studies.cli", "gatetherm.studies.run", "gatetherm.solvers.heat"} <= set(MODULES)
+    assert "gatetherm.validation.plots" in MODULES and len(MODULES) > 50
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_back_edges(name):
+    own = layer(name)
+    later = sorted(m for m in imports(MODULES[name])
+                   if (m == "gatetherm" or m.startswith("gatetherm.")) and m in MODULES and layer(m) > own)
+    assert not later, f"{name} ({LAYERS[own]}) imports later layers: {later}"
+
+
+@pytest.mark.parametrize("name", sorted(m for m in MODULES if layer(m) <= LAYERS.index("gatetherm.solvers")))
+def test_numerics_do_not_plot(name):
+    bad = sorted(m for m in imports(MODULES[name]) if m.split(".")[0] in PLOTTING)
+    assert not bad, f"{name} imports {bad}"
+
+
+def test_the_walk_sees_a_back_edge(tmp_path):
+    """The checker itself: a library module importing the CLI is caught."""
+    path = tmp_path / "bad.py"
+    path.write_text("def f():\n    from gatetherm.studies.cli import main\n    from gatetherm.validation import plots\n")
+    assert {"gatetherm.studies.cli.main", "gatetherm.validation.plots"} <= imports(path)
+    assert layer("gatetherm.studies.cli.simulate") > layer("gatetherm.validation.paper_table") \
+        > layer("gatetherm.studies.run.scenario")
