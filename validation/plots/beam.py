@@ -8,7 +8,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from gatetherm import atomic_path
+from gatetherm.validation.plots import save
 
 KI_LABEL = r"$K_i\,/\,(3\alpha l^2/8h)$  ($l_1 = l/2$)"
 KC_LABEL = r"$K_C\,/\,(\alpha l_C)$  ($l_1 = l/2$)"
@@ -36,9 +36,7 @@ def _plot_one(theory_a, curves: Mapping, fe_points: Mapping | None, ylabel: str,
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3)
     ax.legend(fontsize="small", ncol=2)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    save(fig, path)
 
 
 def plot_ki_kc(theory_a, theory: Mapping, fe: Mapping | None,

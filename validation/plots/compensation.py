@@ -9,15 +9,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from gatetherm import atomic_path
 from gatetherm.studies.control import actuator as piezo
 from gatetherm.studies.control.compensator import ClosedLoop
-
-
-def _save(fig: Figure, path: str | os.PathLike) -> None:
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+from gatetherm.validation.plots import save
 
 
 def plot_compensation(loop: ClosedLoop, path: str | os.PathLike) -> None:
@@ -46,7 +40,7 @@ def plot_compensation(loop: ClosedLoop, path: str | os.PathLike) -> None:
         ax.grid(True, lw=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize="small")
-    _save(fig, path)
+    save(fig, path)
 
 
 def plot_piezo_loops(params: piezo.ActuatorParams, path: str | os.PathLike, steps: int = 30) -> dict:
@@ -76,7 +70,7 @@ def plot_piezo_loops(params: piezo.ActuatorParams, path: str | os.PathLike, step
     axes[0].set_ylabel("stroke / µm")
     axes[0].set_xlim(0, params.max_voltage_V * 1.02)
     axes[0].set_ylim(bottom=min(0.0, float(np.min(stroke))) - 0.5)
-    _save(fig, path)
+    save(fig, path)
     return widths
 
 
@@ -105,4 +99,4 @@ def plot_condition_study(title: str, loops: dict[str, ClosedLoop], path: str | o
         ax.legend(fontsize="x-small", ncol=2)
     for ax in axes:
         ax.grid(True, lw=0.3)
-    _save(fig, path)
+    save(fig, path)

@@ -11,17 +11,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from gatetherm import atomic_path  # noqa: E402
 from gatetherm.studies.diagnosis.locate import significant, smooth, threshold  # noqa: E402
 from gatetherm.studies.diagnosis.replay import label, resolution, unit  # noqa: E402
+from gatetherm.validation.plots import save  # noqa: E402
 
 PHASE_COLOURS = {"pump off": "#dddddd", "heating": "#f6d5c8", "forced cooling": "#cfe0f3"}
-
-
-def _save(fig, path: Path) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110)
-    plt.close(fig)
 
 
 def _phases(ax, diag, names: bool) -> None:
@@ -59,7 +53,7 @@ def plot_residuals(diag, path: Path) -> None:
     axes[-1, 0].set_xlabel("time (h)   — dashed: end of the training window")
     fig.suptitle("Residual of the baseline model", y=0.995)
     fig.tight_layout()
-    _save(fig, path)
+    save(fig, path, dpi=110, tight=False)
 
 
 def plot_before_after(diag, path: Path) -> None:
@@ -83,7 +77,7 @@ def plot_before_after(diag, path: Path) -> None:
     axes[-1, 0].set_xlabel("time (h), held-out window")
     fig.suptitle(f"Held-out residual before and after: {name}", y=0.995)
     fig.tight_layout()
-    _save(fig, path)
+    save(fig, path, dpi=110, tight=False)
 
 
 def plot_scores(diag, path: Path) -> None:
@@ -101,4 +95,4 @@ def plot_scores(diag, path: Path) -> None:
     ax.set_xlabel(f"1 + score − best score  (χ² + k ln n, held-out window; dotted: margin {diag.margin_min:g})")
     ax.set_title("Candidates (green: explains the held-out data)", fontsize=10)
     fig.tight_layout()
-    _save(fig, path)
+    save(fig, path, dpi=110, tight=False)

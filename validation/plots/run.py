@@ -8,12 +8,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from gatetherm import atomic_path  # noqa: E402
-
-
-def _save(fig, path) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
+from gatetherm.validation.plots import save  # noqa: E402
 
 
 def _pump_shading(ax, t_min, pump) -> None:
@@ -35,7 +30,7 @@ def plot_oil(cols: dict, path, title: str) -> None:
     ax.set(xlabel="time [min]", ylabel="temperature [°C]", title=f"{title}\n(grey: pump on)")
     ax.legend()
     ax.grid(alpha=0.3)
-    _save(fig, path)
+    save(fig, path, tight=False)
 
 
 def plot_response(cols: dict, path, title: str) -> None:
@@ -56,7 +51,7 @@ def plot_response(cols: dict, path, title: str) -> None:
     a2.set(xlabel="time [min]", ylabel="δ [µm] (+ = approach)")
     a2.legend()
     a2.grid(alpha=0.3)
-    _save(fig, path)
+    save(fig, path, tight=False)
 
 
 def render_deformed(grid, path, title: str, scale: float) -> None:

@@ -7,21 +7,14 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter, ScalarFormatter
+from gatetherm.validation.plots import save
 
-from gatetherm import atomic_path
 
 
 def new_axes(figsize=(6.0, 4.2)):
     fig = Figure(figsize=figsize)
     FigureCanvasAgg(fig)
     return fig, fig.add_subplot()
-
-
-def save(fig, path: str | os.PathLike) -> None:
-    """Tight layout and an atomic PNG."""
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
 
 
 def _num(v) -> float:
