@@ -2,7 +2,7 @@
 
 Each section of a model file mirrors one parameter dataclass (:data:`SCHEMA`); unknown
 keys and wrong types are errors. ``[effects]`` switches on catalogue effects as
-``NAME = {PARAM = VALUE}``. :func:`config_toml` writes a file that :func:`load_config`
+``NAME = {PARAM = VALUE}``, ``[sensors]`` sets sensor faults as ``CHANNEL = {FAULT = VALUE}``. :func:`config_toml` writes a file that :func:`load_config`
 reads back to the same :class:`Config`.
 """
 from __future__ import annotations
@@ -23,6 +23,7 @@ from gatetherm.geometry.frame import FrameParams, MeshParams, validate, validate
 from gatetherm.solvers.effects import effects_from_table, effects_table
 from gatetherm.solvers.heat import ThermalParams, TimeScheme
 from gatetherm.solvers.material import Material
+from gatetherm.solvers.sensors import faults_from_table, faults_table_lines
 from gatetherm.solvers.model import ModelConfig
 from gatetherm.studies.run.conditions import SupplyParams
 
@@ -41,6 +42,8 @@ class Config:
     """Where the configuration came from (a file path, or ``gatetherm:paper.toml``)."""
     effects: dict = field(default_factory=dict)
     """Catalogue effects switched on, {name: value} (``[effects]``: ``NAME = {PARAM = VALUE}``)."""
+    sensors: dict = field(default_factory=dict)
+    """Sensor faults, {channel: {fault: value}} (``[sensors]``: ``CHANNEL = {FAULT = VALUE}``)."""
 
 
 @dataclass(frozen=True)
@@ -67,7 +70,7 @@ SCHEMA = (
     Section("model.scheme", ("model", "scheme"), TimeScheme),
 )
 """The model file, section by section, in the order :func:`config_toml` writes it."""
-SECTION_NAMES = tuple(s.name for s in SCHEMA) + ("effects",)
+SECTION_NAMES = tuple(s.name for s in SCHEMA) + ("effects", "sensors")
 
 
 def _get(obj, path):
@@ -138,7 +141,8 @@ def parse_config(data: dict, source: str = "<dict>", base: Config | None = None)
     if cfg.model.order not in (1, 2):
         raise InputError("model.order", f"must be 1 or 2, got {cfg.model.order}")
     effects = {**cfg.effects, **effects_from_table(data.get("effects", {}))}
-    return dataclasses.replace(cfg, source=source, effects=effects)
+    sensors = {**cfg.sensors, **faults_from_table(data.get("sensors", {}))}
+    return dataclasses.replace(cfg, source=source, effects=effects, sensors=sensors)
 
 
 def load_config(path: str | os.PathLike | None = None) -> Config:
@@ -186,4 +190,6 @@ def config_toml(cfg: Config, header: str = "") -> str:
     if cfg.effects:
         lines += ["[effects]"] + [f"{name} = {{ {p} = {_value(v)} }}"
                                   for name, table in effects_table(cfg.effects).items() for p, v in table.items()]
+        lines += [""]
+    lines += faults_table_lines(cfg.sensors)
     return "\n".join(lines).rstrip("\n") + "\n"

@@ -1,4 +1,5 @@
-"""The one scenario path: apply effects → build (or reuse) the model → run → observe.
+"""The one scenario path: apply effects → build (or reuse) the model → run → observe
+(the catalogue's observation-side effects, then the sensor faults of ``Config.sensors``).
 
 Every command and study runs a model through :func:`run_scenario` (or, when it needs
 the assembled model without a run, :func:`prepare`), so that the effects of a model
@@ -18,6 +19,7 @@ import numpy as np
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
 from gatetherm.solvers.heat import Drive, HeatSolver
+from gatetherm.solvers.sensors import apply_faults
 from gatetherm.solvers.model import FrameModel, ModelConfig, build_model
 from gatetherm.studies.run.conditions import condition, condition_drive, table_drive
 from gatetherm.studies.run.config import Config
@@ -90,7 +92,7 @@ class ScenarioCache:
             return model, HeatSolver(model.heat)
         return self._lru(self._models, (repr(cfg), dim), make)
 
-    def result(self, key, make: Callable[[], RunResult]) -> RunResult:
+    def result(self, key, make: Callable[[], tuple[RunResult, FrameModel]]) -> tuple[RunResult, FrameModel]:
         def counted():
             self.runs += 1
             return make()
@@ -147,16 +149,20 @@ def run_scenario(config: Config, dim: int, schedule: Schedule, effects: Mapping[
     through ``schedule``; keep full states at ``keep_times``. With a ``cache`` the model,
     its factorisations and (for a plain run from the initial state) the run itself are reused."""
     t0 = time.perf_counter()
-    p = prepare(config, dim, schedule.drive, effects, cache=cache, mesh=mesh)
-
-    def run() -> RunResult:
-        return run_model(p.model, p.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver)
-
     if cache is not None and U0 is None and not keep_times:
-        drive_side = tuple(sorted((k, v) for k, v in p.effects.values.items() if CATALOGUE[k].acts_on == "drive"))
-        key = (repr(p.model.config), dim, drive_side, schedule.label, schedule.times.tobytes())
-        result = cache.result(key, run)
+        eff = ActiveEffects({**config.effects, **dict(effects or {})})
+        model_cfg, _ = apply_effects(config.model, schedule.drive, eff, dim)
+        drive_side = tuple(sorted((k, v) for k, v in eff.values.items() if CATALOGUE[k].acts_on == "drive"))
+        key = (repr(model_cfg), dim, drive_side, schedule.label, schedule.times.tobytes())
+
+        def run() -> tuple[RunResult, FrameModel]:
+            p = prepare(config, dim, schedule.drive, effects, cache=cache)
+            return run_model(p.model, p.drive, schedule.times, (), on_step, solver=p.solver), p.model
+
+        result, model = cache.result(key, run)  # a kept run is observed again without building the model
     else:
-        result = run()
-    return ScenarioRun(p.effects.observe(result.columns), result, p.model, p.effects, schedule,
-                       time.perf_counter() - t0)
+        p = prepare(config, dim, schedule.drive, effects, cache=cache, mesh=mesh)
+        eff, model = p.effects, p.model
+        result = run_model(p.model, p.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver)
+    columns = apply_faults(eff.observe(result.columns), config.sensors)
+    return ScenarioRun(columns, result, model, eff, schedule, time.perf_counter() - t0)
