@@ -13,16 +13,18 @@ import numpy as np
 import pytest
 
 from gatetherm.geometry.frame import MeshParams
-from gatetherm.studies.diagnosis.calibrate import Fit
+from gatetherm.studies.diagnosis.calibrate import Scored
 from gatetherm.studies.cli import main
 from gatetherm.solvers.model import build_model
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config
-from gatetherm.studies.diagnosis.discrepancy import Candidate, Settings, adopted_config, decide, diagnose
+from gatetherm.studies.diagnosis.discrepancy import Settings, _verdict, adopted_config, diagnose
+from gatetherm.studies.diagnosis.hypotheses import effect_pieces
+from gatetherm.studies.diagnosis.select import Selection
 from gatetherm.studies.diagnosis.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
 from gatetherm.studies.run.config import config_toml
 from gatetherm.studies.run.simulate import run_model
-from gatetherm.studies.diagnosis.replay import Hypothesis, Replayer, compared_channels, residuals
+from gatetherm.studies.diagnosis.replay import Replayer, compared_channels, residuals
 from gatetherm.studies.run.timeseries import write_timeseries
 from gatetherm.validation.hidden_effects import Case, measured, truth
 
@@ -77,22 +79,16 @@ def test_locate_flags_only_the_disturbed_phase():
     assert not significant(t, rng.normal(0, 0.1, len(t)), 0.1).any()
 
 
-def _cand(name, score, explains, k=1):
-    return Candidate(Fit(name, Hypothesis(), k, {}, {}, 0.0), score, {"delta_um": 0.1}, explains)
-
-
 def test_verdict_rules():
-    base = _cand("baseline", 5000.0, False, 0)
-    eff, other = _cand("piezo_heat", 500.0, True), _cand("stand_drift", 900.0, False)
-    recal = _cand("recalibration", 800.0, True, 4)
-    assert decide(base, [], False, 10.0)[0] == "no-discrepancy"
-    assert decide(base, [eff, recal, other], True, 10.0)[:4] == ("missing-effect", "piezo_heat", "recalibration", 300.0)
-    close = _cand("stand_drift", 505.0, True)
-    assert decide(base, [eff, close], True, 10.0)[:3] == ("unexplained", None, "stand_drift")
-    assert decide(base, [eff, close, recal], True, 10.0)[0] == "parameter-mismatch"
-    assert decide(base, [recal, other], True, 10.0)[:2] == ("parameter-mismatch", None)
-    none = decide(base, [_cand("piezo_heat", 600.0, False), other], True, 10.0)
-    assert none[:3] == ("unexplained", None, "piezo_heat") and "no candidate explains" in none[4]
+    base = Scored({}, 900.0, 900.0, {"delta_um": 1.0}, False)
+    piece = effect_pieces(("piezo_heat",))[0]
+    some = Scored({piece: 2.0}, 300.0, 306.0, {"delta_um": 0.4}, False)
+    assert _verdict(False, Selection(base, base, []))[0] == "no-discrepancy"
+    assert _verdict(True, Selection(base, base, []))[0] == "unexplained"
+    assert _verdict(True, Selection(base, some, [piece]))[0] == "partly-explained"
+    done = Scored({piece: 2.0}, 0.0, 6.0, {"delta_um": 0.1}, True)
+    assert _verdict(True, Selection(base, done, [piece])) == ("explained", "piezo_heat leave no significant "
+                                                                "held-out residual")
 
 
 def test_replay_reproduces_a_simulation(coarse_config):
@@ -120,15 +116,17 @@ def test_model_file_round_trip(tmp_path):
 
 def test_noise_only_is_no_discrepancy(coarse_config):
     d = diagnose(coarse_config, _measured(coarse_config, "none", 0.0, seed=11))
-    assert (d.verdict, d.named_effect, d.runs) == ("no-discrepancy", None, 1)
+    assert (d.verdict, d.pieces, d.named_effects, d.runs) == ("no-discrepancy", (), [], 1)
     assert d.summary()["rms_before_um"] == pytest.approx(0.1, rel=0.25)
 
 
 def test_names_a_hidden_effect(coarse_config):
     ts = _measured(coarse_config, "piezo_heat", 3.0)
-    d = diagnose(coarse_config, ts, settings=Settings(effects=("piezo_heat", "stand_drift"), recalibrate=False))
+    d = diagnose(coarse_config, ts, settings=Settings(effects=("piezo_heat", "stand_drift"), parameters=(),
+                                                       sensors=False))
     s = d.summary()
-    assert (d.verdict, d.named_effect, d.runner_up) == ("missing-effect", "piezo_heat", "stand_drift")
+    assert (d.verdict, d.named_effects, s["best_rejected"]) == ("explained", ["piezo_heat"], None)
+    assert [p["kind"] for p in s["pieces"]] == ["effect"] and s["pieces"][0]["share_of_residual"] == pytest.approx(1)
     assert s["fitted"]["piezo_heat.power"] == pytest.approx(3.0, rel=0.05)
     assert s["uncertainty"]["piezo_heat.power"] < 0.1
     assert s["rms_after_um"] < 0.3 * s["rms_before_um"]
@@ -138,7 +136,12 @@ def test_names_a_hidden_effect(coarse_config):
 def test_list_effects_json(capsys):
     assert main(["diagnose", "--list-effects", "--json"]) == 0
     listed = json.loads(capsys.readouterr().out)
-    assert {"name", "params"} <= set(listed[0]) and len(listed) >= 6
+    assert {"kind", "name", "params"} <= set(listed[0]) and {d["kind"] for d in listed} == {"effect", "parameter",
+                                                                                             "sensor"}
+    k = next(d for d in listed if d["name"] == "conductivity")
+    assert k["params"]["k"]["unit"] == "W/(m K)" and k["params"]["k"]["range"][0] < 48 < k["params"]["k"]["range"][1]
+    offsets = [d for d in listed if d["name"] == "sensor_offset"]
+    assert {d["channel"] for d in offsets} == {"theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um"}
     assert main(["diagnose", "--data", "x.csv"]) == 2
 
 
@@ -148,16 +151,16 @@ def test_parameter_mismatch(coarse_config):
     wrong = dataclasses.replace(coarse_config, model=dataclasses.replace(
         coarse_config.model, thermal=dataclasses.replace(th, h_oil_on=th.h_oil_on * 1.6)))
     d = diagnose(coarse_config, _measured(wrong, "none", 0.0, condition=2))
-    assert (d.verdict, d.named_effect) == ("parameter-mismatch", None)
-    fit, sd = d.adopted.fit.values, d.adopted.fit.sigma
-    assert abs(fit["h_oil_on"] - 1.6 * th.h_oil_on) < max(3 * sd["h_oil_on"], 0.05 * th.h_oil_on)
+    assert (d.verdict, [r.piece.name for r in d.pieces], d.named_effects) == ("explained", ["oil_film_on"], [])
+    r = d.pieces[0]
+    assert abs(r.value - 1.6 * th.h_oil_on) < max(3 * r.sigma, 0.05 * th.h_oil_on)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("effect, strength", [("tie_heat_leak", 1.5), ("sensor_height", 0.04)])
-def test_outside_catalogue_is_unexplained(coarse_config, effect, strength):
+def test_outside_catalogue_names_no_effect(coarse_config, effect, strength):
     d = diagnose(coarse_config, _measured(coarse_config, effect, strength))
-    assert (d.verdict, d.named_effect) == ("unexplained", None)
+    assert d.verdict in ("unexplained", "partly-explained") and d.named_effects == []
 
 
 @pytest.mark.slow
@@ -166,13 +169,13 @@ def test_cli_end_to_end(coarse_config, tmp_path):
     write_timeseries(data, _measured(coarse_config, "stand_drift", 1.0, condition=2))
     out = tmp_path / "diag"
     assert main(["diagnose", "--data", str(data), "--out", str(out), "--mesh-size", "0.02",
-                 "--effects", "stand_drift,piezo_heat,compliant_base"]) == 0
+                 "--effects", "stand_drift,piezo_heat,compliant_base", "--parameters", "air_film"]) == 0
     s = json.loads((out / "diagnosis.json").read_text())
-    for key in ("named_effect", "verdict", "runner_up", "margin", "rms_before_um", "rms_after_um", "fitted"):
+    for key in ("verdict", "pieces", "named_effects", "best_rejected", "rms_before_um", "rms_after_um", "fitted"):
         assert key in s
-    assert (s["verdict"], s["named_effect"]) == ("missing-effect", "stand_drift")
+    assert (s["verdict"], s["named_effects"]) == ("explained", ["stand_drift"])
     assert s["fitted"]["stand_drift.coefficient"] == pytest.approx(1.0, rel=0.05)
     assert load_config(out / "model.toml").effects == {"stand_drift": s["fitted"]["stand_drift.coefficient"]}
     report = (out / "report.md").read_text()
-    assert "missing-effect" in report and "before_after.png" in report
+    assert "explained" in report and "before_after.png" in report and "Round 1" in report
     assert all((out / f).is_file() for f in ("residuals.png", "scores.png", "before_after.png"))

@@ -1,10 +1,11 @@
-"""``gatetherm diagnose``: where a model and a measured run disagree, which catalogue
-effect the model misses, and how much better it gets with it.
+"""``gatetherm diagnose``: where a model and a measured run disagree, which pieces the model
+misses (catalogue effects, existing parameters off, sensor faults), and how much better
+it gets with them.
 
 Writes, once everything is computed: ``DIR/residuals.png``, ``DIR/scores.png``,
-``DIR/before_after.png`` and ``DIR/model.toml`` (when a hypothesis is adopted),
+``DIR/before_after.png`` and ``DIR/model.toml`` (when pieces were found),
 ``DIR/report.md``, and last ``DIR/diagnosis.json``. ``--list-effects [--json]``
-prints the effect catalogue instead.
+prints the hypotheses instead.
 """
 from __future__ import annotations
 
@@ -16,51 +17,75 @@ import math
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.solvers.effects import CATALOGUE, catalogue_json
 from gatetherm.studies.cli.options import add_model_options
 
 log = logging.getLogger(__name__)
 
+DIM_HELP = ("2 only: the diagnosis replays the 2-D section model. Given a 3-D measurement it also sees the "
+            "2-D/3-D model-form difference (README, 'Discrepancy diagnosis': a no-effect 3-D run gives a "
+            "significant residual that pieces can only partly absorb), so read its pieces as 'what makes the "
+            "section model fit', not as the machine's faults")
+
 
 def register(sub) -> None:
-    p = sub.add_parser("diagnose", help="find where a model and a measured run disagree and name the missing effect",
+    p = sub.add_parser("diagnose", help="find where a model and a measured run disagree and name the missing pieces",
                        description="Replay a measured run (gatetherm time-series file) through the model, locate "
-                       "significant residuals, recalibrate, fit every catalogue effect on a training window, score "
-                       "them on the held-out rest and name the one that explains the data, if any.")
+                       "significant residuals, then select, by forward selection with held-out evidence, the "
+                       "catalogue effects, existing parameters and sensor faults that explain them.")
     p.add_argument("--data", metavar="MEASURED.csv", help="measured run in the gatetherm time-series format")
-    add_model_options(p, dims=(2,))
+    add_model_options(p, dims=(2,), dim_help=DIM_HELP)
     p.add_argument("--out", metavar="DIR", help="output directory")
     p.add_argument("--train-fraction", type=float, default=0.6, metavar="F",
                    help="fit on the first F of the run, score on the rest (default 0.6: 3 h of 5 h)")
-    p.add_argument("--effects", metavar="NAME,...", help="candidate effects (default: the whole catalogue)")
+    p.add_argument("--effects", metavar="NAME,...", help="candidate catalogue effects (default: all; 'none': no effect)")
+    p.add_argument("--parameters", metavar="NAME,...",
+                   help="candidate existing parameters (default: all; 'none': no parameter)")
+    p.add_argument("--no-sensors", action="store_true", help="do not try sensor faults")
     p.add_argument("--mesh-size", type=float, metavar="M",
                    help="element size of the diagnosis mesh, m (default: the model file's)")
-    p.add_argument("--list-effects", action="store_true", help="list the effect catalogue and exit")
+    p.add_argument("--list-effects", action="store_true",
+                   help="list the hypotheses (effects, parameters, sensor faults) and exit")
     p.add_argument("--json", action="store_true", help="with --list-effects: print JSON")
     p.set_defaults(func=run)
 
 
-def list_effects(as_json: bool) -> str:
+def list_effects(config, as_json: bool) -> str:
+    from gatetherm.studies.diagnosis.hypotheses import catalogue
+    from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
+
+    pieces = catalogue(config, OUTPUT_COLUMNS)
     if as_json:
-        return json.dumps(catalogue_json(), indent=2)
-    rows = [f"{'effect':<18} {'parameter':<12} {'plausible range':<17} {'unit':<9} acts on"]
-    for e in CATALOGUE.values():
-        rows += [f"{e.name:<18} {e.param:<12} {f'{e.lo:g} … {e.hi:g}':<17} {e.unit:<9} {e.acts_on}",
-                 f"{'':<19}{e.doc}"]
+        return json.dumps([p.describe() for p in pieces], indent=2)
+    rows = [f"{'kind':<10} {'name':<34} {'parameter':<12} {'plausible range':<23} {'unit':<9}"]
+    for p in pieces:
+        rows.append(f"{p.kind:<10} {p.label:<34} {p.param:<12} {f'{p.lo:.4g} … {p.hi:.4g}':<23} {p.unit:<9}")
+        if p.kind != "sensor":
+            rows.append(f"{'':<11}{p.doc}")
+    rows.append("Sensor faults are tried on every compared channel of the file (further T_<name>_degC too).")
     return "\n".join(rows)
 
 
-def settings_from(args):
-    """Workflow settings from the command line (checked by :func:`studies.discrepancy.diagnose`)."""
-    from gatetherm.studies.diagnosis.discrepancy import Settings
+def _names(text: str | None, default: tuple) -> tuple:
+    if text is None:
+        return default
+    return () if text.strip() == "none" else tuple(e.strip() for e in text.split(",") if e.strip())
 
-    names = tuple(e.strip() for e in (args.effects or "").split(",") if e.strip())
-    return Settings(train_fraction=args.train_fraction, effects=names or tuple(CATALOGUE))
+
+def settings_from(args):
+    """Workflow settings from the command line (checked by :func:`diagnose`)."""
+    from gatetherm.solvers.effects import CATALOGUE
+    from gatetherm.studies.diagnosis.discrepancy import Settings
+    from gatetherm.studies.diagnosis.hypotheses import PARAMETER_DEFS
+
+    return Settings(train_fraction=args.train_fraction, effects=_names(args.effects, tuple(CATALOGUE)),
+                    parameters=_names(args.parameters, tuple(PARAMETER_DEFS)), sensors=not args.no_sensors)
 
 
 def run(args: argparse.Namespace) -> int:
+    from gatetherm.studies.run.config import load_config
+
     if args.list_effects:
-        print(list_effects(args.json))
+        print(list_effects(load_config(args.config), args.json))
         return 0
     if args.json:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")
@@ -69,7 +94,6 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError("--out", f"{out} exists and is not a directory", "give a directory path")
-    from gatetherm.studies.run.config import load_config
     from gatetherm.studies.diagnosis.discrepancy import adopted_config, diagnose
     from gatetherm.studies.run.timeseries import read_timeseries
 
@@ -84,8 +108,13 @@ def run(args: argparse.Namespace) -> int:
     diag = diagnose(cfg, ts, args.dim, mesh, settings)
     _write(args, cfg, diag, adopted_config(cfg, diag), out)
     s = diag.summary()
-    print(f"verdict: {diag.verdict}" + (f" ({diag.named_effect})" if diag.named_effect else "")
-          + f"; runner-up {diag.runner_up}, margin {s['margin'] if s['margin'] is None else round(s['margin'], 1)}")
+    print(f"verdict: {diag.verdict}")
+    for r in diag.pieces:
+        print(f"  {r.piece.kind} {r.piece.label}: {r.piece.param} = {r.value:.4g} ± {r.sigma:.2g} {r.piece.unit}, "
+              f"{100 * r.share:.0f} % of the held-out residual"
+              + (f" (or: {', '.join(q.label for q in r.alternatives)})" if r.alternatives else ""))
+    if s["best_rejected"]:
+        print(f"best rejected: {s['best_rejected']} (gain {s['margin']:.1f} < margin {diag.margin_min:g})")
     if s["rms_after_um"] is not None:
         print(f"held-out RMS of delta: {s['rms_before_um']:.3g} um -> {s['rms_after_um']:.3g} um")
     print(f"wrote {out}/report.md, diagnosis.json ({diag.runs} model runs, {diag.seconds:.0f} s)")
@@ -101,15 +130,15 @@ def _write(args, cfg, diag, adopted, out: Path) -> None:
 
     files = {"residuals": "residuals.png"}
     plot_residuals(diag, out / files["residuals"])
-    if diag.candidates:
+    if diag.rounds:
         files["scores"] = "scores.png"
         plot_scores(diag, out / files["scores"])
     if adopted is not None:
         files["before_after"] = "before_after.png"
         plot_before_after(diag, out / files["before_after"])
         files["model"] = str(out / "model.toml")
-        head = (f"gatetherm diagnose of {args.data}: verdict {diag.verdict}"
-                + (f", effect {diag.named_effect}" if diag.named_effect else "") + f"\nbase model: {cfg.source}")
+        head = (f"gatetherm diagnose of {args.data}: verdict {diag.verdict}, pieces "
+                + ", ".join(r.piece.label for r in diag.pieces) + f"\nbase model: {cfg.source}")
         write_text_atomic(out / "model.toml", config_toml(adopted, head))
     write_text_atomic(out / "report.md", report_markdown(diag, str(args.data), cfg.source, files))
     write_json(out / "diagnosis.json", {**diag.summary(), "data": str(args.data), "config": cfg.source,

@@ -6,9 +6,9 @@ import os
 import sys
 
 
-def add_model_options(p: argparse.ArgumentParser, dims=(2, 3)) -> None:
+def add_model_options(p: argparse.ArgumentParser, dims=(2, 3), dim_help: str = "2-D section or 3-D solid (default 2)") -> None:
     """``--dim`` and ``--config``, shared by the commands that build a model."""
-    p.add_argument("--dim", type=int, choices=dims, default=2, help="2-D section or 3-D solid (default 2)")
+    p.add_argument("--dim", type=int, choices=dims, default=2, help=dim_help)
     p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
 
 

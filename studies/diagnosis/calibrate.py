@@ -1,175 +1,300 @@
-"""Fit a model to a measured run on a training window.
+"""Fit hypotheses to a measured run on a training window; score them on the held-out rest.
 
-Two kinds of fit, both on residuals weighted by the channels' noise scale
-(at least the sensor resolution):
+Residuals (measured − model) are weighted per channel by 1/noise scale (at least the
+sensor resolution) and by a channel-group weight (:func:`group_weights`): the
+displacement channels together weigh as much as the thermocouples together.
 
-* recalibration of the model's existing uncertain parameters, jointly by
-  bounded least squares (film coefficient to air, tank-wall film with the pump
-  on and off, initial frame temperature), with 1-σ uncertainties from the
-  Jacobian;
-* one catalogue effect at a time: a coarse scan of its plausible range and a
-  bounded 1-D search (log scale for positive parameters) around the best point.
+*Score* of a set of hypotheses with k parameters, on the held-out window:
+``Σ_c w_c n_c ln max(χ̄²_c, 1) + k ln N``, with χ̄²_c the mean squared weighted residual of
+channel c over its n_c held-out samples, w_c the group weight and N = Σ w_c n_c: the
+Gaussian log-likelihood of each channel with its own unknown noise level, floored at
+the sensor noise. A channel's residual counts by the *factor* a hypothesis takes off
+it, not by its size in kelvin or micrometres, so a large temperature residual cannot
+hide the hypothesis that explains δ.
+
+*Fits*, on the training window, by weighted least squares: sensor offsets, gains and
+drifts in closed form for every value of the other parameters (variable projection);
+one new hypothesis by a scan of its plausible range (effects) and Gauss–Newton steps on
+secant slopes (one model run each) from the best point or the model's value; all
+chosen hypotheses jointly by bounded least squares from their current values; 1-σ
+uncertainties from the Jacobian.
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 
-from gatetherm.solvers.effects import CATALOGUE
-from gatetherm.studies.diagnosis.replay import Hypothesis, Replayer, residuals
+from gatetherm.solvers.sensors import ORDER, apply_fault
+from gatetherm.studies.diagnosis.hypotheses import Piece, configure, model_side
+from gatetherm.studies.diagnosis.locate import significant
+from gatetherm.studies.diagnosis.replay import Replayer, resolution
 from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
 
+SCAN = 5
+"""Points of the coarse scan of an effect's range (model runs)."""
+CHEAP_SCAN = 9
+"""Points of the scan of a hypothesis that needs no model run."""
+SECANT_STEP = 0.02
+"""First step of a local search, as a fraction of the plausible range."""
+
+
+def group_weights(channels) -> dict[str, float]:
+    """Channel weights: every group (``_degC`` thermocouples, ``_um`` displacements) weighs
+    the same in total, and the weights sum to the number of channels."""
+    group = {c: c.rsplit("_", 1)[-1] for c in channels}
+    n_groups = len(set(group.values()))
+    return {c: len(channels) / (n_groups * sum(g == group[c] for g in group.values())) for c in channels}
+
+
+def coordinate(p: Piece):
+    """(to, back): value ↔ position in [0, 1] across the plausible range (log for positive ranges)."""
+    if p.log_scale:
+        a, b = np.log(p.lo), np.log(p.hi)
+        return (lambda v: (np.log(v) - a) / (b - a)), (lambda x: float(np.exp(a + x * (b - a))))
+    return (lambda v: (v - p.lo) / (p.hi - p.lo)), (lambda x: float(p.lo + x * (p.hi - p.lo)))
+
 
 @dataclass(frozen=True)
-class RecalParam:
-    """An existing model parameter (a ``ThermalParams`` field) and how far it may move."""
+class Scored:
+    """A set of hypotheses with values, scored on the held-out window."""
 
-    name: str
-    unit: str
-    kind: str
-    """"log": searched as log(value / nominal) within ±log(bound); "shift": nominal ± bound."""
-    bound: float
-    doc: str
+    values: dict
+    """{Piece: value}."""
+    fit: float
+    """Held-out score without the penalty."""
+    score: float
+    """``fit + k ln N``."""
+    rms: dict
+    """Held-out RMS residual per channel (channel unit)."""
+    explains: bool
+    """No channel keeps a significant held-out residual."""
+    approx: bool = False
+    """Scored from superposed earlier runs (screening), not from a run of the set itself."""
+
+    @property
+    def k(self) -> int:
+        return len(self.values)
 
 
-RECAL = (
-    RecalParam("h_air", "W/(m2 K)", "log", 4.0, "film coefficient of the free surfaces to room air"),
-    RecalParam("h_oil_on", "W/(m2 K)", "log", 5.0, "tank-wall film coefficient, pump on"),
-    RecalParam("h_oil_off", "W/(m2 K)", "log", 5.0, "tank-wall film coefficient, pump off"),
-    RecalParam("T0", "degC", "shift", 3.0, "initial temperature of frame and oil (room unchanged)"),
-)
-
-
-@dataclass
 class Objective:
-    """Weighted residuals of hypotheses on a window of a measured run (memoised)."""
+    """Residuals of hypotheses on the training and held-out windows of a measured run.
+    Model runs are memoised by their model-side hypotheses; sensor faults act on them."""
 
-    replayer: Replayer
-    measured: TimeSeries
-    channels: tuple[str, ...]
-    scale: dict[str, float]
-    """Noise scale per channel (channel unit), the residual weight is 1/scale."""
-    mask: np.ndarray
-    """Samples of the fitting window."""
-    _memo: dict = dataclasses.field(default_factory=dict, repr=False)
+    def __init__(self, replayer: Replayer, measured: TimeSeries, channels, scale: dict, train: np.ndarray):
+        self.replayer, self.channels, self.scale = replayer, tuple(channels), scale
+        self.train, self.held = train, ~train
+        self.t = replayer.times
+        self.y = {c: np.asarray(measured[c], dtype=float) for c in self.channels}
+        self.weight = group_weights(self.channels)
+        self.n_held = sum(self.weight[c] * np.isfinite(self.y[c][self.held]).sum() for c in self.channels)
+        self._memo: dict = {}
 
-    def columns(self, hyp: Hypothesis) -> dict[str, np.ndarray]:
-        if hyp not in self._memo:
-            self._memo[hyp] = self.replayer.run(hyp)
-        return self._memo[hyp]
+    def model_columns(self, values: dict) -> dict[str, np.ndarray]:
+        """Run columns with the effects and parameters of ``values`` (scenario path, memoised)."""
+        key = model_side(values)
+        if key not in self._memo:
+            self._memo[key] = self.replayer.run(configure(self.replayer.config, dict(key)))
+        return self._memo[key]
 
-    def vector(self, hyp: Hypothesis, mask: np.ndarray | None = None) -> np.ndarray:
-        """Weighted residuals (measured − model)/scale of the finite samples in ``mask``."""
-        m = self.mask if mask is None else mask
-        res = residuals(self.measured, self.columns(hyp), self.channels)
-        parts = [(res[c] / self.scale[c])[m] for c in self.channels]
-        v = np.concatenate(parts)
+    def solo_runs(self, piece: Piece) -> list[tuple[float, dict]]:
+        """Runs made so far with ``piece`` alone, as (value, columns)."""
+        return [(k[0][1], cols) for k, cols in self._memo.items() if len(k) == 1 and k[0][0] == piece]
+
+    def residuals(self, values: dict, cols: dict | None = None, solve: bool = True) -> tuple[dict, dict]:
+        """(measured − model per channel, values) with the sensor faults of ``values`` applied to
+        the model columns (``cols``, default: a run of ``values``); with ``solve`` the offsets,
+        gains and drifts are first fitted in closed form on the training window."""
+        cols = self.model_columns(values) if cols is None else cols
+        values = dict(values)
+        faults: dict[str, list[Piece]] = {}
+        for p in values:
+            if p.kind == "sensor":
+                faults.setdefault(p.channel, []).append(p)
+        res = {}
+        for c in self.channels:
+            x, y = cols[c], self.y[c]
+            mine = {p.param: p for p in faults.get(c, ())}
+            if "lag" in mine:
+                x = apply_fault(self.t, x, "lag", values[mine["lag"]])
+            linear = [p for p in mine.values() if p.linear]
+            if solve and linear:
+                design = {"gain": x - x[0], "offset": np.ones_like(x), "drift": (self.t - self.t[0]) / 3600.0}
+                m = self.train & np.isfinite(y)
+                A = np.column_stack([design[p.param] for p in linear])
+                coef = np.linalg.lstsq(A[m], (y - x)[m], rcond=None)[0]
+                for p, a in zip(linear, coef):
+                    values[p] = float(np.clip(p.neutral + a, p.lo, p.hi))
+            for name in ORDER[1:]:
+                if name in mine:
+                    x = apply_fault(self.t, x, name, values[mine[name]])
+            res[c] = y - x
+        return res, values
+
+    def vector(self, res: dict, mask: np.ndarray) -> np.ndarray:
+        """Weighted residuals of the finite samples in ``mask``."""
+        v = np.concatenate([(np.sqrt(self.weight[c]) * res[c] / self.scale[c])[mask] for c in self.channels])
         return v[np.isfinite(v)]
 
-    def chi2(self, hyp: Hypothesis, mask: np.ndarray | None = None) -> float:
-        v = self.vector(hyp, mask)
+    def chi2(self, res: dict, mask: np.ndarray | None = None) -> float:
+        v = self.vector(res, self.train if mask is None else mask)
         return float(v @ v)
 
+    def held_fit(self, res: dict) -> float:
+        """The held-out score without penalty (see the module docstring)."""
+        total = 0.0
+        for c in self.channels:
+            r = (res[c] / self.scale[c])[self.held]
+            r = r[np.isfinite(r)]
+            if len(r):
+                total += self.weight[c] * len(r) * np.log(max(float(np.mean(r * r)), 1.0))
+        return total
 
-@dataclass(frozen=True)
-class Fit:
-    """A fitted hypothesis."""
+    def penalty(self, k: int) -> float:
+        return k * float(np.log(max(self.n_held, 2.0)))
 
-    name: str
-    """"baseline", "recalibration" or a catalogue effect name."""
-    hypothesis: Hypothesis
-    k: int
-    """Number of fitted parameters."""
-    values: dict[str, float]
-    """Fitted values ({"effect.param" or thermal field: value}) in their units."""
-    sigma: dict[str, float]
-    """1-σ uncertainties of ``values`` (empty when not estimated)."""
-    chi2_train: float
-
-
-def baseline(obj: Objective) -> Fit:
-    return Fit("baseline", Hypothesis(), 0, {}, {}, obj.chi2(Hypothesis()))
-
-
-def _thermal(params, nominal, z) -> dict[str, float]:
-    return {p.name: (getattr(nominal, p.name) * float(np.exp(x)) if p.kind == "log"
-                     else getattr(nominal, p.name) + float(x)) for p, x in zip(params, z)}
+    def scored(self, values: dict, cols: dict | None = None, approx: bool = False) -> Scored:
+        """Score ``values`` (complete: nothing is refitted)."""
+        res, _ = self.residuals(values, cols, solve=False)
+        fit = self.held_fit(res)
+        rms = {c: float(np.sqrt(np.nanmean(res[c][self.held] ** 2))) for c in self.channels}
+        sig = any(np.any(significant(self.t, res[c], resolution(c)) & self.held) for c in self.channels)
+        return Scored(dict(values), fit, fit + self.penalty(len(values)), rms, not sig, approx)
 
 
-def fit_recalibration(obj: Objective, params=RECAL, max_nfev: int = 15) -> Fit:
-    """Joint bounded least-squares fit of ``params`` on the objective's window."""
-    nominal = obj.replayer.config.model.thermal
-    bounds = np.array([np.log(p.bound) if p.kind == "log" else p.bound for p in params])
+def refit(obj: Objective, values: dict, free=None, max_nfev: int = 8) -> dict:
+    """``values`` with the ``free`` pieces (default: all) refitted jointly on the training
+    window by bounded least squares from their current values; sensor offsets, gains and
+    drifts are solved in closed form inside."""
+    free = list(values if free is None else free)
+    nl = [p for p in free if not p.linear]
+    if not nl:
+        return obj.residuals(values)[1]
+    coords = [coordinate(p) for p in nl]
+    x0 = np.clip([to(values[p]) for p, (to, _) in zip(nl, coords)], 1e-6, 1 - 1e-6)
 
-    def fun(z):
-        return obj.vector(Hypothesis.of(thermal=_thermal(params, nominal, z)))
+    def at(x) -> dict:
+        return {**values, **{p: back(float(xi)) for p, (_, back), xi in zip(nl, coords, x)}}
 
-    sol = least_squares(fun, np.zeros(len(params)), bounds=(-bounds, bounds), diff_step=0.01,
-                        x_scale=np.ones(len(params)), max_nfev=max_nfev, ftol=1e-4, method="trf")
-    values = _thermal(params, nominal, sol.x)
-    n = len(sol.fun)
-    s2 = max(float(sol.fun @ sol.fun) / max(n - len(params), 1), 1.0)
+    def fun(x):
+        return obj.vector(obj.residuals(at(x))[0], obj.train)
+
+    sol = least_squares(fun, x0, bounds=(0.0, 1.0), diff_step=0.01, x_scale=1.0, max_nfev=max_nfev,
+                        ftol=1e-4, xtol=1e-3, method="trf")
+    return obj.residuals(at(sol.x))[1]
+
+
+def fit_one(obj: Objective, context: dict, piece: Piece, start: float | None = None) -> dict:
+    """``context`` (kept, except that sensor offsets, gains and drifts are re-solved) plus
+    ``piece`` fitted: in closed form, by a fine scan and Brent's method (no model run
+    needed), or from ``start`` (default: a coarse scan for an effect, the model's value for
+    a parameter) by bounded least squares."""
+    if piece.linear:
+        return obj.residuals({**context, piece: piece.neutral})[1]
+    to, back = coordinate(piece)
+
+    def f(x: float) -> float:
+        return obj.chi2(obj.residuals({**context, piece: back(x)})[0])
+
+    if not piece.rerun:
+        grid = np.linspace(0.0, 1.0, CHEAP_SCAN)
+        vals = [f(x) for x in grid]
+        i = int(np.argmin(vals))
+        sol = minimize_scalar(f, bounds=(grid[max(i - 1, 0)], grid[min(i + 1, CHEAP_SCAN - 1)]), method="bounded",
+                              options={"xatol": 1e-3, "maxiter": 25})
+        x = float(sol.x) if sol.fun < vals[i] else float(grid[i])
+        return obj.residuals({**context, piece: back(x)})[1]
+    def r(x: float) -> np.ndarray:
+        return obj.vector(obj.residuals({**context, piece: back(x)})[0], obj.train)
+
+    if start is None and piece.neutral is None:
+        grid = np.linspace(0.0, 1.0, SCAN)
+        scan = [r(x) for x in grid]
+        i = int(np.argmin([v @ v for v in scan]))
+        j = i + 1 if i == 0 or (i < SCAN - 1 and scan[i + 1] @ scan[i + 1] < scan[i - 1] @ scan[i - 1]) else i - 1
+        x = secant(r, (grid[j], scan[j]), (grid[i], scan[i]))
+    else:
+        x0 = float(np.clip(to(piece.neutral if start is None else start), 0.0, 1.0))
+        x = secant(r, (x0, r(x0)), (x0 + SECANT_STEP if x0 + SECANT_STEP <= 1 else x0 - SECANT_STEP,))
+    return obj.residuals({**context, piece: back(x)})[1]
+
+
+def secant(r, a: tuple, b: tuple, iters: int = 4, tol: float = 2e-3) -> float:
+    """Minimise |r(x)|² over x in [0, 1] by Gauss–Newton steps on secant slopes (one
+    evaluation per step) from the points ``a`` = (x, r(x)) and ``b`` = (x,) or (x, r(x)).
+    Returns the best point evaluated."""
+    if len(b) == 1:
+        b = (b[0], r(b[0]))
+    best = min((a, b), key=lambda p: p[1] @ p[1])
+    for _ in range(iters):
+        J = (b[1] - a[1]) / (b[0] - a[0])
+        if not J @ J > 0:
+            break
+        x = float(np.clip(b[0] - (J @ b[1]) / (J @ J), 0.0, 1.0))
+        if abs(x - b[0]) < tol or abs(x - a[0]) < tol:
+            break
+        a, b = b, (x, r(x))
+        best = min((best, b), key=lambda p: p[1] @ p[1])
+    return float(best[0])
+
+
+def uncertainty(obj: Objective, values: dict, step: float = 0.01) -> dict:
+    """1-σ uncertainty of every value, from the Jacobian of the training residuals (forward
+    differences across 1 % of each plausible range), scaled by the reduced χ² when above 1."""
+    pieces = list(values)
+    if not pieces:
+        return {}
+    coords = [coordinate(p) for p in pieces]
+    x0 = np.array([to(values[p]) for p, (to, _) in zip(pieces, coords)])
+    r0 = obj.vector(obj.residuals(values, solve=False)[0], obj.train)
+    J = np.empty((len(r0), len(pieces)))
+    for j, (p, (_, back)) in enumerate(zip(pieces, coords)):
+        h = step if x0[j] + step <= 1.0 else -step
+        rj = obj.vector(obj.residuals({**values, p: back(x0[j] + h)}, solve=False)[0], obj.train)
+        J[:, j] = (rj - r0) / h
+    s2 = max(float(r0 @ r0) / max(len(r0) - len(pieces), 1), 1.0)
     try:
-        cov = np.linalg.inv(sol.jac.T @ sol.jac) * s2
-        sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        sd_x = np.sqrt(np.clip(np.diag(np.linalg.inv(J.T @ J)) * s2, 0.0, None))
     except np.linalg.LinAlgError:
-        sd = np.full(len(params), np.nan)
-    sigma = {p.name: float(values[p.name] * s if p.kind == "log" else s) for p, s in zip(params, sd)}
-    hyp = Hypothesis.of(thermal=values)
-    log.info("recalibration: %s (χ² %.4g → %.4g)", {k: round(v, 4) for k, v in values.items()},
-             obj.chi2(Hypothesis()), obj.chi2(hyp))
-    return Fit("recalibration", hyp, len(params), values, sigma, obj.chi2(hyp))
+        sd_x = np.full(len(pieces), np.nan)
+    out = {}
+    for p, (to, back), x, s in zip(pieces, coords, x0, sd_x):
+        slope = (back(min(x + 1e-4, 1.0)) - back(max(x - 1e-4, 0.0))) / (min(x + 1e-4, 1.0) - max(x - 1e-4, 0.0))
+        out[p] = float(abs(slope) * s)
+    return out
 
 
-def _coordinate(name: str):
-    """(to search coordinate, from search coordinate, lower, upper) of an effect's parameter."""
-    e = CATALOGUE[name]
-    if e.log_scale:
-        return np.log10, lambda u: float(10.0 ** u), np.log10(e.lo), np.log10(e.hi)
-    return float, float, e.lo, e.hi
+def superposed(obj: Objective, context: dict, piece: Piece, points: int = 41) -> Scored | None:
+    """Screen ``piece`` in ``context`` without a model run: its effect on the columns is
+    taken from its runs alone (interpolated between them) and added to the context's run."""
+    runs = obj.solo_runs(piece)
+    base = obj.model_columns({})
+    if piece.neutral is not None:
+        runs.append((piece.neutral, base))
+    if len(runs) < 2:
+        return None
+    to, back = coordinate(piece)
+    runs.sort(key=lambda vc: to(vc[0]))
+    xs = np.array([to(v) for v, _ in runs])
+    cur = obj.model_columns(context)
 
+    diff = {c: np.array([cols[c] - base[c] for _, cols in runs]) for c in obj.channels}
 
-def fit_effect(obj: Objective, name: str, scan: int = 5, rel_tol: float = 0.004) -> Fit:
-    """Fit one catalogue effect's parameter within its plausible range: ``scan``
-    evenly spaced points, then a bounded Brent search between the best one's neighbours."""
-    _, back, lo, hi = _coordinate(name)
+    def cols_at(x: float) -> dict:
+        i = int(np.clip(np.searchsorted(xs, x) - 1, 0, len(xs) - 2))
+        w = (x - xs[i]) / (xs[i + 1] - xs[i]) if xs[i + 1] > xs[i] else 0.0
+        return {**cur, **{c: cur[c] + (1 - w) * d[i] + w * d[i + 1] for c, d in diff.items()}}
 
-    def f(u: float) -> float:
-        return obj.chi2(Hypothesis.of(effects={name: back(u)}))
+    best = None
+    for x in np.linspace(xs[0], xs[-1], points):
+        cols = cols_at(x)
+        res, vals = obj.residuals({**context, piece: back(x)}, cols)
+        chi2 = obj.chi2(res)
+        if best is None or chi2 < best[0]:
+            best = (chi2, vals, cols)
+    return obj.scored(best[1], best[2], approx=True)
 
-    grid = np.linspace(lo, hi, scan)
-    vals = [f(u) for u in grid]
-    i = int(np.argmin(vals))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, scan - 1)]
-    sol = minimize_scalar(f, bounds=(a, b), method="bounded",
-                          options={"xatol": rel_tol * (hi - lo), "maxiter": 20})
-    u = float(sol.x) if sol.fun < vals[i] else float(grid[i])
-    key = f"{name}.{CATALOGUE[name].param}"
-    log.info("effect %s: %s = %.4g (χ² %.4g)", name, key, back(u), min(sol.fun, vals[i]))
-    return Fit(name, Hypothesis.of(effects={name: back(u)}), 1, {key: back(u)}, {}, min(float(sol.fun), vals[i]))
-
-
-def effect_uncertainty(obj: Objective, fit: Fit, step: float = 0.01) -> Fit:
-    """``fit`` with a 1-σ uncertainty from the curvature of χ² at the optimum
-    (scaled by the reduced χ² when that exceeds 1)."""
-    name = fit.name
-    to, back, lo, hi = _coordinate(name)
-    (key, value), = fit.values.items()
-    u, h = to(value), step * (hi - lo)
-
-    def f(x):
-        return obj.chi2(Hypothesis.of(effects={name: back(x)}))
-
-    f0, fm, fp = fit.chi2_train, f(u - h), f(u + h)
-    curv = (fp - 2 * f0 + fm) / h ** 2
-    n = len(obj.vector(fit.hypothesis))
-    s2 = max(f0 / max(n - 1, 1), 1.0)
-    su = float(np.sqrt(2.0 * s2 / curv)) if curv > 0 else float("nan")
-    sd = value * np.log(10.0) * su if CATALOGUE[name].log_scale else su
-    return dataclasses.replace(fit, sigma={key: float(sd)})

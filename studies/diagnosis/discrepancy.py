@@ -1,27 +1,21 @@
-"""The discrepancy workflow: replay, locate, recalibrate, test candidate effects, name.
+"""The discrepancy workflow: replay, locate, select the missing pieces, name them.
 
-1. *Replay* the measured inputs through the model (:mod:`studies.replay`).
-2. *Locate* significant residuals per channel and phase (:mod:`studies.locate`).
-3. *Recalibrate* the existing uncertain parameters, 4. fit every *candidate*
-   catalogue effect, one parameter each (:mod:`studies.calibrate`), all on the
-   training window (the first ``train_fraction`` of the run).
-5. *Name*: every hypothesis is scored on the held-out rest of the run by
-   ``χ² + k ln n`` (χ² of all channels weighted by their noise scale, at least
-   the sensor resolution; k fitted parameters; n held-out samples). A hypothesis
-   *explains* the data when no channel keeps a significant held-out residual.
-   The verdict is
+1. *Replay* the measured inputs through the model (:mod:`replay`).
+2. *Locate* significant residuals per channel and phase (:mod:`locate`).
+3. *Select*: forward selection over every hypothesis (catalogue effects, existing
+   parameters off, sensor faults; :mod:`hypotheses`), fitted on the training window (the
+   first ``train_fraction`` of the run) and scored on the held-out rest, each
+   channel group weighing the same (:mod:`calibrate`, :mod:`select`).
+4. *Name*. The verdict is
 
    * ``no-discrepancy``: the baseline residual is nowhere significant;
-   * ``missing-effect``: the best-scoring hypothesis is an effect that explains
-     the data and beats every other hypothesis (recalibration included) by at
-     least ``margin_min``;
-   * ``parameter-mismatch``: otherwise, if the recalibrated model explains it
-     (existing parameters come before new physics);
-   * ``unexplained``: nothing explains it, or several effects do equally well.
+   * ``explained``: the chosen pieces leave no significant held-out residual;
+   * ``partly-explained``: pieces were found, but a significant held-out residual remains
+     (the report says where and when);
+   * ``unexplained``: no hypothesis lowers the held-out score by the margin.
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 import time
 from dataclasses import dataclass
@@ -30,16 +24,18 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.solvers.effects import CATALOGUE
-from gatetherm.studies.diagnosis.calibrate import (RECAL, Fit, Objective, baseline, effect_uncertainty,
-                               fit_effect, fit_recalibration)
-from gatetherm.studies.run.config import Config
-from gatetherm.studies.diagnosis.locate import Finding, Phase, locate, noise_sd, phases, significant
+from gatetherm.studies.diagnosis.calibrate import Objective, Scored, uncertainty
+from gatetherm.studies.diagnosis.hypotheses import (PARAMETER_DEFS, Piece, configure, effect_pieces,
+                                                    parameter_pieces, sensor_pieces)
+from gatetherm.studies.diagnosis.locate import Finding, Phase, locate, noise_sd, phases
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
+from gatetherm.studies.diagnosis.select import Round, Selection, select
+from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
 
-VERDICTS = ("no-discrepancy", "parameter-mismatch", "missing-effect", "unexplained")
+VERDICTS = ("no-discrepancy", "explained", "partly-explained", "unexplained")
 
 
 @dataclass(frozen=True)
@@ -49,27 +45,38 @@ class Settings:
     train_fraction: float = 0.6
     """Fraction of the run (from its start) used for fitting; the rest is held out, 1."""
     margin_min: float = 10.0
-    """Score difference (χ² units) by which a named effect must beat every other hypothesis."""
+    """Score units (log-likelihood) by which an addition must lower the held-out score, penalty included."""
     effects: tuple[str, ...] = tuple(CATALOGUE)
-    """Candidate effects."""
-    recalibrate: bool = True
+    """Candidate catalogue effects."""
+    parameters: tuple[str, ...] = tuple(PARAMETER_DEFS)
+    """Candidate existing parameters."""
+    sensors: bool = True
+    """Try sensor faults of every compared channel."""
+    max_pieces: int = 4
+    screen_top: int = 3
+    """Hypotheses that need model runs fitted for real in each round after the first (the rest screened)."""
 
 
 @dataclass(frozen=True)
-class Candidate:
-    """A fitted hypothesis scored on the held-out window."""
+class PieceResult:
+    """A chosen piece with its fitted value."""
 
-    fit: Fit
-    score: float
-    """χ² on the held-out window + k ln n."""
-    rms: dict[str, float]
-    """Held-out RMS residual per channel (channel unit)."""
-    explains: bool
-    """No channel keeps a significant held-out residual."""
+    piece: Piece
+    value: float
+    sigma: float
+    share: float
+    """Share of the held-out score reduction it brings, in the order of selection."""
+    alternatives: tuple[Piece, ...] = ()
 
-    @property
-    def name(self) -> str:
-        return self.fit.name
+    def entry(self) -> dict:
+        """The ``diagnosis.json`` entry."""
+        p = self.piece
+        params = ({"channel": p.channel} if p.channel else {}) | {p.param: float(self.value)}
+        out = {"kind": p.kind, "name": p.name, "params": params, "uncertainty": {p.param: float(self.sigma)},
+               "unit": p.unit, "share_of_residual": float(self.share)}
+        if self.alternatives:
+            out["alternatives"] = [q.label for q in self.alternatives]
+        return out
 
 
 @dataclass(frozen=True)
@@ -77,15 +84,13 @@ class Diagnosis:
     """Everything the report shows."""
 
     verdict: str
-    named_effect: str | None
-    runner_up: str | None
-    margin: float | None
     reason: str
-    adopted: Candidate | None
-    """The hypothesis kept (named effect or recalibration), else None."""
-    baseline: Candidate
-    candidates: tuple[Candidate, ...]
-    """Recalibration and effects, best score first."""
+    pieces: tuple[PieceResult, ...]
+    best_rejected: tuple[Piece, Scored] | None
+    baseline: Scored
+    final: Scored
+    rounds: tuple[Round, ...]
+    removed: tuple[Piece, ...]
     channels: tuple[str, ...]
     scale: dict[str, float]
     time_s: np.ndarray
@@ -93,6 +98,8 @@ class Diagnosis:
     phases: tuple[Phase, ...]
     findings: tuple[Finding, ...]
     """Baseline residual per channel and phase over the whole run."""
+    remaining: tuple[Finding, ...]
+    """Residual with the chosen pieces, per channel and phase (empty without pieces)."""
     residual_before: dict[str, np.ndarray]
     residual_after: dict[str, np.ndarray] | None
     runs: int
@@ -101,59 +108,75 @@ class Diagnosis:
     """The file recorded the room temperature (the model was driven by it)."""
     margin_min: float = Settings.margin_min
 
+    @property
+    def named_effects(self) -> list[str]:
+        return [r.piece.name for r in self.pieces if r.piece.kind == "effect"]
+
+    @property
+    def margin(self) -> float | None:
+        """Score gain the best rejected addition would have brought (below ``margin_min``)."""
+        return None if self.best_rejected is None else float(self.rounds[-1].before - self.best_rejected[1].score)
+
     def summary(self) -> dict:
         """The ``diagnosis.json`` content."""
-        after = self.adopted.rms if self.adopted else None
+        after = self.final.rms if self.pieces else None
+        rej = self.best_rejected
         return {
-            "verdict": self.verdict, "named_effect": self.named_effect, "runner_up": self.runner_up,
-            "margin": self.margin, "reason": self.reason,
+            "verdict": self.verdict, "reason": self.reason, "pieces": [r.entry() for r in self.pieces],
+            "named_effects": self.named_effects, "best_rejected": rej[0].label if rej else None,
+            "margin": self.margin,
             "rms_before_um": self.baseline.rms.get(DELTA), "rms_after_um": after.get(DELTA) if after else None,
             "rms_before": self.baseline.rms, "rms_after": after,
-            "fitted": self.adopted.fit.values if self.adopted else {},
-            "uncertainty": self.adopted.fit.sigma if self.adopted else {},
-            "candidates": [{"name": c.name, "score": c.score, "k": c.fit.k, "explains": c.explains,
-                            "fitted": c.fit.values, "rms_heldout": c.rms} for c in self.candidates],
-            "baseline_score": self.baseline.score, "channels": list(self.channels),
-            "noise_scale": self.scale, "train_end_s": self.train_end_s,
+            "fitted": {f"{r.piece.label}.{r.piece.param}": r.value for r in self.pieces},
+            "uncertainty": {f"{r.piece.label}.{r.piece.param}": r.sigma for r in self.pieces},
+            "removed": [p.label for p in self.removed],
+            "rounds": [{"added": r.added.label if r.added else None, "score_before": r.before,
+                        "trials": [{"name": p.label, "kind": p.kind, "score": s.score, "explains": s.explains,
+                                    "screened_only": s.approx, "value": s.values[p], "rms_heldout": s.rms}
+                                   for p, s in r.trials]} for r in self.rounds],
+            "baseline_score": self.baseline.score, "final_score": self.final.score,
+            "channels": list(self.channels), "noise_scale": self.scale, "train_end_s": self.train_end_s,
             "significant": [f.sentence() for f in self.findings if f.significant],
+            "remaining": [f.sentence() for f in self.remaining if f.significant],
             "model_runs": self.runs, "wall_time_s": round(self.seconds, 1),
         }
 
 
-def _score(obj: Objective, fit: Fit, held: np.ndarray, t: np.ndarray) -> Candidate:
-    cols = obj.columns(fit.hypothesis)
-    res = residuals(obj.measured, cols, obj.channels)
-    n = len(obj.vector(fit.hypothesis, held))
-    rms = {c: float(np.sqrt(np.nanmean(res[c][held] ** 2))) for c in obj.channels}
-    sig = any(np.any(significant(t, res[c], resolution(c)) & held) for c in obj.channels)
-    return Candidate(fit, obj.chi2(fit.hypothesis, held) + fit.k * np.log(max(n, 1)), rms, not sig)
+def candidates(config: Config, channels, has_ambient: bool, settings: Settings) -> list[Piece]:
+    """The hypotheses a diagnosis tries (those that can act on the file)."""
+    unknown = [e for e in settings.effects if e not in CATALOGUE]
+    unknown += [p for p in settings.parameters if p not in PARAMETER_DEFS]
+    if unknown:
+        raise InputError("--effects", f"unknown hypothesis {', '.join(unknown)}",
+                         f"choose from {', '.join((*CATALOGUE, *PARAMETER_DEFS))}")
+    return (effect_pieces(settings.effects, has_ambient) + parameter_pieces(config, settings.parameters)
+            + (sensor_pieces(channels, config) if settings.sensors else []))
 
 
-def decide(base: Candidate, ranked: list[Candidate], discrepant: bool, margin_min: float):
-    """(verdict, named effect, runner-up, margin, reason) from scored hypotheses, best first."""
+def _shares(obj: Objective, sel) -> list[float]:
+    """Score reduction of each chosen piece added in order (final values), over the total."""
+    values = sel.final.values
+    total = sel.base.fit - sel.final.fit
+    out, prev, upto = [], sel.base.fit, {}
+    for p in sel.order:
+        upto[p] = values[p]
+        fit = obj.scored(dict(upto)).fit
+        out.append((prev - fit) / total if total > 0 else float("nan"))
+        prev = fit
+    return out
+
+
+def _verdict(discrepant: bool, sel) -> tuple[str, str]:
     if not discrepant:
-        return "no-discrepancy", None, None, None, "the baseline residual is within the sensor resolution"
-    pool = sorted(ranked + [base], key=lambda c: c.score)
-    if len(pool) < 2:
-        return "unexplained", None, None, None, "no candidate was tried"
-    best, second = pool[0], pool[1]
-    margin = float(second.score - best.score)
-    recal = next((c for c in ranked if c.name == "recalibration"), None)
-    is_effect = best.name not in ("recalibration", "baseline")
-    if is_effect and best.explains and margin >= margin_min:
-        return ("missing-effect", best.name, second.name, margin,
-                f"{best.name} explains the held-out data and beats {second.name} by {margin:.1f}")
-    why_not = (f"{best.name} does not explain the held-out data" if not best.explains else
-               f"{best.name} beats {second.name} by only {margin:.1f} (< {margin_min:g})")
-    if recal is not None and recal.explains:
-        runner = next(c for c in pool if c is not recal)
-        return ("parameter-mismatch", None, runner.name, float(runner.score - recal.score),
-                "recalibrating the existing parameters closes the gap"
-                + (f"; no effect is established: {why_not}" if is_effect and best is not recal else ""))
-    if not any(c.explains for c in ranked):
-        return ("unexplained", None, best.name, margin,
-                f"no candidate explains the held-out residual (best: {best.name})")
-    return "unexplained", None, second.name, margin, f"no single effect is established: {why_not}"
+        return "no-discrepancy", "the baseline residual is within the sensor resolution"
+    if not sel.order:
+        rej = sel.best_rejected
+        return "unexplained", ("no hypothesis lowers the held-out score by the margin"
+                               + (f" (best: {rej[0].label})" if rej else ""))
+    names = " + ".join(p.label for p in sel.order)
+    if sel.final.explains:
+        return "explained", f"{names} leave no significant held-out residual"
+    return "partly-explained", f"{names} lower the held-out score, but a significant held-out residual remains"
 
 
 def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
@@ -162,51 +185,41 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     if not 0.2 <= settings.train_fraction <= 0.9:
         raise InputError("--train-fraction", f"must be between 0.2 and 0.9, got {settings.train_fraction}",
                          "e.g. 0.6: fit on the first 3 h of a 5-h run, score on the last 2 h")
-    unknown = [e for e in settings.effects if e not in CATALOGUE]
-    if unknown:
-        raise InputError("--effects", f"unknown effect(s) {', '.join(unknown)}",
-                         f"choose from {', '.join(CATALOGUE)}")
     t0 = time.perf_counter()
     rep = Replayer(config, ts, dim, mesh)
     t = rep.times
     base_cols = rep.run()
     channels = compared_channels(ts, base_cols)
+    pool = candidates(config, channels, rep.has_ambient, settings)
     res0 = residuals(ts, base_cols, channels)
     scale = {c: max(resolution(c), noise_sd(res0[c])) for c in channels}
     train = t <= settings.train_fraction * t[-1]
-    held = ~train
-    if held.sum() < 5 or train.sum() < 5:
+    if (~train).sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
     run_phases = phases(t, rep.drive.oil, rep.drive.pump)
     findings = locate(t, res0, run_phases)
     obj = Objective(rep, ts, channels, scale, train)
-    base = _score(obj, baseline(obj), held, t)
     discrepant = any(f.significant for f in findings)
-    fits: list[Fit] = []
     if discrepant:
-        if settings.recalibrate:
-            fits.append(fit_recalibration(obj, RECAL))
-        fits += [fit_effect(obj, name) for name in settings.effects]
-    ranked = sorted((_score(obj, f, held, t) for f in fits), key=lambda c: c.score)
-    verdict, named, runner, margin, reason = decide(base, ranked, discrepant, settings.margin_min)
-    adopted = next((c for c in ranked if c.name == (named or "recalibration")), None) \
-        if verdict in ("missing-effect", "parameter-mismatch") else None
-    if adopted is not None and adopted.name != "recalibration":
-        fit = effect_uncertainty(obj, adopted.fit)
-        adopted = dataclasses.replace(adopted, fit=fit)
-        ranked = [adopted if c.name == fit.name else c for c in ranked]
-    after = residuals(ts, obj.columns(adopted.fit.hypothesis), channels) if adopted else None
+        sel = select(obj, pool, settings.margin_min, settings.max_pieces, settings.screen_top)
+    else:
+        base = obj.scored({})
+        sel = Selection(base, base, [])
+    verdict, reason = _verdict(discrepant, sel)
+    sigma = uncertainty(obj, sel.final.values)
+    pieces = tuple(PieceResult(p, sel.final.values[p], sigma[p], share, tuple(sel.alternatives.get(p, ())))
+                   for p, share in zip(sel.order, _shares(obj, sel)))
+    after = obj.residuals(sel.final.values, solve=False)[0] if pieces else None
     log.info("diagnosis: %s (%s), %d model runs", verdict, reason, rep.runs)
-    return Diagnosis(verdict, named, runner, margin, reason, adopted, base, tuple(ranked), channels, scale,
-                     t, float(t[train][-1]), tuple(run_phases), tuple(findings), res0, after, rep.runs,
+    return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, sel.final, tuple(sel.rounds),
+                     tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
+                     tuple(locate(t, after, run_phases)) if after else (), res0, after, rep.runs,
                      time.perf_counter() - t0, rep.has_ambient, settings.margin_min)
 
 
 def adopted_config(config: Config, diag: Diagnosis) -> Config | None:
-    """The model with the diagnosis applied (effect on, or parameters recalibrated)."""
-    if diag.adopted is None:
+    """The model with every chosen piece in it (parameters changed, effects on, sensor faults set)."""
+    if not diag.pieces:
         return None
-    hyp = diag.adopted.fit.hypothesis
-    thermal = dataclasses.replace(config.model.thermal, **dict(hyp.thermal))
-    return dataclasses.replace(config, model=dataclasses.replace(config.model, thermal=thermal),
-                               effects={**config.effects, **dict(hyp.effects)})
+    return configure(config, {r.piece: r.value for r in diag.pieces})
+

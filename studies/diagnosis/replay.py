@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -65,26 +64,13 @@ def compared_channels(ts: TimeSeries, model_columns) -> tuple[str, ...]:
     return out
 
 
-@dataclass(frozen=True)
-class Hypothesis:
-    """What a candidate explanation changes in the model: thermal parameters
-    (fields of ``ThermalParams``) and catalogue effects ({name: value})."""
-
-    thermal: tuple[tuple[str, float], ...] = ()
-    effects: tuple[tuple[str, float], ...] = ()
-
-    @classmethod
-    def of(cls, thermal: dict | None = None, effects: dict | None = None) -> "Hypothesis":
-        return cls(tuple(sorted((thermal or {}).items())), tuple(sorted((effects or {}).items())))
-
-
 class Replayer:
     """Runs ``config`` through the inputs of the measured series ``ts`` (the scenario
     path, one mesh and one :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all
     hypotheses)."""
 
     def __init__(self, config: Config, ts: TimeSeries, dim: int = 2, mesh: MeshParams | None = None,
-                 cache: int = 3):
+                 cache: int = 4):
         self.config = dataclasses.replace(config, model=dataclasses.replace(
             config.model, mesh=mesh or config.model.mesh))
         self.dim = dim
@@ -100,12 +86,10 @@ class Replayer:
         """Model runs made so far."""
         return self.cache.runs
 
-    def run(self, hyp: Hypothesis = Hypothesis()) -> dict[str, np.ndarray]:
-        """Output columns (data-format names and units) of the model under ``hyp``."""
-        model = self.config.model
-        cfg = dataclasses.replace(self.config, model=dataclasses.replace(
-            model, thermal=dataclasses.replace(model.thermal, **dict(hyp.thermal))))
-        return run_scenario(cfg, self.dim, self.schedule, dict(hyp.effects), cache=self.cache).columns
+    def run(self, config: Config | None = None) -> dict[str, np.ndarray]:
+        """Output columns (data-format names and units) of ``config`` (default: the replayer's,
+        which must be a variant of it on the same frame and mesh)."""
+        return run_scenario(config or self.config, self.dim, self.schedule, cache=self.cache).columns
 
 
 def residuals(ts: TimeSeries, cols: dict[str, np.ndarray], channels) -> dict[str, np.ndarray]:

@@ -1,6 +1,6 @@
-"""Plots of a diagnosis (:class:`studies.discrepancy.Diagnosis`): where the residual
-is significant, how the candidates scored, and the held-out residual before and
-after the adopted hypothesis."""
+"""Plots of a diagnosis (:class:`studies.diagnosis.discrepancy.Diagnosis`): where the
+residual is significant, how the additions scored round by round, and the held-out
+residual before and after the chosen pieces."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -57,12 +57,12 @@ def plot_residuals(diag, path: Path) -> None:
 
 
 def plot_before_after(diag, path: Path) -> None:
-    """Held-out residual per channel with the baseline and with the adopted hypothesis."""
+    """Held-out residual per channel with the baseline and with the chosen pieces."""
     t = diag.time_s
     held = t > diag.train_end_s
     n = len(diag.channels)
     fig, axes = plt.subplots(n, 1, figsize=(8, 1.9 * n + 0.8), sharex=True, squeeze=False)
-    name = diag.adopted.name if diag.adopted else "—"
+    name = " + ".join(r.piece.label for r in diag.pieces) or "—"
     for ax, c in zip(axes[:, 0], diag.channels):
         res = resolution(c)
         ax.axhspan(-res, res, color="C2", alpha=0.25, lw=0)
@@ -80,19 +80,22 @@ def plot_before_after(diag, path: Path) -> None:
     save(fig, path, dpi=110, tight=False)
 
 
-def plot_scores(diag, path: Path) -> None:
-    """Held-out score of every hypothesis relative to the best (log scale)."""
-    cands = list(diag.candidates) + [diag.baseline]
-    best = min(c.score for c in cands)
-    cands.sort(key=lambda c: c.score)
-    fig, ax = plt.subplots(figsize=(7, 0.32 * len(cands) + 1.2))
-    y = np.arange(len(cands))[::-1]
-    gaps = [max(c.score - best, 0.0) + 1.0 for c in cands]
-    ax.barh(y, gaps, color=["C2" if c.explains else "C7" for c in cands])
-    ax.set_yticks(y, [f"{c.name} (k={c.fit.k})" for c in cands], fontsize=8)
-    ax.set_xscale("log")
-    ax.axvline(1.0 + diag.margin_min, color="k", ls=":", lw=1)
-    ax.set_xlabel(f"1 + score − best score  (χ² + k ln n, held-out window; dotted: margin {diag.margin_min:g})")
-    ax.set_title("Candidates (green: explains the held-out data)", fontsize=10)
+def plot_scores(diag, path: Path, shown: int = 12) -> None:
+    """Score gain of the best additions tried in each selection round (log scale)."""
+    n = len(diag.rounds)
+    fig, axes = plt.subplots(1, n, figsize=(4.2 * n + 1.5, 0.3 * shown + 1.4), squeeze=False)
+    for ax, k, rnd in zip(axes[0], range(1, n + 1), diag.rounds):
+        trials = rnd.trials[:shown]
+        y = np.arange(len(trials))[::-1]
+        gains = [rnd.before - s.score for _, s in trials]
+        ax.barh(y, np.maximum(gains, 0.0) + 1.0,
+                color=["C2" if s.explains else ("C1" if s.approx else "C7") for _, s in trials])
+        ax.set_yticks(y, [f"{p.label}" for p, _ in trials], fontsize=7)
+        ax.set_xscale("log")
+        ax.axvline(1.0 + diag.margin_min, color="k", ls=":", lw=1)
+        ax.set_title(f"round {k}: " + (f"+ {rnd.added.label}" if rnd.added else "nothing added"), fontsize=9)
+        ax.set_xlabel("1 + score gain", fontsize=8)
+    fig.suptitle(f"Additions by round (green: explains the held-out data, orange: screened only; "
+                 f"dotted: margin {diag.margin_min:g})", fontsize=9)
     fig.tight_layout()
     save(fig, path, dpi=110, tight=False)
