@@ -104,6 +104,24 @@ def run_hidden(args) -> int:
     return 0
 
 
+def _compound_arguments(p) -> None:
+    p.add_argument("--workers", type=int, default=2, metavar="N", help="worker processes (default 2)")
+    p.add_argument("--seed", type=int, default=14, help="seed of the pairs, strengths and noise (default 14)")
+    p.add_argument("--pairs", type=int, default=48, metavar="N", help="two-piece cases (default 48)")
+    p.add_argument("--no-single", action="store_true", help="skip the single-piece cases of the hidden-effect study")
+    p.add_argument("--mesh-size", type=float, metavar="M", help="diagnosis element size, m (default: the model's)")
+
+
+def run_compound(args) -> int:
+    from gatetherm.validation.compound_study import row_line, write_compound
+
+    figures = write_compound(Path(args.out), args.workers, args.seed, args.pairs, not args.no_single,
+                             args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
+    for k, v in figures.items():
+        print(f"{k}: {v}")
+    return 0
+
+
 def _calibrate_arguments(p) -> None:
     p.add_argument("--evals", type=int, default=150, help="objective evaluations (default 150)")
     p.add_argument("--mesh-size", type=float, default=0.012, metavar="M", help="element size, m (default 0.012)")
@@ -128,6 +146,8 @@ TARGETS = {
                      add_model_options, run_compensation),
     "hidden-effects": ("diagnose runs with a hidden catalogue effect, noise only, outside effects, mismatches",
                        _hidden_arguments, run_hidden),
+    "compound": ("diagnose runs with two hidden pieces at once (effects, parameters off, sensor faults), "
+                 "then the hidden-effect cases", _compound_arguments, run_compound),
     "calibrate": ("refit the default paper model to the paper's figures (a record of the procedure)",
                   _calibrate_arguments, run_calibrate),
 }
