@@ -38,7 +38,7 @@ class Fault:
 
 
 THERMOCOUPLE = {f.name: f for f in (
-    Fault("offset", "K", -1.0, 1.0, 0.0, True, "constant error (cold-junction or calibration offset)"),
+    Fault("offset", "K", -1.5, 1.5, 0.0, True, "constant error (cold-junction or calibration offset)"),
     Fault("gain", "1", 0.9, 1.1, 1.0, True, "wrong sensitivity: reports gain × the rise from the first sample"),
     Fault("lag", "s", 15.0, 300.0, 0.0, False, "first-order lag of this thermocouple (loose bonding, thick cement)"),
 )}

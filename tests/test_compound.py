@@ -23,7 +23,7 @@ from gatetherm.studies.diagnosis.replay import Replayer, compared_channels
 from gatetherm.studies.run.config import config_toml, load_config
 from gatetherm.studies.run.scenario import run_scenario, series_schedule
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
-from gatetherm.validation.compound_study import draw_value, pairs, pieces_by_key
+from gatetherm.validation.compound_study import draw_value, pairs, pieces_by_key, visible
 from gatetherm.validation.hidden_effects import measured, truth_with
 
 FAST = dict(mesh_factor=1.0, step_s=120.0)
@@ -131,6 +131,10 @@ def test_study_draws_pairs_in_the_middle_half():
     cfg = load_config()
     drawn = pairs(cfg, 48, seed=14)
     assert len(drawn) == 48 and len({p.pieces for p in drawn}) == 48
+    hidden = {(c, "sensor:sensor_lag@theta_C_degC"): False for c in (1, 2, 3)}
+    shows = {(c, k): hidden.get((c, k), True) for c in (1, 2, 3) for k in pieces_by_key(cfg)}
+    assert "sensor:sensor_lag@theta_C_degC" in {k for p in drawn for k, _ in p.pieces}
+    assert "sensor:sensor_lag@theta_C_degC" not in {k for p in pairs(cfg, 48, 14, shows=shows) for k, _ in p.pieces}
     kinds = {tuple(sorted(k.split(":")[0] for k, _ in p.pieces)) for p in drawn}
     assert len(kinds) == 6 and {p.condition for p in drawn} == {1, 2, 3}
     rng = np.random.default_rng(0)
@@ -181,3 +185,11 @@ def test_acceptance_full_size(case, tmp_path):
                  "--out", str(tmp_path / "r"), "--no-pictures"]) == 0
     again = read_timeseries(tmp_path / "r" / "timeseries.csv")
     assert np.sqrt(np.mean((again["delta_um"] - noisy["delta_um"]) ** 2)) < 0.15
+
+
+@pytest.mark.slow
+def test_visibility_of_the_weakest_drawn_strengths(coarse):
+    shows = visible(coarse, conditions=(2,))
+    assert shows[2, "sensor:sensor_offset@theta_B_degC"] and shows[2, "sensor:sensor_drift@delta_um"]
+    assert shows[2, "parameter:conductivity"] and shows[2, "effect:joint_resistance"]
+    assert not shows[2, "sensor:sensor_lag@theta_C_degC"] and not shows[2, "parameter:oil_film_off"]

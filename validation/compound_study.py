@@ -7,10 +7,13 @@ cases of the hidden-effect study.
 Two-piece cases: ``pairs`` "measured" runs, each with two different hypotheses of the
 diagnosis (:func:`studies.diagnosis.hypotheses.catalogue`) in the model. The kinds of the
 two cycle through effect+effect, effect+parameter, effect+sensor, parameter+parameter,
-parameter+sensor, sensor+sensor; within a kind the hypothesis, the condition (1–3) and the
-strength are drawn at random, the strength in the middle half of its range (:func:`draw_value`).
-The one pair the data cannot separate even in principle (the material's α with a gain of
-the δ sensor: δ is proportional to α) is not drawn. The runs are made on the finer truth
+parameter+sensor, sensor+sensor; the condition (1–3), then within a kind the hypothesis and
+its strength are drawn at random, the strength in the middle half of its range (:func:`draw_value`).
+Only hypotheses that show in the data at the weak end of the middle half are drawn
+(:func:`visible`: the catalogue's criterion, >0.4 µm RMS in δ over the last two hours or
+>0.3 K at a thermocouple's peak, in the case's condition); and the one pair the data cannot
+separate even in principle (the material's α with a gain of the δ sensor: δ is
+proportional to α) is not drawn. The runs are made on the finer truth
 mesh with sensor noise at the resolution (:mod:`validation.hidden_effects`) and diagnosed
 blind. Single-piece cases: the hidden-effect study (catalogue effects at two strengths,
 noise only, out-of-catalogue effects, parameter mismatches), unless ``--no-single``.
@@ -19,8 +22,6 @@ Writes ``DIR/compound.md`` and ``DIR/compound.csv`` and prints the acceptance fi
 """
 from __future__ import annotations
 
-import csv
-import io
 import logging
 import time
 from dataclasses import dataclass
@@ -29,10 +30,14 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import write_text_atomic
+from gatetherm.geometry.build import build_mesh
 from gatetherm.studies.diagnosis.calibrate import coordinate
 from gatetherm.studies.diagnosis.discrepancy import diagnose
 from gatetherm.studies.diagnosis.hypotheses import Piece, catalogue
+from gatetherm.studies.diagnosis.hypotheses import configure
+from gatetherm.studies.diagnosis.replay import DELTA
 from gatetherm.studies.run.config import Config
+from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 from gatetherm.validation import hidden_effects as single
 
@@ -42,6 +47,9 @@ KIND_PAIRS = (("effect", "effect"), ("effect", "parameter"), ("effect", "sensor"
               ("parameter", "parameter"), ("parameter", "sensor"), ("sensor", "sensor"))
 INSEPARABLE = (frozenset({"parameter:expansion", "sensor:sensor_gain@delta_um"}),)
 """Pairs whose signals are proportional: only their product shows in the data."""
+VISIBLE_DELTA_UM, VISIBLE_THETA_K = 0.4, 0.3
+"""The catalogue's visibility criterion (``solvers.effects.Effect``)."""
+THERMOCOUPLES = ("theta_A_degC", "theta_B_degC", "theta_C_degC")
 
 
 @dataclass(frozen=True)
@@ -59,34 +67,67 @@ def pieces_by_key(config: Config) -> dict[str, Piece]:
     return {p.key: p for p in catalogue(config, OUTPUT_COLUMNS)}
 
 
-def draw_value(p: Piece, rng: np.random.Generator) -> float:
-    """A strength in the middle half of ``p``'s range: for a hypothesis with a neutral value
-    inside its range (a parameter's model value, a sensor fault's identity), 25–75 % of the
-    way from it to a randomly chosen end of the range; for a range through zero, a random
-    sign and 25–75 % of its end; else 25–75 % across the range (log scale for positive ones)."""
-    u = rng.uniform(0.25, 0.75)
+def _middle_half(p: Piece, u: float, side: int) -> float:
+    """The value ``u`` (0.25–0.75) of the way along ``p``'s range on ``side`` (±1) of its
+    neutral value (for a hypothesis with one inside its range), of zero (a range through
+    zero), or across the range (log scale for positive ranges)."""
     if p.neutral is not None and p.lo <= p.neutral <= p.hi:
-        end = p.hi if rng.random() < 0.5 else p.lo
+        end = p.hi if side > 0 else p.lo
         return float(p.neutral * (end / p.neutral) ** u if p.log_scale else p.neutral + u * (end - p.neutral))
     if p.lo < 0 < p.hi:
-        return float(u * max(-p.lo, p.hi) * rng.choice((-1.0, 1.0)))
-    return coordinate(p)[1](u)
+        return float(side * u * max(-p.lo, p.hi))
+    return coordinate(p)[1](u if side > 0 else 1.0 - u)
 
 
-def pairs(config: Config, n: int = 48, seed: int = 14, conditions=(1, 2, 3)) -> list[Pair]:
+def draw_value(p: Piece, rng: np.random.Generator) -> float:
+    """A strength in the middle half of ``p``'s range (:func:`_middle_half`, random side)."""
+    return _middle_half(p, rng.uniform(0.25, 0.75), 1 if rng.random() < 0.5 else -1)
+
+
+def weakest(p: Piece) -> tuple[float, float]:
+    """The two ends of the middle half nearest to "no change"."""
+    return _middle_half(p, 0.25, 1), _middle_half(p, 0.25, -1)
+
+
+def visible(config: Config, conditions=(1, 2, 3), dim: int = 2) -> dict[tuple[int, str], bool]:
+    """For every condition and hypothesis: does it show at both :func:`weakest` values, by
+    the catalogue's criterion (δ changes by more than 0.4 µm RMS over the last two hours or
+    a thermocouple by more than 0.3 K at its peak; ``solvers.effects.Effect``)?"""
+    pieces = pieces_by_key(config)
+    out = {(c, k): True for c in conditions for k in pieces}
+    cache = ScenarioCache(build_mesh(config.model.frame, dim, config.model.mesh), 2)
+    for cond in conditions:
+        sched = condition_schedule(cond, config)
+        last = sched.times >= sched.times[-1] - 2 * 3600.0
+        base = run_scenario(config, dim, sched, cache=cache).columns
+        for k, p in pieces.items():
+            for v in weakest(p):
+                cols = run_scenario(configure(config, {p: v}), dim, sched, cache=cache).columns
+                d = float(np.sqrt(np.mean((cols[DELTA] - base[DELTA])[last] ** 2)))
+                th = max(float(np.max(np.abs(cols[c] - base[c]))) for c in THERMOCOUPLES)
+                out[cond, k] &= d > VISIBLE_DELTA_UM or th > VISIBLE_THETA_K
+    return out
+
+
+def pairs(config: Config, n: int = 48, seed: int = 14, conditions=(1, 2, 3), shows=None) -> list[Pair]:
+    """``n`` two-piece cases: a condition, then two hypotheses that ``shows``
+    ({(condition, key): bool}, default: all) marks visible in it."""
     rng = np.random.default_rng(seed)
-    by_kind: dict[str, list[Piece]] = {}
-    for p in pieces_by_key(config).values():
-        by_kind.setdefault(p.kind, []).append(p)
+    known = pieces_by_key(config)
     out = []
     for i in range(n):
+        cond = int(rng.choice(conditions))
+        by_kind: dict[str, list[Piece]] = {}
+        for k, p in known.items():
+            if shows is None or shows[cond, k]:
+                by_kind.setdefault(p.kind, []).append(p)
         ka, kb = KIND_PAIRS[i % len(KIND_PAIRS)]
         while True:
             a, b = (by_kind[k][rng.integers(len(by_kind[k]))] for k in (ka, kb))
             if a != b and frozenset({a.key, b.key}) not in INSEPARABLE:
                 break
-        out.append(Pair(((a.key, draw_value(a, rng)), (b.key, draw_value(b, rng))),
-                        int(rng.choice(conditions)), int(rng.integers(1 << 31))))
+        out.append(Pair(((a.key, draw_value(a, rng)), (b.key, draw_value(b, rng))), cond,
+                        int(rng.integers(1 << 31))))
     return out
 
 
@@ -100,7 +141,7 @@ def run_pair(pair: Pair, config: Config) -> dict:
     named = set(row["pieces"])
     either = named | set(row["alternatives"])
     effects = {k for k in named if k.startswith("effect:")}
-    return {"hidden": hidden, "strengths": [v for _, v in pair.pieces], "condition": pair.condition,
+    return {"hidden": hidden, "strengths": [v for _, v in pair.pieces], "condition": pair.condition, "seed": pair.seed,
             "kinds": "+".join(k.split(":")[0] for k in hidden), **row,
             "both_named": set(hidden) <= named, "both_named_or_equivalent": set(hidden) <= either,
             "wrong_piece": bool(named - set(hidden)), "wrong_effect": bool(effects - set(hidden))}
@@ -131,7 +172,7 @@ def acceptance(rows: list[dict]) -> dict:
     return out
 
 
-COLUMNS = ("hidden", "strengths", "condition", "verdict", "pieces", "alternatives", "both_named", "wrong_piece",
+COLUMNS = ("hidden", "strengths", "condition", "seed", "verdict", "pieces", "alternatives", "both_named", "wrong_piece",
            "best_rejected", "rms_before_um", "rms_after_um", "runs", "seconds")
 
 
@@ -142,7 +183,7 @@ def _fmt(v) -> str:
 
 
 def table_markdown(rows: list[dict], acc: dict, single_rows: list[dict], single_acc: dict | None) -> str:
-    head = ["hidden pieces", "strengths", "cond.", "verdict", "pieces named", "or equally", "both named",
+    head = ["hidden pieces", "strengths", "cond.", "noise seed", "verdict", "pieces named", "or equally", "both named",
             "wrong piece", "best rejected", "δ RMS before (µm)", "δ RMS after (µm)", "model runs", "time (s)"]
     L = ["# Compound-diagnosis study", "",
          "Held-out window: last 40 % of each 5-h, 1-min run; sensor noise at the resolution (0.1 µm, 0.05 K). "
@@ -154,15 +195,6 @@ def table_markdown(rows: list[dict], acc: dict, single_rows: list[dict], single_
         L += ["", "## Single pieces (the hidden-effect study's cases)", "",
               single.table_markdown(single_rows, single_acc).split("\n", 2)[2]]
     return "\n".join(L) + "\n"
-
-
-def table_csv(rows: list[dict]) -> str:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS + ("fitted",))
-    for r in rows:
-        w.writerow([_fmt(r[k]) for k in COLUMNS] + [";".join(f"{k}={v:.4g}" for k, v in r["fitted"].items())])
-    return buf.getvalue()
 
 
 def row_line(row: dict) -> str:
@@ -177,18 +209,22 @@ def write_compound(out: Path, workers: int = 2, seed: int = 14, n_pairs: int = 4
                    mesh_size: float | None = None, on_row=None) -> dict:
     """Run the study, write ``compound.md`` and ``.csv``; returns the figures."""
     t0 = time.perf_counter()
-    todo = pairs(single.study_config(mesh_size), n_pairs, seed)
+    config = single.study_config(mesh_size)
+    shows = visible(config)
+    hidden = sorted(f"{k}(c{c})" for (c, k), v in shows.items() if not v)
+    log.info("not drawn (below the visibility criterion at the weak end of the middle half): %s", hidden)
+    todo = pairs(config, n_pairs, seed, shows=shows)
     rows = single.run_pool(_pair_worker, [(p, mesh_size) for p in todo], workers, on_row)
     acc = acceptance(rows)
     single_rows, single_acc = [], None
     if with_single:
         single_rows = single.run_pool(single.case_worker, [(c, mesh_size) for c in single.cases()], workers, on_row)
         single_acc = single.acceptance(single_rows)
-    figures = {**acc, **({f"single.{k}": v for k, v in single_acc.items()} if single_acc else {}),
+    figures = {"not_drawn_invisible": hidden, **acc, **({f"single.{k}": v for k, v in single_acc.items()} if single_acc else {}),
                "study_wall_time_s": round(time.perf_counter() - t0, 1)}
     out = Path(out)
     write_text_atomic(out / "compound.md", table_markdown(rows, figures, single_rows, single_acc))
-    write_text_atomic(out / "compound.csv", table_csv(rows))
+    write_text_atomic(out / "compound.csv", single.table_csv(rows, COLUMNS, _fmt))
     if single_rows:
         write_text_atomic(out / "hidden_effects.csv", single.table_csv(single_rows))
     return {k: _fmt(v) for k, v in figures.items()}

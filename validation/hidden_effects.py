@@ -280,12 +280,13 @@ def table_markdown(rows: list[dict], acc: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def table_csv(rows: list[dict]) -> str:
+def table_csv(rows: list[dict], columns=COLUMNS, cell=fmt) -> str:
+    """One line per row: ``columns`` formatted by ``cell`` (missing: empty), then the fitted values."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS + ("fitted",))
+    w.writerow(columns + ("fitted",))
     for r in rows:
-        w.writerow([fmt(r[k]) if r[k] is not None else "" for k in COLUMNS]
+        w.writerow([cell(r[k]) if r[k] is not None else "" for k in columns]
                    + [";".join(f"{k}={v:.4g}" for k, v in r["fitted"].items())])
     return buf.getvalue()
 

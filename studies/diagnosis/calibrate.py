@@ -96,7 +96,8 @@ class Objective:
 
     def model_columns(self, values: dict) -> dict[str, np.ndarray]:
         """Run columns with the effects and parameters of ``values`` (scenario path, memoised)."""
-        key = model_side(values)
+        key = model_side({p: v for p, v in values.items()  # a neutral value changes nothing
+                          if p.neutral is None or abs(v - p.neutral) > 1e-9 * abs(p.neutral)})
         if key not in self._memo:
             self._memo[key] = self.replayer.run(configure(self.replayer.config, dict(key)))
         return self._memo[key]
@@ -191,8 +192,8 @@ def refit(obj: Objective, values: dict, free=None, max_nfev: int = 8) -> dict:
 def fit_one(obj: Objective, context: dict, piece: Piece, start: float | None = None) -> dict:
     """``context`` (kept, except that sensor offsets, gains and drifts are re-solved) plus
     ``piece`` fitted: in closed form, by a fine scan and Brent's method (no model run
-    needed), or from ``start`` (default: a coarse scan for an effect, the model's value for
-    a parameter) by bounded least squares."""
+    needed), or by Gauss–Newton steps on secant slopes from ``start`` (default: from the best
+    two points of a coarse scan of the range)."""
     if piece.linear:
         return obj.residuals({**context, piece: piece.neutral})[1]
     to, back = coordinate(piece)
@@ -211,16 +212,25 @@ def fit_one(obj: Objective, context: dict, piece: Piece, start: float | None = N
     def r(x: float) -> np.ndarray:
         return obj.vector(obj.residuals({**context, piece: back(x)})[0], obj.train)
 
-    if start is None and piece.neutral is None:
-        grid = np.linspace(0.0, 1.0, SCAN)
+    if start is None:
+        grid = scan_grid(piece, SCAN)
         scan = [r(x) for x in grid]
         i = int(np.argmin([v @ v for v in scan]))
         j = i + 1 if i == 0 or (i < SCAN - 1 and scan[i + 1] @ scan[i + 1] < scan[i - 1] @ scan[i - 1]) else i - 1
         x = secant(r, (grid[j], scan[j]), (grid[i], scan[i]))
     else:
-        x0 = float(np.clip(to(piece.neutral if start is None else start), 0.0, 1.0))
+        x0 = float(np.clip(to(start), 0.0, 1.0))
         x = secant(r, (x0, r(x0)), (x0 + SECANT_STEP if x0 + SECANT_STEP <= 1 else x0 - SECANT_STEP,))
     return obj.residuals({**context, piece: back(x)})[1]
+
+
+def scan_grid(piece: Piece, n: int) -> np.ndarray:
+    """``n`` evenly spaced positions across the range; the middle one moved to the neutral
+    value (which needs no run) when that lies inside."""
+    grid = np.linspace(0.0, 1.0, n)
+    if piece.neutral is not None and piece.lo <= piece.neutral <= piece.hi:
+        grid[n // 2] = coordinate(piece)[0](piece.neutral)
+    return grid
 
 
 def secant(r, a: tuple, b: tuple, iters: int = 4, tol: float = 2e-3) -> float:
@@ -266,35 +276,3 @@ def uncertainty(obj: Objective, values: dict, step: float = 0.01) -> dict:
         slope = (back(min(x + 1e-4, 1.0)) - back(max(x - 1e-4, 0.0))) / (min(x + 1e-4, 1.0) - max(x - 1e-4, 0.0))
         out[p] = float(abs(slope) * s)
     return out
-
-
-def superposed(obj: Objective, context: dict, piece: Piece, points: int = 41) -> Scored | None:
-    """Screen ``piece`` in ``context`` without a model run: its effect on the columns is
-    taken from its runs alone (interpolated between them) and added to the context's run."""
-    runs = obj.solo_runs(piece)
-    base = obj.model_columns({})
-    if piece.neutral is not None:
-        runs.append((piece.neutral, base))
-    if len(runs) < 2:
-        return None
-    to, back = coordinate(piece)
-    runs.sort(key=lambda vc: to(vc[0]))
-    xs = np.array([to(v) for v, _ in runs])
-    cur = obj.model_columns(context)
-
-    diff = {c: np.array([cols[c] - base[c] for _, cols in runs]) for c in obj.channels}
-
-    def cols_at(x: float) -> dict:
-        i = int(np.clip(np.searchsorted(xs, x) - 1, 0, len(xs) - 2))
-        w = (x - xs[i]) / (xs[i + 1] - xs[i]) if xs[i + 1] > xs[i] else 0.0
-        return {**cur, **{c: cur[c] + (1 - w) * d[i] + w * d[i + 1] for c, d in diff.items()}}
-
-    best = None
-    for x in np.linspace(xs[0], xs[-1], points):
-        cols = cols_at(x)
-        res, vals = obj.residuals({**context, piece: back(x)}, cols)
-        chi2 = obj.chi2(res)
-        if best is None or chi2 < best[0]:
-            best = (chi2, vals, cols)
-    return obj.scored(best[1], best[2], approx=True)
-

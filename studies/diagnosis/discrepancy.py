@@ -65,7 +65,8 @@ class PieceResult:
     value: float
     sigma: float
     share: float
-    """Share of the held-out score reduction it brings, in the order of selection."""
+    """Its share of the held-out residual: the rise of the held-out score when it alone is taken out of
+    the final set, over the sum of those rises."""
     alternatives: tuple[Piece, ...] = ()
 
     def entry(self) -> dict:
@@ -130,10 +131,13 @@ class Diagnosis:
             "fitted": {f"{r.piece.label}.{r.piece.param}": r.value for r in self.pieces},
             "uncertainty": {f"{r.piece.label}.{r.piece.param}": r.sigma for r in self.pieces},
             "removed": [p.label for p in self.removed],
-            "rounds": [{"added": r.added.label if r.added else None, "score_before": r.before,
+            "rounds": [{"added": [p.label for p in r.added], "score_before": r.before,
                         "trials": [{"name": p.label, "kind": p.kind, "score": s.score, "explains": s.explains,
                                     "screened_only": s.approx, "value": s.values[p], "rms_heldout": s.rms}
-                                   for p, s in r.trials]} for r in self.rounds],
+                                   for p, s in r.trials],
+                        "pairs": [{"names": [p.label for p in pq], "score": s.score, "explains": s.explains,
+                                   "screened_only": s.approx, "values": [s.values[p] for p in pq]}
+                                  for pq, s in r.pairs[:5]]} for r in self.rounds],
             "baseline_score": self.baseline.score, "final_score": self.final.score,
             "channels": list(self.channels), "noise_scale": self.scale, "train_end_s": self.train_end_s,
             "significant": [f.sentence() for f in self.findings if f.significant],
@@ -154,16 +158,12 @@ def candidates(config: Config, channels, has_ambient: bool, settings: Settings) 
 
 
 def _shares(obj: Objective, sel) -> list[float]:
-    """Score reduction of each chosen piece added in order (final values), over the total."""
+    """Per chosen piece: how much the held-out score rises when it alone is taken out of the
+    final set (the others keep their values), as a fraction of the sum over the pieces."""
     values = sel.final.values
-    total = sel.base.fit - sel.final.fit
-    out, prev, upto = [], sel.base.fit, {}
-    for p in sel.order:
-        upto[p] = values[p]
-        fit = obj.scored(dict(upto)).fit
-        out.append((prev - fit) / total if total > 0 else float("nan"))
-        prev = fit
-    return out
+    rise = [max(obj.scored({q: v for q, v in values.items() if q != p}).fit - sel.final.fit, 0.0) for p in sel.order]
+    total = sum(rise)
+    return [r / total if total > 0 else float("nan") for r in rise]
 
 
 def _verdict(discrepant: bool, sel) -> tuple[str, str]:

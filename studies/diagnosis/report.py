@@ -15,8 +15,8 @@ VERDICT_TEXT = {
                         "(section 5 says where and when): something outside the hypotheses is missing too.",
     "unexplained": "The model and the measurement disagree, and no hypothesis clearly lowers the held-out residual.",
 }
-SHOWN = 8
-"""Trials shown per selection round."""
+SHOWN, SHOWN_PAIRS = 8, 3
+"""Single and two-piece additions shown per selection round."""
 
 
 def _num(v, digits: int = 4) -> str:
@@ -61,7 +61,7 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     if d.best_rejected:
         L += ["", f"Best rejected: {d.best_rejected[0].label} (score gain {_num(d.margin)} < margin {d.margin_min:g})."]
     if d.removed:
-        L += ["", f"Chosen, then dropped by the removal check: {', '.join(p.label for p in d.removed)}."]
+        L += ["", f"Chosen, then dropped (removal check or swap): {', '.join(p.label for p in d.removed)}."]
     L += ["", "## 1. Replay", "",
           "The model was driven by the file's oil temperature and pump state"
           + (" and room temperature" if d.has_ambient else " (room at the model's constant T_room)")
@@ -82,14 +82,19 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
           "Each round fits every hypothesis added to the pieces already chosen (training window) and scores the "
           "set on the held-out window: Σ over channels of w·n·ln max(mean squared residual / noise², 1) "
           "+ (number of parameters)·ln N, the displacement and the temperature channels weighing the same. "
-          f"An addition is kept when it lowers the score by at least {d.margin_min:g}; 'screened' = scored "
-          "from superposed runs only."]
+          f"An addition is kept when it lowers the score by at least {d.margin_min:g} (a pair: when it also "
+          "beats the best single addition by that); 'screened' = scored from superposed runs only."]
     for i, rnd in enumerate(d.rounds, 1):
         L += ["", f"Round {i} (score before {_num(rnd.before, 6)}): "
-              + (f"**{rnd.added.label}** added." if rnd.added else "nothing added."), "",
+              + (f"**{' + '.join(p.label for p in rnd.added)}** added." if rnd.added else "nothing added."), "",
               "| hypothesis | kind | fitted | score − before | δ RMS held-out (µm) | explains |", "|---|---|---|---|---|---|"]
         for p, s in rnd.trials[:SHOWN]:
             L.append(f"| {p.label} | {p.kind} | {p.param} = {_num(s.values[p])} {p.unit} | "
+                     f"{_num(s.score - rnd.before, 4)}{' (screened)' if s.approx else ''} | "
+                     f"{_num(s.rms.get(DELTA))} | {'yes' if s.explains else 'no'} |")
+        for pq, s in rnd.pairs[:SHOWN_PAIRS]:
+            L.append(f"| {' + '.join(p.label for p in pq)} | pair | "
+                     + ", ".join(f"{p.param} = {_num(s.values[p])} {p.unit}" for p in pq) + " | "
                      f"{_num(s.score - rnd.before, 4)}{' (screened)' if s.approx else ''} | "
                      f"{_num(s.rms.get(DELTA))} | {'yes' if s.explains else 'no'} |")
     if "scores" in files:

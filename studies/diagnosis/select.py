@@ -1,26 +1,35 @@
 """Forward selection of hypotheses with held-out evidence.
 
-Start from the baseline model. Each round fits every hypothesis not yet chosen *added*
-to the chosen ones (which keep their values; sensor offsets, gains and drifts are
-re-solved) and scores it on the held-out window (:class:`calibrate.Objective`). In the
-first round every hypothesis is fitted alone; later, a hypothesis that needs model runs
-is first screened by superposing its first-round runs on the current model, and only the
-best ``screen_top`` of those are fitted for real. The best addition is kept when it
-lowers the score (penalty included) by at least ``margin_min``; then all chosen
-hypotheses are refitted jointly. Rounds stop when the held-out residual is nowhere
-significant, when no addition clears the margin, or at ``max_pieces``. Then every
-chosen piece is checked by removing it and refitting the others: a piece whose removal
-costs less than the margin is dropped. Last, a close runner-up of the round that added
-a piece is swapped in for it and refitted: if that scores within the margin, the data
-cannot tell the two apart and the piece lists it as an alternative.
+Start from the baseline model. The first round fits every hypothesis alone and scores
+it on the held-out window (:class:`calibrate.Objective`). Each later round adds every
+hypothesis not yet chosen to the chosen ones and refits *all* of them on a surrogate
+that needs no model run (:mod:`surrogate`); the best ``screen_top`` sets are then refitted
+jointly for real (bounded least squares from the surrogate's values). Every round also
+looks one step ahead: every pair of its best single additions is fitted on the surrogate
+and the best two pairs for real, so that two pieces that hide each other (each alone
+fits badly, e.g. film coefficients to air and to the oil both off) are found together.
+The best addition is kept when it lowers the score (penalty included) by at least
+``margin_min`` (a pair: when it also beats the best single addition by it). Rounds stop
+when the held-out residual is nowhere significant, when no addition clears the margin, or
+at ``max_pieces``. Then every chosen piece is checked by removing it and refitting the
+others: a piece whose removal costs less than the margin is dropped. If a significant
+held-out residual remains, one chosen piece may be swapped for one not chosen (the best
+swaps on the surrogate, refitted for real, kept when they gain the margin), and the
+rounds go on (at most ``swaps`` times). Last, every piece not chosen is put in place of
+each chosen one on the surrogate; where that scores within the margin, the closest are
+refitted for real, and if they still do, the data cannot tell the two apart: the chosen
+piece lists them as alternatives.
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass, field
+from itertools import combinations
 
-from gatetherm.studies.diagnosis.calibrate import Objective, Scored, fit_one, refit, superposed
+from gatetherm.studies.diagnosis.calibrate import Objective, Scored, fit_one, refit
 from gatetherm.studies.diagnosis.hypotheses import Piece
+from gatetherm.studies.diagnosis.surrogate import Surrogate, screen
 
 log = logging.getLogger(__name__)
 
@@ -30,7 +39,11 @@ class Round:
     """One round of forward selection: every addition tried, best first."""
 
     trials: tuple[tuple[Piece, Scored], ...]
-    added: Piece | None
+    """Single additions."""
+    pairs: tuple[tuple[tuple[Piece, Piece], Scored], ...]
+    """Two-piece additions (look-ahead), best first."""
+    added: tuple[Piece, ...]
+    """What the round added (nothing, one piece, or a pair)."""
     before: float
     """Score of the chosen set before the round."""
 
@@ -45,58 +58,121 @@ class Selection:
     """Chosen pieces in the order they were added."""
     rounds: list[Round] = field(default_factory=list)
     removed: list[Piece] = field(default_factory=list)
-    """Pieces chosen, then dropped by the removal check."""
+    """Pieces chosen, then dropped by the removal check or swapped out."""
+    swaps: list[tuple[Piece, Piece]] = field(default_factory=list)
+    """(piece swapped out, piece swapped in)."""
     alternatives: dict = field(default_factory=dict)
     """{piece: [pieces that explain the data as well in its place]}."""
     best_rejected: tuple[Piece, Scored] | None = None
     """The best addition that did not clear the margin in the last round."""
 
 
-def _round(obj: Objective, current: Scored, pool: list[Piece], top: int) -> list[tuple[Piece, Scored]]:
+def _best_first(trials):
+    return sorted(trials, key=lambda t: (t[1].approx, t[1].score))
+
+
+def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: dict, pair_top: int = 2) -> Round:
+    """Every single addition (fitted for real in the first round, else on the surrogate with
+    the best ``top`` refitted for real), then every pair of additions on the surrogate
+    (starting from the single fits), the best ``pair_top`` pairs refitted for real."""
     ctx = current.values
-    trials, screened = [], []
-    for p in pool:
-        if not p.rerun or not ctx:
-            trials.append((p, obj.scored(fit_one(obj, ctx, p))))
-        else:
-            s = superposed(obj, ctx, p)
-            screened.append((p, s)) if s is not None else trials.append((p, obj.scored(fit_one(obj, ctx, p))))
-    screened.sort(key=lambda ps: ps[1].score)
-    for i, (p, s) in enumerate(screened):
-        trials.append((p, obj.scored(fit_one(obj, ctx, p, start=s.values[p])) if i < top else s))
-    return sorted(trials, key=lambda ps: (ps[1].approx, ps[1].score))
+    if not ctx:
+        singles = [(p, obj.scored(fit_one(obj, {}, p))) for p in pool]
+        fits.update({frozenset([p]): s for p, s in singles})
+        sur = Surrogate(obj, ctx)
+    else:
+        sur = Surrogate(obj, ctx)
+        screened = sorted(((p, screen(sur, ctx, {p: None})) for p in pool if sur.usable(p)),
+                          key=lambda ps: ps[1].score)
+        singles = [(p, obj.scored(fit_one(obj, ctx, p))) for p in pool if not sur.usable(p)]
+        for i, (p, s) in enumerate(screened):
+            singles.append((p, _real(obj, s, fits) if i < top else s))
+    singles = _best_first(singles)
+    lead = [(p, s) for p, s in singles if sur.usable(p)]
+    pairs = sorted((((p, q), screen(sur, ctx, {p: sp.values[p], q: sq.values[q]}))
+                    for (p, sp), (q, sq) in combinations(lead, 2)), key=lambda t: t[1].score)
+    pairs = [(pq, _real(obj, s, fits) if i < pair_top else s) for i, (pq, s) in enumerate(pairs)]
+    return Round(tuple(singles), tuple(_best_first(pairs)), (), current.score)
 
 
-def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: int = 4, top: int = 3) -> Selection:
+def _real(obj: Objective, screened: Scored, fits: dict) -> Scored:
+    """A set screened on the surrogate, refitted jointly for real from the surrogate's values."""
+    s = fits[frozenset(screened.values)] = obj.scored(refit(obj, screened.values, max_nfev=5))
+    return s
+
+
+def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: int = 4, top: int = 3,
+           swaps: int = 2) -> Selection:
     base = obj.scored({})
     sel = Selection(base, base, [])
     fits: dict[frozenset, Scored] = {}
     current = base
-    while len(current.values) < max_pieces:
+    for _ in range(swaps + 1):
+        current = _forward(obj, sel, current, candidates, margin, max_pieces, top, fits)
+        current = _removal(obj, sel, current, fits, margin)
+        if current.explains or not current.values:
+            break
+        swapped = _swap(obj, sel, current, candidates, margin)
+        if swapped is None:
+            break
+        current = swapped
+    sel.final = current
+    _alternatives(obj, sel, candidates, margin)
+    return sel
+
+
+def _forward(obj: Objective, sel: Selection, current: Scored, candidates, margin: float, max_pieces: int, top: int,
+             fits: dict) -> Scored:
+    """Rounds of additions: the best pair when it gains the margin over the best single
+    addition (and there is room for two), else the best single one when it gains the margin."""
+    while len(current.values) < max_pieces and not current.explains:
         pool = [p for p in candidates if p not in current.values and p not in sel.removed]
         if not pool:
             break
-        trials = _round(obj, current, pool, top)
-        if not current.values:
-            fits.update({frozenset([p]): s for p, s in trials})
-        p, best = trials[0]
-        gain = current.score - best.score
-        log.info("round %d: best addition %s (gain %.1f), %d model runs so far", len(sel.rounds) + 1, p.label, gain,
-                 obj.replayer.runs)
-        if gain < margin:
-            sel.rounds.append(Round(tuple(trials), None, current.score))
-            sel.best_rejected = (p, best)
+        rnd = _round(obj, current, pool, top, fits)
+        p, one = rnd.trials[0]
+        gain = current.score - one.score
+        pair = rnd.pairs[0] if rnd.pairs and not rnd.pairs[0][1].approx else None
+        if pair and len(current.values) + 2 <= max_pieces and one.score - pair[1].score >= margin \
+                and current.score - pair[1].score >= 2 * margin:
+            added, best = pair
+        elif gain >= margin:
+            added, best = (p,), one
+        else:
+            log.info("round %d: no addition gains the margin (best: %s, %.1f)", len(sel.rounds) + 1, p.label, gain)
+            sel.rounds.append(rnd)
+            sel.best_rejected = (p, one)
             break
-        sel.rounds.append(Round(tuple(trials), p, current.score))
-        current = obj.scored(refit(obj, best.values))
-        fits[frozenset(current.values)] = current
-        sel.order.append(p)
-        if current.explains:
-            break
-    current = _removal(obj, sel, current, fits, margin)
-    sel.final = current
-    _alternatives(obj, sel, margin)
-    return sel
+        log.info("round %d: added %s (gain %.1f), %d model runs so far", len(sel.rounds) + 1,
+                 " + ".join(q.label for q in added), current.score - best.score, obj.replayer.runs)
+        sel.rounds.append(dataclasses.replace(rnd, added=added))
+        current = best  # fitted jointly already
+        sel.order += list(added)
+    return current
+
+
+def _replacements(obj: Objective, current: Scored, pool) -> list[tuple[Piece, Piece, Scored]]:
+    """Every set with one chosen piece replaced by one of ``pool``, refitted on the surrogate, best first."""
+    sur = Surrogate(obj, current.values)
+    tried = []
+    for p in current.values:
+        rest = {r: v for r, v in current.values.items() if r != p}
+        tried += [(p, q, screen(sur, rest, {q: None})) for q in pool if sur.usable(q)]
+    return sorted(tried, key=lambda t: t[2].score)
+
+
+def _swap(obj: Objective, sel: Selection, current: Scored, candidates, margin: float, top: int = 2) -> Scored | None:
+    """Replace one chosen piece by one not chosen, if that (refitted) lowers the score by the margin."""
+    pool = [q for q in candidates if q not in current.values and q not in sel.removed]
+    for p, q, s in _replacements(obj, current, pool)[:top]:
+        real = obj.scored(refit(obj, s.values, max_nfev=5))
+        if current.score - real.score >= margin:
+            log.info("swap: %s for %s (gain %.1f)", q.label, p.label, current.score - real.score)
+            sel.removed.append(p)
+            sel.order[sel.order.index(p)] = q
+            sel.swaps.append((p, q))
+            return real
+    return None
 
 
 def _removal(obj: Objective, sel: Selection, current: Scored, fits: dict, margin: float) -> Scored:
@@ -117,18 +193,18 @@ def _removal(obj: Objective, sel: Selection, current: Scored, fits: dict, margin
     return current
 
 
-def _alternatives(obj: Objective, sel: Selection, margin: float, most: int = 2) -> None:
+def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, most: int = 2) -> None:
+    """For every chosen piece, the pieces that, put in its place and refitted, score within the
+    margin of the chosen set (screened on the surrogate, the closest ``most`` refitted for real)."""
     final = sel.final
-    for rnd in sel.rounds:
-        p = rnd.added
-        if p is None or p not in final.values:
+    pool = [q for q in candidates if q not in final.values]
+    tried: dict[Piece, int] = {}
+    for p, q, s in _replacements(obj, final, pool):
+        if s.score - final.score >= margin or tried.get(p, 0) >= most:
             continue
-        mine = next(s for q, s in rnd.trials if q == p)
-        close = [(q, s) for q, s in rnd.trials if q != p and q not in final.values and s.score - mine.score < margin]
-        for q, s in close[:most]:
-            rest = {r: v for r, v in final.values.items() if r != p}
-            swapped = obj.scored(refit(obj, {**rest, q: s.values[q]}))
-            if swapped.score - final.score < margin:
-                sel.alternatives.setdefault(p, []).append(q)
-                log.info("%s and %s explain the data equally well (scores %.1f, %.1f)", p.label, q.label,
-                         final.score, swapped.score)
+        tried[p] = tried.get(p, 0) + 1
+        swapped = obj.scored(refit(obj, s.values, max_nfev=5))
+        if swapped.score - final.score < margin:
+            sel.alternatives.setdefault(p, []).append(q)
+            log.info("%s and %s explain the data equally well (scores %.1f, %.1f)", p.label, q.label,
+                     final.score, swapped.score)
