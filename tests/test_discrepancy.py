@@ -87,8 +87,7 @@ def test_verdict_rules():
     assert _verdict(True, Selection(base, base, []))[0] == "unexplained"
     assert _verdict(True, Selection(base, some, [piece]))[0] == "partly-explained"
     done = Scored({piece: 2.0}, 0.0, 6.0, {"delta_um": 0.1}, True)
-    assert _verdict(True, Selection(base, done, [piece])) == ("explained", "piezo_heat leave no significant "
-                                                                "held-out residual")
+    assert _verdict(True, Selection(base, done, [piece])) == ("explained", "piezo_heat leave no significant residual")
 
 
 def test_replay_reproduces_a_simulation(coarse_config):

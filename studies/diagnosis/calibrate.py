@@ -72,7 +72,8 @@ class Scored:
     rms: dict
     """Held-out RMS residual per channel (channel unit)."""
     explains: bool
-    """No channel keeps a significant held-out residual."""
+    """No channel keeps a significant residual anywhere in the run (training window included:
+    a set that only fits the held-out part does not explain the run)."""
     approx: bool = False
     """Scored from superposed earlier runs (screening), not from a run of the set itself."""
 
@@ -163,7 +164,7 @@ class Objective:
         res, _ = self.residuals(values, cols, solve=False)
         fit = self.held_fit(res)
         rms = {c: float(np.sqrt(np.nanmean(res[c][self.held] ** 2))) for c in self.channels}
-        sig = any(np.any(significant(self.t, res[c], resolution(c)) & self.held) for c in self.channels)
+        sig = any(np.any(significant(self.t, res[c], resolution(c))) for c in self.channels)
         return Scored(dict(values), fit, fit + self.penalty(len(values)), rms, not sig, approx)
 
 

@@ -9,9 +9,9 @@
 4. *Name*. The verdict is
 
    * ``no-discrepancy``: the baseline residual is nowhere significant;
-   * ``explained``: the chosen pieces leave no significant held-out residual;
-   * ``partly-explained``: pieces were found, but a significant held-out residual remains
-     (the report says where and when);
+   * ``explained``: the chosen pieces leave no significant residual, anywhere in the run;
+   * ``partly-explained``: pieces were found, but a significant residual remains (the
+     report says where and when);
    * ``unexplained``: no hypothesis lowers the held-out score by the margin.
 """
 from __future__ import annotations
@@ -175,8 +175,8 @@ def _verdict(discrepant: bool, sel) -> tuple[str, str]:
                                + (f" (best: {rej[0].label})" if rej else ""))
     names = " + ".join(p.label for p in sel.order)
     if sel.final.explains:
-        return "explained", f"{names} leave no significant held-out residual"
-    return "partly-explained", f"{names} lower the held-out score, but a significant held-out residual remains"
+        return "explained", f"{names} leave no significant residual"
+    return "partly-explained", f"{names} lower the held-out score, but a significant residual remains"
 
 
 def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,

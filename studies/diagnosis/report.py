@@ -10,7 +10,7 @@ from gatetherm.studies.diagnosis.replay import DELTA, label, resolution, unit
 
 VERDICT_TEXT = {
     "no-discrepancy": "The model agrees with the measurement within the sensor resolution; nothing to add.",
-    "explained": "The pieces below, together, leave no significant held-out residual.",
+    "explained": "The pieces below, together, leave no significant residual anywhere in the run.",
     "partly-explained": "The pieces below lower the held-out residual, but a significant part remains "
                         "(section 5 says where and when): something outside the hypotheses is missing too.",
     "unexplained": "The model and the measurement disagree, and no hypothesis clearly lowers the held-out residual.",

@@ -5,20 +5,21 @@ it on the held-out window (:class:`calibrate.Objective`). Each later round adds 
 hypothesis not yet chosen to the chosen ones and refits *all* of them on a surrogate
 that needs no model run (:mod:`surrogate`); the best ``screen_top`` sets are then refitted
 jointly for real (bounded least squares from the surrogate's values). Every round also
-looks one step ahead: every pair of its best single additions is fitted on the surrogate
-and the best two pairs for real, so that two pieces that hide each other (each alone
+looks one step ahead: every pair of additions is fitted on the surrogate (from the
+single fits) and the best two pairs for real, so that two pieces that hide each other (each alone
 fits badly, e.g. film coefficients to air and to the oil both off) are found together.
 The best addition is kept when it lowers the score (penalty included) by at least
 ``margin_min`` (a pair: when it also beats the best single addition by it). Rounds stop
-when the held-out residual is nowhere significant, when no addition clears the margin, or
-at ``max_pieces``. Then every chosen piece is checked by removing it and refitting the
-others: a piece whose removal costs less than the margin is dropped. If a significant
-held-out residual remains, one chosen piece may be swapped for one not chosen (the best
-swaps on the surrogate, refitted for real, kept when they gain the margin), and the
-rounds go on (at most ``swaps`` times). Last, every piece not chosen is put in place of
-each chosen one on the surrogate; where that scores within the margin, the closest are
-refitted for real, and if they still do, the data cannot tell the two apart: the chosen
-piece lists them as alternatives.
+when the residual is nowhere significant (training window included), when no addition
+clears the margin, or at ``max_pieces``. Then every chosen piece is checked by removing
+it and refitting the others: a piece whose removal costs less than the margin is dropped,
+and so is a piece that changes no channel by the sensor resolution (a model error below
+the resolution is not a finding). If a significant residual remains, one chosen piece may
+be swapped for one not chosen (the best swaps on the surrogate, refitted for real, kept
+when they gain the margin), and the rounds go on (at most ``swaps`` times). Last, every
+piece not chosen is put in place of each chosen one on the surrogate; where that scores
+within the margin, the closest are refitted for real, and if they still do, the data
+cannot tell the two apart: the chosen piece lists them as alternatives.
 """
 from __future__ import annotations
 
@@ -27,8 +28,11 @@ import logging
 from dataclasses import dataclass, field
 from itertools import combinations
 
+import numpy as np
+
 from gatetherm.studies.diagnosis.calibrate import Objective, Scored, fit_one, refit
 from gatetherm.studies.diagnosis.hypotheses import Piece
+from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.diagnosis.surrogate import Surrogate, screen
 
 log = logging.getLogger(__name__)
@@ -175,18 +179,30 @@ def _swap(obj: Objective, sel: Selection, current: Scored, candidates, margin: f
     return None
 
 
+def _contribution(obj: Objective, values: dict, p: Piece) -> float:
+    """The largest change ``p`` makes to a compared channel, the others kept, in units of
+    the channel's resolution."""
+    res = obj.residuals(values, solve=False)[0]
+    without = obj.residuals({q: v for q, v in values.items() if q != p}, solve=False)[0]
+    return max(float(np.nanmax(np.abs(res[c] - without[c]))) / resolution(c) for c in obj.channels)
+
+
 def _removal(obj: Objective, sel: Selection, current: Scored, fits: dict, margin: float) -> Scored:
-    while len(current.values) >= 2:
+    """Drop, one at a time, a piece that changes no channel by the resolution, or (of two or more)
+    whose removal, the others refitted, costs less than the margin."""
+    while current.values:
         costs = []
         for p in current.values:
             rest = frozenset(current.values) - {p}
             if rest not in fits:
-                fits[rest] = obj.scored(refit(obj, {q: current.values[q] for q in rest}))
-            costs.append((fits[rest].score - current.score, p, fits[rest]))
-        cost, p, without = min(costs, key=lambda c: c[0])
-        if cost >= margin:
+                fits[rest] = obj.scored(refit(obj, {q: current.values[q] for q in rest}) if rest else {})
+            small = _contribution(obj, current.values, p) < 1.0
+            costs.append((not small, fits[rest].score - current.score, p, fits[rest]))
+        needed, cost, p, without = min(costs, key=lambda c: c[:2])
+        if needed and (cost >= margin or len(current.values) < 2):
             break
-        log.info("removal check: %s not needed (removing it costs %.1f)", p.label, cost)
+        log.info("removal check: %s not needed (%s)", p.label,
+                 f"removing it costs {cost:.1f}" if needed else "it changes no channel by the resolution")
         sel.removed.append(p)
         sel.order.remove(p)
         current = without
