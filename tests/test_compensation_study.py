@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from gatetherm.solvers import beam
-from gatetherm.solvers.model import build_model
+from gatetherm.solvers.frame import build_model
 from gatetherm.solvers.reduced import fe_coefficients
 from gatetherm.studies import cli
 from gatetherm.studies.control.actuator import ActuatorParams, dead_band_um

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.solvers.heat import Drive, Inputs
+from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
+from gatetherm.solvers.heat import Drive
 
 HOUR = 3600.0
 
@@ -97,8 +98,9 @@ def pump_state(cond: Condition, t: float) -> bool:
 def condition_drive(cond: Condition, sp: SupplyParams) -> Drive:
     """The model input for a paper condition."""
 
-    def drive(t: float) -> Inputs:
-        return Inputs(float(supply_temperature(cond, sp, t)[0]), pump_state(cond, t), sp.T_room)
+    def drive(t: float) -> dict[str, float]:
+        return {SUPPLY: float(supply_temperature(cond, sp, t)[0]), PUMP: float(pump_state(cond, t)),
+                AMBIENT: sp.T_room}
 
     return drive
 
@@ -113,10 +115,10 @@ class TableDrive:
     pump: np.ndarray
     ambient: np.ndarray
 
-    def __call__(self, t: float) -> Inputs:
+    def __call__(self, t: float) -> dict[str, float]:
         i = max(int(np.searchsorted(self.time, t, side="right")) - 1, 0)
-        return Inputs(float(np.interp(t, self.time, self.oil)), bool(self.pump[i] > 0.5),
-                      float(np.interp(t, self.time, self.ambient)))
+        return {SUPPLY: float(np.interp(t, self.time, self.oil)), PUMP: float(self.pump[i] > 0.5),
+                AMBIENT: float(np.interp(t, self.time, self.ambient))}
 
 
 def table_drive(time, oil, pump, ambient=None, T_room: float = 20.0) -> TableDrive:

@@ -21,9 +21,9 @@ from pathlib import Path
 from gatetherm import InputError
 from gatetherm.geometry.frame import FrameParams, MeshParams, validate, validate_mesh
 from gatetherm.solvers.effects import effects_from_table, effects_table
-from gatetherm.solvers.heat import ThermalParams, TimeScheme
+from gatetherm.solvers.frame import ModelConfig, ThermalParams
+from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
-from gatetherm.solvers.model import ModelConfig
 from gatetherm.studies.run.conditions import SupplyParams
 
 log = logging.getLogger(__name__)

@@ -8,21 +8,29 @@ import numpy as np
 
 from gatetherm import atomic_path, write_text_atomic
 from gatetherm.geometry.mesh import to_meshio
-from gatetherm.solvers.model import FrameModel
+from gatetherm.solvers.model import Model, static_fields
 
 
-def nodal_fields(model: FrameModel, U: np.ndarray) -> dict[str, np.ndarray]:
-    """Temperature (°C) and displacement (m, 3 components) at the mesh nodes."""
+def nodal_fields(model: Model, U: np.ndarray | None) -> dict[str, np.ndarray]:
+    """Temperature (°C), displacement (m, 3 components) and stress (Pa: components
+    ``sigma_xx`` … and ``von_mises``) at the mesh nodes, for the heat state ``U`` (None:
+    the prescribed temperature of a problem without a heat solve)."""
+    if U is None:
+        return static_fields(model)
     T = U[:model.heat.n_solid][model.heat.basis.nodal_dofs[0]]
-    u_dofs = model.displacement_field(U)
-    u = np.zeros((len(T), 3))
-    u[:, : model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
-    return {"T": T, "u": u}
+    out = {"T": T}
+    if model.elastic is not None:
+        u_dofs = model.displacement_field(U)
+        u = np.zeros((len(T), 3))
+        u[:, : model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
+        out["u"] = u
+        out.update({f"sigma_{k}" if k != "von_mises" else k: v for k, v in model.stress_field(u_dofs, U).items()})
+    return out
 
 
-def write_fields(model: FrameModel, states, out: Path) -> list[Path]:
-    """One ``.vtu`` per saved state (arrays ``T``, ``u``) and a ``fields.pvd``
-    collection that ParaView opens as a time series."""
+def write_fields(model: Model, states, out: Path) -> list[Path]:
+    """One ``.vtu`` per saved state (point arrays of :func:`nodal_fields`) and a
+    ``fields.pvd`` collection that ParaView opens as a time series."""
     import meshio
 
     out.mkdir(parents=True, exist_ok=True)

@@ -18,7 +18,8 @@ import numpy as np
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
 from gatetherm.solvers.heat import Drive, HeatSolver
-from gatetherm.solvers.model import FrameModel, ModelConfig, build_model
+from gatetherm.solvers.frame import ModelConfig, build_model
+from gatetherm.solvers.model import Model
 from gatetherm.studies.run.conditions import condition, condition_drive, table_drive
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.simulate import RunResult, run_model, sample_times
@@ -84,7 +85,7 @@ class ScenarioCache:
             store.popitem(last=False)
         return value
 
-    def model(self, cfg: ModelConfig, dim: int) -> tuple[FrameModel, HeatSolver]:
+    def model(self, cfg: ModelConfig, dim: int) -> tuple[Model, HeatSolver]:
         def make():
             model = build_model(cfg, dim, self.fmesh)
             return model, HeatSolver(model.heat)
@@ -101,7 +102,7 @@ class ScenarioCache:
 class Prepared:
     """A model ready to run: effects applied and assembled."""
 
-    model: FrameModel
+    model: Model
     solver: HeatSolver
     drive: Drive
     """The schedule's drive with the drive-side effects applied."""
@@ -113,7 +114,7 @@ def prepare(config: Config, dim: int, drive: Drive, effects: Mapping[str, float]
             cache: ScenarioCache | None = None, mesh: FrameMesh | None = None) -> Prepared:
     """Apply the effects of ``config`` and ``effects`` (these win) and build or reuse the model."""
     eff = ActiveEffects({**config.effects, **dict(effects or {})})
-    model_cfg, drive = apply_effects(config.model, drive, eff, dim)
+    model_cfg, drive = apply_effects(config.model, drive, eff)
     if cache is not None:
         model, solver = cache.model(model_cfg, dim)
     else:
@@ -130,7 +131,7 @@ class ScenarioRun:
     """What the sensors report, in the data format (observation-side effects applied)."""
     result: RunResult
     """The model's own columns, kept states and march time."""
-    model: FrameModel
+    model: Model
     effects: ActiveEffects
     schedule: Schedule
     seconds: float

@@ -15,7 +15,9 @@ import numpy as np
 from scipy.signal import find_peaks
 
 from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, march
-from gatetherm.solvers.model import FrameModel
+from gatetherm.solvers.model import Model
+from gatetherm.solvers.problem import Problem
+from gatetherm.solvers.stress import von_mises
 
 log = logging.getLogger(__name__)
 
@@ -37,42 +39,58 @@ def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
     return np.linspace(0.0, n * step_s, n + 1)
 
 
-def run_model(model: FrameModel, drive: Drive, times: np.ndarray, keep_times=(),
+def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarray]:
+    """Data-format columns of the outputs ``Y`` (samples × ``keys``, SI units): the signals
+    θ_A, θ_B, θ_C and δ under their data-format names, then the other relative
+    displacements (µm), temperatures at probes, displacements (µm) and stresses (MPa) at
+    probes, fluids and boundary means (°C)."""
+    Y = np.atleast_2d(Y)
+    at = {k: Y[:, i] for i, k in enumerate(keys)}
+    s, out = problem.signals, {}
+    if s.theta_A:
+        out["theta_A_degC"] = at[("T", s.theta_A)]
+    if s.theta_B:
+        out["theta_B_degC"] = at[("T", s.theta_B)]
+    if s.theta_C:
+        out["theta_C_degC"] = np.mean([at[("T", c)] for c in s.theta_C], axis=0)
+    if s.delta:
+        out["delta_um"] = at[("relative", s.delta)] * 1e6
+    out.update({f"{r.name}_um": at[("relative", r.name)] * 1e6 for r in problem.relative if r.name != s.delta})
+    for pr in problem.probes:
+        if ("T", pr.name) in at and pr.name not in (s.theta_A, s.theta_B):
+            out[f"T_{pr.name}_degC"] = at[("T", pr.name)]
+        out.update({f"u{a}_{pr.name}_um": at[k] * 1e6 for k in at if k[:2] == ("u", pr.name) for a in k[2]})
+        sig = {k[2]: at[k] / 1e6 for k in at if k[:2] == ("sigma", pr.name)}
+        out.update({f"sigma_{c}_{pr.name}_MPa": v for c, v in sig.items()})
+        if sig:
+            out[f"von_mises_{pr.name}_MPa"] = von_mises(sig)
+    out.update({f"T_{k[1]}_degC": v for k, v in at.items() if k[0] in ("fluid", "mean")})
+    return out
+
+
+def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
               U0: np.ndarray | None = None, solver: HeatSolver | None = None) -> RunResult:
     """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0)
-    with ``scheme`` (default: the model's); keep full states at ``keep_times``. A
-    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs."""
+    with ``scheme`` (default: the problem's); keep full states at ``keep_times``. A
+    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs.
+    Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
-    rows, states = [], []
+    inputs, Y, states = [], [], []
     t0 = _time.perf_counter()
-    scheme = model.config.scheme if scheme is None else scheme
+    scheme = model.problem.scheme if scheme is None else scheme
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
-        u = drive(t)
-        temps = model.temperatures(U)
-        disp = model.displacements(U)
-        rows.append((t, u.T_supply, float(u.pump), u.T_amb, temps, disp))
+        inputs.append({"time_s": t, **drive(t)})
+        Y.append(model.read(U))
         if t in keep:
             states.append((t, U.copy()))
         if on_step:
             on_step(i + 1, len(times))
-    cols: dict[str, np.ndarray] = {
-        "time_s": np.array([r[0] for r in rows]),
-        "oil_degC": np.array([r[1] for r in rows]),
-        "pump": np.array([r[2] for r in rows]),
-        "ambient_degC": np.array([r[3] for r in rows]),
-        "theta_A_degC": np.array([r[4]["A"] for r in rows]),
-        "theta_B_degC": np.array([r[4]["B"] for r in rows]),
-        "theta_C_degC": np.array([r[4]["C"] for r in rows]),
-        "delta_um": np.array([r[5]["delta"] for r in rows]) * 1e6,
-    }
-    cols["delta_E_um"] = np.array([r[5]["delta_E"] for r in rows]) * 1e6
-    for name in list(rows[0][4]):
-        if name not in ("A", "B", "C"):
-            cols[f"T_{'tank_' if name in ('oil', 'wall') else ''}{name}_degC"] = np.array([r[4][name] for r in rows])
+    cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
+    cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
     secs = _time.perf_counter() - t0
-    log.info("marched %d steps in %.2f s", len(rows) - 1, secs)
+    log.info("marched %d steps in %.2f s", len(Y) - 1, secs)
     return RunResult(cols, states, secs)
 
 

@@ -15,7 +15,7 @@ from typing import Any, Callable
 import numpy as np
 
 import gatetherm
-from gatetherm.solvers.model import scheme_digest
+from gatetherm.solvers.frame import scheme_digest
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.sweeps.sweep import Task
 

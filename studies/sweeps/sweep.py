@@ -36,7 +36,7 @@ from gatetherm import InputError
 from gatetherm.geometry.frame import FrameParams, tie_depth, tie_heights, validate
 import gatetherm
 from gatetherm.solvers.beam import beta_area
-from gatetherm.solvers.model import scheme_digest
+from gatetherm.solvers.frame import scheme_digest
 from gatetherm.studies.run.config import Config, parse_config
 
 SECTIONS = ("geometry", "mesh", "material", "material.tie_bar", "thermal", "supply", "model")
@@ -50,7 +50,7 @@ COMPUTE = {
 }
 MADE_BY = ("version", "scheme")
 """Table columns naming what computed a point: gatetherm version and scheme digest
-(:func:`~gatetherm.solvers.model.scheme_digest`), both part of the point key."""
+(:func:`~gatetherm.solvers.frame.scheme_digest`), both part of the point key."""
 PINHOLE = 0.003
 """Side of the cavity left by ``derived.tank_cavity = false``, m."""
 

@@ -1,0 +1,130 @@
+"""Stress recovery: the thermoelastic stress projected (L2) onto the continuous Lagrange
+space of the displacement's degree, over all elements or over one region (a stress
+that jumps between regions, as at a heated spot, is read from one side).
+
+A projected component at a point is linear in the displacement and the temperature
+rise, ``σ_c(p) = g_u·u + g_T·ΔT``; :class:`Recovery` gives those vectors, so a stress
+probe costs what a displacement probe costs. Von Mises is computed from the components.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+from skfem import BilinearForm, CellBasis, LinearForm, asm
+from skfem.helpers import div, sym_grad
+
+from gatetherm.solvers.elasticity import moduli
+from gatetherm.solvers.fem import Field, element
+
+COMPONENTS = {(2, "stress"): ("xx", "yy", "xy"), (2, "strain"): ("xx", "yy", "zz", "xy"),
+              (3, "stress"): ("xx", "yy", "zz", "xy", "yz", "xz"), (3, "strain"): ("xx", "yy", "zz", "xy", "yz", "xz")}
+"""Stress components reported, by (dimension, 2-D plane kind)."""
+_INDEX = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "xz": (0, 2)}
+
+
+@BilinearForm
+def mass(u, v, w):
+    return u * v
+
+
+@BilinearForm
+def stress_of_u(u, v, w):
+    """Trial: displacement; test: scalar. Component ``(w.i, w.j)`` of ``λ tr ε I + 2 μ ε``."""
+    i, j = w.i, w.j
+    s = 2.0 * w.mu * sym_grad(u)[i][j] if i < w.dim and j < w.dim else 0.0 * div(u)
+    return (s + w.lam * div(u)) * v if i == j else s * v
+
+
+@BilinearForm
+def stress_of_T(T, v, w):
+    """Trial: temperature rise; test: scalar. The thermal part ``−b ΔT`` of a normal component."""
+    return -w.b * T * v
+
+
+@LinearForm
+def stress_of_T_at(v, w):
+    """The thermal part of a normal component for a rise ``w.T`` given at the quadrature points."""
+    return -w.b * w.T * v
+
+
+def von_mises(s: dict[str, np.ndarray]) -> np.ndarray:
+    """Von Mises stress from components (missing ones are zero)."""
+    g = {k: np.asarray(s.get(k, 0.0)) for k in _INDEX}
+    return np.sqrt(0.5 * ((g["xx"] - g["yy"]) ** 2 + (g["yy"] - g["zz"]) ** 2 + (g["zz"] - g["xx"]) ** 2)
+                   + 3.0 * (g["xy"] ** 2 + g["yz"] ** 2 + g["xz"] ** 2))
+
+
+@dataclass
+class Recovery:
+    """L2 projection of the stress onto the scalar space ``scalar`` restricted to the
+    elements ``elements`` (all when None). Set up once per region; holds a factor."""
+
+    scalar: CellBasis
+    """Scalar Lagrange basis of the displacement's degree on the region."""
+    active: np.ndarray
+    """Its DOFs touched by the region."""
+    lu: object
+    """Factor of the region's mass matrix on the active DOFs."""
+    S: dict[str, sp.csr_matrix]
+    """Per component: the projection's right-hand side per unit displacement."""
+    Q: dict[str, sp.csr_matrix]
+    """Per normal component: the right-hand side per unit nodal temperature rise."""
+    components: tuple[str, ...]
+
+    def _z(self, xyz) -> np.ndarray:
+        phi = self.scalar.probes(np.asarray(xyz, float).reshape(-1, 1)).toarray().ravel()
+        z = np.zeros(self.scalar.N)
+        z[self.active] = self.lu.solve(phi[self.active])
+        return z
+
+    def point(self, xyz) -> dict[str, tuple[np.ndarray, np.ndarray | None]]:
+        """Per component at ``xyz``: ``(g_u, g_T)`` with ``σ = g_u·u + g_T·ΔT`` (g_T None
+        for shear components)."""
+        z = self._z(xyz)
+        return {c: (self.S[c].T @ z, self.Q[c].T @ z if c in self.Q else None) for c in self.components}
+
+    def field(self, u: np.ndarray, rhs_T: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Projected components (on ``scalar``) for displacement ``u`` and the thermal
+        right-hand sides ``rhs_T`` (per normal component, see :meth:`thermal_rhs`)."""
+        out = {}
+        for c in self.components:
+            b = self.S[c] @ u + rhs_T.get(c, 0.0)
+            s = np.zeros(self.scalar.N)
+            s[self.active] = self.lu.solve(b[self.active])
+            out[c] = s
+        return out
+
+    def thermal_rhs(self, dT: np.ndarray) -> dict[str, np.ndarray]:
+        """The thermal right-hand sides for a nodal temperature rise."""
+        return {c: Q @ dT for c, Q in self.Q.items()}
+
+
+def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T_elem,
+             elements: np.ndarray | None = None, T_at=None) -> Recovery:
+    """Set up the projection on ``elements`` (all if None). ``T_elem`` is the element of
+    the nodal temperature rise; when the rise is prescribed instead, ``T_elem`` is None and
+    ``T_at(basis)`` gives it at a basis's quadrature points: ``Q`` then holds one column,
+    the thermal right-hand side itself (``thermal_rhs(np.ones(1))``)."""
+    from skfem import ElementVector
+
+    q = 2 * order
+    kw = {"intorder": q} if elements is None else {"intorder": q, "elements": elements}
+    sb = CellBasis(mesh, element(dim, order), **kw)
+    ub = CellBasis(mesh, ElementVector(element(dim, order)), **kw)
+    lam, mu, b = moduli(fields["E"].values, fields["nu"].values, fields["alpha"].values, dim, plane)
+    lam, mu, b = (Field(v).at(sb) for v in (lam, mu, b))
+    M = asm(mass, sb).tocsr()
+    active = np.unique(sb.element_dofs)
+    comps = COMPONENTS[(dim, plane)]
+    S = {c: asm(stress_of_u, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr()
+         for c in comps}
+    normal = [c for c in comps if c[0] == c[1] and not (dim == 2 and plane == "stress" and c == "zz")]
+    if T_elem is not None:
+        tb = CellBasis(mesh, T_elem, **kw)
+        Q = {c: asm(stress_of_T, tb, sb, b=b).tocsr() for c in normal}
+    else:
+        Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=b, T=T_at(sb))[:, None]) for c in normal}
+    return Recovery(sb, active, splu(M[active][:, active].tocsc()), S, Q, comps)
