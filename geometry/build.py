@@ -159,4 +159,4 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
         boundaries = {k: remap[v] for k, v in boundaries.items()}
         sensors = {k: int(remap[v]) for k, v in sensors.items()}
     log.info("meshed %d-D frame: %d nodes, %d elements", dim, len(points), len(cells))
-    return FrameMesh(dim, points, cells, regions, boundaries, sensors, {"frame": p})
+    return FrameMesh(dim, points, cells, regions, boundaries, sensors, {"frame": p} if p is not None else {})

@@ -186,12 +186,17 @@ def apply_effects(cfg: ModelConfig, drive: Drive, eff: ActiveEffects) -> tuple[M
         changes["thermal"] = dataclasses.replace(cfg.thermal, h_base=v["base_conduction"])
     if "piezo_heat" in v:
         changes["power"] = {**cfg.power, "arm_R": v["piezo_heat"]}
-    if "ambient_drift" in v:
-        rate = v["ambient_drift"] / 3600.0
-        base = drive
+    return (dataclasses.replace(cfg, **changes) if changes else cfg), drive_effects(drive, eff)
 
-        def drive(t: float) -> dict[str, float]:
-            u = base(t)
-            return {**u, AMBIENT: u[AMBIENT] + rate * t}
 
-    return (dataclasses.replace(cfg, **changes) if changes else cfg), drive
+def drive_effects(drive: Drive, eff: ActiveEffects) -> Drive:
+    """The drive with the drive-side effects on (the room drifting from its initial value)."""
+    if "ambient_drift" not in eff.values:
+        return drive
+    rate, base = eff.values["ambient_drift"] / 3600.0, drive
+
+    def drifting(t: float) -> dict[str, float]:
+        u = base(t)
+        return {**u, AMBIENT: u[AMBIENT] + rate * t}
+
+    return drifting

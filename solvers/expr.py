@@ -121,7 +121,9 @@ class Value:
         """Variables the expression reads (time ``t``, inputs, coordinates)."""
         if self.is_constant:
             return set()
-        return {n.id for n in ast.walk(self.tree) if isinstance(n, ast.Name)} - set(CONSTANTS)
+        nodes = list(ast.walk(self.tree))
+        called = {id(n.func) for n in nodes if isinstance(n, ast.Call)}
+        return {n.id for n in nodes if isinstance(n, ast.Name) and id(n) not in called} - set(CONSTANTS)
 
     def __call__(self, env: Mapping[str, object] | None = None):
         """The value for the variables ``env`` (numbers or arrays, which broadcast)."""

@@ -114,8 +114,8 @@ class Model:
         out: dict[Key, float] = {}
         T = _prescribed_at_points(self, np.array([pr.xyz for pr in p.probes]).T) if p.probes else []
         for pr, Tp in zip(p.probes, T):
-            if "T" in pr.quantities:
-                out[("T", pr.name)] = float(Tp)
+            if "T" in pr.quantities:  # on a region's side where the prescribed temperature jumps
+                out[("T", pr.name)] = float(p.prescribed_regions.get(pr.region, Tp))
         if self.elastic is None:
             return out
         u = self.elastic.from_load(_prescribed_load(self))
@@ -126,7 +126,7 @@ class Model:
             if "sigma" in pr.quantities:
                 rec = _probe_recovery(self, pr.region)
                 comps = rec.field(u, rec.thermal_rhs(np.ones(1)))
-                phi = rec.scalar.probes(np.asarray(pr.xyz, float).reshape(-1, 1)).toarray().ravel()
+                phi = rec.at(pr.xyz)
                 out.update({("sigma", pr.name, c): float(phi @ v) for c, v in comps.items()})
         for r in p.relative:
             a, b = (next(x for x in p.probes if x.name == n).xyz for n in (r.a, r.b))

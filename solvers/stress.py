@@ -64,6 +64,8 @@ class Recovery:
 
     scalar: CellBasis
     """Scalar Lagrange basis of the displacement's degree on the region."""
+    full: CellBasis
+    """The same on the whole mesh (same DOF numbers), to evaluate at points."""
     active: np.ndarray
     """Its DOFs touched by the region."""
     lu: object
@@ -74,8 +76,12 @@ class Recovery:
     """Per normal component: the right-hand side per unit nodal temperature rise."""
     components: tuple[str, ...]
 
+    def at(self, xyz) -> np.ndarray:
+        """Row φ with φ·s = the value at ``xyz`` of a field ``s`` on :attr:`scalar`."""
+        return self.full.probes(np.asarray(xyz, float).reshape(-1, 1)).toarray().ravel()
+
     def _z(self, xyz) -> np.ndarray:
-        phi = self.scalar.probes(np.asarray(xyz, float).reshape(-1, 1)).toarray().ravel()
+        phi = self.at(xyz)
         z = np.zeros(self.scalar.N)
         z[self.active] = self.lu.solve(phi[self.active])
         return z
@@ -127,4 +133,5 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
         Q = {c: asm(stress_of_T, tb, sb, b=b).tocsr() for c in normal}
     else:
         Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=b, T=T_at(sb))[:, None]) for c in normal}
-    return Recovery(sb, active, splu(M[active][:, active].tocsc()), S, Q, comps)
+    full = sb if elements is None else CellBasis(mesh, element(dim, order), intorder=q)
+    return Recovery(sb, full, active, splu(M[active][:, active].tocsc()), S, Q, comps)

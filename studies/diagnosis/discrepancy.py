@@ -30,6 +30,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.solvers.effects import CATALOGUE
+from gatetherm.solvers.frame import PUMP, SUPPLY
 from gatetherm.studies.diagnosis.calibrate import (RECAL, Fit, Objective, baseline, effect_uncertainty,
                                fit_effect, fit_recalibration)
 from gatetherm.studies.run.config import Config
@@ -177,7 +178,7 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     held = ~train
     if held.sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
-    run_phases = phases(t, rep.drive.oil, rep.drive.pump)
+    run_phases = phases(t, rep.drive.columns[SUPPLY], rep.drive.columns[PUMP])
     findings = locate(t, res0, run_phases)
     obj = Objective(rep, ts, channels, scale, train)
     base = _score(obj, baseline(obj), held, t)

@@ -35,8 +35,9 @@ def write_fields(model: Model, states, out: Path) -> list[Path]:
 
     out.mkdir(parents=True, exist_ok=True)
     written, entries = [], []
-    for t, U in states:
-        name = f"fields_{int(round(t / 60)):04d}min.vtu"
+    minutes = all(abs(t / 60 - round(t / 60)) < 1e-9 for t, _ in states)
+    for k, (t, U) in enumerate(states):
+        name = f"fields_{int(round(t / 60)):04d}min.vtu" if minutes else f"fields_{k:04d}.vtu"
         with atomic_path(out / name) as tmp:
             meshio.write(tmp, to_meshio(model.fmesh, nodal_fields(model, U)), file_format="vtu")
         entries.append(f'    <DataSet timestep="{t:g}" file="{name}"/>')
@@ -75,3 +76,28 @@ def deformed_grid(run, t_pic: float):
     """(time, pyvista grid with T and u) of the kept state nearest ``t_pic`` (s)."""
     t, U = min(run.result.states, key=lambda s: abs(s[0] - t_pic))
     return t, pyvista_grid(run.model, U)
+
+
+def probe_summary(problem, cols: dict[str, np.ndarray]) -> dict:
+    """``{"probes": {NAME: {QUANTITY: value}}, "relative": {NAME: µm}}`` at the last sample
+    (quantities ``T_degC``, ``ux_um`` …, ``sigma_xx_MPa`` …, ``von_mises_MPa``)."""
+    from gatetherm.solvers.problem import AXES
+    from gatetherm.solvers.stress import COMPONENTS
+    from gatetherm.studies.run.simulate import column
+
+    def last(key):
+        name, _ = column(problem, key)
+        return float(cols[name][-1]) if name in cols else None
+
+    probes = {}
+    for pr in problem.probes:
+        q = {}
+        if "T" in pr.quantities:
+            q["T_degC"] = last(("T", pr.name))
+        if "u" in pr.quantities and problem.elastic:
+            q.update({f"u{a}_um": last(("u", pr.name, a)) for a in AXES[:problem.dim]})
+        if "sigma" in pr.quantities and problem.elastic:
+            q.update({f"sigma_{c}_MPa": last(("sigma", pr.name, c)) for c in COMPONENTS[(problem.dim, problem.plane)]})
+            q["von_mises_MPa"] = float(cols[f"von_mises_{pr.name}_MPa"][-1])
+        probes[pr.name] = q
+    return {"probes": probes, "relative": {r.name: last(("relative", r.name)) for r in problem.relative}}

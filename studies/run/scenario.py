@@ -2,8 +2,11 @@
 
 Every command and study runs a model through :func:`run_scenario` (or, when it needs
 the assembled model without a run, :func:`prepare`), so that the effects of a model
-file act the same everywhere. What drives a run is a :class:`Schedule`: a paper
-condition, a schedule file, or the inputs of a measured series.
+file act the same everywhere. The model is the paper's frame (a model file's
+:class:`~gatetherm.studies.run.config.Config`) or any frame of a case file
+(:class:`~gatetherm.studies.run.case.Case`). What drives a run is a :class:`Schedule`:
+a paper condition, a schedule file, the inputs of a measured series, or a case's time
+settings; a case without them is solved once, in steady state.
 """
 from __future__ import annotations
 
@@ -16,13 +19,15 @@ from typing import Callable, Mapping
 import numpy as np
 
 from gatetherm.geometry.mesh import FrameMesh
-from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
-from gatetherm.solvers.heat import Drive, HeatSolver
+from gatetherm import InputError
+from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects, drive_effects
 from gatetherm.solvers.frame import ModelConfig, build_model
-from gatetherm.solvers.model import Model
-from gatetherm.studies.run.conditions import condition, condition_drive, table_drive
+from gatetherm.solvers.heat import Drive, HeatSolver, environment
+from gatetherm.solvers.model import Model, build
+from gatetherm.studies.run.case import Case
+from gatetherm.studies.run.conditions import TableDrive, condition, condition_drive, filled, table_drive
 from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.simulate import RunResult, run_model, sample_times
+from gatetherm.studies.run.simulate import RunResult, output_columns, run_model, sample_times
 from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, read_timeseries
 
 log = logging.getLogger(__name__)
@@ -40,6 +45,8 @@ class Schedule:
     """What the schedule is, for file metadata and reports."""
     condition: int | None = None
     """The paper's condition number, if it is one."""
+    every: int = 1
+    """Report every ``every``-th step (the output interval of a case whose step is smaller)."""
 
 
 def condition_schedule(number: int, cfg: Config, step_s: float = 60.0) -> Schedule:
@@ -54,6 +61,24 @@ def series_schedule(ts: TimeSeries, cfg: Config, label: str) -> Schedule:
     t = np.asarray(ts.time_s - ts.time_s[0], dtype=float)
     amb = ts["ambient_degC"] if "ambient_degC" in ts else None
     return Schedule(table_drive(t, ts["oil_degC"], ts["pump"], amb, cfg.supply.T_room), t, label)
+
+
+def case_schedule(case: Case) -> Schedule:
+    """The time steps of a case (one sample, t = 0, for a steady case) and its schedule
+    file's columns (linear between samples; the columns a fluid reads as its pump keep
+    their last sample)."""
+    t = case.time
+    if t is None:
+        return Schedule(lambda _: {}, np.zeros(1), "steady state")
+    times = np.linspace(0.0, t.end, int(round(t.end / t.step)) + 1)
+    if t.schedule is None:
+        return Schedule(lambda _: {}, times, "no schedule", every=int(round(t.output / t.step)))
+    ts = read_timeseries(t.schedule, required=("time_s",))
+    held = {n for f in case.problem.fluids for n in f.pump.names()}
+    time = np.asarray(ts.time_s - ts.time_s[0], float)
+    columns = {k: filled(k, time, ts[k], hold=k in held) for k in ts.names if k != "time_s"}
+    return Schedule(TableDrive(time, columns, frozenset(held)), times, f"schedule {t.schedule}",
+                    every=int(round(t.output / t.step)))
 
 
 def file_schedule(path, cfg: Config, step_s: float = 60.0) -> Schedule:
@@ -85,11 +110,11 @@ class ScenarioCache:
             store.popitem(last=False)
         return value
 
-    def model(self, cfg: ModelConfig, dim: int) -> tuple[Model, HeatSolver]:
+    def model(self, cfg: ModelConfig | Case, dim: int) -> tuple[Model, HeatSolver | None]:
         def make():
-            model = build_model(cfg, dim, self.fmesh)
-            return model, HeatSolver(model.heat)
-        return self._lru(self._models, (repr(cfg), dim), make)
+            model = build(cfg.problem, cfg.mesh) if isinstance(cfg, Case) else build_model(cfg, dim, self.fmesh)
+            return model, HeatSolver(model.heat) if model.heat is not None else None
+        return self._lru(self._models, (repr(cfg.problem if isinstance(cfg, Case) else cfg), dim), make)
 
     def result(self, key, make: Callable[[], RunResult]) -> RunResult:
         def counted():
@@ -110,17 +135,42 @@ class Prepared:
     """The model file's effects, then the caller's."""
 
 
-def prepare(config: Config, dim: int, drive: Drive, effects: Mapping[str, float] | None = None, *,
+def prepare(config: Config | Case, dim: int, drive: Drive, effects: Mapping[str, float] | None = None, *,
             cache: ScenarioCache | None = None, mesh: FrameMesh | None = None) -> Prepared:
     """Apply the effects of ``config`` and ``effects`` (these win) and build or reuse the model."""
     eff = ActiveEffects({**config.effects, **dict(effects or {})})
-    model_cfg, drive = apply_effects(config.model, drive, eff)
-    if cache is not None:
-        model, solver = cache.model(model_cfg, dim)
+    if isinstance(config, Case):
+        frame_only = [k for k in eff.values if CATALOGUE[k].acts_on == "model"]
+        if frame_only:
+            raise InputError("--effect", f"{frame_only[0]} acts on the paper frame's model, not on a case file",
+                             "model it in the case (materials, supports, sources) instead")
+        model_cfg, drive = config, drive_effects(drive, eff)
+        if cache is None:
+            model = build(config.problem, config.mesh)
+            return Prepared(model, HeatSolver(model.heat) if model.heat is not None else None, drive, eff)
     else:
-        model = build_model(model_cfg, dim, mesh)
-        solver = HeatSolver(model.heat)
+        model_cfg, drive = apply_effects(config.model, drive, eff)
+        if cache is None:
+            model = build_model(model_cfg, dim, mesh)
+            return Prepared(model, HeatSolver(model.heat), drive, eff)
+    model, solver = cache.model(model_cfg, dim)
     return Prepared(model, solver, drive, eff)
+
+
+def _once(p: Prepared, schedule: Schedule) -> RunResult:
+    """A prescribed-temperature or steady problem: the outputs of its one state at t = 0."""
+    t0 = time.perf_counter()
+    model = p.model
+    if model.heat is None:
+        values, state = model.static(), None
+        keys = tuple(values)
+        Y = np.array([[values[k] for k in keys]])
+    else:
+        state = p.solver.steady(environment(p.drive, 0.0))
+        keys, Y = model.readout.keys, model.read(state)[None, :]
+    cols = {"time_s": np.zeros(1), **{k: np.array([v]) for k, v in p.drive(0.0).items()}}
+    cols.update(output_columns(model.problem, keys, Y))
+    return RunResult(cols, [(0.0, state)], time.perf_counter() - t0)
 
 
 @dataclass(frozen=True)
@@ -141,7 +191,7 @@ class ScenarioRun:
         return TimeSeries(self.columns, metadata)
 
 
-def run_scenario(config: Config, dim: int, schedule: Schedule, effects: Mapping[str, float] | None = None, *,
+def run_scenario(config: Config | Case, dim: int, schedule: Schedule, effects: Mapping[str, float] | None = None, *,
                  cache: ScenarioCache | None = None, mesh: FrameMesh | None = None, keep_times=(),
                  on_step: Callable[[int, int], None] | None = None, U0: np.ndarray | None = None) -> ScenarioRun:
     """Run ``config`` (its model and its effects, plus ``effects``) in ``dim`` dimensions
@@ -151,13 +201,18 @@ def run_scenario(config: Config, dim: int, schedule: Schedule, effects: Mapping[
     p = prepare(config, dim, schedule.drive, effects, cache=cache, mesh=mesh)
 
     def run() -> RunResult:
+        if p.model.heat is None or len(schedule.times) == 1:
+            return _once(p, schedule)
         return run_model(p.model, p.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver)
 
     if cache is not None and U0 is None and not keep_times:
         drive_side = tuple(sorted((k, v) for k, v in p.effects.values.items() if CATALOGUE[k].acts_on == "drive"))
-        key = (repr(p.model.config), dim, drive_side, schedule.label, schedule.times.tobytes())
+        what = p.model.config if p.model.config is not None else p.model.problem
+        key = (repr(what), dim, drive_side, schedule.label, schedule.times.tobytes())
         result = cache.result(key, run)
     else:
         result = run()
-    return ScenarioRun(p.effects.observe(result.columns), result, p.model, p.effects, schedule,
-                       time.perf_counter() - t0)
+    cols = p.effects.observe(result.columns)
+    if schedule.every > 1:
+        cols = {k: v[::schedule.every] for k, v in cols.items()}
+    return ScenarioRun(cols, result, p.model, p.effects, schedule, time.perf_counter() - t0)

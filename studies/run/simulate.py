@@ -39,32 +39,53 @@ def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
     return np.linspace(0.0, n * step_s, n + 1)
 
 
+def column(problem: Problem, key) -> tuple[str, float]:
+    """Data-format column name of an output and the factor from SI units to the column's:
+    temperatures °C, displacements µm, stresses MPa. θ_A, θ_B and δ carry their
+    data-format names when the problem's signals map them."""
+    s, kind, name = problem.signals, key[0], key[1]
+    if kind == "T":
+        return {s.theta_A: "theta_A_degC", s.theta_B: "theta_B_degC"}.get(name, f"T_{name}_degC"), 1.0
+    if kind == "relative":
+        return ("delta_um" if name == s.delta else f"{name}_um"), 1e6
+    if kind == "u":
+        return f"u{key[2]}_{name}_um", 1e6
+    if kind == "sigma":
+        return f"sigma_{key[2]}_{name}_MPa", 1e-6
+    return f"T_{name}_degC", 1.0
+
+
 def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarray]:
-    """Data-format columns of the outputs ``Y`` (samples × ``keys``, SI units): the signals
-    θ_A, θ_B, θ_C and δ under their data-format names, then the other relative
-    displacements (µm), temperatures at probes, displacements (µm) and stresses (MPa) at
-    probes, fluids and boundary means (°C)."""
+    """Data-format columns of the outputs ``Y`` (samples × ``keys``, SI units), by
+    :func:`column`: the signals θ_A, θ_B, θ_C (the mean of its probes) and δ first, then
+    the other relative displacements, temperatures, displacements, stresses and von
+    Mises at probes, fluids and boundary means."""
     Y = np.atleast_2d(Y)
     at = {k: Y[:, i] for i, k in enumerate(keys)}
-    s, out = problem.signals, {}
-    if s.theta_A:
-        out["theta_A_degC"] = at[("T", s.theta_A)]
-    if s.theta_B:
-        out["theta_B_degC"] = at[("T", s.theta_B)]
+    s = problem.signals
+
+    def put(out, key):
+        name, scale = column(problem, key)
+        out[name] = at[key] * scale
+
+    out: dict[str, np.ndarray] = {}
+    for probe in (s.theta_A, s.theta_B):
+        if probe:
+            put(out, ("T", probe))
     if s.theta_C:
         out["theta_C_degC"] = np.mean([at[("T", c)] for c in s.theta_C], axis=0)
-    if s.delta:
-        out["delta_um"] = at[("relative", s.delta)] * 1e6
-    out.update({f"{r.name}_um": at[("relative", r.name)] * 1e6 for r in problem.relative if r.name != s.delta})
+    order = [k for k in keys if k[0] == "relative"]
+    order.sort(key=lambda k: k[1] != s.delta)
     for pr in problem.probes:
-        if ("T", pr.name) in at and pr.name not in (s.theta_A, s.theta_B):
-            out[f"T_{pr.name}_degC"] = at[("T", pr.name)]
-        out.update({f"u{a}_{pr.name}_um": at[k] * 1e6 for k in at if k[:2] == ("u", pr.name) for a in k[2]})
-        sig = {k[2]: at[k] / 1e6 for k in at if k[:2] == ("sigma", pr.name)}
-        out.update({f"sigma_{c}_{pr.name}_MPa": v for c, v in sig.items()})
-        if sig:
-            out[f"von_mises_{pr.name}_MPa"] = von_mises(sig)
-    out.update({f"T_{k[1]}_degC": v for k, v in at.items() if k[0] in ("fluid", "mean")})
+        order += [k for k in keys if k[1] == pr.name and k[0] in ("T", "u", "sigma")
+                  and not (k[0] == "T" and pr.name in (s.theta_A, s.theta_B))]
+    for key in order:
+        put(out, key)
+        if key[0] == "sigma" and key == [k for k in keys if k[:2] == key[:2]][-1]:
+            out[f"von_mises_{key[1]}_MPa"] = von_mises({k[2]: at[k] / 1e6 for k in keys if k[:2] == key[:2]})
+    for key in keys:
+        if key[0] in ("fluid", "mean"):
+            put(out, key)
     return out
 
 
