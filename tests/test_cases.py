@@ -170,3 +170,27 @@ def test_expressions_are_restricted():
     for bad in ("().__class__", "open('x')", "a.b", "[1]", "lambda: 1", "1 if t else 2"):
         with pytest.raises(ExpressionError):
             Value.of(bad)
+
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame"
+
+
+def test_c_frame_example_runs_end_to_end(tmp_path, capsys):
+    """The second machine (README "A second machine"): regression values of its 6-h run,
+    its fields and pictures, and the paper's compensator on it through its signals."""
+    s = run_case(EXAMPLE / "case.toml", tmp_path / "run")
+    assert s["nodes"] == 2036 and s["analysis"] == "transient"
+    assert s["relative"]["delta"] == pytest.approx(32.159, abs=2e-3)
+    assert s["relative"]["drift_x"] == pytest.approx(19.679, abs=2e-3)
+    assert s["probes"]["TS"]["T_degC"] == pytest.approx(28.409, abs=2e-3)
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["channels.png", "deformed.png", "fields",
+                                                                     "summary.json", "timeseries.csv"]
+    assert len(list((tmp_path / "run" / "fields").glob("*.vtu"))) == 7  # 0 to 6 h
+    assert main(["compensate", "--case", str(EXAMPLE / "case.toml"), "--out", str(tmp_path / "c"),
+                 "--no-actuator"]) == 0
+    c = json.loads((tmp_path / "c" / "summary.json").read_text())
+    assert c["k_source"] == "fit" and c["swing_um"] == pytest.approx(54.887, abs=2e-3)
+    assert c["prediction_error_band_um"] < 0.5
+    assert main(["compensate", "--case", str(EXAMPLE / "case.toml"), "--out", str(tmp_path / "t"),
+                 "--k-source", "theory"]) == 2
+    assert "a case file has no beam theory" in capsys.readouterr().err

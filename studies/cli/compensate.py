@@ -58,6 +58,9 @@ def register(subparsers) -> None:
     src.add_argument("--data", metavar="FILE.csv", help="time-series file (docs/data-format.md)")
     src.add_argument("--condition", type=int, metavar="N",
                      help="simulate the paper's condition 1, 2 or 3 on the model and compensate it")
+    src.add_argument("--case", metavar="CASE.toml",
+                     help="run a case file whose [signals] map theta_A, theta_B, theta_C and delta, and compensate "
+                     "it (K from --Ki/--Kc or --k-source fit)")
     add_model_options(p)
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--Ki", type=float, metavar="UM_PER_K", help="K_i in um/K (with --Kc)")
@@ -82,8 +85,24 @@ def coefficients(args: argparse.Namespace, ts, cfg, model) -> tuple[float, float
         if not (math.isfinite(args.Ki) and math.isfinite(args.Kc)):
             raise InputError("--Ki/--Kc", "must be finite numbers", "e.g. --Ki 2.1 --Kc 0.8")
         return args.Ki, args.Kc, "explicit"
-    source = args.k_source or DEFAULT_K_SOURCE
+    source = args.k_source or ("fit" if args.case else DEFAULT_K_SOURCE)
+    if args.case and source != "fit":
+        raise InputError("--k-source", f"'{source}' needs the paper frame's model; a case file has no beam theory",
+                         "use --k-source fit or --Ki/--Kc")
     return (*K_SOURCES[source](ts, cfg, model), source)
+
+
+def _case_series(path):
+    """The time series of a case's run; its signals must map the compensator's channels."""
+    from gatetherm.studies.run.case import load_case
+    from gatetherm.studies.run.scenario import case_schedule, run_scenario
+
+    case = load_case(path)
+    if not case.problem.signals.complete or case.time is None:
+        raise InputError(f"{path}: signals", "a compensated case needs [time] and [signals] with theta_A, theta_B, "
+                         "theta_C and delta", "map them to the case's probes and relative displacement")
+    run = run_scenario(case, case.mesh.dim, case_schedule(case))
+    return run.series({"format": FORMAT, "source": "gatetherm compensate", "case": str(path)})
 
 
 def _um(value) -> str:
@@ -114,6 +133,8 @@ def run(args: argparse.Namespace) -> int:
         ts = sim.series({"format": FORMAT, "source": "gatetherm compensate", "schedule": sim.schedule.label,
                          "dim": str(args.dim), "config": cfg.source, "condition": str(args.condition)})
         what = f"condition {args.condition}"
+    elif args.case is not None:
+        ts, what = _case_series(args.case), str(args.case)
     else:
         ts, what = read_timeseries(args.data), str(args.data)
         validate_complete(ts, NEEDED, source=args.data)
@@ -123,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
         log.warning("%s: the existing u_piezo_um column is replaced", what)
     loop = compensate(ts, ki, kc, params, actuator)
     summary = {**summarize(loop, params.settle_s), "Ki_um_per_K": ki, "Kc_um_per_K": kc,
-               "k_source": source, "data": None if args.condition is not None else str(args.data),
+               "k_source": source, "data": args.data, "case": args.case,
                "condition": args.condition, "config": cfg.source, "dim": args.dim,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
                "actuator": dataclasses.asdict(actuator) if actuator else None}

@@ -14,6 +14,7 @@ def register(sub) -> None:
                        "(DIR/fields/*.vtu, fields.pvd). README 'Case files' lists every key.")
     p.add_argument("case", metavar="CASE.toml", help="case file")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--no-pictures", action="store_true", help="skip channels.png and deformed.png")
     p.set_defaults(func=run)
 
 
@@ -30,6 +31,10 @@ def run(args) -> int:
     res = run_scenario(case, case.mesh.dim, schedule, keep_times=sorted(fields), on_step=Progress(case.name))
     out = Path(args.out)
     write_run(out, res, {"source": "gatetherm run", "case": str(args.case), "name": case.name}, fields)
+    if not args.no_pictures:
+        from gatetherm.validation.plots.run import plot_case
+
+        plot_case(res, out, case.name)
     p = case.problem
     summary = {"case": case.name, "file": str(args.case), "dim": p.dim, "order": p.order,
                "analysis": "prescribed temperature" if not p.heat else ("transient" if case.time else "steady"),

@@ -73,7 +73,8 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times) -> None:
 
 
 def deformed_grid(run, t_pic: float):
-    """(time, pyvista grid with T and u) of the kept state nearest ``t_pic`` (s)."""
+    """(time, pyvista grid with the point arrays of :func:`nodal_fields`) of the kept state
+    nearest ``t_pic`` (s)."""
     t, U = min(run.result.states, key=lambda s: abs(s[0] - t_pic))
     return t, pyvista_grid(run.model, U)
 

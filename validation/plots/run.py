@@ -94,3 +94,39 @@ def plot_run(run, figs: dict, out, title: str) -> None:
     umax = float(np.abs(grid["u"]).max()) or 1.0
     scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
     render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 60:.0f} min", scale)
+
+
+def plot_channels(cols: dict, path, title: str) -> None:
+    """Every temperature (°C) and displacement (µm) column of a run against time."""
+    t = cols["time_s"] / 3600.0
+    temps = [k for k in cols if k.endswith("_degC")]
+    disp = [k for k in cols if k.endswith("_um")]
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for ax, keys, label in ((axes[0], temps, "temperature [°C]"), (axes[1], disp, "displacement [µm]")):
+        for k in keys:
+            ax.plot(t, cols[k], label=k)
+        ax.set(ylabel=label)
+        ax.grid(alpha=0.3)
+        if keys:
+            ax.legend(fontsize="small", ncol=2)
+    axes[0].set_title(title)
+    axes[1].set(xlabel="time [h]")
+    save(fig, path, tight=False)
+
+
+def plot_case(run, out, title: str) -> None:
+    """``channels.png`` (transient runs) and ``deformed.png`` (the last state, when the case
+    has elasticity) of a case run."""
+    from pathlib import Path
+
+    from gatetherm.studies.run.output import deformed_grid
+
+    out = Path(out)
+    if len(run.columns["time_s"]) > 1:
+        plot_channels(run.columns, out / "channels.png", title)
+    if run.model.elastic is None:
+        return
+    t, grid = deformed_grid(run, float(run.columns["time_s"][-1]))
+    umax = float(np.abs(grid["u"]).max()) or 1.0
+    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
+    render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 3600:.3g} h", scale)
