@@ -29,26 +29,49 @@ def nodal_fields(model: Model, U: np.ndarray | None) -> dict[str, np.ndarray]:
 
 
 def write_fields(model: Model, states, out: Path) -> list[Path]:
-    """One ``.vtu`` per saved state (point arrays of :func:`nodal_fields`) and a
-    ``fields.pvd`` collection that ParaView opens as a time series."""
+    """One ``.vtu`` per saved state (point arrays of :func:`nodal_fields`) with a
+    ``fields.pvd`` collection, and the same as one XDMF time series, ``fields.xdmf`` (one
+    mesh, every step; XML, no HDF5): ParaView opens either as one animated data set."""
     import meshio
 
     out.mkdir(parents=True, exist_ok=True)
-    written, entries = [], []
+    written, entries, steps = [], [], []
     minutes = all(abs(t / 60 - round(t / 60)) < 1e-9 for t, _ in states)
     for k, (t, U) in enumerate(states):
         name = f"fields_{int(round(t / 60)):04d}min.vtu" if minutes else f"fields_{k:04d}.vtu"
+        data = nodal_fields(model, U)
         with atomic_path(out / name) as tmp:
-            meshio.write(tmp, to_meshio(model.fmesh, nodal_fields(model, U)), file_format="vtu")
+            meshio.write(tmp, to_meshio(model.fmesh, data), file_format="vtu")
         entries.append(f'    <DataSet timestep="{t:g}" file="{name}"/>')
         written.append(out / name)
+        steps.append((t, data))
     pvd = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
            + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
     write_text_atomic(out / "fields.pvd", pvd)
-    return written + [out / "fields.pvd"]
+    write_xdmf(model, steps, out / "fields.xdmf")
+    return written + [out / "fields.pvd", out / "fields.xdmf"]
 
 
-def pyvista_grid(model: FrameModel, U: np.ndarray):
+def write_xdmf(model: Model, steps, path: Path) -> None:
+    """``steps`` [(t, point arrays)] as an XDMF time series on the volume cells (cell
+    array ``region``: the index of the cell's region in the mesh's region order)."""
+    import meshio
+
+    fm = model.fmesh
+    pts = np.zeros((len(fm.points), 3))
+    pts[:, :fm.dim] = fm.points
+    region = np.zeros(len(fm.cells), dtype=np.int32)
+    for i, idx in enumerate(fm.regions.values()):
+        region[idx] = i
+    cell = "triangle" if fm.dim == 2 else "tetra"
+    with atomic_path(path) as tmp:
+        with meshio.xdmf.TimeSeriesWriter(tmp, data_format="XML") as w:
+            w.write_points_cells(pts, [(cell, fm.cells)])
+            for t, data in steps:
+                w.write_data(t, point_data=data, cell_data={"region": [region]})
+
+
+def pyvista_grid(model: Model, U: np.ndarray):
     """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``."""
     import pyvista as pv
 
