@@ -112,7 +112,7 @@ class Model:
         """The outputs of a prescribed-temperature problem: one elastic solve."""
         p = self.problem
         out: dict[Key, float] = {}
-        T = _prescribed_at_points(self, np.array([pr.xyz for pr in p.probes]).T) if p.probes else []
+        T = prescribed_at(self, np.array([pr.xyz for pr in p.probes]).T) if p.probes else []
         for pr, Tp in zip(p.probes, T):
             if "T" in pr.quantities:  # on a region's side where the prescribed temperature jumps
                 out[("T", pr.name)] = float(p.prescribed_regions.get(pr.region, Tp))
@@ -139,7 +139,7 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
     """Nodal temperature (°C), displacement (m, 3 components) and stress (Pa) of a
     prescribed-temperature problem (the temperature interpolated at the nodes)."""
     X = model.fmesh.points.T
-    out = {"T": _prescribed_at_points(model, X)}
+    out = {"T": prescribed_at(model, X)}
     if model.elastic is not None:
         u_dofs = model.elastic.from_load(_prescribed_load(model))
         u = np.zeros((X.shape[1], 3))
@@ -149,7 +149,7 @@ def static_fields(model: Model) -> dict[str, np.ndarray]:
     return out
 
 
-def _prescribed_at_points(model: Model, X: np.ndarray) -> np.ndarray:
+def prescribed_at(model: Model, X: np.ndarray) -> np.ndarray:
     """The prescribed temperature (°C) at points ``X`` (dim, n)."""
     p = model.problem
     if p.prescribed is not None:
