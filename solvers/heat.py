@@ -30,6 +30,7 @@ from scipy.sparse.linalg import splu
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
+from gatetherm.checks import CELSIUS, NONNEGATIVE, POSITIVE, Range, admissible
 from gatetherm.solvers.fem import Field, element
 
 log = logging.getLogger(__name__)
@@ -55,6 +56,8 @@ def film_load(v, w):
     return w.h * w.t * v
 
 
+@admissible(T0=CELSIUS, h_air=NONNEGATIVE, h_base=NONNEGATIVE, h_oil_on=NONNEGATIVE, h_oil_off=NONNEGATIVE,
+            oil_rho_c=POSITIVE, flow_rate=NONNEGATIVE, hose_capacity=NONNEGATIVE, hose_loss=NONNEGATIVE)
 @dataclass(frozen=True)
 class ThermalParams:
     """Heat-transfer coefficients of the frame and the oil tank."""
@@ -98,6 +101,7 @@ class Inputs(NamedTuple):
 Drive = Callable[[float], Inputs]
 
 
+@admissible(theta=Range(0.5, 1.0), restart=Range(1, 1000, whole=True), restart_intervals=Range(0, 1000, whole=True))
 @dataclass(frozen=True)
 class TimeScheme:
     """The θ-method with Rannacher start-up at input switches."""

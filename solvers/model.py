@@ -15,8 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gatetherm.geometry.build import build_mesh
 from gatetherm import InputError
+from gatetherm.checks import POSITIVE, Range, admissible
+from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.frame import (FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth,
                                       width)
 from gatetherm.geometry.mesh import FrameMesh
@@ -44,6 +45,7 @@ GEOMETRY_FREE = ("l1",)
 OUTPUTS = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
 
 
+@admissible(order=Range(1, 2, whole=True), k_base=POSITIVE, joint_conductance=POSITIVE, joint_stiffness=POSITIVE)
 @dataclass(frozen=True)
 class ModelConfig:
     """Everything that defines a frame model (the TOML file mirrors it)."""
