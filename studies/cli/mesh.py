@@ -1,11 +1,12 @@
 """``gatetherm mesh``: build the frame mesh and write it as .msh and .vtu."""
 from __future__ import annotations
 
-from pathlib import Path
-
 from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.mesh import save_mesh
 from gatetherm.studies.cli.options import add_model_options
+
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("mesh.msh", "mesh.vtu")
 
 
 def register(sub) -> None:
@@ -16,14 +17,15 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from gatetherm.outdir import output_dir
     from gatetherm.studies.run.config import load_config
 
     cfg = load_config(args.config).model
-    fm = build_mesh(cfg.frame, args.dim, cfg.mesh)
-    out = Path(args.out)
-    for name in ("mesh.msh", "mesh.vtu"):
-        save_mesh(fm, out / name)
-        print(f"wrote {out / name}")
+    with output_dir(args.out, OUTPUTS, keep=(args.config,)) as out:
+        fm = build_mesh(cfg.frame, args.dim, cfg.mesh)
+        for name in OUTPUTS:
+            save_mesh(fm, out / name)
+            print(f"wrote {out / name}")
     c = fm.counts()
     print(f"{args.dim}-D frame: {c['nodes']} nodes, {c['elements']} elements")
     print(f"regions ({len(fm.regions)}): " + ", ".join(f"{k}={len(v)}" for k, v in fm.regions.items()))
