@@ -21,6 +21,11 @@ PR_SET_PDEATHSIG = 1
 _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
+def _mask(how: str, signals=_SIGNALS) -> set:
+    """``signal.pthread_sigmask(signal.<how>, signals)`` where there is one (not on Windows)."""
+    return signal.pthread_sigmask(getattr(signal, how), signals) if hasattr(signal, "pthread_sigmask") else set()
+
+
 def _watch(parent: int) -> None:
     while os.getppid() == parent:
         time.sleep(0.5)
@@ -31,11 +36,11 @@ def _die_with(parent: int | None) -> None:
     """Worker initializer: ignore Ctrl-C, end on SIGTERM, be killed when the parent dies."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, _SIGNALS)
+    _mask("SIG_UNBLOCK")
     try:
         if ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL) != 0:
             raise OSError(ctypes.get_errno(), "prctl failed")
-    except (OSError, AttributeError):  # not Linux: poll the parent instead
+    except (OSError, AttributeError, TypeError):  # not Linux: poll the parent instead
         if parent is not None:
             threading.Thread(target=_watch, args=(parent,), daemon=True).start()
     if parent is not None and os.getppid() != parent:  # the parent died before the above
@@ -44,11 +49,11 @@ def _die_with(parent: int | None) -> None:
 
 class _Pool(ProcessPoolExecutor):
     def submit(self, fn, /, *args, **kwargs):
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)  # workers start here and inherit the mask
+        old = _mask("SIG_BLOCK")  # workers start here and inherit the mask
         try:
             return super().submit(fn, *args, **kwargs)
         finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+            _mask("SIG_SETMASK", old)
 
 
 @contextlib.contextmanager
