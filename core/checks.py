@@ -58,14 +58,14 @@ class Range:
             return False
 
     def __str__(self) -> str:
-        unit = f" {self.unit}" if self.unit else ""
-        lo, hi = (f"{b:g}" for b in (self.lo, self.hi))
         if self.whole and np.isfinite(self.hi) and self.hi - self.lo <= 1:
             return " or ".join(str(int(x)) for x in np.arange(self.lo, self.hi + 1))
-        kind = "a whole number" if self.whole else "a finite number"
+        unit = f" {self.unit}" if self.unit else ""
+        lo, hi = f"{self.lo:g}", f"{self.hi:g}"
         if np.isfinite(self.lo) and np.isfinite(self.hi):
-            return (f"{'a whole number' if self.whole else 'a number'} in {'(' if self.lo_open else '['}{lo}, {hi}{')' if self.hi_open else ']'}"
-                    + unit)
+            bounds = f"{'(' if self.lo_open else '['}{lo}, {hi}{')' if self.hi_open else ']'}"
+            return f"{'a whole number' if self.whole else 'a number'} in {bounds}{unit}"
+        kind = "a whole number" if self.whole else "a finite number"
         if np.isfinite(self.lo):
             return f"{kind} {'>' if self.lo_open else '>='} {lo}{unit}"
         if np.isfinite(self.hi):

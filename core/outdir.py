@@ -93,9 +93,9 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
     """Yield ``path`` as a :class:`~pathlib.Path`, ready for this run's files: created if
     needed, writable, locked against other runs, with stale temporaries and the files
     matching the glob patterns ``owns`` (the command's output set, relative to ``path``)
-    removed, except the run's input files ``keep`` (None entries are skipped). A directory this call created is removed again if the run fails before
-    writing anything into it. Raises InputError (``option`` names a file) or
-    :class:`OutputError` (cannot write, locked)."""
+    removed, except the run's input files ``keep`` (None entries are skipped). A directory
+    this call created is removed again if the run fails before writing anything into it.
+    Raises InputError (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
     out = Path(path)
     created = _check_path(out, option)
     try:

@@ -56,7 +56,8 @@ MODEL_FILES = {
     "h_oil_on nan": ("[thermal]\nh_oil_on = nan\n", "thermal.h_oil_on: got nan, must be a finite number >= 0"),
     "h_air < 0": ("[thermal]\nh_air = -8\n", "thermal.h_air: got -8, must be a finite number >= 0"),
     "flow_rate < 0": ("[thermal]\nflow_rate = -3e-5\n", "thermal.flow_rate: got -3e-05, must be a finite number >= 0"),
-    "T0 below absolute zero": ("[thermal]\nT0 = -300\n", "thermal.T0: got -300, must be a number in (-273.15, 1000] °C"),
+    "T0 below absolute zero": ("[thermal]\nT0 = -300\n",
+                               "thermal.T0: got -300, must be a number in (-273.15, 1000] °C"),
     "tie-bar E = 0": ("[material.tie_bar]\nE = 0\n", "material.tie_bar.E: got 0, must be a finite number > 0"),
     "E < 0": ("[material]\nE = -1.2e11\n", "material.E: got -1.2e+11, must be a finite number > 0"),
     "k = -48": ("[material]\nk = -48\n", "material.k: got -48, must be a finite number > 0"),
@@ -244,7 +245,8 @@ def test_valid_files_in_many_shapes_still_run(tmp_path, capsys):
 # ---- command-line arguments --------------------------------------------------------------------
 
 @pytest.mark.parametrize("argv, needle", [
-    (["simulate", "--condition", "1", "--fields-every", "-5"], "argument --fields-every: got -5, must be a finite number > 0"),
+    (["simulate", "--condition", "1", "--fields-every", "-5"],
+     "argument --fields-every: got -5, must be a finite number > 0"),
     (["simulate", "--condition", "1", "--fields-every", "nan"], "argument --fields-every: got nan"),
     (["simulate", "--condition", "x"], "argument --condition: invalid int value: 'x'"),
     (["simulate", "--condition", "1", "--dim", "4"], "argument --dim: invalid choice: 4"),
@@ -278,7 +280,8 @@ def test_no_command_prints_the_help_and_exits_2(capsys):
 
 @pytest.mark.parametrize("where, needle", [
     (lambda d: _write(d / "afile", "x"), "--out: 'DIR/afile' exists and is not a directory"),
-    (lambda d: _write(d / "afile", "x") / "sub", "--out: 'DIR/afile/sub' lies below 'DIR/afile', which is not a directory"),
+    (lambda d: _write(d / "afile", "x") / "sub",
+     "--out: 'DIR/afile/sub' lies below 'DIR/afile', which is not a directory"),
 ], ids=["a file", "below a file"])
 def test_out_is_checked_before_the_run(tmp_path, capsys, monkeypatch, where, needle):
     from gatetherm.studies.run import scenario

@@ -3,8 +3,8 @@
 Each section of a model file mirrors one parameter dataclass (:data:`SCHEMA`); unknown
 keys, wrong types and values outside a parameter's admissible range (declared on its
 dataclass, :mod:`gatetherm.checks`) are errors naming the file and the key. ``[effects]``
-switches on catalogue effects as ``NAME = {PARAM = VALUE}``. :func:`config_toml` writes a file that :func:`load_config`
-reads back to the same :class:`Config`.
+switches on catalogue effects as ``NAME = {PARAM = VALUE}``. :func:`config_toml` writes a
+file that :func:`load_config` reads back to the same :class:`Config`.
 """
 from __future__ import annotations
 
