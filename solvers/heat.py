@@ -29,6 +29,7 @@ from scipy.sparse.linalg import splu
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
+from gatetherm.checks import Range, admissible
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.fem import Field, element
 
@@ -60,6 +61,7 @@ def film_load(v, w):
     return w.h * w.t * v
 
 
+@admissible(theta=Range(0.5, 1.0), restart=Range(1, 1000, whole=True), restart_intervals=Range(0, 1000, whole=True))
 @dataclass(frozen=True)
 class TimeScheme:
     """The θ-method with Rannacher start-up at input switches."""

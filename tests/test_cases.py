@@ -143,8 +143,8 @@ BAD = {
     "bad expression": ("[thermal.base]\ntemperature = \"__import__('os')\"\n", "thermal.base.temperature: '__import__' "
                        "is not allowed"),
     "unknown input": ("[thermal.base]\ntemperature = \"oil_degC + 1\"\n", "unknown input 'oil_degC'"),
-    "negative k": ("[materials.plate]\nk = -48.0\nE = 2e11\nnu = 0.3\nalpha = 1e-5\n", "materials.plate.k: -48.0 is "
-                   "not admissible"),
+    "negative k": ("[materials.plate]\nk = -48.0\nE = 2e11\nnu = 0.3\nalpha = 1e-5\n", "materials.plate.k: got -48, must "
+                   "be a finite number > 0"),
 }
 
 

@@ -39,6 +39,12 @@ K_SOURCES = {
     "fit": lambda ts, cfg, model: fit_coefficients(ts),
 }
 DEFAULT_K_SOURCE = "theory"
+WRITTEN = ("u_piezo_um", "delta_pred_um", "delta_comp_um")
+"""Columns compensate adds to its input. Those of an earlier compensation (a file with its
+``compensation`` metadata) and ``u_piezo_um`` are replaced with a warning; in any other
+file a column of these names is refused, since it would be lost."""
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("compensated.csv", "compensation.png", "piezo_loops.png", "summary.json")
 
 
 def _tips(model) -> tuple[float, float]:
@@ -92,6 +98,43 @@ def coefficients(args: argparse.Namespace, ts, cfg, model) -> tuple[float, float
     return (*K_SOURCES[source](ts, cfg, model), source)
 
 
+def _um(value) -> str:
+    return "n/a" if value is None else f"{value:.2f} um"
+
+
+def run(args: argparse.Namespace) -> int:
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.conditions import condition
+    from gatetherm.studies.run.config import load_config
+    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, prepare
+
+    if not (math.isfinite(args.interval_min) and args.interval_min > 0):
+        raise InputError("--interval-min", f"must be > 0, got {args.interval_min}", "e.g. --interval-min 5")
+    params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
+    cfg = load_config(args.config)
+
+    cache = ScenarioCache()
+
+    def model():  # the FE model with the model file's effects, built on first use
+        return prepare(cfg, args.dim, condition_schedule(args.condition or 1, cfg).drive, cache=cache).model
+
+    if args.data is not None:
+        ts, what = read_timeseries(args.data), str(args.data)
+        validate_complete(ts, NEEDED, source=args.data)
+        clash = [name for name in WRITTEN[1:] if name in ts]
+        if clash and "compensation" not in ts.metadata:
+            raise InputError(f"{args.data}, column {clash[0]}", "compensate writes a column of this name "
+                             "and the file is not from an earlier compensate", "rename the column so that it is kept")
+    elif args.condition is not None:
+        condition(args.condition)  # a bad number fails before the model is built
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out_dir:
+        if args.condition is not None:
+            ts, what = _simulated(args, cfg, cache), f"condition {args.condition}"
+        elif args.case is not None:
+            ts, what = _case_series(args.case), str(args.case)
+        return _compensate(args, cfg, ts, what, params, model, out_dir)
+
+
 def _case_series(path):
     """The time series of a case's run; its signals must map the compensator's channels."""
     from gatetherm.studies.run.case import load_case
@@ -105,43 +148,20 @@ def _case_series(path):
     return run.series({"format": FORMAT, "source": "gatetherm compensate", "case": str(path)})
 
 
-def _um(value) -> str:
-    return "n/a" if value is None else f"{value:.2f} um"
+def _simulated(args, cfg, cache):
+    from gatetherm.studies.run.scenario import condition_schedule, run_scenario
+
+    sim = run_scenario(cfg, args.dim, condition_schedule(args.condition, cfg), cache=cache)
+    return sim.series({"format": FORMAT, "source": "gatetherm compensate", "schedule": sim.schedule.label,
+                       "dim": str(args.dim), "config": cfg.source, "condition": str(args.condition)})
 
 
-def run(args: argparse.Namespace) -> int:
-    from gatetherm.studies.run.conditions import condition
-    from gatetherm.studies.run.config import load_config
-    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, prepare, run_scenario
-
-    if not (math.isfinite(args.interval_min) and args.interval_min > 0):
-        raise InputError("--interval-min", f"must be > 0, got {args.interval_min}", "e.g. --interval-min 5")
-    out_dir = Path(args.out)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError("--out", f"{out_dir} exists and is not a directory", "give a directory path")
-    params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
-    cfg = load_config(args.config)
-
-    cache = ScenarioCache()
-
-    def model():  # the FE model with the model file's effects, built on first use
-        return prepare(cfg, args.dim, condition_schedule(args.condition or 1, cfg).drive, cache=cache).model
-
-    if args.condition is not None:
-        condition(args.condition)  # a bad number fails before the model is built
-        sim = run_scenario(cfg, args.dim, condition_schedule(args.condition, cfg), cache=cache)
-        ts = sim.series({"format": FORMAT, "source": "gatetherm compensate", "schedule": sim.schedule.label,
-                         "dim": str(args.dim), "config": cfg.source, "condition": str(args.condition)})
-        what = f"condition {args.condition}"
-    elif args.case is not None:
-        ts, what = _case_series(args.case), str(args.case)
-    else:
-        ts, what = read_timeseries(args.data), str(args.data)
-        validate_complete(ts, NEEDED, source=args.data)
+def _compensate(args, cfg, ts, what, params, model, out_dir: Path) -> int:
     actuator = None if args.no_actuator else ActuatorParams()
     ki, kc, source = coefficients(args, ts, cfg, model)
-    if "u_piezo_um" in ts:
-        log.warning("%s: the existing u_piezo_um column is replaced", what)
+    replaced = [name for name in WRITTEN if name in ts]
+    if replaced:
+        log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
     loop = compensate(ts, ki, kc, params, actuator)
     summary = {**summarize(loop, params.settle_s), "Ki_um_per_K": ki, "Kc_um_per_K": kc,
                "k_source": source, "data": args.data, "case": args.case,

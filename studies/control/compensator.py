@@ -44,7 +44,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.studies.control import actuator as piezo
-from gatetherm.studies.run.timeseries import TimeSeries, rises, validate_complete
+from gatetherm.studies.run.timeseries import TimeSeries, check_steps, rises, validate_complete
 
 log = logging.getLogger(__name__)
 
@@ -156,6 +156,7 @@ def controller_grid(ts: TimeSeries, params: CompensatorParams) -> tuple[TimeSeri
     if back.size:
         raise InputError(f"data row {back[0] + 2}, column time_s", "time does not increase",
                          "sort the rows or remove the duplicate")
+    check_steps(t[-1] - t[0], dt, "time_s")
     grid = t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
     if len(grid) < 3:
         raise InputError("time_s", f"the run covers fewer than 3 samples of {dt:g} s",
