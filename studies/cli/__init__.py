@@ -9,7 +9,7 @@ import sys
 from gatetherm import InputError
 
 #: Sub-command modules of this package, in ``--help`` order.
-COMMAND_MODULES = ("mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose")
+COMMAND_MODULES = ("mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,92 @@
+"""Reduced models of a model file, and their check against full FE runs.
+
+The frame model is assembled through the scenario path (:func:`~gatetherm.studies.run.scenario.prepare`,
+so a model file's effects act as everywhere), read off as a switched linear system
+(:func:`gatetherm.solvers.rom.linear_heat_model`) and reduced; the full FE runs of the
+check go through :func:`~gatetherm.studies.run.scenario.run_scenario`.
+"""
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from gatetherm.solvers.rom import Reduction, ReducedModel, linear_heat_model, reduce
+from gatetherm.solvers.rom_time import discretise, march_rom
+from gatetherm.studies.run.config import Config
+from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, prepare, run_scenario
+
+log = logging.getLogger(__name__)
+
+#: Output of the reduced model -> time-series column holding the same quantity.
+COLUMN_UNITS = {"_K": "_degC", "_um": "_um"}
+
+
+def column_of(output: str) -> str:
+    """The time-series column of a reduced-model output (``theta_A_K`` -> ``theta_A_degC``)."""
+    for tail, col in COLUMN_UNITS.items():
+        if output.endswith(tail):
+            return output[: -len(tail)] + col
+    return output
+
+
+def output_of(column: str) -> str:
+    """The reduced-model output of a time-series column (``theta_A_degC`` -> ``theta_A_K``)."""
+    return column[: -len("_degC")] + "_K" if column.endswith("_degC") else column
+
+
+def series_inputs(rom: ReducedModel, columns, T_room: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs (samples × 2, deviations from the model's T0) and the pump state of each interval
+    (the state recorded at its start, as a schedule file holds it) from time-series columns;
+    without ``ambient_degC`` the room stays at ``T_room``."""
+    oil = np.asarray(columns["oil_degC"], float)
+    amb = np.asarray(columns["ambient_degC"], float) if "ambient_degC" in columns else np.full_like(oil, T_room)
+    u = np.column_stack([oil, amb]) - rom.T0
+    return u, np.asarray(columns["pump"], float)[:-1] > 0.5
+
+
+def build_rom(config: Config, dim: int, states: int = 30, cache: ScenarioCache | None = None) -> Reduction:
+    """Assemble ``config``'s model in ``dim`` dimensions and reduce it to ``states`` states."""
+    t0 = time.perf_counter()
+    model = prepare(config, dim, condition_schedule(1, config).drive, cache=cache).model
+    build = time.perf_counter() - t0
+    red = reduce(linear_heat_model(model), states)
+    red.seconds["model_build"] = build
+    return red
+
+
+@dataclass(frozen=True)
+class Check:
+    """The reduced model against a full FE run of one condition."""
+
+    condition: int
+    max_delta_error_um: float
+    max_theta_error_K: float
+    """Largest error of θ_A, θ_B, θ_C, K."""
+    fe_seconds: float
+    """Wall time of the full run (build excluded when the model was cached), s."""
+    rom_ms: float
+    """Wall time of the reduced run (5 h of 1-min steps, discretisation excluded), ms."""
+
+
+def check(config: Config, dim: int, rom: ReducedModel, conditions=(1, 2, 3),
+          cache: ScenarioCache | None = None) -> list[Check]:
+    """Run each condition on the full model and on ``rom`` (1-min samples, the run's own inputs)."""
+    out = []
+    for n in conditions:
+        fe = run_scenario(config, dim, condition_schedule(n, config), cache=cache)
+        cols = fe.result.columns
+        u, modes = series_inputs(rom, cols, config.supply.T_room)
+        disc = discretise(rom, float(cols["time_s"][1] - cols["time_s"][0]))
+        t0 = time.perf_counter()
+        y = march_rom(disc, u, modes) @ rom.C.T
+        ms = 1e3 * (time.perf_counter() - t0)
+        err = {o: float(np.max(np.abs(y[:, rom.output(o)] + (0 if o.endswith("_um") else rom.T0)
+                                      - cols[column_of(o)])))
+               for o in ("delta_um", "theta_A_K", "theta_B_K", "theta_C_K")}
+        out.append(Check(n, err["delta_um"], max(err[k] for k in err if k != "delta_um"),
+                         fe.result.seconds, ms))
+        log.info("condition %d: max |δ_rom − δ_FE| = %.3f µm, θ %.3f K", n, err["delta_um"], out[-1].max_theta_error_K)
+    return out
