@@ -197,6 +197,7 @@ def _rom_loop(args, ts, cfg, cache, params, actuator):
     from gatetherm.solvers.rom import load_rom
     from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
     from gatetherm.studies.control.observer import ObserverParams
+    from gatetherm.studies.run.reduce import cached_rom
 
     sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
     if not sensors:
@@ -205,7 +206,7 @@ def _rom_loop(args, ts, cfg, cache, params, actuator):
     if args.rom:
         rom, where = load_rom(args.rom), args.rom
     else:
-        rom, where = _cached_rom(args, cfg, cache), str(Path(args.out) / "rom.npz")
+        rom, where = cached_rom(cfg, args.dim, args.states, Path(args.out), cache), str(Path(args.out) / "rom.npz")
     pr, cmds = rom_prediction(ts, rom, params, control, ObserverParams(), sensors, cfg.supply.T_room)
     loop = close_loop(ts, pr, params, actuator)
     extra = {"rom": where, "rom_states": rom.states, "sensors": list(sensors), "threshold_um": cmds.threshold_um,
@@ -214,21 +215,3 @@ def _rom_loop(args, ts, cfg, cache, params, actuator):
         f"every {args.interval_min:g} min"
     return loop, extra, f"reduced model ({rom.states} states), Kalman filter on {', '.join(sensors)}, {how}"
 
-
-def _cached_rom(args, cfg, cache):
-    """The reduced model of --config/--dim/--states, kept in DIR/rom.npz with its key in DIR/rom.key."""
-    import hashlib
-
-    from gatetherm import __version__
-    from gatetherm.solvers.rom import load_rom
-    from gatetherm.studies.run.reduce import build_rom
-
-    out = Path(args.out)
-    key = hashlib.sha256(repr((cfg.model, cfg.effects, args.dim, args.states, __version__)).encode()).hexdigest()
-    if (out / "rom.npz").exists() and (out / "rom.key").exists() and (out / "rom.key").read_text().strip() == key:
-        log.info("reusing %s", out / "rom.npz")
-        return load_rom(out / "rom.npz")
-    red = build_rom(cfg, args.dim, args.states, cache)
-    red.rom.save(out / "rom.npz")
-    write_text_atomic(out / "rom.key", key + "\n")
-    return red.rom

@@ -7,13 +7,16 @@ check go through :func:`~gatetherm.studies.run.scenario.run_scenario`.
 """
 from __future__ import annotations
 
+import hashlib
 import logging
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from gatetherm.solvers.rom import Reduction, ReducedModel, linear_heat_model, reduce
+from gatetherm import __version__, write_text_atomic
+from gatetherm.solvers.rom import Reduction, ReducedModel, linear_heat_model, load_rom, reduce
 from gatetherm.solvers.rom_time import discretise, march_rom
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, prepare, run_scenario
@@ -55,6 +58,21 @@ def build_rom(config: Config, dim: int, states: int = 30, cache: ScenarioCache |
     red = reduce(linear_heat_model(model), states)
     red.seconds["model_build"] = build
     return red
+
+
+def cached_rom(config: Config, dim: int, states: int, directory: Path, cache: ScenarioCache | None = None,
+               name: str = "rom") -> ReducedModel:
+    """The reduced model of ``config`` in ``dim`` dimensions, kept as ``directory/<name>.npz`` with
+    a key of what it depends on in ``<name>.key``; reused while the key matches."""
+    path, keyfile = Path(directory) / f"{name}.npz", Path(directory) / f"{name}.key"
+    key = hashlib.sha256(repr((config.model, config.effects, dim, states, __version__)).encode()).hexdigest()
+    if path.exists() and keyfile.exists() and keyfile.read_text().strip() == key:
+        log.info("reusing %s", path)
+        return load_rom(path)
+    rom = build_rom(config, dim, states, cache).rom
+    rom.save(path)
+    write_text_atomic(keyfile, key + "\n")
+    return rom
 
 
 @dataclass(frozen=True)
