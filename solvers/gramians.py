@@ -42,12 +42,15 @@ def spectrum_bounds(K: sp.spmatrix, M: sp.spmatrix, iterations: int = 30) -> tup
 class ShiftedSolves:
     """``(K + q M)⁻¹`` (or its transpose) for a fixed set of shifts q, each factorised on first use."""
 
-    def __init__(self, K: sp.spmatrix, M: sp.spmatrix, per_decade: float = 2.0, margin: float = 4.0):
+    def __init__(self, K: sp.spmatrix, M: sp.spmatrix, per_decade: float = 2.0, margin: float = 4.0,
+                 slowest: float | None = None):
         self.K, self.M = sp.csc_matrix(K), sp.csc_matrix(M)
         slow, fast = spectrum_bounds(K, M)
+        slow = min(slow, slowest or slow)
         lo, hi = np.log10(slow / margin), np.log10(fast * margin)
         self.shifts = np.logspace(lo, hi, max(int(np.ceil((hi - lo) * per_decade)) + 1, 2))
-        """Shifts q, 1/s: log-spaced from a ``margin`` below the slowest to above the fastest rate."""
+        """Shifts q, 1/s: log-spaced from a ``margin`` below the slowest rate (or ``slowest``, if
+        lower) to a ``margin`` above the fastest."""
         self._lu: dict[int, object] = {}
         log.info("ADI: %d shifts over %.3g .. %.3g 1/s", len(self.shifts), *self.shifts[[0, -1]])
 

@@ -1,9 +1,11 @@
 """``gatetherm reduce``: a reduced-order model of the frame's heat model, checked against FE.
 
 Writes ``DIR/rom.npz`` (continuous-time ``A_on, B_on, A_off, B_off`` with E = identity, ``C``,
-``T0``, string arrays ``inputs`` and ``outputs``; outputs are rises from T0 in K, δ in µm;
-the zero state is the frame at T0) and, last, ``DIR/summary.json`` (states, the error
-estimates, timings and, for conditions 1-3, ``max_delta_error_um`` against the full FE run).
+``T0``, string arrays ``inputs`` and ``outputs``; outputs are rises from T0 in K, δ in µm; the
+zero state is the frame at T0), ``DIR/rom.key`` (by which ``gatetherm compensate --method rom
+--out DIR`` recognises it as the model it would build) and, last, ``DIR/summary.json`` (states,
+the error estimates, timings and, for conditions 1-3, ``max_delta_error_um`` against the full
+FE run).
 """
 from __future__ import annotations
 
@@ -30,7 +32,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.run.output import write_json
-    from gatetherm.studies.run.reduce import build_rom, check
+    from gatetherm.studies.run.reduce import build_rom, check, rom_key, save_rom
     from gatetherm.studies.run.scenario import ScenarioCache
 
     if not 2 <= args.states <= MAX_STATES:
@@ -44,7 +46,7 @@ def run(args) -> int:
     red = build_rom(cfg, args.dim, args.states, cache)
     seconds = time.perf_counter() - t0
     out.mkdir(parents=True, exist_ok=True)
-    red.rom.save(out / "rom.npz")
+    save_rom(red.rom, rom_key(cfg, args.dim, args.states), out)
     checks = [] if args.no_check else check(cfg, args.dim, red.rom, cache=cache)
     summary = {"states": red.rom.states, "dim": args.dim, "config": cfg.source,
                "nodes_full": int(red.basis.shape[0]), "inputs": list(red.rom.inputs), "outputs": list(red.rom.outputs),

@@ -60,18 +60,28 @@ def build_rom(config: Config, dim: int, states: int = 30, cache: ScenarioCache |
     return red
 
 
+def rom_key(config: Config, dim: int, states: int) -> str:
+    """What a reduced model depends on, as a digest: model, effects, dimension, states, version."""
+    return hashlib.sha256(repr((config.model, config.effects, dim, states, __version__)).encode()).hexdigest()
+
+
+def save_rom(rom: ReducedModel, key: str, directory: Path, name: str = "rom") -> None:
+    """``directory/<name>.npz`` and its key ``<name>.key`` (written last)."""
+    rom.save(Path(directory) / f"{name}.npz")
+    write_text_atomic(Path(directory) / f"{name}.key", key + "\n")
+
+
 def cached_rom(config: Config, dim: int, states: int, directory: Path, cache: ScenarioCache | None = None,
                name: str = "rom") -> ReducedModel:
-    """The reduced model of ``config`` in ``dim`` dimensions, kept as ``directory/<name>.npz`` with
-    a key of what it depends on in ``<name>.key``; reused while the key matches."""
+    """The reduced model of ``config`` in ``dim`` dimensions kept as ``directory/<name>.npz``,
+    reused while its key (:func:`rom_key`, in ``<name>.key``) matches, else built and kept."""
     path, keyfile = Path(directory) / f"{name}.npz", Path(directory) / f"{name}.key"
-    key = hashlib.sha256(repr((config.model, config.effects, dim, states, __version__)).encode()).hexdigest()
+    key = rom_key(config, dim, states)
     if path.exists() and keyfile.exists() and keyfile.read_text().strip() == key:
         log.info("reusing %s", path)
         return load_rom(path)
     rom = build_rom(config, dim, states, cache).rom
-    rom.save(path)
-    write_text_atomic(keyfile, key + "\n")
+    save_rom(rom, key, directory, name)
     return rom
 
 
