@@ -27,6 +27,7 @@ from __future__ import annotations
 import csv
 import io
 import logging
+import time
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
@@ -40,7 +41,7 @@ from gatetherm.studies.control.compensator import CompensatorParams, close_loop,
 from gatetherm.studies.control.observer import ObserverParams
 from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
 from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
-from gatetherm.studies.run.reduce import cached_rom
+from gatetherm.studies.run.reduce import cached_rom, check_run
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.validation.hidden_effects import Case, measured, truth
 
@@ -100,16 +101,25 @@ def compare(ts, rom, mlr, K, T_room: float, params: CompensatorParams = Compensa
     return out
 
 
-def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATALOGUE), on_row=None) -> list[Row]:
-    """Run every case (see the module docstring); ``on_row(row)`` as each finishes."""
+def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATALOGUE), on_row=None,
+          checks: list | None = None) -> list[Row]:
+    """Run every case (see the module docstring); ``on_row(row)`` as each finishes; each reduced
+    model's check against the FE runs is appended to ``checks`` as (dim, seconds to build or
+    None if reused, :class:`~gatetherm.studies.run.reduce.Check`)."""
     rows: list[Row] = []
     K = theory_coefficients(cfg.model)
     roms, mlrs, runs = {}, {}, {}
     for dim in dims:
         cache = ScenarioCache()
+        t0 = time.perf_counter()
         roms[dim] = cached_rom(cfg, dim, STATES, out, cache, name=f"rom_{dim}d")
+        built = time.perf_counter() - t0
         for n in conditions:
-            runs[dim, n] = run_scenario(cfg, dim, condition_schedule(n, cfg), cache=cache).series({})
+            fe = run_scenario(cfg, dim, condition_schedule(n, cfg), cache=cache)
+            runs[dim, n] = fe.series({})
+            if checks is not None:
+                checks.append((dim, built if built > 1.0 else None,
+                               check_run(roms[dim], n, fe.result.columns, fe.result.seconds, cfg.supply.T_room)))
         first = runs[dim, 1] if 1 in conditions else run_scenario(cfg, dim, condition_schedule(1, cfg), cache=cache).series({})
         mlrs[dim] = fit_regression(first, THETAS)
 
@@ -140,8 +150,16 @@ def _f(v) -> str:
     return f"{v:.2f}" if isinstance(v, float) else str(v)
 
 
-def markdown(rows: list[Row]) -> str:
-    lines = ["# Compensation on a reduced model (gatetherm, issue 13)", "",
+def markdown(rows: list[Row], checks=()) -> str:
+    lines = ["# Compensation on a reduced model (gatetherm, issue 13)", ""]
+    if checks:
+        lines += ["| reduced model (built in: assembly + reduction) | cond. | max abs(δ_rom − δ_FE) µm | max θ error K | 5-h run ms | FE run s |",
+                  "|---|---|---|---|---|---|"]
+        lines += [f"| {dim}-D, {STATES} states{'' if built is None else f' (built in {built:.0f} s)'} | "
+                  f"{c.condition} | {c.max_delta_error_um:.3f} | {c.max_theta_error_K:.3f} | {c.rom_ms:.2f} | "
+                  f"{c.fe_seconds:.1f} |" for dim, built, c in checks]
+        lines += [""]
+    lines += [
              f"Residual band: largest |compensated δ| at every 1-min sample after the first 10 min, µm; piezo "
              f"model in the loop. paper: K theory, 5-min updates; MLR: θ_A θ_B θ_C fitted on condition 1 of the "
              f"model, 1-min forecast, 5-min updates; rom: Kalman filter on θ_A θ_B θ_C and δ, forecast over the "
@@ -173,7 +191,8 @@ def write_rom_study(out: Path, cfg, dims=(2, 3), on_row=None) -> str:
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # clipped commands are counted by the compensators' own summaries
     try:
-        rows = study(cfg, out, tuple(dims), on_row=on_row)
+        checks: list = []
+        rows = study(cfg, out, tuple(dims), on_row=on_row, checks=checks)
     finally:
         quiet.setLevel(level)
     buf = io.StringIO()
@@ -181,6 +200,6 @@ def write_rom_study(out: Path, cfg, dims=(2, 3), on_row=None) -> str:
     writer.writerow([f.name for f in fields(Row)])
     writer.writerows([list(asdict(r).values()) for r in rows])
     write_text_atomic(out / "rom_study.csv", buf.getvalue())
-    text = markdown(rows)
+    text = markdown(rows, checks)
     write_text_atomic(out / "rom_study.md", text)
     return text
