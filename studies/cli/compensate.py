@@ -154,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
         ki, kc, source = coefficients(args, ts, cfg, model)
         loop = compensate(ts, ki, kc, params, actuator)
         extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source}
-        label = f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source})"
+        label = f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source}), update every {args.interval_min:g} min"
+        head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source})"
     elif args.method == "mlr":
         from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
 
@@ -162,9 +163,12 @@ def run(args: argparse.Namespace) -> int:
         mlr = fit_regression(train, THETAS)
         loop = close_loop(ts, external_prediction(ts, regression_forecast(mlr, ts), params), params, actuator)
         extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))}}
-        label = "regression on theta_A, theta_B, theta_C (condition 1 of the model), 1-sample forecast"
+        label = "regression on theta_A, theta_B, theta_C (condition 1 of the model), 1-sample forecast, update " \
+            f"every {args.interval_min:g} min"
+        head = f"mlr ({label})"
     else:
         loop, extra, label = _rom_loop(args, ts, cfg, cache, params, actuator)
+        head = f"rom ({label})"
     summary = {**summarize(loop, params.settle_s), "method": args.method, **extra,
                "data": None if args.condition is not None else str(args.data),
                "condition": args.condition, "config": cfg.source, "dim": args.dim,
@@ -174,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
     out = ts.with_columns(u_piezo_um=loop.stroke_um, delta_pred_um=loop.delta_pred_um,
                           delta_comp_um=loop.delta_comp_um)
     out = dataclasses.replace(out, metadata={
-        **out.metadata, "compensation": f"{args.method}: {label}, {summary['updates']} updates, "
+        **out.metadata, "compensation": f"{'' if args.method == 'paper' else args.method + ': '}{label}, "
         f"{'actuator model' if actuator else 'ideal piezo'}"})
 
     from gatetherm.validation.plots.compensation import plot_compensation, plot_piezo_loops  # outer layer
@@ -185,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
     write_text_atomic(out_dir / "summary.json", text)
     print(f"wrote {out_dir}/compensated.csv, compensation.png, "
           f"{'piezo_loops.png, ' if actuator else ''}summary.json")
-    print(f"{what}: {args.method} ({label}); swing {summary['swing_um']:.2f} um, "
+    print(f"{what}: {head}; swing {summary['swing_um']:.2f} um, "
           f"prediction error band {_um(summary['prediction_error_band_um'])}, "
           f"residual band {_um(summary['residual_band_um'])} "
           f"({_um(summary['residual_at_updates_um'])} at the update instants), {summary['updates']} updates")
@@ -199,6 +203,8 @@ def _rom_loop(args, ts, cfg, cache, params, actuator):
     from gatetherm.studies.control.observer import ObserverParams
     from gatetherm.studies.run.reduce import cached_rom
 
+    if not 2 <= args.states <= 200:
+        raise InputError("--states", f"{args.states} is outside 2..200", "e.g. --states 30")
     sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
     if not sensors:
         raise InputError("--sensors", "no column named", "e.g. --sensors theta_A_degC,theta_B_degC")
