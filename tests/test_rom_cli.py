@@ -83,9 +83,14 @@ def test_compensate_noisy_hidden_effect_file_with_the_rom(reduced, tmp_path):
     assert s["residual_band_um"] <= 5.0 and s["updates"] <= 60
 
 
-def test_paper_method_stays_the_default(tmp_path):
+def test_paper_method_stays_the_default_and_bad_rom_input(reduced, tmp_path, capsys):
     assert cli.main(["compensate", "--condition", "2", "--out", str(tmp_path), "--no-actuator"]) == 0
     s = json.loads((tmp_path / "summary.json").read_text())
     assert s["method"] == "paper" and s["k_source"] == "theory" and s["updates"] == 61
+    capsys.readouterr()
     assert cli.main(["compensate", "--condition", "2", "--method", "rom", "--rom", str(tmp_path / "none.npz"),
                      "--out", str(tmp_path)]) == 2
+    assert "not a reduced model" in capsys.readouterr().err
+    assert cli.main(["compensate", "--condition", "2", "--method", "rom", "--rom", str(reduced / "rom.npz"),
+                     "--sensors", "theta_A_degC,T_C1_degC,T_nowhere_degC", "--out", str(tmp_path)]) == 2
+    assert "T_nowhere_degC" in capsys.readouterr().err
