@@ -9,7 +9,7 @@ from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 from gatetherm.solvers.model import build_model
 from gatetherm.solvers.rom import INPUTS, KEY_OUTPUTS, ReducedModel, linear_heat_model, load_rom, reduce
 from gatetherm.solvers.rom_time import discretise, march_rom, simulate_rom
-from gatetherm.studies.control.observer import ObserverParams, kalman
+from gatetherm.studies.control.observer import ObserverParams, kalman, uniform_state
 from gatetherm.studies.control.predictive import PredictiveParams, event_updates, minimax, plan_threshold
 from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
 from gatetherm.studies.run.simulate import run_model, sample_times
@@ -110,8 +110,6 @@ def test_observer_recovers_state_and_learns_a_wrong_delta_map(coarse):
     t = sample_times(5 * 3600.0)
     oil = np.where((t // 3600) % 2 == 0, 20.0, 0.0)
     u, modes = np.column_stack([oil, np.zeros_like(t)]), (t[:-1] // 3600) % 2 == 0
-    from gatetherm.studies.control.observer import uniform_state
-
     X = march_rom(disc, u, modes, 1.5 * uniform_state(rom, disc))
     Y = X @ rom.C.T
     ch = [rom.output(k) for k in ("theta_A_K", "theta_B_K", "theta_C_K")]

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.studies.control.compensator import extrapolate
 from gatetherm.studies.run.timeseries import TimeSeries, rises
 
 log = logging.getLogger(__name__)
@@ -105,4 +106,4 @@ def regression_forecast(model: LinearModel, ts: TimeSeries) -> np.ndarray:
     """One-sample-ahead forecast of delta (um) from temperatures extrapolated one step (eq 33):
     the model is linear, so extrapolating its inputs extrapolates its output (NaN for the first two)."""
     now = apply_regression(model, ts)
-    return np.r_[np.nan, np.nan, 2 * now[1:-1] - now[:-2]]
+    return np.r_[np.nan, np.nan, extrapolate(now[:-2], now[1:-1])]

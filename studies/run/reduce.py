@@ -23,16 +23,9 @@ from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, pr
 
 log = logging.getLogger(__name__)
 
-#: Output of the reduced model -> time-series column holding the same quantity.
-COLUMN_UNITS = {"_K": "_degC", "_um": "_um"}
-
-
 def column_of(output: str) -> str:
     """The time-series column of a reduced-model output (``theta_A_K`` -> ``theta_A_degC``)."""
-    for tail, col in COLUMN_UNITS.items():
-        if output.endswith(tail):
-            return output[: -len(tail)] + col
-    return output
+    return output[: -len("_K")] + "_degC" if output.endswith("_K") else output
 
 
 def output_of(column: str) -> str:
