@@ -15,7 +15,8 @@ import sys
 import threading
 
 #: Sub-command modules of this package, in ``--help`` order.
-COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose", "export")
+COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
+                   "export")
 
 
 class Terminated(BaseException):

@@ -90,6 +90,22 @@ def _conditions(text: str) -> tuple[int, ...]:
     return tuple(map(int, items))
 
 
+def _rom_arguments(p) -> None:
+    p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
+    p.add_argument("--dims", type=int, nargs="+", choices=(2, 3), default=[2, 3], help="dimensions (default 2 3)")
+
+
+def run_rom(args) -> int:
+    from gatetherm.studies.run.config import load_config
+    from gatetherm.validation.rom_study import write_rom_study
+
+    print(write_rom_study(Path(args.out), load_config(args.config), args.dims,
+                          on_row=lambda r: print(f"{r.case}, condition {r.condition}, {r.data}: paper {r.paper_um:.2f}, "
+                                                 f"MLR {r.mlr_um:.2f}, rom {r.rom_5min_um:.2f} / {r.rom_event_um:.2f} "
+                                                 f"µm ({r.rom_updates} updates)", flush=True)), end="")
+    return 0
+
+
 def _hidden_arguments(p) -> None:
     from gatetherm.validation.hidden_effects import ALL_CASES
 
@@ -141,6 +157,8 @@ TARGETS = {
               run_paper),
     "compensation": ("the paper's compensator, the regression baseline and the piezo on conditions 1-3",
                      add_model_options, run_compensation),
+    "rom": ("paper vs regression vs reduced-model compensation: conditions 1-3 in 2-D/3-D, hidden effects",
+            _rom_arguments, run_rom),
     "hidden-effects": ("diagnose runs with a hidden catalogue effect, noise only, outside effects, mismatches",
                        _hidden_arguments, run_hidden),
     "calibrate": ("refit the default paper model to the paper's figures (a record of the procedure)",
