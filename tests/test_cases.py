@@ -39,7 +39,7 @@ def test_benchmark_outputs_for_paraview(tmp_path):
     run_case(NAFEMS / "t3.toml", tmp_path)
     rows = [r for r in (tmp_path / "timeseries.csv").read_text().splitlines() if not r.startswith("#")]
     assert rows[0] == "time_s,T_target_degC" and len(rows) == 1 + 33 and rows[-1].startswith("32,")
-    assert sorted(p.name for p in (tmp_path / "fields").iterdir()) == ["fields.pvd", "fields.xdmf",
+    assert sorted(p.name for p in (tmp_path / "fields").iterdir()) == ["fields.h5", "fields.pvd", "fields.xdmf",
                                                                          "fields_0000.vtu", "fields_0001.vtu"]
 
 

@@ -88,7 +88,7 @@ def test_killed_runs_and_reruns_into_the_same_directory(tmp_path):
         proc.send_signal(sig)
     assert procs[signal.SIGKILL].wait() == -signal.SIGKILL and ".gatetherm.lock" in files(tmp_path / "SIGKILL")
     assert (procs[signal.SIGTERM].wait(), procs[signal.SIGTERM].stderr.read()) == (143, "gatetherm: terminated\n")
-    rerun = ["fields/fields.pvd", "fields/fields.xdmf", *(f"fields/fields_{m:04d}min.vtu" for m in range(0, 301, 60)),
+    rerun = ["fields/fields.h5", "fields/fields.pvd", "fields/fields.xdmf", *(f"fields/fields_{m:04d}min.vtu" for m in range(0, 301, 60)),
              "summary.json", "timeseries.csv"]
     for sig in procs:
         out = tmp_path / sig.name
@@ -100,15 +100,26 @@ def test_killed_runs_and_reruns_into_the_same_directory(tmp_path):
 
 def test_ctrl_c_at_any_moment(tmp_path):
     """While the command modules are imported (numpy's extension just loaded), while gmsh
-    meshes (its library loaded) and while the model runs: one line, exit 130, nothing left."""
+    meshes (its library loaded) and while the model runs: one line, exit 130, nothing left; had
+    a fast machine reached the output files, still no hidden or partial file and no
+    summary.json, which marks a finished run."""
     def mapped(name):
         return lambda pid: name in Path(f"/proc/{pid}/maps").read_text()
 
-    start = time.monotonic()
-    triggers = {"importing": mapped("_multiarray_umath"), "meshing": mapped("libgmsh"),
-                "running": lambda pid: time.monotonic() - start > 3.0}
+    locked = {}
+
+    def running(pid):
+        """1 s after the output directory was locked: inside the 5-s run on the fine mesh."""
+        if (tmp_path / "running" / ".gatetherm.lock").exists():
+            locked.setdefault(pid, time.monotonic())
+        return pid in locked and time.monotonic() - locked[pid] > 1.0
+
+    (tmp_path / "fine.toml").write_text("[mesh]\nsize = 0.003\n")
+    triggers = {"importing": mapped("_multiarray_umath"), "meshing": mapped("libgmsh"), "running": running}
     procs = {name: subprocess.Popen([*GATETHERM, "simulate", "--condition", "1", "--no-pictures", "--out",
-                                     str(tmp_path / name)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                     str(tmp_path / name), *(["--config", str(tmp_path / "fine.toml")]
+                                                             if name == "running" else [])],
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                     text=True, preexec_fn=foreground) for name in triggers}
     pending = dict(triggers)
     deadline = time.monotonic() + 60
@@ -123,7 +134,11 @@ def test_ctrl_c_at_any_moment(tmp_path):
     for name, proc in procs.items():
         err = proc.communicate()[1]
         assert proc.returncode in INTERRUPTED and err == "gatetherm: interrupted\n", name
-        assert not (tmp_path / name).exists() or not files(tmp_path / name), name
+        left = files(tmp_path / name) if (tmp_path / name).exists() else []
+        if name == "running":
+            assert "summary.json" not in left and not any(Path(f).name.startswith(".") for f in left), left
+        else:
+            assert not left, name
 
 
 STUDY = """[study]

@@ -115,8 +115,10 @@ def _run(argv: list[str] | None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from gatetherm.studies.cli.process import configure
     from gatetherm.studies.sweeps.runner import PointsFailed
 
+    configure()
     try:
         return int(args.func(args) or 0)
     except InputError as err:

@@ -7,7 +7,7 @@ from pathlib import Path
 from gatetherm.studies.cli.options import Progress
 
 #: What a run writes into --out; a rerun replaces all of it.
-OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf",
+OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5",
            "channels.png", "deformed.png")
 
 
@@ -41,11 +41,11 @@ def _run(args, case, out: Path, t0: float) -> int:
     every = case.time.fields if case.time else 1.0
     fields = {float(t) for t in schedule.times if abs(t / every - round(t / every)) < 1e-9} | {float(schedule.times[-1])}
     res = run_scenario(case, case.mesh.dim, schedule, keep_times=sorted(fields), on_step=Progress(case.name))
-    write_run(out, res, {"source": "gatetherm run", "case": str(args.case), "name": case.name}, fields)
+    solved = write_run(out, res, {"source": "gatetherm run", "case": str(args.case), "name": case.name}, fields)
     if not args.no_pictures:
         from gatetherm.validation.plots.run import plot_case
 
-        plot_case(res, out, case.name)
+        plot_case(res, out, case.name, solved)
     p = case.problem
     summary = {"case": case.name, "file": str(args.case), "dim": p.dim, "order": p.order,
                "analysis": "prescribed temperature" if not p.heat else ("transient" if case.time else "steady"),

@@ -8,7 +8,7 @@ from gatetherm.checks import POSITIVE
 from gatetherm.studies.cli.options import Progress, add_model_options, number
 
 #: What a run writes into --out; a rerun replaces all of it.
-OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf",
+OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5",
            "oil_temperatures.png", "response.png", "deformed.png")
 
 
@@ -57,13 +57,14 @@ def _simulate(args, cfg, effects, schedule, out: Path) -> int:
     meta = {"source": "gatetherm simulate", "schedule": schedule.label, "dim": str(args.dim), "config": cfg.source}
     if args.condition:
         meta["condition"] = str(args.condition)
-    write_run(out, res, meta, field_times)
-    if not args.no_pictures:
-        from gatetherm.validation.plots.run import plot_run
-
+    pictures = not args.no_pictures
+    if pictures:
+        from gatetherm.validation.plots.run import picture_time, plot_run
+    solved = write_run(out, res, meta, field_times, (picture_time(figs),) if pictures else ())
+    if pictures:
         title = f"gatetherm {args.dim}-D, " + (f"condition {args.condition}" if args.condition
                                                else Path(args.schedule).name)
-        plot_run(res, figs, out, title)
+        plot_run(res, figs, out, title, solved)
     model = res.model
     summary = {**figs, "wall_time_s": round(time.perf_counter() - t_start, 2),
                "build_s": round(res.seconds - res.result.seconds, 2), "march_s": round(res.result.seconds, 2),

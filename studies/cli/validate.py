@@ -107,13 +107,11 @@ def run_rom(args) -> int:
 
 
 def _hidden_arguments(p) -> None:
-    from gatetherm.validation.hidden_effects import ALL_CASES
-
     p.add_argument("--workers", type=number(WORKERS), default=2, metavar="N", help="worker processes (default 2)")
     p.add_argument("--seed", type=int, default=6, help="seed of the strengths and the noise (default 6)")
     p.add_argument("--conditions", type=_conditions, default=(1, 2, 3),
                    help="conditions, comma separated (default 1,2,3)")
-    p.add_argument("--effects", default=",".join(ALL_CASES), metavar="NAME,...",
+    p.add_argument("--effects", metavar="NAME,...",
                    help="catalogue effects, outside-catalogue cases, mismatches and 'none' (default: all)")
     p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M",
                    help="diagnosis element size, m (default: the model's)")
@@ -122,7 +120,7 @@ def _hidden_arguments(p) -> None:
 def run_hidden(args) -> int:
     from gatetherm.validation.hidden_effects import ALL_CASES, row_line, write_hidden_effects
 
-    effects = set(args.effects.split(","))
+    effects = set(args.effects.split(",")) if args.effects else set(ALL_CASES)
     if effects - set(ALL_CASES):
         raise InputError("--effects", f"unknown {', '.join(sorted(effects - set(ALL_CASES)))}",
                          f"choose from {', '.join(ALL_CASES)}")
