@@ -89,41 +89,78 @@ def save_mesh(m: FrameMesh, path: str | os.PathLike) -> None:
         meshio.write(tmp, mm, file_format=fmt)
 
 
+_CORNERS = {"line": 2, "line3": 2, "triangle": 3, "triangle6": 3, "tetra": 4, "tetra10": 4, "vertex": 1}
+"""Corner nodes of the cell types read (higher-order cells keep their corners)."""
+_KIND = {0: "point", 1: "curve", 2: "surface", 3: "volume"}
+
+
+def group_name(dim: int, tag: int, names: dict) -> str:
+    """The name of the physical group (``dim``, ``tag``), or ``<kind><tag>`` (e.g.
+    ``surface3``) for a group without one."""
+    return names.get((dim, tag), f"{_KIND[dim]}{tag}")
+
+
 def _named_blocks(mm):
-    """Yield (name, cell type, connectivity) per group, from group masks (VTU)
-    or gmsh tags and names (MSH); readers may merge blocks of one cell type."""
+    """Yield (name, dimension, corner connectivity) per group, from group masks (VTU) or
+    gmsh physical tags matched by (dimension, number) with their names (MSH 2.2 and 4.1);
+    readers may merge blocks of one cell type."""
+    blocks = [(b, _CORNERS[b.type]) for b in mm.cells if b.type in _CORNERS]
     masks = [k for k in mm.cell_data if k.startswith(_MASK)]
     if masks:
-        sel = {k[len(_MASK):]: mm.cell_data[k] for k in masks}
-    else:
-        names = {int(v[0]): k for k, v in mm.field_data.items()}
-        phys = mm.cell_data["gmsh:physical"]
-        sel = {n: [arr == t for arr in phys] for t, n in names.items()}
-    for name, per_block in sel.items():
-        for block, on in zip(mm.cells, per_block):
-            on = np.asarray(on, dtype=bool)
-            if on.any():
-                yield name, block.type, block.data[on]
+        for k in masks:
+            for block, on in zip(mm.cells, mm.cell_data[k]):
+                on = np.asarray(on, dtype=bool)
+                if block.type in _CORNERS and on.any():
+                    yield k[len(_MASK):], block.dim, block.data[on][:, :_CORNERS[block.type]]
+        return
+    if "gmsh:physical" not in mm.cell_data:
+        raise InputError("mesh", "has no physical groups", "name the regions, boundaries and points in gmsh")
+    names = {(int(v[1]), int(v[0])): k for k, v in mm.field_data.items()}
+    phys = dict(zip([id(b) for b in mm.cells], mm.cell_data["gmsh:physical"]))
+    for block, n in blocks:
+        tags = np.asarray(phys[id(block)])
+        for tag in np.unique(tags):
+            yield group_name(block.dim, int(tag), names), block.dim, block.data[tags == tag][:, :n]
+
+
+def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
+    """A :class:`FrameMesh` from (name, dimension, connectivity) groups; nodes in no
+    element are dropped."""
+    regions, boundaries, sensors, chunks, offset = {}, {}, {}, [], 0
+    for name, d, conn in groups:
+        if d == dim:
+            chunks.append(conn)
+            regions[name] = np.arange(offset, offset + len(conn)) if name not in regions else \
+                np.r_[regions[name], np.arange(offset, offset + len(conn))]
+            offset += len(conn)
+        elif d == dim - 1:
+            boundaries[name] = np.vstack([boundaries[name], conn]) if name in boundaries else conn
+        elif d == 0:
+            sensors[name] = int(conn[0, 0])
+    if not chunks:
+        raise InputError("mesh", f"holds no named {_KIND[dim]} groups", f"add a Physical {_KIND[dim].title()}")
+    cells = np.vstack(chunks)
+    used = np.unique(cells)
+    remap = -np.ones(len(points), dtype=np.int64)
+    remap[used] = np.arange(len(used))
+    orphans = [k for k, v in sensors.items() if remap[v] < 0]
+    if orphans:
+        raise InputError(f"mesh point {orphans[0]}", "is not a node of the mesh's elements",
+                         "put the point inside the meshed body (embed it in gmsh)")
+    return FrameMesh(dim, points[used][:, :dim].copy(), remap[cells], regions,
+                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()})
 
 
 def load_mesh(path: str | os.PathLike) -> FrameMesh:
-    """Read a mesh written by :func:`save_mesh` (``.msh`` or ``.vtu``)."""
+    """Read a mesh with named groups: ``.msh`` (gmsh 2.2 or 4.1, physical groups matched
+    by dimension and number) or a ``.vtu`` written by :func:`save_mesh`."""
     import meshio
 
     path = Path(path)
     mm = meshio.read(path, file_format="gmsh" if path.suffix == ".msh" else None)
-    dim = 3 if any(c.type == "tetra" for c in mm.cells) else 2
-    regions, boundaries, sensors, chunks = {}, {}, {}, []
-    offset = 0
-    for name, ctype, conn in _named_blocks(mm):
-        if ctype == _CELL[dim]:
-            chunks.append(conn)
-            regions[name] = np.arange(offset, offset + len(conn))
-            offset += len(conn)
-        elif ctype == _FACET[dim]:
-            boundaries[name] = conn
-        elif ctype == "vertex":
-            sensors[name] = int(conn[0, 0])
-    if not chunks:
-        raise InputError(str(path), "holds no named volume groups", "write it with 'gatetherm mesh'")
-    return FrameMesh(dim, mm.points[:, :dim].copy(), np.vstack(chunks), regions, boundaries, sensors)
+    dim = max((b.dim for b in mm.cells if b.type in _CORNERS), default=0)
+    if dim < 2:
+        raise InputError(str(path), "holds no triangles or tetrahedra", "mesh a surface (2-D) or a volume (3-D)")
+    if dim == 2 and np.ptp(mm.points[:, 2]) > 1e-12 * max(np.ptp(mm.points[:, :2]), 1.0):
+        raise InputError(str(path), "a 2-D mesh must lie in the x-y plane", "mesh the section in z = 0")
+    return from_groups(dim, mm.points, _named_blocks(mm))

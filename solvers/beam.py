@@ -23,7 +23,7 @@ from gatetherm import InputError
 
 if TYPE_CHECKING:
     from gatetherm.geometry.frame import FrameParams
-    from gatetherm.solvers.model import ModelConfig
+    from gatetherm.solvers.frame import ModelConfig
 
 
 @dataclass(frozen=True)

@@ -14,9 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.geometry.frame import part_boxes
-from gatetherm.solvers.heat import Drive, Inputs
-from gatetherm.solvers.model import ModelConfig
+from gatetherm.solvers.frame import AMBIENT, ModelConfig
+from gatetherm.solvers.heat import Drive
 
 
 @dataclass(frozen=True)
@@ -173,15 +172,7 @@ def effects_table(values: dict[str, float]) -> dict[str, dict[str, float]]:
     return {name: {CATALOGUE[name].param: float(v)} for name, v in values.items()}
 
 
-def _piezo_source(cfg: ModelConfig, power: float, dim: int) -> dict[str, float]:
-    """W/m³ in the workpiece-side arm for a total power (W)."""
-    x0, x1, y0, y1, z0, z1 = part_boxes(cfg.frame, dim)["arm_R"]
-    vol = (x1 - x0) * (y1 - y0) * (z1 - z0)
-    return {"arm_R": power / vol}
-
-
-def apply_effects(cfg: ModelConfig, drive: Drive, eff: ActiveEffects,
-                  dim: int) -> tuple[ModelConfig, Drive]:
+def apply_effects(cfg: ModelConfig, drive: Drive, eff: ActiveEffects) -> tuple[ModelConfig, Drive]:
     """The model configuration and drive with the model- and drive-side effects on."""
     v = eff.values
     changes: dict = {}
@@ -194,13 +185,18 @@ def apply_effects(cfg: ModelConfig, drive: Drive, eff: ActiveEffects,
     if "base_conduction" in v:
         changes["thermal"] = dataclasses.replace(cfg.thermal, h_base=v["base_conduction"])
     if "piezo_heat" in v:
-        changes["source"] = {**cfg.source, **_piezo_source(cfg, v["piezo_heat"], dim)}
-    if "ambient_drift" in v:
-        rate = v["ambient_drift"] / 3600.0
-        base = drive
+        changes["power"] = {**cfg.power, "arm_R": v["piezo_heat"]}
+    return (dataclasses.replace(cfg, **changes) if changes else cfg), drive_effects(drive, eff)
 
-        def drive(t: float) -> Inputs:
-            u = base(t)
-            return u._replace(T_amb=u.T_amb + rate * t)
 
-    return (dataclasses.replace(cfg, **changes) if changes else cfg), drive
+def drive_effects(drive: Drive, eff: ActiveEffects) -> Drive:
+    """The drive with the drive-side effects on (the room drifting from its initial value)."""
+    if "ambient_drift" not in eff.values:
+        return drive
+    rate, base = eff.values["ambient_drift"] / 3600.0, drive
+
+    def drifting(t: float) -> dict[str, float]:
+        u = base(t)
+        return {**u, AMBIENT: u[AMBIENT] + rate * t}
+
+    return drifting

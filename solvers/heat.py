@@ -1,38 +1,45 @@
-"""Transient heat conduction in the frame, coupled to a lumped oil tank.
+"""Heat conduction in a solid, with lumped fluid volumes on its boundaries.
 
-Unknowns are the nodal temperatures of the solid (°C) followed by the tank oil
-temperature and, if the supply hose has a heat capacity, the hose temperature.
+Unknowns are the nodal temperatures of the solid (°C) followed by one temperature per
+lumped fluid volume and per supply hose (:class:`~gatetherm.solvers.problem.Fluid`).
 Per unit of the 2-D out-of-plane thickness ``t`` (``t = 1`` in 3-D) the weak form is
 
-    ∫ t ρc Ṫ v + ∫ t k ∇T·∇v + Σ_Γ ∫ t h_Γ (T − T_amb) v + ∫ h_s (T − T_amb) v
-        + ∫_wall t h_oil (T − T_oil) v = ∫ t q v
-    C_oil Ṫ_oil + ∫_wall t h_oil (T_oil − T) + G (T_oil − T_in) = 0
-    C_hose Ṫ_hose + G (T_hose − T_supply) + UA_hose (T_hose − T_amb) = 0
+    ∫ t ρc Ṫ v + ∫ t k ∇T·∇v + Σ_films ∫ t h (T − T_amb) v + ∫ h_f (T − T_amb) v
+        + Σ_fluids ∫_wall t h_p (T − T_oil) v = ∫ t q v + Σ_flux ∫ t q_n v
+    C_oil Ṫ_oil + ∫_wall t h_p (T_oil − T) + G_p (T_oil − T_in) = 0
+    C_hose Ṫ_hose + G_p (T_hose − T_supply) + UA (T_hose − T_amb) = 0
 
-with ``h_s`` the out-of-plane loss (2 h_air for the front and back faces of a
-2-D section), ``h_oil`` and the pump conductance ``G = ρc_oil Q`` following the
-pump state, and ``T_in`` the oil reaching the tank: ``T_hose`` (``T_supply``
-without a hose). The hose is one well-mixed lump, the simplest model of the oil
-that stands and cools in it while the pump is off and reaches the tank first
-when it restarts. Integrated with the θ-method (:class:`TimeScheme`); each
-distinct (θ dt, pump) matrix is factorised once.
+with ``h_f`` the loss of the front and back faces of a 2-D section (2 h per unit of
+section area), the wall film ``h_p`` and the supply's enthalpy flow ``G_p = ρc Q``
+following the fluid's pump state ``p``, and ``T_in`` the fluid entering the volume: the
+hose, or the supply without one. Fixed temperatures are Dirichlet conditions. The
+matrix of the system depends only on the pump states (the *mode*); the right-hand side
+is a sum of fixed vectors times input values.
 """
 from __future__ import annotations
 
 import logging
 import time
 from dataclasses import dataclass
-from typing import Callable, Iterator, NamedTuple
+from typing import Callable, Iterator, Mapping
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
-from gatetherm.solvers.fem import Field, element
+from gatetherm.checks import Range, admissible
+from gatetherm.solvers import p1
+from gatetherm.solvers.expr import Value
+from gatetherm.solvers.fem import Field, dof_basis, element
+from gatetherm.solvers.linsolve import Bordered, nd_order, restrict_order
 
 log = logging.getLogger(__name__)
+
+Drive = Callable[[float], Mapping[str, float]]
+"""The inputs of a run (schedule columns by name) at a time in s."""
+Mode = tuple[bool, ...]
+"""Pump state of every fluid."""
 
 
 @BilinearForm
@@ -55,49 +62,7 @@ def film_load(v, w):
     return w.h * w.t * v
 
 
-@dataclass(frozen=True)
-class ThermalParams:
-    """Heat-transfer coefficients of the frame and the oil tank."""
-
-    T0: float = 20.0
-    """Initial temperature of frame, oil and room, and the stress-free reference, °C."""
-    h_air: float = 8.0
-    """Film coefficient of the free surfaces to room air (convection + linearised radiation), W/(m² K)."""
-    h_base: float = 0.0
-    """Film coefficient of the mounting face to a foundation at room temperature, W/(m² K)."""
-    h_oil_on: float = 260.0
-    """Tank-wall film coefficient while the pump circulates the oil, W/(m² K)."""
-    h_oil_off: float = 28.0
-    """Tank-wall film coefficient of standing oil, W/(m² K)."""
-    oil_rho_c: float = 1.7e6
-    """Volumetric heat capacity of the oil, J/(m³ K)."""
-    flow_rate: float = 3.3e-5
-    """Oil flow through the tank while the pump runs, m³/s."""
-    out_of_plane: bool = True
-    """2-D only: the front and back faces of the section lose heat with ``h_air``."""
-    hose_capacity: float = 1800.0
-    """Heat capacity of the supply hose from the oil unit to the tank, its oil and its wall,
-    J/K (0: no hose). Default: 2 m of 13 mm-bore rubber hose, 0.27 L of oil (450 J/K) and
-    0.68 kg of rubber (1360 J/K)."""
-    hose_loss: float = 0.9
-    """Heat loss of the supply hose to the room, W/K. Default: 2 m of 23 mm outer diameter,
-    8 W/(m² K) outside, 5 mm of rubber (k = 0.2 W/(m K))."""
-
-
-class Inputs(NamedTuple):
-    """What drives the model at one instant."""
-
-    T_supply: float
-    """Temperature of the oil supplied to the tank, °C."""
-    pump: bool
-    """Oil circulation on."""
-    T_amb: float
-    """Room temperature, °C."""
-
-
-Drive = Callable[[float], Inputs]
-
-
+@admissible(theta=Range(0.5, 1.0), restart=Range(1, 1000, whole=True), restart_intervals=Range(0, 1000, whole=True))
 @dataclass(frozen=True)
 class TimeScheme:
     """The θ-method with Rannacher start-up at input switches."""
@@ -113,146 +78,188 @@ class TimeScheme:
     """How many intervals after a switch are divided."""
 
 
+def environment(drive: Drive, t: float) -> dict[str, float]:
+    """The variables an input expression sees at time ``t``: ``t`` and the drive's inputs."""
+    return {"t": t, **drive(t)}
+
+
+@dataclass(frozen=True)
+class Load:
+    """A term ``vector · value(env)`` of the right-hand side."""
+
+    vector: np.ndarray
+    value: Value
+    kind: str
+    """"film", "flux", "faces", "source" or "hose" (the hose's loss): for energy accounts."""
+
+
+@dataclass(frozen=True)
+class Pumped:
+    """The part of the conductance and the load that follows one fluid's pump."""
+
+    wall: sp.csr_matrix
+    """Coupling of the wetted boundary and the fluid unknown for a unit film coefficient."""
+    film_on: float
+    film_off: float
+    flow: sp.csr_matrix
+    """Coupling of fluid and inlet unknowns by the supply for a unit conductance."""
+    conductance: float
+    """Enthalpy flow while pumping, W/K."""
+    inlet: int
+    """Index of the unknown the supply enters (the hose, or the fluid)."""
+    pump: Value
+    supply: Value
+
+    def on(self, env) -> bool:
+        return bool(self.pump(env) > 0.5)
+
+    def coefficients(self, on: bool) -> tuple[float, float]:
+        """(wall film coefficient, conductance) for a pump state."""
+        return (self.film_on, self.conductance) if on else (self.film_off, 0.0)
+
+
 @dataclass(frozen=True)
 class HeatSystem:
-    """Assembled operators; the unknowns are the solid's (``n_solid``), then the tank
-    oil, then the hose (if ``params.hose_capacity > 0``). Immutable: the factorisations
-    of its step matrices live in a :class:`HeatSolver`."""
+    """Assembled operators: ``M U' + K(mode) U = f(env, mode)`` with ``U[fixed]`` given.
+    Immutable: the factorisations of its step matrices live in a :class:`HeatSolver`."""
 
     basis: CellBasis
     M: sp.csr_matrix
     K0: sp.csr_matrix
-    K_wall: sp.csr_matrix
-    f_amb: np.ndarray
-    f_src: np.ndarray
-    params: ThermalParams
+    """Conductance that does not depend on the pumps."""
+    pumped: tuple[Pumped, ...]
+    loads: tuple[Load, ...]
+    """``f = Σ vector · value(env)`` (+ the supplies of the pumped fluids)."""
+    fixed: tuple[tuple[np.ndarray, Value], ...]
+    """Dirichlet conditions: solid dofs and their temperature."""
     n_solid: int
+    lumped: dict[str, int]
+    """Index of every fluid and hose unknown, by name."""
+    T0: float
+    """Initial temperature, °C."""
+    order: np.ndarray | None = None
+    """A fill-reducing order of the solid's unknowns, shared with the other factors on the
+    mesh (None: found from the first step matrix)."""
 
     @property
     def n(self) -> int:
         return self.M.shape[0]
 
     @property
-    def oil(self) -> int:
-        """Index of the tank-oil unknown."""
-        return self.n_solid
+    def fixed_dofs(self) -> np.ndarray:
+        return np.unique(np.concatenate([d for d, _ in self.fixed])) if self.fixed else np.zeros(0, int)
 
-    @property
-    def inlet(self) -> int:
-        """Index of the unknown the supplied oil enters: the hose, or the tank without one."""
-        return self.n - 1
+    def mode(self, env) -> Mode:
+        return tuple(p.on(env) for p in self.pumped)
 
-    def coefficients(self, pump: bool) -> tuple[float, float]:
-        """(tank-wall film coefficient, pump conductance in W/K) for a pump state."""
-        p = self.params
-        return (p.h_oil_on, p.oil_rho_c * p.flow_rate) if pump else (p.h_oil_off, 0.0)
+    def K(self, mode: Mode) -> sp.csr_matrix:
+        """Conductance matrix for a mode."""
+        K = self.K0
+        for p, on in zip(self.pumped, mode):
+            h, G = p.coefficients(on)
+            K = K + h * p.wall + G * p.flow
+        return K.tocsr()
 
-    def K(self, pump: bool) -> sp.csr_matrix:
-        """Conductance matrix for a pump state."""
-        h, G = self.coefficients(pump)
-        o, i = self.oil, self.inlet  # G (T_oil − T_in) and G T_in, summed if the same unknown
-        e = sp.csr_matrix(([G, -G, G], ([o, o, i], [o, i, i])), shape=(self.n, self.n))
-        return (self.K0 + h * self.K_wall + e).tocsr()
-
-    def f(self, t: float, drive: Drive, pump: bool) -> np.ndarray:
-        u = drive(t)
-        out = self.f_amb * u.T_amb + self.f_src
-        out[self.inlet] += self.coefficients(pump)[1] * u.T_supply
+    def f(self, env, mode: Mode) -> np.ndarray:
+        out = np.zeros(self.n)
+        for load in self.loads:
+            out += load.vector * load.value(env)
+        for p, on in zip(self.pumped, mode):
+            out[p.inlet] += p.coefficients(on)[1] * p.supply(env)
         return out
 
+    def boundary_values(self, env) -> np.ndarray:
+        """Temperatures of :attr:`fixed_dofs` (a later condition wins at shared nodes)."""
+        out = np.zeros(self.n)
+        for dofs, value in self.fixed:
+            out[dofs] = value(env)
+        return out[self.fixed_dofs]
+
     def initial(self, T0: float | None = None) -> np.ndarray:
-        return np.full(self.n, self.params.T0 if T0 is None else T0)
+        return np.full(self.n, self.T0 if T0 is None else T0)
 
 
 class HeatSolver:
-    """Step solves of one :class:`HeatSystem`: the conductance matrix of each pump state
-    and the factor of each distinct (θ dt, pump) step matrix, made on first use and kept
-    (four per paper condition: 60-s and 15-s steps, pump on and off)."""
+    """Step solves of one :class:`HeatSystem`: the conductance matrix of each mode and the
+    factor of each distinct (θ dt, mode) step matrix on the free unknowns, made on first
+    use and kept (four per paper condition: 60-s and 15-s steps, pump on and off)."""
 
     def __init__(self, system: HeatSystem):
         self.system = system
-        self._K: dict[bool, sp.csr_matrix] = {}
-        self._lu: dict[tuple[float, bool], object] = {}
+        self.free = np.setdiff1d(np.arange(system.n), system.fixed_dofs)
+        """Unknowns not held by a fixed temperature (the solid's first, then the lumped ones)."""
+        self.n_inner = int(np.sum(self.free < system.n_solid))
+        """Free unknowns of the solid: the SPD block of every step matrix."""
+        self._K: dict[Mode, sp.csr_matrix] = {}
+        self._lu: dict[tuple[float, Mode], tuple[Bordered, sp.csr_matrix | None]] = {}
+        self._order: list = []
         self.factor_seconds = 0.0
         """Seconds spent factorising so far."""
 
-    def K(self, pump: bool) -> sp.csr_matrix:
-        if pump not in self._K:
-            self._K[pump] = self.system.K(pump)
-        return self._K[pump]
+    def K(self, mode: Mode) -> sp.csr_matrix:
+        if mode not in self._K:
+            self._K[mode] = self.system.K(mode)
+        return self._K[mode]
 
     @property
     def factorisations(self) -> int:
         """How many step matrices were factorised so far."""
         return len(self._lu)
 
-    def solve(self, dt: float, theta: float, pump: bool, rhs: np.ndarray) -> np.ndarray:
-        """Solve ``(M/dt + θ K) U = rhs`` with the factor of ``M/(θ dt) + K``, which backward
-        Euler over dt/2 and Crank–Nicolson over dt share."""
-        key = (round(theta * dt, 9), pump)
+    def solve(self, dt: float, theta: float, mode: Mode, rhs: np.ndarray, held: np.ndarray) -> np.ndarray:
+        """Solve ``(M/dt + θ K) U = rhs`` with ``U[fixed] = held``, by the factor of
+        ``M/(θ dt) + K`` on the free unknowns, which backward Euler over dt/2 and
+        Crank–Nicolson over dt share: a sparse Cholesky of its SPD solid block (one METIS
+        order for all, the matrices share a pattern) bordered by the lumped unknowns."""
+        key = (round(theta * dt, 9), mode)
+        fixed = self.system.fixed_dofs
         if key not in self._lu:
             t0 = time.perf_counter()
-            A = (self.system.M / (theta * dt) + self.K(pump)).tocsc()
-            self._lu[key] = splu(A, permc_spec="COLAMD")
+            A = (self.system.M / (theta * dt) + self.K(mode)).tocsr()
+            coupling = None
+            if fixed.size:
+                coupling, A = A[self.free][:, fixed], A[self.free][:, self.free]
+            if not self._order:
+                inner = A[:self.n_inner, :self.n_inner]
+                self._order.append(nd_order(inner) if self.system.order is None else
+                                   restrict_order(self.system.order, self.free[:self.n_inner], self.system.n_solid))
+            self._lu[key] = (Bordered(A, self.n_inner, self._order[0]), coupling)
             seconds = time.perf_counter() - t0
             self.factor_seconds += seconds
-            log.debug("factorised heat matrix for θdt=%g s, pump=%s in %.2f s", theta * dt, pump, seconds)
-        return self._lu[key].solve(rhs / theta)
+            log.debug("factorised heat matrix for θdt=%g s, mode=%s in %.2f s (%s)", theta * dt, mode, seconds,
+                      self._lu[key][0].backend)
+        solve, coupling = self._lu[key]
+        if coupling is None:
+            return solve(rhs / theta)
+        U = np.empty(self.system.n)
+        U[fixed] = held
+        U[self.free] = solve(rhs[self.free] / theta - coupling @ held)
+        return U
 
+    def steady(self, env) -> np.ndarray:
+        """The state in equilibrium with the inputs ``env``."""
+        from scipy.sparse.linalg import spsolve
 
-def assemble_heat(mesh, order: int, k: Field, rho_c: Field, thickness: Field,
-                  params: ThermalParams, oil_volume: float,
-                  source: Field | None = None, extra_films: dict[str, float] | None = None,
-                  intorder: int | None = None) -> HeatSystem:
-    """Assemble the heat operators on a scikit-fem ``mesh`` with named boundaries
-    ``free_surface``, ``mounting_face`` and ``tank_wall``.
-
-    ``oil_volume`` (m³) sets the oil capacity; ``source`` is a volumetric heat
-    source (W/m³); ``extra_films`` adds film coefficients on further boundaries.
-    """
-    dim = mesh.dim()
-    e = element(dim, order)
-    q = intorder or 2 * order
-    basis = CellBasis(mesh, e, intorder=q)
-    t = thickness.at(basis)
-    M = asm(capacity, basis, rc=rho_c.at(basis), t=t)
-    K = asm(conduction, basis, k=k.at(basis), t=t)
-    f_amb = np.zeros(basis.N)
-    films = {"free_surface": params.h_air, "mounting_face": params.h_base, **(extra_films or {})}
-    for name, h in films.items():
-        if h:
-            fb = FacetBasis(mesh, e, facets=mesh.boundaries[name], intorder=q)
-            tf = thickness.at(fb)
-            K = K + asm(film, fb, h=h, t=tf)
-            f_amb += asm(film_load, fb, h=h, t=tf)
-    if dim == 2 and params.out_of_plane and params.h_air:
-        K = K + asm(film, basis, h=params.h_air, t=2.0)
-        f_amb += asm(film_load, basis, h=params.h_air, t=2.0)
-    f_src = asm(film_load, basis, h=source.at(basis), t=t) if source is not None else np.zeros(basis.N)
-    wb = FacetBasis(mesh, e, facets=mesh.boundaries["tank_wall"], intorder=q)
-    tw = thickness.at(wb)
-    A_ww = asm(film, wb, h=1.0, t=tw)
-    c = asm(film_load, wb, h=1.0, t=tw)
-    K_wall = sp.bmat([[A_ww, -c[:, None]], [-c[None, :], np.array([[c.sum()]])]]).tocsr()
-    caps, loss = [params.oil_rho_c * oil_volume], [0.0]
-    if params.hose_capacity > 0:
-        caps, loss = caps + [params.hose_capacity], loss + [params.hose_loss]
-        K_wall = sp.block_diag([K_wall, sp.csr_matrix((1, 1))]).tocsr()
-    M = sp.block_diag([M, sp.diags(caps)]).tocsr()
-    K0 = sp.block_diag([K, sp.diags(loss)]).tocsr()
-    f_amb, f_src = np.concatenate([f_amb, loss]), np.concatenate([f_src, np.zeros(len(caps))])
-    log.info("heat system: %d unknowns (P%d), wall area %.4g m²", M.shape[0], order, c.sum())
-    return HeatSystem(basis, M, K0, K_wall, f_amb, f_src, params, basis.N)
+        sys = self.system
+        mode = sys.mode(env)
+        K, f, held = self.K(mode), sys.f(env, mode), sys.boundary_values(env)
+        U = np.empty(sys.n)
+        U[sys.fixed_dofs] = held
+        D = sys.fixed_dofs
+        rhs = f[self.free] - (K[self.free][:, D] @ held if D.size else 0.0)
+        U[self.free] = spsolve(K[self.free][:, self.free].tocsc(), rhs)
+        return U
 
 
 def theta_step(solver: HeatSolver, drive: Drive, U: np.ndarray, t0: float, t1: float, theta: float,
-               pump: bool) -> np.ndarray:
-    """One θ-method step from ``U`` at ``t0`` to ``t1`` with the pump state ``pump``."""
+               mode: Mode) -> np.ndarray:
+    """One θ-method step from ``U`` at ``t0`` to ``t1`` in ``mode``."""
     sys, dt = solver.system, t1 - t0
-    rhs = sys.M @ U / dt + theta * sys.f(t1, drive, pump)
+    env1 = environment(drive, t1)
+    rhs = sys.M @ U / dt + theta * sys.f(env1, mode)
     if theta < 1:
-        rhs += (1 - theta) * (sys.f(t0, drive, pump) - solver.K(pump) @ U)
-    return solver.solve(dt, theta, pump, rhs)
+        rhs += (1 - theta) * (sys.f(environment(drive, t0), mode) - solver.K(mode) @ U)
+    return solver.solve(dt, theta, mode, rhs, sys.boundary_values(env1) if sys.fixed else np.zeros(0))
 
 
 def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple[float, float, float]]:
@@ -271,44 +278,118 @@ def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple
 
 def march(system: HeatSystem | HeatSolver, drive: Drive, times: np.ndarray, scheme: TimeScheme = TimeScheme(),
           U0: np.ndarray | None = None) -> Iterator[tuple[float, np.ndarray]]:
-    """Yield ``(t, U)`` at every entry of ``times``, starting with the initial state.
+    """Yield ``(t, U)`` at every entry of ``times``, starting with the initial state
+    (fixed temperatures applied).
 
     Pass a :class:`HeatSolver` to reuse its factorisations across runs; a bare
     :class:`HeatSystem` gets a solver of its own for this run.
 
-    The pump state of an interval is read at its midpoint, so a switch at a sample
+    The mode of an interval is read at its midpoint, so a pump switch at a sample
     time takes effect for the whole following interval; that interval (and the
     first) is refined as :class:`TimeScheme` says.
     """
     solver = system if isinstance(system, HeatSolver) else HeatSolver(system)
-    U = solver.system.initial() if U0 is None else np.array(U0, dtype=float)
+    sys = solver.system
+    U = sys.initial() if U0 is None else np.array(U0, dtype=float)
+    if sys.fixed:
+        U[sys.fixed_dofs] = sys.boundary_values(environment(drive, float(times[0])))
     yield float(times[0]), U
     last, since = None, 0
     for t0, t1 in zip(times[:-1], times[1:]):
-        pump = bool(drive(0.5 * (t0 + t1)).pump)
-        since = 0 if pump != last else since + 1
+        mode = sys.mode(environment(drive, 0.5 * (t0 + t1)))
+        since = 0 if mode != last else since + 1
         for a, b, theta in substeps(float(t0), float(t1), scheme, since):
-            U = theta_step(solver, drive, U, a, b, theta, pump)
-        last = pump
+            U = theta_step(solver, drive, U, a, b, theta, mode)
+        last = mode
         yield float(t1), U
 
 
-def energy_step(sys: HeatSystem, U0: np.ndarray, U1: np.ndarray, t0: float, t1: float,
-                drive: Drive, theta: float = 1.0) -> dict[str, float]:
-    """Heat (J) over one step: into the solid through the tank wall, stored in the
-    solid, lost to the room/foundation, and added by sources, with the same
-    θ-weighting as the scheme, so that ``wall + source = stored + lost`` holds
-    to round-off."""
-    dt = t1 - t0
-    pump = bool(drive(0.5 * (t0 + t1)).pump)
-    h, _ = sys.coefficients(pump)
-    Um = theta * U1 + (1 - theta) * U0
-    solid = np.zeros(sys.n)
-    solid[:sys.n_solid] = 1.0
-    f_amb = theta * drive(t1).T_amb + (1 - theta) * drive(t0).T_amb
-    return {
-        "wall": -dt * h * float(solid @ (sys.K_wall @ Um)),
-        "stored": float(solid @ (sys.M @ (U1 - U0))),
-        "lost": dt * float(solid @ (sys.K0 @ Um) - solid @ sys.f_amb * f_amb),
-        "source": dt * float(solid @ sys.f_src),
-    }
+def _facets(mesh, name: str, e, q: int):
+    return FacetBasis(mesh, e, facets=mesh.boundaries[name], intorder=q)
+
+
+def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None,
+                  simplices: p1.Simplices | None = None) -> HeatSystem:
+    """Assemble the heat system of ``problem`` (a :class:`~gatetherm.solvers.problem.Problem`)
+    on a scikit-fem ``mesh`` with its named boundaries and subdomains; ``fields`` holds the
+    element-wise ``k``, ``rho_c`` and ``thickness``. Linear elements use ``simplices``
+    (:func:`~gatetherm.solvers.p1.simplices` of the mesh, found if not given)."""
+    order = problem.order
+    e = element(mesh.dim(), order)
+    q = intorder or 2 * order
+    th = fields["thickness"]
+    node_order = None
+    if order == 1:  # the same matrices, vectorised (solvers/p1.py)
+        s = simplices or p1.simplices(mesh)
+        M = s.pattern.scalar(p1.mass(s.G, s.vol, fields["rho_c"].values * th.values))
+        K = s.pattern.scalar(p1.conduction(s.G, s.vol, fields["k"].values * th.values))
+        basis, node_order = dof_basis(mesh, e), s.order
+    else:
+        basis = CellBasis(mesh, e, intorder=q)
+        M = asm(capacity, basis, rc=fields["rho_c"].at(basis), t=th.at(basis))
+        K = asm(conduction, basis, k=fields["k"].at(basis), t=th.at(basis))
+
+    def cells():  # a basis with quadrature, made only where a volume integral needs it
+        return CellBasis(mesh, e, intorder=q) if order == 1 else basis
+
+    loads: list[tuple[np.ndarray, Value, str]] = []
+    for fl in problem.films:
+        fb = _facets(mesh, fl.boundary, e, q)
+        tf = th.at(fb)
+        K = K + asm(film, fb, h=fl.h, t=tf)
+        loads.append((asm(film_load, fb, h=fl.h, t=tf), fl.ambient, "film"))
+    for fx in problem.fluxes:
+        fb = _facets(mesh, fx.boundary, e, q)
+        loads.append((asm(film_load, fb, h=1.0, t=th.at(fb)), fx.value, "flux"))
+    if problem.faces is not None and mesh.dim() == 2:
+        cb = cells()
+        K = K + asm(film, cb, h=problem.faces.h, t=2.0)
+        loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
+    for src in problem.sources:
+        cb = cells()
+        on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
+        loads.append((asm(film_load, cb, h=on.at(cb), t=th.at(cb)), src.density, "source"))
+    n_solid = basis.N
+    caps, losses, lumped, couplings = [], [], {}, []
+    for fluid in problem.fluids:
+        wb = _facets(mesh, fluid.boundary, e, q)
+        tw = th.at(wb)
+        lumped[fluid.name] = n_solid + len(caps)
+        caps.append(fluid.capacity)
+        losses.append((0.0, None))
+        couplings.append((asm(film, wb, h=1.0, t=tw), asm(film_load, wb, h=1.0, t=tw)))
+        if fluid.hose_capacity > 0:
+            lumped[fluid.hose_name or f"{fluid.name}_hose"] = n_solid + len(caps)
+            caps.append(fluid.hose_capacity)
+            losses.append((fluid.hose_loss, fluid.ambient))
+    n = n_solid + len(caps)
+
+    def grow(A):
+        return sp.block_diag([A, sp.csr_matrix((len(caps), len(caps)))]).tocsr() if caps else A.tocsr()
+
+    pumped = []
+    for fluid, (A_ww, c) in zip(problem.fluids, couplings):
+        o = lumped[fluid.name]
+        i = lumped.get(fluid.hose_name or f"{fluid.name}_hose", o) if fluid.hose_capacity > 0 else o
+        A, idx = A_ww.tocoo(), np.flatnonzero(c)
+        oo = np.full(len(idx), o)
+        wall = sp.csr_matrix((np.r_[A.data, -c[idx], -c[idx], c.sum()],
+                              (np.r_[A.row, idx, oo, o], np.r_[A.col, oo, idx, o])), shape=(n, n))
+        flow = sp.csr_matrix(([1.0, -1.0, 1.0], ([o, o, i], [o, i, i])), shape=(n, n))
+        pumped.append(Pumped(wall, fluid.film_on, fluid.film_off, flow, fluid.conductance, i,
+                             fluid.pump, fluid.supply))
+        log.info("heat system: fluid %s on %s, wall area %.4g m²", fluid.name, fluid.boundary, c.sum())
+    M = sp.block_diag([M, sp.diags(caps)]).tocsr() if caps else M.tocsr()
+    K0 = grow(K)
+    if any(ua for ua, _ in losses):
+        K0 = (K0 + sp.diags(np.r_[np.zeros(n_solid), [ua for ua, _ in losses]])).tocsr()
+    loads = [Load(np.r_[v, np.zeros(len(caps))], value, kind) for v, value, kind in loads]
+    for k, (ua, ambient) in enumerate(losses):
+        if ua:
+            v = np.zeros(n)
+            v[n_solid + k] = ua
+            loads.append(Load(v, ambient, "hose"))
+    fixed = tuple((basis.get_dofs(mesh.boundaries[c.boundary]).all(), c.value) for c in problem.fixed)
+    log.info("heat system: %d unknowns (P%d), %d fixed", n, order, len(np.unique(np.concatenate(
+        [d for d, _ in fixed]))) if fixed else 0)
+    return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, node_order)

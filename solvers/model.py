@@ -1,214 +1,271 @@
-"""The assembled frame model: mesh, heat and elastic operators, sensor read-outs.
+"""An assembled problem: mesh, heat and elastic operators, and every output as a linear
+read-out of the heat state.
 
-Everything here is set up once per configuration; the time loop only calls
-``march`` and the cheap read-outs (a sparse probe for temperatures, fixed
-weight vectors for displacements).
+Everything here is set up once per problem; a time step costs one sparse and one dense
+matrix-vector product for all outputs: temperatures at probes, fluid and hose
+temperatures and boundary means (sparse rows on the state), and displacements,
+relative displacements and stresses at probes (dense weight rows on the temperature
+rise, one adjoint elastic solve each). A problem with a prescribed temperature field
+has no heat state: it is solved once (:meth:`Model.static`).
 """
 from __future__ import annotations
 
-import dataclasses
-import hashlib
-import json
 import logging
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
+from skfem import CellBasis, FacetBasis, asm
 
-from gatetherm.geometry.build import build_mesh
-from gatetherm import InputError
-from gatetherm.geometry.frame import (FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth,
-                                      width)
 from gatetherm.geometry.mesh import FrameMesh
-from gatetherm.solvers import linsolve
-from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic
-from gatetherm.solvers.fem import Field, to_skfem
-from skfem import FacetBasis, asm
-
-from gatetherm.solvers.heat import HeatSystem, ThermalParams, TimeScheme, assemble_heat, film_load
-from gatetherm.solvers.material import FC300, Material
+from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, moduli, thermal_load_at
+from gatetherm.solvers import p1
+from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
+from gatetherm.solvers.heat import HeatSystem, assemble_heat, film_load
+from gatetherm.solvers.problem import AXES, Problem
+from gatetherm.solvers.stress import Recovery, recovery, von_mises
 
 log = logging.getLogger(__name__)
 
-def scheme_digest(cfg: ModelConfig) -> str:
-    """Eight hex digits naming the numerical scheme: element order, time stepping and the
-    linear solvers' settings (not the physics)."""
-    blob = json.dumps({"order": cfg.order, "time": dataclasses.asdict(cfg.scheme), "linear": linsolve.SETTINGS},
-                      sort_keys=True)
-    return hashlib.sha256(blob.encode()).hexdigest()[:8]
+Key = tuple
+"""An output: ("T", probe), ("u", probe, axis), ("sigma", probe, component), ("relative", name),
+("fluid", name), ("mean", name)."""
 
 
-GEOMETRY_FREE = ("l1",)
-"""FrameParams fields the mesh does not depend on (the beam theory's heated height)."""
-#: Displacement outputs: relative x-displacement (left minus right, m) of a sensor pair.
-OUTPUTS = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
-
-
-@dataclass(frozen=True)
-class ModelConfig:
-    """Everything that defines a frame model (the TOML file mirrors it)."""
-
-    frame: FrameParams = FrameParams()
-    mesh: MeshParams = MeshParams()
-    material: Material = FC300
-    tie_material: Material | None = None
-    """Material of the tie bars (default: same as ``material``)."""
-    thermal: ThermalParams = ThermalParams()
-    order: int = 1
-    """Polynomial degree of temperature and displacement (1 or 2)."""
-    k_base: float | None = None
-    """Foundation stiffness of the mounting face, N/m³ (None: clamped)."""
-    joint_conductance: float | None = None
-    """Thermal contact conductance at the tie-bar joints, W/(m² K) (None: perfect contact)."""
-    joint_stiffness: float | None = None
-    """Normal contact stiffness of the tie-bar joints per unit area, N/m³ (None: rigid contact)."""
-    source: dict = field(default_factory=dict)
-    """Volumetric heat sources by region name, W/m³."""
-    scheme: TimeScheme = TimeScheme()
-    """Time stepping of the heat equation."""
-
-
-def is_tie(region: str) -> bool:
-    return region.startswith("tie_")
-
-
-def region_fields(cfg: ModelConfig, fm: FrameMesh, mesh) -> dict[str, Field]:
-    """Element-wise coefficients: thickness (m, 2-D), k, ρc, E, ν, α, q."""
-    tie_m = cfg.tie_material or cfg.material
-    ties = [r for r in fm.regions if is_tie(r)]
-    props = {"k": lambda m: m.k, "rho_c": lambda m: m.rho * m.c, "E": lambda m: m.E,
-             "nu": lambda m: m.nu, "alpha": lambda m: m.alpha}
-    per_region = {name: {r: get(tie_m) for r in ties} for name, get in props.items()}
-    if cfg.joint_conductance is not None:  # contact resistance in series with the end layer
-        L = cfg.frame.joint_layer
-        per_region["k"].update({r: L / (L / tie_m.k + 1.0 / cfg.joint_conductance)
-                                for r in ties if "joint" in r})
-    if cfg.joint_stiffness is not None:  # contact compliance in series with the end layer
-        L = cfg.frame.joint_layer
-        per_region["E"].update({r: L / (L / tie_m.E + 1.0 / cfg.joint_stiffness)
-                                for r in ties if "joint" in r})
-    out = {name: Field.by_region(mesh, per_region[name], get(cfg.material))
-           for name, get in props.items()}
-    thick = (cfg.frame.depth, tie_depth(cfg.frame)) if fm.dim == 2 else (1.0, 1.0)
-    out["thickness"] = Field.by_region(mesh, {r: thick[1] for r in ties}, thick[0])
-    out["source"] = Field.by_region(mesh, cfg.source, 0.0)
+def region_fields(problem: Problem, mesh) -> dict[str, Field]:
+    """Element-wise coefficients: k, ρc, E, ν, α and the 2-D thickness (m; 1 in 3-D)."""
+    m = problem.materials
+    out = {name: Field.by_region(mesh, {r: get(mat) for r, mat in m.items()}, np.nan) for name, get in (
+        ("k", lambda a: a.k), ("rho_c", lambda a: a.rho * a.c), ("E", lambda a: a.E), ("nu", lambda a: a.nu),
+        ("alpha", lambda a: a.alpha))}
+    thick = problem.thickness if problem.dim == 2 else {}
+    out["thickness"] = Field.by_region(mesh, thick, 1.0)
     return out
 
 
-def oil_volume(p: FrameParams, dim: int) -> float:
-    """Oil volume in the tank, m³ (2-D: the tank runs through the column depth)."""
-    b = tank_box(p, dim)
-    return (b[1] - b[0]) * (b[3] - b[2]) * (b[5] - b[4])
+def boundary_mean(mesh, basis: CellBasis, name: str, thickness: Field) -> np.ndarray:
+    """Weights giving the area-mean of a nodal field over a named boundary."""
+    fb = FacetBasis(mesh, basis.elem, facets=mesh.boundaries[name])
+    a = asm(film_load, fb, h=1.0, t=thickness.at(fb))
+    return a / a.sum()
 
 
 @dataclass(frozen=True)
-class FrameModel:
-    """A meshed and assembled frame, ready to march and read out."""
+class Readout:
+    """``y = L @ U + W @ (U_solid − T_ref)``: the outputs :attr:`keys` of a heat state."""
 
-    config: ModelConfig
+    keys: tuple[Key, ...]
+    L: sp.csr_matrix
+    """Rows on the whole state (temperatures, °C)."""
+    W: np.ndarray
+    """Rows on the solid's temperature rise (displacements in m, stresses in Pa)."""
+    n_L: int
+    """The first ``n_L`` keys are rows of ``L``, the rest rows of ``W``."""
+
+    def __call__(self, U: np.ndarray, n_solid: int, T_ref: float) -> np.ndarray:
+        y = self.L @ U
+        return np.concatenate([y, self.W @ (U[:n_solid] - T_ref)]) if len(self.W) else y
+
+
+@dataclass(frozen=True)
+class Model:
+    """An assembled :class:`~gatetherm.solvers.problem.Problem` on its mesh."""
+
+    problem: Problem
     fmesh: FrameMesh
     mesh: object
-    heat: HeatSystem
-    elastic: ElasticSystem
-    sensor_names: tuple[str, ...]
-    probe: object
-    weights: dict[str, np.ndarray]
-    surface_means: dict[str, np.ndarray]
-    """Weight vectors giving the area-mean temperature of the tank wall and the mounting face."""
+    fields: dict[str, Field]
+    heat: HeatSystem | None
+    elastic: ElasticSystem | None
+    readout: Readout | None
+    """None for a prescribed temperature (see :meth:`static`)."""
+    config: object = None
+    """What the problem was generated from, if anything (the frame's ModelConfig)."""
     timings: dict[str, float] = field(default_factory=dict, compare=False)
     """Seconds spent building: mesh, heat_assembly, elastic_setup, adjoint_solves."""
+    simplices: p1.Simplices | None = field(default=None, compare=False)
+    """Linear elements: what all P1 matrices and factors on the mesh share."""
 
     @property
     def dim(self) -> int:
         return self.fmesh.dim
 
-    def temperatures(self, U: np.ndarray) -> dict[str, float]:
-        """Sensor temperatures (°C), θ_C as the mean of C1–C10, tank oil, supply hose
-        (``hose``, if modelled), and the area means of the tank wall and the mounting face."""
-        T = U[:self.heat.n_solid]
-        out = dict(zip(self.sensor_names, map(float, self.probe @ T)))
-        out["C"] = float(np.mean([out[c] for c in TIE_SENSORS]))
-        out["oil"] = float(U[self.heat.oil])
-        if self.heat.inlet != self.heat.oil:
-            out["hose"] = float(U[self.heat.inlet])
-        out.update({k: float(v @ T) for k, v in self.surface_means.items()})
-        return out
+    def read(self, U: np.ndarray) -> np.ndarray:
+        """All outputs of the heat state ``U`` (order of ``readout.keys``)."""
+        return self.readout(U, self.heat.n_solid, self.problem.T_ref)
 
     def rise(self, U: np.ndarray) -> np.ndarray:
-        """Temperature rise of the solid above the stress-free T0, K."""
-        return U[:self.heat.n_solid] - self.config.thermal.T0
-
-    def displacements(self, U: np.ndarray) -> dict[str, float]:
-        """The outputs of :data:`OUTPUTS` in metres for the state ``U``."""
-        dT = self.rise(U)
-        return {k: float(w @ dT) for k, w in self.weights.items()}
+        """Temperature rise of the solid above the stress-free temperature, K."""
+        return U[:self.heat.n_solid] - self.problem.T_ref
 
     def displacement_field(self, U: np.ndarray) -> np.ndarray:
-        """Full displacement field (m) on the elastic basis: one elastic solve."""
+        """Full displacement field (m) on the elastic basis: one elastic solve (``U`` (n, k): k fields)."""
         return self.elastic.displacement(self.rise(U))
 
+    def stress_field(self, u: np.ndarray, U: np.ndarray | None = None,
+                     rec: Recovery | None = None) -> dict[str, np.ndarray]:
+        """Stress components and von Mises (Pa) at the nodes, projected over the whole mesh
+        (``rec``: :func:`field_recovery` of this model, set up once for many states)."""
+        rec = rec or field_recovery(self)
+        rhs = rec.thermal_rhs(self.rise(U)) if U is not None else rec.thermal_rhs(np.ones(1))
+        comps = rec.field(u, rhs)
+        nodal = {c: v[rec.scalar.nodal_dofs[0]] for c, v in comps.items()}
+        return {**nodal, "von_mises": von_mises(nodal)}
 
-def check_mesh(fm: FrameMesh, p: FrameParams, dim: int) -> FrameMesh:
-    """``fm`` if it is a mesh of the frame ``p`` in ``dim`` dimensions, else InputError naming
-    the first field (a mesh built here) or region (a mesh read from a file) that differs."""
-    if fm.dim != dim:
-        raise InputError("--dim", f"the mesh is {fm.dim}-D, the model {dim}-D", "mesh and model must agree")
-    built = fm.meta.get("frame")
-    if built is not None:
-        for f in dataclasses.fields(p):
-            if f.name not in GEOMETRY_FREE and getattr(built, f.name) != getattr(p, f.name):
-                raise InputError(f"geometry.{f.name}", f"the mesh was built with {getattr(built, f.name)!r}, the "
-                                 f"model says {getattr(p, f.name)!r}", "mesh the model's own geometry")
-        return fm
-    tol = 1e-6 * max(width(p), p.column_height)
-    boxes = {**part_boxes(p, dim), "tank_wall": tank_box(p, dim)}
-    for name, box in boxes.items():
-        where = fm.regions.get(name) if name != "tank_wall" else None
-        if name == "tank_wall":
-            nodes = np.unique(fm.boundaries.get(name, np.zeros((0, dim), int)))
-        else:
-            nodes = np.unique(fm.cells[where]) if where is not None else np.zeros(0, int)
-        if nodes.size == 0:
-            raise InputError(f"mesh region {name}", "missing from the mesh", "mesh the model's own geometry")
-        lo, hi = fm.points[nodes].min(axis=0), fm.points[nodes].max(axis=0)
-        want = np.array(box[:2 * dim]).reshape(dim, 2)
-        if not (np.allclose(lo, want[:, 0], atol=tol) and np.allclose(hi, want[:, 1], atol=tol)):
-            raise InputError(f"mesh region {name}", f"spans {np.round(lo, 6).tolist()}..{np.round(hi, 6).tolist()} m, "
-                             f"the model's geometry puts it at {want[:, 0].tolist()}..{want[:, 1].tolist()} m",
-                             "mesh the model's own geometry")
-    return fm
+    def static(self) -> dict[Key, float]:
+        """The outputs of a prescribed-temperature problem: one elastic solve."""
+        p = self.problem
+        out: dict[Key, float] = {}
+        T = prescribed_at(self, np.array([pr.xyz for pr in p.probes]).T) if p.probes else []
+        for pr, Tp in zip(p.probes, T):
+            if "T" in pr.quantities:  # on a region's side where the prescribed temperature jumps
+                out[("T", pr.name)] = float(p.prescribed_regions.get(pr.region, Tp))
+        if self.elastic is None:
+            return out
+        u = self.elastic.from_load(_prescribed_load(self))
+        for pr in p.probes:
+            if "u" in pr.quantities:
+                for c in range(self.dim):
+                    out[("u", pr.name, AXES[c])] = float(self.elastic.point_functional(pr.xyz, c) @ u)
+            if "sigma" in pr.quantities:
+                rec = _probe_recovery(self, pr.region)
+                comps = rec.field(u, rec.thermal_rhs(np.ones(1)))
+                phi = rec.at(pr.xyz)
+                out.update({("sigma", pr.name, c): float(phi @ v) for c, v in comps.items()})
+        for r in p.relative:
+            a, b = (next(x for x in p.probes if x.name == n).xyz for n in (r.a, r.b))
+            out[("relative", r.name)] = float((self.elastic.point_functional(a, r.axis)
+                                               - self.elastic.point_functional(b, r.axis)) @ u)
+        return out
 
 
-def build_model(cfg: ModelConfig, dim: int, fmesh: FrameMesh | None = None) -> FrameModel:
-    """Mesh (unless ``fmesh`` is given, which must be a mesh of ``cfg.frame``) and assemble the frame model."""
+def static_fields(model: Model) -> dict[str, np.ndarray]:
+    """Nodal temperature (°C), displacement (m, 3 components) and stress (Pa) of a
+    prescribed-temperature problem (the temperature interpolated at the nodes)."""
+    X = model.fmesh.points.T
+    out = {"T": prescribed_at(model, X)}
+    if model.elastic is not None:
+        u_dofs = model.elastic.from_load(_prescribed_load(model))
+        u = np.zeros((X.shape[1], 3))
+        u[:, :model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
+        out["u"] = u
+        out.update({f"sigma_{k}" if k != "von_mises" else k: v for k, v in model.stress_field(u_dofs).items()})
+    return out
+
+
+def prescribed_at(model: Model, X: np.ndarray) -> np.ndarray:
+    """The prescribed temperature (°C) at points ``X`` (dim, n)."""
+    p = model.problem
+    if p.prescribed is not None:
+        return np.broadcast_to(p.prescribed(dict(zip("xyz", X))), X.shape[1:]).astype(float)
+    cells = model.mesh.element_finder()(*X)
+    regions = {int(e): r for r, els in model.mesh.subdomains.items() for e in els}
+    return np.array([p.prescribed_regions.get(regions.get(int(c)), 0.0) for c in cells])
+
+
+def _prescribed_rise(model: Model):
+    """``basis -> prescribed rise above T_ref`` at the basis's quadrature points."""
+    p = model.problem
+
+    def at(basis):
+        if p.prescribed is not None:
+            X = basis.global_coordinates().value
+            return np.broadcast_to(p.prescribed(dict(zip("xyz", X))), X.shape[1:]) - p.T_ref
+        per = Field.by_region(model.mesh, p.prescribed_regions, np.nan)
+        return per.at(basis) - p.T_ref
+    return at
+
+
+def _prescribed_load(model: Model) -> np.ndarray:
+    el, f = model.elastic, model.fields
+    vb = CellBasis(model.mesh, el.basis.elem, intorder=2 * model.problem.order)
+    b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim, model.problem.plane)[2]
+    return asm(thermal_load_at, vb, b=Field(b).at(vb), t=f["thickness"].at(vb), T=_prescribed_rise(model)(vb))
+
+
+def _recovery_for(model: Model, elements) -> Recovery:
+    p = model.problem
+    T_elem = model.heat.basis.elem if model.heat is not None else None
+    T_at = None if model.heat is not None else _prescribed_rise(model)
+    return recovery(model.mesh, p.order, model.fields, model.dim, p.plane, T_elem, elements, T_at, model.simplices)
+
+
+def _probe_recovery(model: Model, region: str | None) -> Recovery:
+    return _recovery_for(model, None if region is None else model.mesh.subdomains[region])
+
+
+def field_recovery(model: Model) -> Recovery:
+    """The stress projection over the whole mesh (set up once, used for every field state)."""
+    return _recovery_for(model, None)
+
+
+def _readout(model: Model) -> Readout:
+    """Sparse rows (temperatures) and adjoint weight rows (mechanics) of every output."""
+    p, heat, el = model.problem, model.heat, model.elastic
+    keys, rows = [], []
+    probes = [pr for pr in p.probes if "T" in pr.quantities]
+    if probes:
+        P = heat.basis.probes(np.array([pr.xyz for pr in probes]).T).tocsr()
+        keys += [("T", pr.name) for pr in probes]
+        rows.append(sp.hstack([P, sp.csr_matrix((len(probes), heat.n - heat.n_solid))]))
+    for name, index in heat.lumped.items():
+        keys.append(("fluid", name))
+        rows.append(sp.csr_matrix(([1.0], ([0], [index])), shape=(1, heat.n)))
+    for name, boundary in p.means:
+        keys.append(("mean", name))
+        w = boundary_mean(model.mesh, heat.basis, boundary, model.fields["thickness"])
+        rows.append(sp.csr_matrix(np.r_[w, np.zeros(heat.n - heat.n_solid)][None, :]))
+    L = sp.vstack(rows).tocsr() if rows else sp.csr_matrix((0, heat.n))
+    n_L = len(keys)
+    G, GT = [], []
+    if el is not None:
+        xyz = {pr.name: pr.xyz for pr in p.probes}
+        for r in p.relative:
+            keys.append(("relative", r.name))
+            G.append(el.point_functional(xyz[r.a], r.axis) - el.point_functional(xyz[r.b], r.axis))
+            GT.append(None)
+        for pr in p.probes:
+            if "u" in pr.quantities:
+                for c in range(model.dim):
+                    keys.append(("u", pr.name, AXES[c]))
+                    G.append(el.point_functional(pr.xyz, c))
+                    GT.append(None)
+            if "sigma" in pr.quantities:
+                for c, (gu, gT) in _probe_recovery(model, pr.region).point(pr.xyz).items():
+                    keys.append(("sigma", pr.name, c))
+                    G.append(gu)
+                    GT.append(gT)
+    W = el.weights(np.array(G)) if G else np.zeros((0, heat.n_solid))
+    for i, gT in enumerate(GT):
+        if gT is not None:
+            W[i] += gT
+    return Readout(tuple(keys), L, W, n_L)
+
+
+def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float = 0.0) -> Model:
+    """Assemble ``problem`` on ``fmesh``."""
     clock = [time.perf_counter()]
-    timings = {}
+    timings = {"mesh": mesh_seconds}
 
     def lap(name):
         now = time.perf_counter()
         timings[name] = now - clock[0]
         clock[0] = now
 
-    fm = build_mesh(cfg.frame, dim, cfg.mesh) if fmesh is None else check_mesh(fmesh, cfg.frame, dim)
-    lap("mesh")
-    mesh = to_skfem(fm)
-    f = region_fields(cfg, fm, mesh)
-    src = f["source"] if cfg.source else None
-    heat = assemble_heat(mesh, cfg.order, f["k"], f["rho_c"], f["thickness"], cfg.thermal,
-                         oil_volume(cfg.frame, dim), source=src)
+    mesh = to_skfem(fmesh)
+    f = region_fields(problem, mesh)
+    s = p1.simplices(mesh) if problem.order == 1 else None
+    heat = assemble_heat(mesh, problem, f, simplices=s) if problem.heat else None
     lap("heat_assembly")
-    el = assemble_elastic(mesh, cfg.order, heat.basis, f["E"], f["nu"], f["alpha"],
-                          f["thickness"], cfg.k_base)
+    el = None
+    if problem.elastic:
+        T_basis = heat.basis if heat is not None else dof_basis(mesh, element(problem.dim, problem.order))
+        el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
+                              problem.supports, problem.plane, simplices=s)
     lap("elastic_setup")
-    names = tuple(fm.sensors)
-    xyz = np.array([fm.points[fm.sensors[n]] for n in names]).T
-    probe = heat.basis.probes(xyz).tocsr()
-    gx = {s: el.point_functional(fm.points[fm.sensors[s]], 0) for s in ("F_L", "F_R", "E_L", "E_R")}
-    weights = {k: el.weights(gx[a] - gx[b]) for k, (a, b) in OUTPUTS.items()}
+    model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s)
+    if heat is not None:
+        model = Model(problem, fmesh, mesh, f, heat, el, _readout(model), config, timings, s)
     lap("adjoint_solves")
-    means = {}
-    for key, bnd in (("wall", "tank_wall"), ("base", "mounting_face")):
-        fb = FacetBasis(mesh, heat.basis.elem, facets=mesh.boundaries[bnd])
-        a = asm(film_load, fb, h=1.0, t=f["thickness"].at(fb))
-        means[key] = a / a.sum()
-    return FrameModel(cfg, fm, mesh, heat, el, names, probe, weights, means, timings)
+    return model

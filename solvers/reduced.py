@@ -18,12 +18,12 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from skfem import CellBasis, LinearForm, asm
-from skfem.helpers import div
+from skfem import CellBasis, asm
 
-from gatetherm.solvers.elasticity import moduli
+from gatetherm.solvers.elasticity import moduli, thermal_load_at
 from gatetherm.solvers.fem import Field
-from gatetherm.solvers.model import FrameModel, is_tie, region_fields
+from gatetherm.solvers.frame import is_tie
+from gatetherm.solvers.model import Model
 
 
 @dataclass(frozen=True)
@@ -36,49 +36,37 @@ class Coefficients:
     Kc_F: float
 
 
-@LinearForm
-def _thermal_rhs(v, w):
-    return w.t * w.b * w.T * div(v)
-
-
-def region_load(model: FrameModel, temperature: Callable[[np.ndarray], np.ndarray],
+def region_load(model: Model, temperature: Callable[[np.ndarray], np.ndarray],
                 regions) -> np.ndarray:
     """Elastic load vector (N) of the temperature rise ``temperature(x)`` (K, x the
     quadrature-point coordinates ``(dim, elements, points)``) acting on ``regions`` only."""
     vb = CellBasis(model.mesh, model.elastic.basis.elem, intorder=4)
-    f = region_fields(model.config, model.fmesh, model.mesh)
-    b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim)[2]
+    f = model.fields
+    b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim, model.problem.plane)[2]
     on = Field.by_region(model.mesh, {r: 1.0 for r in regions}, 0.0).at(vb)
     T = on * temperature(vb.mapping.F(vb.X))
-    return asm(_thermal_rhs, vb, b=Field(b).at(vb), t=f["thickness"].at(vb), T=T)
+    return asm(thermal_load_at, vb, b=Field(b).at(vb), t=f["thickness"].at(vb), T=T)
 
 
-def _read(model: FrameModel, u: np.ndarray, a: str, b: str) -> float:
+def _read(model: Model, u: np.ndarray, a: str, b: str) -> float:
     pts = model.fmesh.points
     g = (model.elastic.point_functional(pts[model.fmesh.sensors[a]], 0)
          - model.elastic.point_functional(pts[model.fmesh.sensors[b]], 0))
     return float(g @ u)
 
 
-def _displacement(model: FrameModel, load: np.ndarray) -> np.ndarray:
-    el = model.elastic
-    u = np.zeros(el.basis.N)
-    u[el.free] = el.solve(load[el.free])
-    return u
-
-
-def tip_coefficients_um(model: FrameModel) -> tuple[float, float]:
+def tip_coefficients_um(model: Model) -> tuple[float, float]:
     """(K_i, K_C) of ``model`` from the two load cases, read at the tips F, um/K."""
     c = fe_coefficients(model)
     return c.Ki_F * 1e6, c.Kc_F * 1e6
 
 
-def fe_coefficients(model: FrameModel) -> Coefficients:
+def fe_coefficients(model: Model) -> Coefficients:
     """K_i, K_C (m/K) of ``model`` from the two load cases."""
     p = model.config.frame
     ties = [r for r in model.fmesh.regions if is_tie(r)]
-    ua = _displacement(model, region_load(model, lambda X: (0.5 - X[0] / p.h) * (X[1] <= p.l1),
+    ua = model.elastic.from_load(region_load(model, lambda X: (0.5 - X[0] / p.h) * (X[1] <= p.l1),
                                           ["column_L"]))
-    ub = _displacement(model, region_load(model, lambda X: np.ones(X.shape[1:]), ties))
+    ub = model.elastic.from_load(region_load(model, lambda X: np.ones(X.shape[1:]), ties))
     return Coefficients(_read(model, ua, "E_L", "E_R"), -_read(model, ub, "E_L", "E_R"),
                         _read(model, ua, "F_L", "F_R"), -_read(model, ub, "F_L", "F_R"))

@@ -6,7 +6,7 @@ import pytest
 
 from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.frame import FrameParams, MeshParams
-from gatetherm.solvers.model import ModelConfig
+from gatetherm.solvers.frame import ModelConfig
 
 COARSE = MeshParams(size=0.02, size_3d=0.02)
 """Mesh density of the shared frame fixtures (about 1.6k triangles / 24k tetrahedra)."""

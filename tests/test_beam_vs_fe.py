@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gatetherm.solvers import beam
-from gatetherm.solvers.model import build_model
+from gatetherm.solvers.frame import build_model
 from gatetherm.solvers.reduced import fe_coefficients
 from gatetherm.solvers.beam import theory_coefficients
 from gatetherm.studies.run.config import parse_config

@@ -15,7 +15,7 @@ import pytest
 from gatetherm.geometry.frame import MeshParams
 from gatetherm.studies.diagnosis.calibrate import Scored
 from gatetherm.studies.cli import main
-from gatetherm.solvers.model import build_model
+from gatetherm.solvers.frame import build_model
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config
 from gatetherm.studies.diagnosis.discrepancy import Settings, _verdict, adopted_config, diagnose

@@ -12,8 +12,8 @@ from gatetherm import InputError
 from gatetherm.solvers.effects import (CATALOGUE, ActiveEffects, apply_effects, catalogue_json, effects_from_table,
                              effects_table, first_order_lag, parse_effect)
 from gatetherm.solvers.fem import to_skfem
-from gatetherm.solvers.heat import Inputs
-from gatetherm.solvers.model import ModelConfig, build_model, region_fields
+from gatetherm.solvers.frame import AMBIENT, ModelConfig, build_model, frame_problem
+from gatetherm.solvers.model import region_fields
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config, parse_config
 from gatetherm.studies.run.simulate import run_model, sample_times
@@ -73,20 +73,23 @@ def test_observation_and_drive_effects():
     assert out["T_tank_oil_degC"] is cols["T_tank_oil_degC"]  # the tank oil is not a thermocouple
     assert 20.0 < out["theta_A_degC"][1] < 25.0
     drive = condition_drive(CONDITIONS[1], load_config().supply)
-    _, d2 = apply_effects(ModelConfig(), drive, ActiveEffects({"ambient_drift": 0.6}), 2)
-    assert d2(7200.0).T_amb == pytest.approx(drive(7200.0).T_amb + 1.2, abs=1e-12)
-    assert isinstance(d2(0.0), Inputs)
+    _, d2 = apply_effects(ModelConfig(), drive, ActiveEffects({"ambient_drift": 0.6}))
+    assert d2(7200.0)[AMBIENT] == pytest.approx(drive(7200.0)[AMBIENT] + 1.2, abs=1e-12)
+    assert set(d2(0.0)) == set(drive(0.0))
 
 
 def test_model_effects_map_to_model_fields(frame_2d):
     cfg = FIXED_MODEL
     eff = ActiveEffects({"joint_resistance": 500.0, "joint_compliance": 2e11, "compliant_base": 1e10,
                          "base_conduction": 100.0, "piezo_heat": 2.0})
-    m, _ = apply_effects(cfg, condition_drive(CONDITIONS[1], load_config().supply), eff, 2)
+    m, _ = apply_effects(cfg, condition_drive(CONDITIONS[1], load_config().supply), eff)
     assert (m.joint_conductance, m.joint_stiffness, m.k_base, m.thermal.h_base) == (500.0, 2e11, 1e10, 100.0)
-    assert set(m.source) == {"arm_R"}
-    f = region_fields(m, frame_2d, to_skfem(frame_2d))
+    assert m.power == {"arm_R": 2.0}
     mesh = to_skfem(frame_2d)
+    problem = frame_problem(m, frame_2d)
+    f = region_fields(problem, mesh)
+    src, = problem.sources  # 2 W over the arm's volume (0.19 x 0.06 x depth 0.12 m³ on the FIXED frame)
+    assert src.region == "arm_R" and src.density() == pytest.approx(2.0 / (0.19 * 0.06 * 0.12), rel=1e-12)
     L, E, k = cfg.frame.joint_layer, cfg.material.E, cfg.material.k
     joint = mesh.subdomains["tie_joint_L"]
     assert np.allclose(f["E"].values[joint], L / (L / E + 1 / 2e11))
@@ -113,7 +116,7 @@ def _detectability(conditions):
         for name in CATALOGUE:
             for v in _ends(name):
                 eff = ActiveEffects({name: v})
-                mcfg, drv = apply_effects(base_cfg, drive, eff, 2)
+                mcfg, drv = apply_effects(base_cfg, drive, eff)
                 model = model0 if mcfg == base_cfg else build_model(mcfg, 2, model0.fmesh)
                 cols = eff.observe(run_model(model, drv, times).columns)
                 dT = max(np.abs(cols[k] - base[k]).max() for k in ("theta_A_degC", "theta_B_degC", "theta_C_degC"))

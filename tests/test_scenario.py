@@ -10,7 +10,7 @@ import pytest
 
 from conftest import COARSE, FIXED, FIXED_MODEL
 from gatetherm import InputError
-from gatetherm.solvers.model import build_model
+from gatetherm.solvers.frame import build_model
 from gatetherm.studies.cli import main
 from gatetherm.studies.run.config import Config, config_toml, load_config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from gatetherm.geometry.frame import MeshParams
-from gatetherm.solvers.heat import Inputs, TimeScheme
-from gatetherm.solvers.model import ModelConfig, build_model
+from gatetherm.solvers.heat import TimeScheme
+from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY, ModelConfig, build_model
 from conftest import FIXED_MODEL
 from gatetherm.validation.verification import heat_mms_error, observed_order, spatial_study
 from gatetherm.validation.verification_time import (HarmonicDrive, energy_balance, slab_film_error, steady_state,
@@ -87,10 +87,10 @@ def test_slab_fourier(scheme, dt, tol):
 SOURCE = 2.0e4  # W/m³ in arm_L
 
 
-def _frame_drive(t: float) -> Inputs:
+def _frame_drive(t: float) -> dict[str, float]:
     """Pump on for the first 20 min of every 40, supply and room both varying."""
-    return Inputs(40.0 + 5.0 * np.sin(t / 900.0), (t // 1200.0) % 2 == 0,
-                  20.0 + 2.0 * np.sin(t / 1500.0))
+    return {SUPPLY: 40.0 + 5.0 * np.sin(t / 900.0), PUMP: float((t // 1200.0) % 2 == 0),
+            AMBIENT: 20.0 + 2.0 * np.sin(t / 1500.0)}
 
 
 @pytest.fixture(scope="module")
@@ -120,7 +120,7 @@ def test_frame_energy_balance(frame_model, theta):
     # 0.19 m x arm_thickness 0.06 m x depth 0.12 m = 1.368e-3 m³; 2e4 W/m³ for 10800 s = 295488 J
     assert e["source"].sum() == pytest.approx(295488.0, rel=1e-12)
     # both pump states occur: no supply while the pump is off
-    off = np.array([not _frame_drive(0.5 * (a + b)).pump for a, b in zip(times[:-1], times[1:])])
+    off = np.array([not _frame_drive(0.5 * (a + b))[PUMP] for a, b in zip(times[:-1], times[1:])])
     assert off.any() and not off.all()
     assert np.all(e["supply"][off] == 0.0) and np.all(e["supply"][~off] != 0.0)
     assert np.all(e["hose_lost"] > 0.0)  # the hose stays warmer than the room

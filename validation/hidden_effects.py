@@ -28,7 +28,6 @@ import logging
 import multiprocessing
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,6 +42,7 @@ from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
+from gatetherm.studies.sweeps.pool import worker_pool
 
 log = logging.getLogger(__name__)
 
@@ -307,7 +307,7 @@ def run_pool(worker, items, workers: int, on_row=None) -> list[dict]:
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
     rows = []
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    with worker_pool(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         for row in pool.map(worker, items):
             rows.append(row)
             if on_row:

@@ -19,6 +19,7 @@ from skfem import (CellBasis, ElementVector, FacetBasis, Functional, LinearForm,
 from skfem.helpers import dot
 
 from gatetherm.solvers.elasticity import assemble_elastic, moduli, stiffness, thermal_load
+from gatetherm.solvers.problem import Support
 from gatetherm.solvers.fem import Field, element
 from gatetherm.solvers.heat import capacity, conduction, film, film_load
 
@@ -237,7 +238,7 @@ def clamped_bar_tip(L: float = 0.4, h: float = 0.02, dT: float = 10.0, order: in
     Beam theory: uniform curvature α dT/h, tip ``−α dT L² / (2h)``."""
     m = rectangle(np.linspace(0.0, h, nx + 1), np.linspace(0.0, L, ny + 1), {"bottom": "mounting_face"})
     tb = CellBasis(m, element(2, order), intorder=2 * order)
-    el = assemble_elastic(m, order, tb, *uniform_fields(m, E, nu, alpha, 0.1))
+    el = assemble_elastic(m, order, tb, *uniform_fields(m, E, nu, alpha, 0.1), (Support("mounting_face", (0, 1)),))
     T = dT * (tb.doflocs[0] / h - 0.5)
     g = el.point_functional([0.5 * h, L], 0)
     return float(g @ el.displacement(T)), -alpha * dT * L ** 2 / (2 * h), float(el.weights(g) @ T)

@@ -11,9 +11,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 from scipy.optimize import brentq
-from scipy.sparse.linalg import spsolve
 
-from gatetherm.solvers.heat import HeatSystem, Inputs, ThermalParams, TimeScheme, assemble_heat, energy_step, march
+from gatetherm.solvers.expr import Value
+from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY, ThermalParams, paper_heat
+from gatetherm.solvers.heat import HeatSolver, HeatSystem, TimeScheme, assemble_heat, environment, march
+from gatetherm.solvers.problem import Film, Problem
 from gatetherm.validation.verification import uniform_fields, rectangle
 
 
@@ -32,9 +34,9 @@ class HarmonicDrive:
     def pump(self, t: float) -> bool:
         return bool(np.floor(t / self.period) % 2 == 0)
 
-    def __call__(self, t: float) -> Inputs:
+    def __call__(self, t: float) -> dict[str, float]:
         c = np.cos(self.omega * t)
-        return Inputs(self.sup0 + self.sup1 * c, self.pump(t), self.amb0 + self.amb1 * c)
+        return {SUPPLY: self.sup0 + self.sup1 * c, PUMP: float(self.pump(t)), AMBIENT: self.amb0 + self.amb1 * c}
 
 
 def unit_heat_system(n: int = 4, order: int = 1) -> HeatSystem:
@@ -47,13 +49,17 @@ def unit_heat_system(n: int = 4, order: int = 1) -> HeatSystem:
                          "right": "free_surface", "top": "free_surface"})
     p = ThermalParams(T0=20.0, h_air=1.0, h_base=0.5, h_oil_on=5.0, h_oil_off=1.0,
                       oil_rho_c=1.0, flow_rate=2.0, hose_capacity=0.25, hose_loss=0.5)
-    return assemble_heat(m, order, *uniform_fields(m, 1.0, 1.0, 1.0), p, oil_volume=0.5)
+    return _heat(m, Problem(2, {}, order, T0=p.T0, T_ref=p.T0, **paper_heat(p, oil_volume=0.5)), 1.0, 1.0)
+
+
+def _heat(mesh, problem: Problem, k: float, rho_c: float) -> HeatSystem:
+    fields = dict(zip(("k", "rho_c", "thickness"), uniform_fields(mesh, k, rho_c, 1.0)))
+    return assemble_heat(mesh, problem, fields)
 
 
 def steady_state(sys: HeatSystem, drive, t: float = 0.0) -> np.ndarray:
     """The state in equilibrium with the inputs frozen at time ``t``."""
-    pump = bool(drive(t).pump)
-    return spsolve(sys.K(pump).tocsc(), sys.f(t, drive, pump))
+    return HeatSolver(sys).steady(environment(drive, t))
 
 
 def exact_response(sys: HeatSystem, drive: HarmonicDrive, times: np.ndarray,
@@ -68,19 +74,18 @@ def exact_response(sys: HeatSystem, drive: HarmonicDrive, times: np.ndarray,
     ``y(t0) = φ⁻¹ U(t0)``.
     """
     M, w = sys.M.toarray(), drive.omega
-    inlet = np.zeros(sys.n)
-    inlet[sys.inlet] = 1.0
     modes = {}
     U = sys.initial() if U0 is None else np.array(U0, float)
     out = [U]
     for t0, t1 in zip(times[:-1], times[1:]):
         pump = drive.pump(0.5 * (t0 + t1))
         if pump not in modes:
-            lam, phi = scipy.linalg.eig(sys.K(pump).toarray(), M)
+            mode = (pump,)
+            lam, phi = scipy.linalg.eig(sys.K(mode).toarray(), M)
             lam, phi = lam.real, phi.real  # real: the hose feeds the symmetric solid-oil block one way
-            G = sys.coefficients(pump)[1]
-            a = sys.f_amb * drive.amb0 + sys.f_src + G * drive.sup0 * inlet
-            c = sys.f_amb * drive.amb1 + G * drive.sup1 * inlet
+            # f is affine in the inputs: f = a + c cos(ωt)
+            a = sys.f({SUPPLY: drive.sup0, AMBIENT: drive.amb0}, mode)
+            c = sys.f({SUPPLY: drive.sup1, AMBIENT: drive.amb1}, mode) - sys.f({SUPPLY: 0.0, AMBIENT: 0.0}, mode)
             inv = np.linalg.inv(phi)
             Minv = inv @ np.linalg.inv(M)
             modes[pump] = lam, phi, inv, Minv @ a, Minv @ c / (lam ** 2 + w ** 2)
@@ -127,10 +132,9 @@ def slab_film_error(order: int = 2, nx: int = 20, dt: float = 2.0, scheme: TimeS
     on at t = 0)."""
     T_i, T_amb = 20.0, 60.0
     m = rectangle(np.linspace(0.0, L, nx + 1), [0.0, L / 20], {
-        "left": "mounting_face", "right": "tank_wall", "top": "free_surface", "bottom": "free_surface"})
-    params = ThermalParams(T0=T_i, h_air=0.0, h_base=h, h_oil_on=0.0, h_oil_off=0.0, flow_rate=0.0)
-    sys = assemble_heat(m, order, *uniform_fields(m, k, rho_c, 1.0), params, oil_volume=1e-6)
-    drive = lambda t: Inputs(T_i, False, T_amb)  # noqa: E731
+        "left": "mounting_face", "right": "free_surface", "top": "free_surface", "bottom": "free_surface"})
+    sys = _heat(m, Problem(2, {}, order, T0=T_i, films=(Film("mounting_face", h, Value(T_amb)),)), k, rho_c)
+    drive = lambda t: {}  # noqa: E731
     times = np.arange(0.0, t_end + 0.5 * dt, dt)
     xi = (L - sys.basis.doflocs[0]) / L
     err = 0.0
@@ -141,27 +145,54 @@ def slab_film_error(order: int = 2, nx: int = 20, dt: float = 2.0, scheme: TimeS
     return err
 
 
+def energy_step(sys: HeatSystem, U0: np.ndarray, U1: np.ndarray, env0, env1, mode, theta: float = 1.0,
+                dt: float = 1.0) -> dict[str, float]:
+    """Heat (J) over one step of the solid: in through the fluid's wall, stored, lost to
+    the room and the foundation (films, faces) and added by sources, with the same
+    θ-weighting as the scheme, so that ``wall + source = stored + lost`` holds to round-off."""
+    Um = theta * U1 + (1 - theta) * U0
+    solid = np.zeros(sys.n)
+    solid[:sys.n_solid] = 1.0
+    p, = sys.pumped
+    h = p.coefficients(mode[0])[0]
+
+    def loads(kinds):
+        return sum(float(solid @ ld.vector) * (theta * ld.value(env1) + (1 - theta) * ld.value(env0))
+                   for ld in sys.loads if ld.kind in kinds)
+
+    return {"wall": -dt * h * float(solid @ (p.wall @ Um)),
+            "stored": float(solid @ (sys.M @ (U1 - U0))),
+            "lost": dt * (float(solid @ (sys.K0 @ Um)) - loads(("film", "faces"))),
+            "source": dt * loads(("source",))}
+
+
 def energy_balance(sys: HeatSystem, drive, times: np.ndarray, theta: float) -> dict[str, np.ndarray]:
     """Per-step heat (J) over a θ-method march without start-up grading: the terms of
-    :func:`solvers.heat.energy_step` (solid: ``wall + source = stored + lost``), the
-    oil's own account (``supply`` brought by the flow, ``supply = oil_stored + wall``)
-    and, with a hose, the hose's (``hose_in = hose_stored + hose_lost``; enthalpy flows
-    G (T_supply − T_hose) into the hose, G (T_hose − T_oil) into the tank)."""
+    :func:`energy_step` (solid: ``wall + source = stored + lost``), the oil's own account
+    (``supply`` brought by the flow, ``supply = oil_stored + wall``) and, with a hose, the
+    hose's (``hose_in = hose_stored + hose_lost``; enthalpy flows G (T_supply − T_hose) into
+    the hose, G (T_hose − T_oil) into the tank)."""
     states = list(march(sys, drive, times, TimeScheme(theta, restart=1)))
-    o, i = sys.oil, sys.inlet
+    p, = sys.pumped
+    o = sys.lumped["tank_oil"]
+    i = p.inlet
+    ua = next((ld.vector[i] for ld in sys.loads if ld.kind == "hose"), 0.0)
     out: dict[str, list[float]] = {}
     for (t0, U0), (t1, U1) in zip(states[:-1], states[1:]):
-        dt, G = t1 - t0, sys.coefficients(bool(drive(0.5 * (t0 + t1)).pump))[1]
+        dt = t1 - t0
+        env0, env1 = environment(drive, t0), environment(drive, t1)
+        mode = sys.mode(environment(drive, 0.5 * (t0 + t1)))
+        G = p.coefficients(mode[0])[1]
         Um = theta * U1 + (1 - theta) * U0
-        u = {k: theta * getattr(drive(t1), k) + (1 - theta) * getattr(drive(t0), k) for k in ("T_supply", "T_amb")}
-        terms = {**energy_step(sys, U0, U1, t0, t1, drive, theta),
+        u = {k: theta * env1[k] + (1 - theta) * env0[k] for k in (SUPPLY, AMBIENT)}
+        terms = {**energy_step(sys, U0, U1, env0, env1, mode, theta, dt),
                  "oil_stored": sys.M[o, o] * (U1[o] - U0[o])}
         if i == o:
-            terms["supply"] = dt * G * (u["T_supply"] - Um[o])
+            terms["supply"] = dt * G * (u[SUPPLY] - Um[o])
         else:
             terms["supply"] = dt * G * (Um[i] - Um[o])
-            terms["hose_in"] = dt * G * (u["T_supply"] - Um[i])
-            terms["hose_lost"] = dt * sys.params.hose_loss * (Um[i] - u["T_amb"])
+            terms["hose_in"] = dt * G * (u[SUPPLY] - Um[i])
+            terms["hose_lost"] = dt * ua * (Um[i] - u[AMBIENT])
             terms["hose_stored"] = sys.M[i, i] * (U1[i] - U0[i])
         for key, v in terms.items():
             out.setdefault(key, []).append(float(v))

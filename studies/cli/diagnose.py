@@ -13,13 +13,16 @@ import argparse
 import dataclasses
 import json
 import logging
-import math
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.studies.cli.options import add_model_options
+from gatetherm.checks import POSITIVE
+from gatetherm.studies.cli.options import add_model_options, number
 
 log = logging.getLogger(__name__)
+
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "report.md", "diagnosis.json")
 
 DIM_HELP = ("2 only: the diagnosis replays the 2-D section model. Given a 3-D measurement it also sees the "
             "2-D/3-D model-form difference (README, 'Discrepancy diagnosis': a no-effect 3-D run gives a "
@@ -41,7 +44,7 @@ def register(sub) -> None:
     p.add_argument("--parameters", metavar="NAME,...",
                    help="candidate existing parameters (default: all; 'none': no parameter)")
     p.add_argument("--no-sensors", action="store_true", help="do not try sensor faults")
-    p.add_argument("--mesh-size", type=float, metavar="M",
+    p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M",
                    help="element size of the diagnosis mesh, m (default: the model file's)")
     p.add_argument("--list-effects", action="store_true",
                    help="list the hypotheses (effects, parameters, sensor faults) and exit")
@@ -91,22 +94,17 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")
     if not args.data or not args.out:
         raise InputError("--data/--out", "both are required", "e.g. gatetherm diagnose --data run.csv --out diag")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError("--out", f"{out} exists and is not a directory", "give a directory path")
+    from gatetherm.outdir import output_dir
     from gatetherm.studies.diagnosis.discrepancy import adopted_config, diagnose
     from gatetherm.studies.run.timeseries import read_timeseries
 
     settings = settings_from(args)
     cfg = load_config(args.config)
-    mesh = cfg.model.mesh
-    if args.mesh_size is not None:
-        if not (math.isfinite(args.mesh_size) and args.mesh_size > 0):
-            raise InputError("--mesh-size", f"must be a positive size in m, got {args.mesh_size}", "e.g. 0.012")
-        mesh = dataclasses.replace(mesh, size=args.mesh_size)
+    mesh = cfg.model.mesh if args.mesh_size is None else dataclasses.replace(cfg.model.mesh, size=args.mesh_size)
     ts = read_timeseries(args.data)
-    diag = diagnose(cfg, ts, args.dim, mesh, settings)
-    _write(args, cfg, diag, adopted_config(cfg, diag), out)
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data)) as out:
+        diag = diagnose(cfg, ts, args.dim, mesh, settings)
+        _write(args, cfg, diag, adopted_config(cfg, diag), out)
     s = diag.summary()
     print(f"verdict: {diag.verdict}")
     for r in diag.pieces:

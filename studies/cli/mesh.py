@@ -1,29 +1,38 @@
-"""``gatetherm mesh``: build the frame mesh and write it as .msh and .vtu."""
+"""``gatetherm mesh``: build the frame mesh, write it as .msh and .vtu, and the frame as a
+case file (``case.toml`` with ``schedule.csv``: a paper condition) that ``gatetherm run``
+runs and a user can copy."""
 from __future__ import annotations
-
-from pathlib import Path
 
 from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.mesh import save_mesh
 from gatetherm.studies.cli.options import add_model_options
 
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("mesh.msh", "mesh.vtu", "case.toml", "schedule.csv")
+
 
 def register(sub) -> None:
-    p = sub.add_parser("mesh", help="mesh the frame; write DIR/mesh.msh and DIR/mesh.vtu")
+    p = sub.add_parser("mesh", help="mesh the frame; write DIR/mesh.msh, mesh.vtu and the frame as DIR/case.toml")
     add_model_options(p)
+    p.add_argument("--condition", type=int, default=1, metavar="N",
+                   help="the paper's condition written as the case's schedule.csv (default 1)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    from gatetherm.outdir import output_dir
     from gatetherm.studies.run.config import load_config
+    from gatetherm.studies.run.frame_case import write_frame_case
 
-    cfg = load_config(args.config).model
-    fm = build_mesh(cfg.frame, args.dim, cfg.mesh)
-    out = Path(args.out)
-    for name in ("mesh.msh", "mesh.vtu"):
-        save_mesh(fm, out / name)
-        print(f"wrote {out / name}")
+    cfg = load_config(args.config)
+    with output_dir(args.out, OUTPUTS, keep=(args.config,)) as out:
+        fm = build_mesh(cfg.model.frame, args.dim, cfg.model.mesh)
+        for name in OUTPUTS[:2]:
+            save_mesh(fm, out / name)
+            print(f"wrote {out / name}")
+        write_frame_case(cfg, fm, args.condition, out)
+    print(f"wrote {out / 'case.toml'} and {out / 'schedule.csv'} (the frame as a case: gatetherm run {out / 'case.toml'})")
     c = fm.counts()
     print(f"{args.dim}-D frame: {c['nodes']} nodes, {c['elements']} elements")
     print(f"regions ({len(fm.regions)}): " + ", ".join(f"{k}={len(v)}" for k, v in fm.regions.items()))

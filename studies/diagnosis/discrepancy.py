@@ -24,6 +24,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.solvers.effects import CATALOGUE
+from gatetherm.solvers.frame import PUMP, SUPPLY
 from gatetherm.studies.diagnosis.calibrate import Objective, Scored, uncertainty
 from gatetherm.studies.diagnosis.hypotheses import (PARAMETER_DEFS, Piece, configure, effect_pieces,
                                                     parameter_pieces, sensor_pieces)
@@ -196,7 +197,7 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     train = t <= settings.train_fraction * t[-1]
     if (~train).sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
-    run_phases = phases(t, rep.drive.oil, rep.drive.pump)
+    run_phases = phases(t, rep.drive.columns[SUPPLY], rep.drive.columns[PUMP])
     findings = locate(t, res0, run_phases)
     obj = Objective(rep, ts, channels, scale, train)
     discrepant = any(f.significant for f in findings)

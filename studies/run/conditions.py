@@ -13,11 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.solvers.heat import Drive, Inputs
+from gatetherm.checks import CELSIUS, POSITIVE, admissible
+from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
+from gatetherm.solvers.heat import Drive
 
 HOUR = 3600.0
 
 
+@admissible(T_room=CELSIUS, tau_heat=POSITIVE, tau_cool=POSITIVE)
 @dataclass(frozen=True)
 class SupplyParams:
     """The oil temperature controller feeding the tank."""
@@ -97,43 +100,46 @@ def pump_state(cond: Condition, t: float) -> bool:
 def condition_drive(cond: Condition, sp: SupplyParams) -> Drive:
     """The model input for a paper condition."""
 
-    def drive(t: float) -> Inputs:
-        return Inputs(float(supply_temperature(cond, sp, t)[0]), pump_state(cond, t), sp.T_room)
+    def drive(t: float) -> dict[str, float]:
+        return {SUPPLY: float(supply_temperature(cond, sp, t)[0]), PUMP: float(pump_state(cond, t)),
+                AMBIENT: sp.T_room}
 
     return drive
 
 
 @dataclass(frozen=True)
 class TableDrive:
-    """Inputs from a recorded schedule: oil and ambient interpolated linearly
-    (missing samples skipped), pump held from the last sample."""
+    """Inputs from a recorded schedule: every column interpolated linearly, except the
+    ``held`` ones (pump states), which keep their last sample."""
 
     time: np.ndarray
-    oil: np.ndarray
-    pump: np.ndarray
-    ambient: np.ndarray
+    columns: dict[str, np.ndarray]
+    """Gap-free values by input name."""
+    held: frozenset[str] = frozenset({PUMP})
 
-    def __call__(self, t: float) -> Inputs:
+    def __call__(self, t: float) -> dict[str, float]:
         i = max(int(np.searchsorted(self.time, t, side="right")) - 1, 0)
-        return Inputs(float(np.interp(t, self.time, self.oil)), bool(self.pump[i] > 0.5),
-                      float(np.interp(t, self.time, self.ambient)))
+        return {k: float(v[i] > 0.5) if k in self.held else float(np.interp(t, self.time, v))
+                for k, v in self.columns.items()}
+
+
+def filled(name: str, time: np.ndarray, v, hold: bool = False) -> np.ndarray:
+    """``v`` with its missing samples filled: linearly, or with the last known value (the
+    first known one before it) for a ``hold`` column."""
+    v = np.asarray(v, dtype=float)
+    ok = np.isfinite(v)
+    if not ok.any():
+        raise InputError(name, "has no values", "fill the column or leave it out")
+    if hold:
+        idx = np.maximum.accumulate(np.where(ok, np.arange(len(v)), 0))
+        return np.where(ok[idx], v[idx], v[ok][0])
+    return np.interp(time, time[ok], v[ok])
 
 
 def table_drive(time, oil, pump, ambient=None, T_room: float = 20.0) -> TableDrive:
-    """Build a :class:`TableDrive`, filling missing samples channel by channel;
-    without an ambient column the room stays at ``T_room`` (°C)."""
+    """The frame's :class:`TableDrive` from a schedule's columns, missing samples filled
+    channel by channel; without an ambient column the room stays at ``T_room`` (°C)."""
     time = np.asarray(time, dtype=float)
-
-    def filled(name, v, hold=False):
-        v = np.asarray(v, dtype=float)
-        ok = np.isfinite(v)
-        if not ok.any():
-            raise InputError(name, "has no values", "fill the column or leave it out")
-        if hold:  # last known value, the first known one before it
-            idx = np.maximum.accumulate(np.where(ok, np.arange(len(v)), 0))
-            v = np.where(ok[idx], v[idx], v[ok][0])
-            return v
-        return np.interp(time, time[ok], v[ok])
-
-    amb = np.full_like(time, T_room) if ambient is None else filled("ambient_degC", ambient)
-    return TableDrive(time, filled("oil_degC", oil), filled("pump", pump, hold=True), amb)
+    amb = np.full_like(time, T_room) if ambient is None else filled(AMBIENT, time, ambient)
+    return TableDrive(time, {SUPPLY: filled(SUPPLY, time, oil), PUMP: filled(PUMP, time, pump, hold=True),
+                             AMBIENT: amb})

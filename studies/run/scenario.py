@@ -1,10 +1,13 @@
 """The one scenario path: apply effects → build (or reuse) the model → run → observe
-(the catalogue's observation-side effects, then the sensor faults of ``Config.sensors``).
+(the catalogue's observation-side effects, then the model's sensor faults, ``sensors``).
 
 Every command and study runs a model through :func:`run_scenario` (or, when it needs
 the assembled model without a run, :func:`prepare`), so that the effects of a model
-file act the same everywhere. What drives a run is a :class:`Schedule`: a paper
-condition, a schedule file, or the inputs of a measured series.
+file act the same everywhere. The model is the paper's frame (a model file's
+:class:`~gatetherm.studies.run.config.Config`) or any frame of a case file
+(:class:`~gatetherm.studies.run.case.Case`). What drives a run is a :class:`Schedule`:
+a paper condition, a schedule file, the inputs of a measured series, or a case's time
+settings; a case without them is solved once, in steady state.
 """
 from __future__ import annotations
 
@@ -17,14 +20,17 @@ from typing import Callable, Mapping
 import numpy as np
 
 from gatetherm.geometry.mesh import FrameMesh
-from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects
-from gatetherm.solvers.heat import Drive, HeatSolver
+from gatetherm import InputError
+from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects, drive_effects
+from gatetherm.solvers.frame import ModelConfig, build_model
+from gatetherm.solvers.heat import Drive, HeatSolver, environment
+from gatetherm.solvers.model import Model, build
+from gatetherm.studies.run.case import Case
 from gatetherm.solvers.sensors import apply_faults
-from gatetherm.solvers.model import FrameModel, ModelConfig, build_model
-from gatetherm.studies.run.conditions import condition, condition_drive, table_drive
+from gatetherm.studies.run.conditions import TableDrive, condition, condition_drive, filled, table_drive
 from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.simulate import RunResult, run_model, sample_times
-from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, read_timeseries
+from gatetherm.studies.run.simulate import RunResult, output_columns, run_model, sample_times
+from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, check_steps, read_timeseries
 
 log = logging.getLogger(__name__)
 
@@ -41,6 +47,8 @@ class Schedule:
     """What the schedule is, for file metadata and reports."""
     condition: int | None = None
     """The paper's condition number, if it is one."""
+    every: int = 1
+    """Report every ``every``-th step (the output interval of a case whose step is smaller)."""
 
 
 def condition_schedule(number: int, cfg: Config, step_s: float = 60.0) -> Schedule:
@@ -57,10 +65,35 @@ def series_schedule(ts: TimeSeries, cfg: Config, label: str) -> Schedule:
     return Schedule(table_drive(t, ts["oil_degC"], ts["pump"], amb, cfg.supply.T_room), t, label)
 
 
+def case_schedule(case: Case) -> Schedule:
+    """The time steps of a case (one sample, t = 0, for a steady case) and its schedule
+    file's columns (linear between samples; the columns a fluid reads as its pump keep
+    their last sample)."""
+    t = case.time
+    if t is None:
+        return Schedule(lambda _: {}, np.zeros(1), "steady state")
+    times = np.linspace(0.0, t.end, int(round(t.end / t.step)) + 1)
+    if t.schedule is None:
+        return Schedule(lambda _: {}, times, "no schedule", every=int(round(t.output / t.step)))
+    ts = read_timeseries(t.schedule, required=("time_s",))
+    held = {n for f in case.problem.fluids for n in f.pump.names()}
+    time = np.asarray(ts.time_s - ts.time_s[0], float)
+    columns = {k: filled(k, time, ts[k], hold=k in held) for k in ts.names if k != "time_s"}
+    return Schedule(TableDrive(time, columns, frozenset(held)), times, f"schedule {t.schedule}",
+                    every=int(round(t.output / t.step)))
+
+
 def file_schedule(path, cfg: Config, step_s: float = 60.0) -> Schedule:
-    """A schedule file (data format, input columns), sampled every ``step_s`` over its length."""
-    s = series_schedule(read_timeseries(path, required=INPUT_COLUMNS), cfg, f"schedule {path}")
-    return Schedule(s.drive, sample_times(float(s.times[-1]), step_s), s.label)
+    """A schedule file (data format, input columns), sampled every ``step_s`` over its length
+    (at least one step, at most :data:`~gatetherm.studies.run.timeseries.MAX_STEPS`)."""
+    ts = read_timeseries(path, required=INPUT_COLUMNS)
+    span = float(ts.time_s[-1] - ts.time_s[0])
+    if span < step_s:
+        raise InputError(str(path), f"the schedule spans {span:g} s, less than one {step_s:g}-s step",
+                         "give at least two rows a step or more apart")
+    check_steps(span, step_s, f"{path}, column time_s")
+    s = series_schedule(ts, cfg, f"schedule {path}")
+    return Schedule(s.drive, sample_times(span, step_s), s.label)
 
 
 class ScenarioCache:
@@ -86,13 +119,13 @@ class ScenarioCache:
             store.popitem(last=False)
         return value
 
-    def model(self, cfg: ModelConfig, dim: int) -> tuple[FrameModel, HeatSolver]:
+    def model(self, cfg: ModelConfig | Case, dim: int) -> tuple[Model, HeatSolver | None]:
         def make():
-            model = build_model(cfg, dim, self.fmesh)
-            return model, HeatSolver(model.heat)
-        return self._lru(self._models, (repr(cfg), dim), make)
+            model = build(cfg.problem, cfg.mesh) if isinstance(cfg, Case) else build_model(cfg, dim, self.fmesh)
+            return model, HeatSolver(model.heat) if model.heat is not None else None
+        return self._lru(self._models, (repr(cfg.problem if isinstance(cfg, Case) else cfg), dim), make)
 
-    def result(self, key, make: Callable[[], tuple[RunResult, FrameModel]]) -> tuple[RunResult, FrameModel]:
+    def result(self, key, make: Callable[[], tuple[RunResult, Model]]) -> tuple[RunResult, Model]:
         def counted():
             self.runs += 1
             return make()
@@ -103,7 +136,7 @@ class ScenarioCache:
 class Prepared:
     """A model ready to run: effects applied and assembled."""
 
-    model: FrameModel
+    model: Model
     solver: HeatSolver
     drive: Drive
     """The schedule's drive with the drive-side effects applied."""
@@ -111,17 +144,42 @@ class Prepared:
     """The model file's effects, then the caller's."""
 
 
-def prepare(config: Config, dim: int, drive: Drive, effects: Mapping[str, float] | None = None, *,
+def prepare(config: Config | Case, dim: int, drive: Drive, effects: Mapping[str, float] | None = None, *,
             cache: ScenarioCache | None = None, mesh: FrameMesh | None = None) -> Prepared:
     """Apply the effects of ``config`` and ``effects`` (these win) and build or reuse the model."""
     eff = ActiveEffects({**config.effects, **dict(effects or {})})
-    model_cfg, drive = apply_effects(config.model, drive, eff, dim)
-    if cache is not None:
-        model, solver = cache.model(model_cfg, dim)
+    if isinstance(config, Case):
+        frame_only = [k for k in eff.values if CATALOGUE[k].acts_on == "model"]
+        if frame_only:
+            raise InputError("--effect", f"{frame_only[0]} acts on the paper frame's model, not on a case file",
+                             "model it in the case (materials, supports, sources) instead")
+        model_cfg, drive = config, drive_effects(drive, eff)
+        if cache is None:
+            model = build(config.problem, config.mesh)
+            return Prepared(model, HeatSolver(model.heat) if model.heat is not None else None, drive, eff)
     else:
-        model = build_model(model_cfg, dim, mesh)
-        solver = HeatSolver(model.heat)
+        model_cfg, drive = apply_effects(config.model, drive, eff)
+        if cache is None:
+            model = build_model(model_cfg, dim, mesh)
+            return Prepared(model, HeatSolver(model.heat), drive, eff)
+    model, solver = cache.model(model_cfg, dim)
     return Prepared(model, solver, drive, eff)
+
+
+def _once(p: Prepared, schedule: Schedule) -> RunResult:
+    """A prescribed-temperature or steady problem: the outputs of its one state at t = 0."""
+    t0 = time.perf_counter()
+    model = p.model
+    if model.heat is None:
+        values, state = model.static(), None
+        keys = tuple(values)
+        Y = np.array([[values[k] for k in keys]])
+    else:
+        state = p.solver.steady(environment(p.drive, 0.0))
+        keys, Y = model.readout.keys, model.read(state)[None, :]
+    cols = {"time_s": np.zeros(1), **{k: np.array([v]) for k, v in p.drive(0.0).items()}}
+    cols.update(output_columns(model.problem, keys, Y))
+    return RunResult(cols, [(0.0, state)], time.perf_counter() - t0)
 
 
 @dataclass(frozen=True)
@@ -132,7 +190,7 @@ class ScenarioRun:
     """What the sensors report, in the data format (observation-side effects applied)."""
     result: RunResult
     """The model's own columns, kept states and march time."""
-    model: FrameModel
+    model: Model
     effects: ActiveEffects
     schedule: Schedule
     seconds: float
@@ -142,27 +200,34 @@ class ScenarioRun:
         return TimeSeries(self.columns, metadata)
 
 
-def run_scenario(config: Config, dim: int, schedule: Schedule, effects: Mapping[str, float] | None = None, *,
+def run_scenario(config: Config | Case, dim: int, schedule: Schedule, effects: Mapping[str, float] | None = None, *,
                  cache: ScenarioCache | None = None, mesh: FrameMesh | None = None, keep_times=(),
                  on_step: Callable[[int, int], None] | None = None, U0: np.ndarray | None = None) -> ScenarioRun:
     """Run ``config`` (its model and its effects, plus ``effects``) in ``dim`` dimensions
     through ``schedule``; keep full states at ``keep_times``. With a ``cache`` the model,
     its factorisations and (for a plain run from the initial state) the run itself are reused."""
     t0 = time.perf_counter()
+    eff = ActiveEffects({**config.effects, **dict(effects or {})})
+
+    def run(p: Prepared) -> RunResult:
+        if p.model.heat is None or len(schedule.times) == 1:
+            return _once(p, schedule)
+        return run_model(p.model, p.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver)
+
     if cache is not None and U0 is None and not keep_times:
-        eff = ActiveEffects({**config.effects, **dict(effects or {})})
-        model_cfg, _ = apply_effects(config.model, schedule.drive, eff, dim)
+        what = config.problem if isinstance(config, Case) else apply_effects(config.model, schedule.drive, eff)[0]
         drive_side = tuple(sorted((k, v) for k, v in eff.values.items() if CATALOGUE[k].acts_on == "drive"))
-        key = (repr(model_cfg), dim, drive_side, schedule.label, schedule.times.tobytes())
+        key = (repr(what), dim, drive_side, schedule.label, schedule.times.tobytes())
 
-        def run() -> tuple[RunResult, FrameModel]:
+        def make() -> tuple[RunResult, Model]:
             p = prepare(config, dim, schedule.drive, effects, cache=cache)
-            return run_model(p.model, p.drive, schedule.times, (), on_step, solver=p.solver), p.model
+            return run(p), p.model
 
-        result, model = cache.result(key, run)  # a kept run is observed again without building the model
+        result, model = cache.result(key, make)  # a kept run is observed again without building the model
     else:
         p = prepare(config, dim, schedule.drive, effects, cache=cache, mesh=mesh)
-        eff, model = p.effects, p.model
-        result = run_model(p.model, p.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver)
-    columns = apply_faults(eff.observe(result.columns), config.sensors)
-    return ScenarioRun(columns, result, model, eff, schedule, time.perf_counter() - t0)
+        result, model = run(p), p.model
+    cols = apply_faults(eff.observe(result.columns), config.sensors)
+    if schedule.every > 1:
+        cols = {k: v[::schedule.every] for k, v in cols.items()}
+    return ScenarioRun(cols, result, model, eff, schedule, time.perf_counter() - t0)

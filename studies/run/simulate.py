@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, march
-from gatetherm.solvers.model import FrameModel
+from gatetherm.solvers.model import Model
+from gatetherm.solvers.problem import Problem
+from gatetherm.solvers.stress import von_mises
 
 log = logging.getLogger(__name__)
 
@@ -37,50 +38,114 @@ def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
     return np.linspace(0.0, n * step_s, n + 1)
 
 
-def run_model(model: FrameModel, drive: Drive, times: np.ndarray, keep_times=(),
+def column(problem: Problem, key) -> tuple[str, float]:
+    """Data-format column name of an output and the factor from SI units to the column's:
+    temperatures °C, displacements µm, stresses MPa. θ_A, θ_B and δ carry their
+    data-format names when the problem's signals map them."""
+    s, kind, name = problem.signals, key[0], key[1]
+    if kind == "T":
+        return {s.theta_A: "theta_A_degC", s.theta_B: "theta_B_degC"}.get(name, f"T_{name}_degC"), 1.0
+    if kind == "relative":
+        return ("delta_um" if name == s.delta else f"{name}_um"), 1e6
+    if kind == "u":
+        return f"u{key[2]}_{name}_um", 1e6
+    if kind == "sigma":
+        return f"sigma_{key[2]}_{name}_MPa", 1e-6
+    return f"T_{name}_degC", 1.0
+
+
+def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarray]:
+    """Data-format columns of the outputs ``Y`` (samples × ``keys``, SI units), by
+    :func:`column`: the signals θ_A, θ_B, θ_C (the mean of its probes) and δ first, then
+    the other relative displacements, temperatures, displacements, stresses and von
+    Mises at probes, fluids and boundary means."""
+    Y = np.atleast_2d(Y)
+    at = {k: Y[:, i] for i, k in enumerate(keys)}
+    s = problem.signals
+
+    def put(out, key):
+        name, scale = column(problem, key)
+        out[name] = at[key] * scale
+
+    out: dict[str, np.ndarray] = {}
+    for probe in (s.theta_A, s.theta_B):
+        if probe:
+            put(out, ("T", probe))
+    if s.theta_C:
+        out["theta_C_degC"] = np.mean([at[("T", c)] for c in s.theta_C], axis=0)
+    order = [k for k in keys if k[0] == "relative"]
+    order.sort(key=lambda k: k[1] != s.delta)
+    for pr in problem.probes:
+        order += [k for k in keys if k[1] == pr.name and k[0] in ("T", "u", "sigma")
+                  and not (k[0] == "T" and pr.name in (s.theta_A, s.theta_B))]
+    for key in order:
+        put(out, key)
+        if key[0] == "sigma" and key == [k for k in keys if k[:2] == key[:2]][-1]:
+            out[f"von_mises_{key[1]}_MPa"] = von_mises({k[2]: at[k] / 1e6 for k in keys if k[:2] == key[:2]})
+    for key in keys:
+        if key[0] in ("fluid", "mean"):
+            put(out, key)
+    return out
+
+
+def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
               U0: np.ndarray | None = None, solver: HeatSolver | None = None) -> RunResult:
     """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0)
-    with ``scheme`` (default: the model's); keep full states at ``keep_times``. A
-    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs."""
+    with ``scheme`` (default: the problem's); keep full states at ``keep_times``. A
+    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs.
+    Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
-    rows, states = [], []
+    inputs, Y, states = [], [], []
     t0 = _time.perf_counter()
-    scheme = model.config.scheme if scheme is None else scheme
+    scheme = model.problem.scheme if scheme is None else scheme
+    if model.elastic is not None:  # outputs come from adjoint weights: room for the heat factors
+        model.elastic.solve.release()
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
-        u = drive(t)
-        temps = model.temperatures(U)
-        disp = model.displacements(U)
-        rows.append((t, u.T_supply, float(u.pump), u.T_amb, temps, disp))
+        inputs.append({"time_s": t, **drive(t)})
+        Y.append(model.read(U))
         if t in keep:
             states.append((t, U.copy()))
         if on_step:
             on_step(i + 1, len(times))
-    cols: dict[str, np.ndarray] = {
-        "time_s": np.array([r[0] for r in rows]),
-        "oil_degC": np.array([r[1] for r in rows]),
-        "pump": np.array([r[2] for r in rows]),
-        "ambient_degC": np.array([r[3] for r in rows]),
-        "theta_A_degC": np.array([r[4]["A"] for r in rows]),
-        "theta_B_degC": np.array([r[4]["B"] for r in rows]),
-        "theta_C_degC": np.array([r[4]["C"] for r in rows]),
-        "delta_um": np.array([r[5]["delta"] for r in rows]) * 1e6,
-    }
-    cols["delta_E_um"] = np.array([r[5]["delta_E"] for r in rows]) * 1e6
-    for name in list(rows[0][4]):
-        if name not in ("A", "B", "C"):
-            cols[f"T_{'tank_' if name in ('oil', 'wall') else ''}{name}_degC"] = np.array([r[4][name] for r in rows])
+    cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
+    cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
     secs = _time.perf_counter() - t0
-    log.info("marched %d steps in %.2f s", len(rows) - 1, secs)
+    log.info("marched %d steps in %.2f s", len(Y) - 1, secs)
     return RunResult(cols, states, secs)
+
+
+def prominent_peaks(x: np.ndarray, prominence: float) -> list[int]:
+    """Indices of the local maxima of ``x`` (a plateau: its middle, rounded down; not the
+    ends) whose prominence is at least ``prominence``, as ``scipy.signal.find_peaks``
+    finds them (``tests/test_peaks.py`` compares), without its 2 s of imports."""
+    n, out, i = len(x), [], 1
+    while i < n - 1:
+        if x[i - 1] < x[i]:
+            ahead = i + 1
+            while ahead < n - 1 and x[ahead] == x[i]:
+                ahead += 1
+            if x[ahead] < x[i]:
+                peak = (i + ahead - 1) // 2
+                lowest = []
+                for step in (-1, 1):  # the lowest point on each side before a higher one
+                    j, low = peak, x[peak]
+                    while 0 <= j < n and x[j] <= x[peak]:
+                        low = min(low, x[j])
+                        j += step
+                    lowest.append(low)
+                if x[peak] - max(lowest) >= prominence:
+                    out.append(peak)
+                i = ahead
+        i += 1
+    return out
 
 
 def delta_figures(time_s: np.ndarray, delta_um: np.ndarray) -> dict[str, float | None]:
     """The paper's figures of a δ history: first and second positive peak (µm)
     and time of the first (min), full swing (µm)."""
-    peaks, _ = find_peaks(np.concatenate([[-np.inf], delta_um, [-np.inf]]),
-                          prominence=PEAK_PROMINENCE_UM)
+    peaks = prominent_peaks(np.concatenate([[-np.inf], delta_um, [-np.inf]]), PEAK_PROMINENCE_UM)
     peaks = [p - 1 for p in peaks if delta_um[p - 1] > 0]
     first = peaks[0] if peaks else None
     return {

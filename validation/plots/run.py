@@ -79,10 +79,16 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     p.close()
 
 
-def plot_run(run, figs: dict, out, title: str) -> None:
+def picture_time(figs: dict) -> float:
+    """When ``deformed.png`` of :func:`plot_run` shows the frame (s): the first peak of δ, else 1 h."""
+    return (figs["first_peak_min"] or 60.0) * 60.0
+
+
+def plot_run(run, figs: dict, out, title: str, solved: dict | None = None) -> None:
     """``oil_temperatures.png`` (Fig. 10), ``response.png`` (Figs. 11–13) and ``deformed.png``
-    (at the first peak of δ, else at 1 h) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`
-    whose kept states include that time."""
+    (at :func:`picture_time`) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`
+    whose kept states include that time; ``solved``: displacements of kept states, by time,
+    if solved already."""
     from pathlib import Path
 
     from gatetherm.studies.run.output import deformed_grid
@@ -90,7 +96,43 @@ def plot_run(run, figs: dict, out, title: str) -> None:
     out = Path(out)
     plot_oil(run.columns, out / "oil_temperatures.png", title)
     plot_response(run.columns, out / "response.png", title)
-    t, grid = deformed_grid(run, (figs["first_peak_min"] or 60.0) * 60.0)
+    t, grid = deformed_grid(run, picture_time(figs), solved)
     umax = float(np.abs(grid["u"]).max()) or 1.0
     scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
     render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 60:.0f} min", scale)
+
+
+def plot_channels(cols: dict, path, title: str) -> None:
+    """Every temperature (°C) and displacement (µm) column of a run against time."""
+    t = cols["time_s"] / 3600.0
+    temps = [k for k in cols if k.endswith("_degC")]
+    disp = [k for k in cols if k.endswith("_um")]
+    fig, axes = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    for ax, keys, label in ((axes[0], temps, "temperature [°C]"), (axes[1], disp, "displacement [µm]")):
+        for k in keys:
+            ax.plot(t, cols[k], label=k)
+        ax.set(ylabel=label)
+        ax.grid(alpha=0.3)
+        if keys:
+            ax.legend(fontsize="small", ncol=2)
+    axes[0].set_title(title)
+    axes[1].set(xlabel="time [h]")
+    save(fig, path, tight=False)
+
+
+def plot_case(run, out, title: str, solved: dict | None = None) -> None:
+    """``channels.png`` (transient runs) and ``deformed.png`` (the last state, when the case
+    has elasticity) of a case run; ``solved`` as for :func:`plot_run`."""
+    from pathlib import Path
+
+    from gatetherm.studies.run.output import deformed_grid
+
+    out = Path(out)
+    if len(run.columns["time_s"]) > 1:
+        plot_channels(run.columns, out / "channels.png", title)
+    if run.model.elastic is None:
+        return
+    t, grid = deformed_grid(run, float(run.columns["time_s"][-1]), solved)
+    umax = float(np.abs(grid["u"]).max()) or 1.0
+    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
+    render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 3600:.3g} h", scale)

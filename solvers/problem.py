@@ -1,0 +1,195 @@
+"""What a thermoelastic problem on a named mesh is: materials per region, thermal
+conditions per boundary, lumped fluid volumes, supports, probes. Everything refers to
+the mesh's regions, boundaries and points by name; values that vary in time are
+:class:`~gatetherm.solvers.expr.Value` expressions of the run's inputs.
+
+A case file (``gatetherm run``) is read into a :class:`Problem`; the paper's frame is
+one too (:func:`gatetherm.solvers.frame.frame_problem`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from gatetherm.solvers.expr import Value
+from gatetherm.solvers.heat import TimeScheme
+from gatetherm.solvers.material import Material
+
+AXES = "xyz"
+
+
+@dataclass(frozen=True)
+class Film:
+    """Convection from a boundary to an ambient: ``q = h (T − ambient)``."""
+
+    boundary: str
+    h: float
+    """Film coefficient, W/(m² K)."""
+    ambient: Value
+    """Ambient temperature, °C."""
+
+
+@dataclass(frozen=True)
+class FixedTemperature:
+    """A boundary held at a temperature."""
+
+    boundary: str
+    value: Value
+    """Temperature, °C."""
+
+
+@dataclass(frozen=True)
+class Flux:
+    """A heat flux into the solid through a boundary."""
+
+    boundary: str
+    value: Value
+    """Heat flux density into the solid, W/m²."""
+
+
+@dataclass(frozen=True)
+class Source:
+    """A volumetric heat source in a region."""
+
+    region: str
+    density: Value
+    """Power density, W/m³."""
+
+
+@dataclass(frozen=True)
+class FaceFilm:
+    """2-D only: convection from the front and back faces of the section (both faces, per
+    unit of section area) to an ambient."""
+
+    h: float
+    """Film coefficient of each face, W/(m² K)."""
+    ambient: Value
+    """Ambient temperature, °C."""
+
+
+@dataclass(frozen=True)
+class Fluid:
+    """A lumped, well-mixed fluid volume wetting a boundary (an oil tank), fed through an
+    optional supply hose (one more lump) while its pump runs."""
+
+    name: str
+    """Its temperature is reported as ``T_<name>_degC``."""
+    boundary: str
+    """The wetted boundary."""
+    capacity: float
+    """Heat capacity of the fluid in the volume, J/K."""
+    film_on: float
+    """Wall film coefficient while the pump runs, W/(m² K)."""
+    film_off: float
+    """Wall film coefficient of standing fluid, W/(m² K)."""
+    conductance: float
+    """Enthalpy flow of the supply while the pump runs, ρc·Q, W/K."""
+    supply: Value
+    """Temperature of the supplied fluid, °C."""
+    pump: Value
+    """Pump state: on where > 0.5."""
+    hose_capacity: float = 0.0
+    """Heat capacity of the supply hose and its fluid, J/K (0: no hose)."""
+    hose_loss: float = 0.0
+    """Heat loss of the hose to the ambient, W/K."""
+    ambient: Value = Value(0.0)
+    """Ambient of the hose, °C."""
+    hose_name: str = ""
+    """Name of the hose temperature in the outputs (default ``<name>_hose``)."""
+
+
+@dataclass(frozen=True)
+class Support:
+    """Displacement components of a boundary held at zero, or an elastic foundation."""
+
+    boundary: str
+    components: tuple[int, ...]
+    """Displacement components (0 = x, 1 = y, 2 = z) concerned."""
+    stiffness: float | None = None
+    """Foundation stiffness per unit area, N/m³ (None: the components are fixed)."""
+
+
+@dataclass(frozen=True)
+class Probe:
+    """A named point and what is reported there."""
+
+    name: str
+    xyz: tuple[float, ...]
+    """Coordinates, m."""
+    quantities: tuple[str, ...] = ("T",)
+    """Any of "T" (temperature), "u" (displacement components), "sigma" (stress components
+    and von Mises)."""
+    region: str | None = None
+    """Recover the stress from this region's elements only (None: all)."""
+
+
+@dataclass(frozen=True)
+class Relative:
+    """The displacement of probe ``a`` minus that of probe ``b`` along an axis."""
+
+    name: str
+    a: str
+    b: str
+    axis: int
+    """0 = x, 1 = y, 2 = z."""
+
+
+@dataclass(frozen=True)
+class Signals:
+    """Which outputs are the data format's θ_A, θ_B, θ_C and δ (compensate, diagnose)."""
+
+    theta_A: str | None = None
+    """Probe of θ_A."""
+    theta_B: str | None = None
+    """Probe of θ_B."""
+    theta_C: tuple[str, ...] = ()
+    """Probes whose mean is θ_C."""
+    delta: str | None = None
+    """Relative displacement that is δ."""
+
+    @property
+    def complete(self) -> bool:
+        return bool(self.theta_A and self.theta_B and self.theta_C and self.delta)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A thermoelastic problem on a mesh with named groups."""
+
+    dim: int
+    materials: dict[str, Material]
+    """Material of every region, by region name."""
+    order: int = 1
+    """Polynomial degree of temperature and displacement (1 or 2)."""
+    thickness: dict[str, float] = field(default_factory=dict)
+    """2-D: out-of-plane thickness by region, m (default 1)."""
+    plane: str = "stress"
+    """2-D: "stress" or "strain"."""
+    T0: float = 20.0
+    """Initial temperature of solid and fluids, °C."""
+    T_ref: float = 20.0
+    """Stress-free temperature, °C."""
+    films: tuple[Film, ...] = ()
+    fixed: tuple[FixedTemperature, ...] = ()
+    fluxes: tuple[Flux, ...] = ()
+    sources: tuple[Source, ...] = ()
+    faces: FaceFilm | None = None
+    fluids: tuple[Fluid, ...] = ()
+    supports: tuple[Support, ...] = ()
+    probes: tuple[Probe, ...] = ()
+    relative: tuple[Relative, ...] = ()
+    means: tuple[tuple[str, str], ...] = ()
+    """(name, boundary): the area-mean temperature of a boundary, reported as ``T_<name>_degC``."""
+    signals: Signals = Signals()
+    prescribed: Value | None = None
+    """A temperature field (°C, an expression of x, y, z) instead of a heat solve."""
+    prescribed_regions: dict[str, float] = field(default_factory=dict)
+    """A temperature per region (°C) instead of a heat solve (may jump between regions)."""
+    elastic: bool = True
+    """Solve the thermoelastic problem (needs E, ν, α of every region and supports)."""
+    scheme: TimeScheme = TimeScheme()
+    """Time stepping of a transient heat solve."""
+
+    @property
+    def heat(self) -> bool:
+        """The temperature is solved for (not prescribed)."""
+        return self.prescribed is None and not self.prescribed_regions

@@ -1,0 +1,195 @@
+"""Stress recovery: the thermoelastic stress projected (L2) onto the continuous Lagrange
+space of the displacement's degree, over all elements or over one region (a stress
+that jumps between regions, as at a heated spot, is read from one side).
+
+A projected component at a point is linear in the displacement and the temperature
+rise, ``σ_c(p) = g_u·u + g_T·ΔT``; :class:`Recovery` gives those vectors, so a stress
+probe costs what a displacement probe costs. Von Mises is computed from the components.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import BilinearForm, CellBasis, LinearForm, asm
+from skfem.helpers import div, sym_grad
+
+from gatetherm.solvers.elasticity import moduli
+from gatetherm.solvers.fem import Field, dof_basis, element
+
+COMPONENTS = {(2, "stress"): ("xx", "yy", "xy"), (2, "strain"): ("xx", "yy", "zz", "xy"),
+              (3, "stress"): ("xx", "yy", "zz", "xy", "yz", "xz"), (3, "strain"): ("xx", "yy", "zz", "xy", "yz", "xz")}
+"""Stress components reported, by (dimension, 2-D plane kind)."""
+_INDEX = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "xz": (0, 2)}
+
+
+@BilinearForm
+def mass(u, v, w):
+    return u * v
+
+
+@BilinearForm
+def stress_of_u(u, v, w):
+    """Trial: displacement; test: scalar. Component ``(w.i, w.j)`` of ``λ tr ε I + 2 μ ε``."""
+    i, j = w.i, w.j
+    s = 2.0 * w.mu * sym_grad(u)[i][j] if i < w.dim and j < w.dim else 0.0 * div(u)
+    return (s + w.lam * div(u)) * v if i == j else s * v
+
+
+@BilinearForm
+def stress_of_T(T, v, w):
+    """Trial: temperature rise; test: scalar. The thermal part ``−b ΔT`` of a normal component."""
+    return -w.b * T * v
+
+
+@LinearForm
+def stress_of_T_at(v, w):
+    """The thermal part of a normal component for a rise ``w.T`` given at the quadrature points."""
+    return -w.b * w.T * v
+
+
+def von_mises(s: dict[str, np.ndarray]) -> np.ndarray:
+    """Von Mises stress from components (missing ones are zero)."""
+    g = {k: np.asarray(s.get(k, 0.0)) for k in _INDEX}
+    return np.sqrt(0.5 * ((g["xx"] - g["yy"]) ** 2 + (g["yy"] - g["zz"]) ** 2 + (g["zz"] - g["xx"]) ** 2)
+                   + 3.0 * (g["xy"] ** 2 + g["yz"] ** 2 + g["xz"] ** 2))
+
+
+@dataclass
+class Recovery:
+    """L2 projection of the stress onto the scalar space ``scalar`` restricted to the
+    elements ``elements`` (all when None). Set up once per region; holds a factor."""
+
+    scalar: CellBasis
+    """Scalar Lagrange basis of the displacement's degree on the region."""
+    full: CellBasis
+    """The same on the whole mesh (same DOF numbers), to evaluate at points."""
+    active: np.ndarray
+    """Its DOFs touched by the region."""
+    lu: object
+    """Factor of the region's mass matrix on the active DOFs."""
+    S: dict[str, sp.csr_matrix]
+    """Per component: the projection's right-hand side per unit displacement."""
+    Q: dict[str, sp.csr_matrix]
+    """Per normal component: the right-hand side per unit nodal temperature rise."""
+    components: tuple[str, ...]
+
+    def at(self, xyz) -> np.ndarray:
+        """Row φ with φ·s = the value at ``xyz`` of a field ``s`` on :attr:`scalar`."""
+        return self.full.probes(np.asarray(xyz, float).reshape(-1, 1)).toarray().ravel()
+
+    def _z(self, xyz) -> np.ndarray:
+        phi = self.at(xyz)
+        z = np.zeros(self.scalar.N)
+        z[self.active] = self.lu.solve(phi[self.active])
+        return z
+
+    def point(self, xyz) -> dict[str, tuple[np.ndarray, np.ndarray | None]]:
+        """Per component at ``xyz``: ``(g_u, g_T)`` with ``σ = g_u·u + g_T·ΔT`` (g_T None
+        for shear components)."""
+        z = self._z(xyz)
+        return {c: (self.S[c].T @ z, self.Q[c].T @ z if c in self.Q else None) for c in self.components}
+
+    def field(self, u: np.ndarray, rhs_T: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Projected components (on ``scalar``) for displacement ``u`` and the thermal
+        right-hand sides ``rhs_T`` (per normal component, see :meth:`thermal_rhs`)."""
+        b = np.column_stack([(self.S[c] @ u + rhs_T.get(c, 0.0))[self.active] for c in self.components])
+        s = np.zeros((self.scalar.N, len(self.components)))
+        s[self.active] = self.lu.solve(b).reshape(b.shape)  # every component in one solve
+        return dict(zip(self.components, s.T))
+
+    def thermal_rhs(self, dT: np.ndarray) -> dict[str, np.ndarray]:
+        """The thermal right-hand sides for a nodal temperature rise."""
+        return {c: Q @ dT for c, Q in self.Q.items()}
+
+
+def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T_elem,
+             elements: np.ndarray | None = None, T_at=None, simplices=None) -> Recovery:
+    """Set up the projection on ``elements`` (all if None). ``T_elem`` is the element of
+    the nodal temperature rise; when the rise is prescribed instead, ``T_elem`` is None and
+    ``T_at(basis)`` gives it at a basis's quadrature points: ``Q`` then holds one column,
+    the thermal right-hand side itself (``thermal_rhs(np.ones(1))``). ``simplices``: the
+    mesh's :class:`~gatetherm.solvers.p1.Simplices`, if found already (linear elements)."""
+    from skfem import ElementVector
+
+    q = 2 * order
+    comps = COMPONENTS[(dim, plane)]
+    normal = [c for c in comps if c[0] == c[1] and not (dim == 2 and plane == "stress" and c == "zz")]
+    lam_e, mu_e, b_e = moduli(fields["E"].values, fields["nu"].values, fields["alpha"].values, dim, plane)
+    if order == 1:
+        return _p1_recovery(mesh, dim, comps, normal, lam_e, mu_e, b_e, elements, T_at, simplices)
+    kw = {"intorder": q} if elements is None else {"intorder": q, "elements": elements}
+    sb = CellBasis(mesh, element(dim, order), **kw)
+    ub = CellBasis(mesh, ElementVector(element(dim, order)), **kw)
+    lam, mu, b = (Field(v).at(sb) for v in (lam_e, mu_e, b_e))
+    M = asm(mass, sb).tocsr()
+    active = np.unique(sb.element_dofs)
+    S = {c: asm(stress_of_u, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr()
+         for c in comps}
+    if T_elem is not None:
+        tb = CellBasis(mesh, T_elem, **kw)
+        Q = {c: asm(stress_of_T, tb, sb, b=b).tocsr() for c in normal}
+    else:
+        Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=b, T=T_at(sb))[:, None]) for c in normal}
+    full = sb if elements is None else CellBasis(mesh, element(dim, order), intorder=q)
+    return Recovery(sb, full, active, _factor(M[active][:, active]), S, Q, comps)
+
+
+def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simplices) -> Recovery:
+    """:func:`recovery` for linear elements, vectorised (solvers/p1.py): the element stress
+    is constant, so ``∫ σ_c(φ_jb) ψ_i = vol σ_c(φ_jb) / (d+1)`` and the thermal part is the
+    mass matrix times ``−b``."""
+    from gatetherm.solvers import p1
+    from gatetherm.solvers.linsolve import restrict_order
+
+    if elements is None:
+        s = simplices or p1.simplices(mesh)
+        cells, G, vol, pattern = mesh.t.T, s.G, s.vol, s.pattern
+        active = np.arange(mesh.nvertices)
+        order = s.order
+    else:
+        cells = mesh.t.T[elements]
+        G, vol = p1.gradients(mesh.p.T, cells)
+        lam, mu, b = lam[elements], mu[elements], b[elements]
+        pattern, active, order = p1.Pattern(cells, mesh.nvertices), np.unique(cells), None
+    k = dim + 1
+    M = pattern.scalar(p1.mass(G, vol, np.ones(len(vol))))[active][:, active]
+    order = None if order is None else restrict_order(order, active, mesh.nvertices)
+
+    def s_entry(i, j):  # σ_ij of the trial function of node (last axis), component b, per element
+        def entry(_, bb):
+            s = mu[:, None] * ((j == bb) * G[:, :, i] + (i == bb) * G[:, :, j]) if i < dim and j < dim else 0.0
+            s = s + (lam[:, None] * G[:, :, bb] if i == j else 0.0)
+            return np.broadcast_to((vol / k)[:, None, None] * s[:, None, :], (len(vol), k, k))
+        return entry
+
+    S = {c: pattern.blocks(s_entry(*_INDEX[c]), 1, dim) for c in comps}
+    if T_at is None:
+        Q = {c: pattern.scalar(p1.mass(G, vol, -b)) for c in normal}
+    else:
+        from skfem import CellBasis as _CB
+
+        sb = _CB(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))
+        Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=Field(b_full(b, elements, mesh)).at(sb),
+                                  T=T_at(sb))[:, None]) for c in normal}
+    full = dof_basis(mesh, element(dim, 1))
+    return Recovery(full, full, active, _factor(M, order), S, Q, comps)
+
+
+def _factor(M: sp.spmatrix, order: np.ndarray | None = None):
+    """The mass matrix's factor as an object with ``solve`` (sparse Cholesky, METIS order)."""
+    from types import SimpleNamespace
+
+    from gatetherm.solvers.linsolve import nd_order, spd_factor
+
+    return SimpleNamespace(solve=spd_factor(M, nd_order(M) if order is None else order)[0])
+
+
+def b_full(b_sel: np.ndarray, elements, mesh) -> np.ndarray:
+    """An element field given on ``elements`` as a field on all elements (0 elsewhere)."""
+    if elements is None:
+        return b_sel
+    out = np.zeros(mesh.nelements)
+    out[elements] = b_sel
+    return out

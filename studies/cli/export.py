@@ -1,0 +1,70 @@
+"""``gatetherm export ccx``: a thermoelastic state as a CalculiX input deck, to check
+gatetherm against an independent FE code."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from gatetherm import InputError, write_text_atomic
+from gatetherm.studies.cli.options import add_model_options
+
+#: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
+OUTPUTS = ("job.inp", "gatetherm.json")
+
+
+def register(sub) -> None:
+    p = sub.add_parser("export", help="export a state for another code (ccx: CalculiX input deck)",
+                       description="Write DIR/job.inp for CalculiX 2.20 (mesh, materials, supports, the temperature "
+                       "field at one time, a static step, *NODE PRINT of U at every probe; run 'ccx job' in DIR) "
+                       "and DIR/gatetherm.json with gatetherm's own displacements at the probes.")
+    p.add_argument("format", choices=("ccx",), help="ccx: CalculiX")
+    p.add_argument("case", nargs="?", metavar="CASE.toml", help="a case file (else the paper's frame, --condition)")
+    p.add_argument("--condition", type=int, metavar="N", help="the paper's condition N (with --time)")
+    p.add_argument("--time", type=float, metavar="MIN", help="time of the state, minutes (transient runs)")
+    add_model_options(p)
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from gatetherm.studies.run.scenario import case_schedule, condition_schedule, run_scenario
+
+    if (args.case is None) == (args.condition is None):
+        raise InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
+    if args.case:
+        from gatetherm.studies.run.case import load_case
+
+        cfg = load_case(args.case)
+        schedule, dim, what = case_schedule(cfg), cfg.mesh.dim, str(args.case)
+    else:
+        from gatetherm.studies.run.config import load_config
+
+        cfg = load_config(args.config)
+        schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
+    t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
+    if not any(abs(t - s) < 1e-6 for s in schedule.times):
+        raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
+    from gatetherm.outdir import output_dir
+
+    with output_dir(args.out, OUTPUTS, keep=(args.case, args.config)) as out:
+        run_ = run_scenario(cfg, dim, schedule, keep_times=[t])
+        (_, U), = [s for s in run_.result.states if abs(s[0] - t) < 1e-6]
+        _write(out, run_.model, U, f"gatetherm {what}, t = {t / 60:g} min", t, args)
+    return 0
+
+
+def _write(out: Path, model, U, title: str, t: float, args) -> None:
+    from gatetherm.studies.run.ccx import job_inp, probe_set
+
+    write_text_atomic(out / "job.inp", job_inp(model, U, title))
+    u = {}
+    if U is not None:
+        values = dict(zip(model.readout.keys, model.read(U)))
+        u = {k[1]: v for k, v in values.items() if k[0] == "relative"}
+    probes = {pr.name: probe_set(pr.name) for pr in model.problem.probes}
+    rel = {r.name: {"a": probes[r.a], "b": probes[r.b], "axis": r.axis} for r in model.problem.relative}
+    write_text_atomic(out / "gatetherm.json", json.dumps(
+        {"title": title, "time_s": t, "relative_m": u, "relative": rel, "probe_sets": probes}, indent=2) + "\n")
+    print(f"wrote {args.out}/job.inp ({len(model.fmesh.points)} vertices) and gatetherm.json; run: cd {args.out} && ccx job")
+    for name, v in u.items():
+        print(f"gatetherm {name}: {v * 1e6:.6g} um")
