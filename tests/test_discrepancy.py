@@ -25,7 +25,8 @@ from gatetherm.studies.diagnosis.locate import Phase, locate, noise_sd, phases, 
 from gatetherm.studies.run.config import config_toml
 from gatetherm.studies.run.simulate import run_model
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels, residuals
-from gatetherm.studies.run.timeseries import write_timeseries
+from gatetherm.studies.run.scenario import condition_schedule, run_scenario, series_schedule
+from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.hidden_effects import Case, measured, truth
 
 COARSE = MeshParams(size=0.02)
@@ -142,6 +143,28 @@ def test_list_effects_json(capsys):
     offsets = [d for d in listed if d["name"] == "sensor_offset"]
     assert {d["channel"] for d in offsets} == {"theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um"}
     assert main(["diagnose", "--data", "x.csv"]) == 2
+
+
+def test_diagnose_in_3d(tmp_path):
+    """``--dim 3`` replays the 3-D solid: a file made by the 3-D model from the file's own inputs
+    is no discrepancy in 3-D (one model run), while the 2-D section model sees a significant residual."""
+    cfg = load_config()
+    cfg = dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, mesh=dataclasses.replace(
+        cfg.model.mesh, size_3d=0.03)))
+    inputs = run_scenario(cfg, 3, condition_schedule(1, cfg, 300.0)).series({})
+    cols = run_scenario(cfg, 3, series_schedule(inputs, cfg, "inputs")).columns
+    data = tmp_path / "run3d.csv"
+    write_timeseries(data, TimeSeries({c: cols[c] for c in ("time_s", "oil_degC", "pump", "theta_A_degC",
+                                                            "theta_B_degC", "theta_C_degC", "delta_um")}, {}))
+    assert main(["diagnose", "--data", str(data), "--out", str(tmp_path / "d3"), "--dim", "3",
+                 "--mesh-size", "0.03"]) == 0
+    s = json.loads((tmp_path / "d3" / "diagnosis.json").read_text())
+    assert (s["verdict"], s["dim"], s["model_runs"]) == ("no-discrepancy", 3, 1)
+    assert "3-D FE" in (tmp_path / "d3" / "report.md").read_text()
+    assert main(["diagnose", "--data", str(data), "--out", str(tmp_path / "d2"), "--effects", "none",
+                 "--parameters", "none", "--no-sensors"]) == 0
+    s = json.loads((tmp_path / "d2" / "diagnosis.json").read_text())
+    assert (s["verdict"], s["dim"], s["pieces"], s["best_rejected"]) == ("unexplained", 2, [], None)
 
 
 @pytest.mark.slow

@@ -132,11 +132,11 @@ def run_hidden(args) -> int:
 
 
 def _compound_arguments(p) -> None:
-    p.add_argument("--workers", type=int, default=2, metavar="N", help="worker processes (default 2)")
+    p.add_argument("--workers", type=number(WORKERS), default=2, metavar="N", help="worker processes (default 2)")
     p.add_argument("--seed", type=int, default=14, help="seed of the pairs, strengths and noise (default 14)")
-    p.add_argument("--pairs", type=int, default=48, metavar="N", help="two-piece cases (default 48)")
+    p.add_argument("--pairs", type=number(Range(1, whole=True)), default=48, metavar="N", help="two-piece cases (default 48)")
     p.add_argument("--no-single", action="store_true", help="skip the single-piece cases of the hidden-effect study")
-    p.add_argument("--mesh-size", type=float, metavar="M", help="diagnosis element size, m (default: the model's)")
+    p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M", help="diagnosis element size, m (default: the model's)")
 
 
 def run_compound(args) -> int:

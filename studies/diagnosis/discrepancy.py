@@ -109,6 +109,8 @@ class Diagnosis:
     has_ambient: bool = False
     """The file recorded the room temperature (the model was driven by it)."""
     margin_min: float = Settings.margin_min
+    dim: int = 2
+    """Dimension of the replayed model."""
 
     @property
     def named_effects(self) -> list[str]:
@@ -143,7 +145,7 @@ class Diagnosis:
             "channels": list(self.channels), "noise_scale": self.scale, "train_end_s": self.train_end_s,
             "significant": [f.sentence() for f in self.findings if f.significant],
             "remaining": [f.sentence() for f in self.remaining if f.significant],
-            "model_runs": self.runs, "wall_time_s": round(self.seconds, 1),
+            "model_runs": self.runs, "wall_time_s": round(self.seconds, 1), "dim": self.dim,
         }
 
 
@@ -215,7 +217,7 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, sel.final, tuple(sel.rounds),
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
                      tuple(locate(t, after, run_phases)) if after else (), res0, after, rep.runs,
-                     time.perf_counter() - t0, rep.has_ambient, settings.margin_min)
+                     time.perf_counter() - t0, rep.has_ambient, settings.margin_min, dim)
 
 
 def adopted_config(config: Config, diag: Diagnosis) -> Config | None:

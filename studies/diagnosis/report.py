@@ -46,7 +46,7 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     """``files``: {"residuals", "scores", "before_after", "model"} → file names written (if any)."""
     t = d.time_s
     L = [f"# Discrepancy diagnosis: {data}", "",
-         f"Model: `{model}`, 2-D FE, {d.runs} model runs, {d.seconds:.0f} s. "
+         f"Model: `{model}`, {d.dim}-D FE, {d.runs} model runs, {d.seconds:.0f} s. "
          f"Channels compared: {', '.join(label(c) for c in d.channels)} ({len(t)} samples, "
          f"{clock(t[0])}–{clock(t[-1])}). Training window {clock(t[0])}–{clock(d.train_end_s)}, "
          f"held out {clock(d.train_end_s)}–{clock(t[-1])}.", "",
