@@ -25,9 +25,10 @@ log = logging.getLogger(__name__)
 OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "report.md", "diagnosis.json")
 
 DIM_HELP = ("2-D section (default) or 3-D solid. A 3-D diagnosis replays the 3-D model for every hypothesis "
-            "(about 100 runs of 30-50 s each at the default 3-D mesh: over an hour). A 2-D diagnosis of a 3-D "
-            "measurement also sees the 2-D/3-D model-form difference (README, 'Compound diagnosis': a no-effect 3-D "
-            "run comes out partly-explained, by pieces that make the section model fit, not faults of the machine)")
+            "(about 100 runs of about 50 s each at the default 3-D mesh, README 'Speed': over an hour). A 2-D diagnosis of a 3-D "
+            "measurement also sees the 2-D/3-D model-form difference as a significant residual; the pieces it "
+            "names then make the section model fit, they are not faults of the machine (README, 'Discrepancy "
+            "diagnosis')")
 
 
 def register(sub) -> None:
