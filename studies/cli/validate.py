@@ -76,9 +76,9 @@ def run_paper(args) -> int:
 
 def run_compensation(args) -> int:
     from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.compensation_study import write_compensation_study
+    from gatetherm.validation.compensation_study import markdown, write_compensation_study
 
-    print(write_compensation_study(Path(args.out), load_config(args.config), args.dim), end="")
+    print(markdown(write_compensation_study(Path(args.out), load_config(args.config), args.dim)), end="")
     return 0
 
 
@@ -100,7 +100,8 @@ def run_hidden(args) -> int:
                                tuple(int(x) for x in args.conditions.split(",")), set(args.effects.split(",")),
                                args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
     for k, v in acc.items():
-        print(f"{k}: {v}")
+        if k != "rows":
+            print(f"{k}: {v}")
     return 0
 
 
