@@ -9,7 +9,8 @@ import sys
 from gatetherm import InputError
 
 #: Sub-command modules of this package, in ``--help`` order.
-COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose", "export")
+COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose", "export",
+                   "report")
 
 
 def build_parser() -> argparse.ArgumentParser:
