@@ -123,7 +123,8 @@ def compute(section: Section, scope: dict, stamp: dict, out: Path, workers: int)
     if final.exists():
         final.rename(old)
     work.rename(final)
-    shutil.rmtree(old, ignore_errors=True)
+    for stale in base.glob(f".{section.key}-*"):  # the old result and unfinished runs of other digests
+        shutil.rmtree(stale, ignore_errors=True)
     return res
 
 

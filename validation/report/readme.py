@@ -7,13 +7,15 @@ import re
 
 from gatetherm import InputError
 
-BLOCK = re.compile(r"(<!-- report:([\w-]+) -->\n)(.*?)(<!-- /report -->)", re.S)
+BLOCK = re.compile(r"^(<!-- report:([\w-]+) -->\n)(.*?)^(<!-- /report -->)$", re.S | re.M)
+START = re.compile(r"^<!-- report:[\w-]+ -->$", re.M)
+"""A block's first line (a marker quoted inside a line of text is not one)."""
 
 
 def blocks(text: str) -> list[str]:
     """Names of the generated blocks of a README text, in order."""
     names = [m.group(2) for m in BLOCK.finditer(text)]
-    if text.count("<!-- report:") != len(names):
+    if len(START.findall(text)) != len(names):
         raise InputError("README", "a <!-- report:NAME --> marker without its <!-- /report --> end",
                          "close every block with <!-- /report -->")
     return names

@@ -3,15 +3,15 @@ and β (Figs. 7-8 analogues: theory curves, FE markers), the error table per coe
 β, and the effective coefficients of the transient runs (``gatetherm validate beam``)."""
 from __future__ import annotations
 
+from gatetherm.validation.report.sections import paper_model
 from gatetherm.validation.report.result import Figure, Result, from_dicts
 
 
 def compute(ctx) -> Result:
-    from gatetherm.studies.run.config import load_config
     from gatetherm.validation.beam_study import write_beam_study
 
     s = ctx.scope
-    out = write_beam_study(ctx.work, load_config(), s["dim"], ctx.workers, a_every=s["a_every"], series=s["series"])
+    out = write_beam_study(ctx.work, paper_model(), s["dim"], ctx.workers, a_every=s["a_every"], series=s["series"])
     figures = [Figure("fig7_Ki.png", "Fig. 7 analogue: K_i / (3αl²/8h) against l/l4, beam theory (lines) and FE "
                       "(markers) for five β, l1 = l/2, with the tank cavity"),
                Figure("fig8_Kc.png", "Fig. 8 analogue: K_C / (α l_C) against l/l4, beam theory (lines) and FE "

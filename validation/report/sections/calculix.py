@@ -3,7 +3,6 @@ export ccx``) and solved by ``ccx``, an independent FE code, on the same mesh, m
 supports and temperatures; δ between the probes against gatetherm's."""
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 import shutil
@@ -11,6 +10,7 @@ import subprocess
 import time
 
 from gatetherm.validation.report.result import Result, table
+from gatetherm.validation.report.sections import paper_model
 
 TOLERANCE = 5e-3
 """Acceptance of the issue: |δ_ccx / δ − 1| within 0.5 %."""
@@ -19,13 +19,10 @@ TOLERANCE = 5e-3
 def compute(ctx) -> Result:
     from gatetherm import write_text_atomic
     from gatetherm.studies.run.ccx import export_state, relative_from_dat
-    from gatetherm.studies.run.config import load_config
     from gatetherm.studies.run.scenario import condition_schedule
 
-    s, cfg = ctx.scope, load_config()
-    if s["size_3d"]:
-        cfg = dataclasses.replace(cfg, model=dataclasses.replace(
-            cfg.model, mesh=dataclasses.replace(cfg.model.mesh, size_3d=s["size_3d"])))
+    s = ctx.scope
+    cfg = paper_model(size_3d=s["size_3d"])
     t = 60.0 * s["time_min"]
     inp, info = export_state(cfg, 3, condition_schedule(s["condition"], cfg), t,
                              f"gatetherm condition {s['condition']}, t = {s['time_min']:g} min")

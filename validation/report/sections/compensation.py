@@ -5,14 +5,14 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
+from gatetherm.validation.report.sections import paper_model
 from gatetherm.validation.report.result import Figure, Result, from_dicts, table
 
 
 def compute(ctx) -> Result:
-    from gatetherm.studies.run.config import load_config
     from gatetherm.validation.compensation_study import FIGURES, summary_rows, write_compensation_study
 
-    st = write_compensation_study(ctx.work, load_config(), ctx.scope["dim"])
+    st = write_compensation_study(ctx.work, paper_model(), ctx.scope["dim"])
     summary = table("Compensation on conditions 1-3: the paper's procedure against its ±6–7 µm", *summary_rows(st),
                     readme="compensation",
                     note="Bands counted after the first 10 min; the residual columns are the K-theory loop with the "

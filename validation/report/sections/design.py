@@ -3,19 +3,16 @@
 from __future__ import annotations
 
 import csv
-import dataclasses
 
 from gatetherm.validation.report.result import Figure, Result, table
+from gatetherm.validation.report.sections import paper_model
 
 
 def compute(ctx) -> Result:
-    from gatetherm.studies.run.config import load_config
     from gatetherm.validation.design_study import write_design_study
 
-    s, cfg = ctx.scope, load_config()
-    if s["size"]:
-        cfg = dataclasses.replace(cfg, model=dataclasses.replace(
-            cfg.model, mesh=dataclasses.replace(cfg.model.mesh, size=s["size"])))
+    s = ctx.scope
+    cfg = paper_model(size=s["size"])
     lines = write_design_study(ctx.work, cfg, s["dim"], ctx.workers, positions=s["positions"], refine=s["refine"],
                                second_above=s["second_above"])
     with open(ctx.work / "second_tie_bar.csv", newline="", encoding="utf-8") as f:

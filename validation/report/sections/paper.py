@@ -4,23 +4,12 @@ Figs. 11-13 analogues (θ rises and δ, 2-D and 3-D together) and the deformed f
 first peak of δ."""
 from __future__ import annotations
 
-import dataclasses
 import os
 
 from gatetherm.validation.report.result import Figure, Result, table
+from gatetherm.validation.report.sections import paper_model
 
 CONDITIONS = (1, 2, 3)
-
-
-def model(scope, dim: int):
-    """The shipped paper model, its 3-D element size set by the scope (None: the model's)."""
-    from gatetherm.studies.run.config import load_config
-
-    cfg = load_config()
-    if dim == 3 and scope.get("size_3d"):
-        mesh = dataclasses.replace(cfg.model.mesh, size_3d=scope["size_3d"])
-        cfg = dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, mesh=mesh))
-    return cfg
 
 
 def compute(ctx) -> Result:
@@ -32,7 +21,7 @@ def compute(ctx) -> Result:
     keep = [60.0 * k for k in range(61)]  # every minute of the first hour: the first peak of δ is in it
     runs, res = {}, {}
     for dim in dims:
-        cfg, cache = model(ctx.scope, dim), ScenarioCache()
+        cfg, cache = paper_model(size_3d=ctx.scope.get("size_3d")), ScenarioCache()
         for c in CONDITIONS:
             runs[(c, dim)], res[(c, dim)] = run_condition(cfg, dim, c, cache, keep_times=keep if c == 1 else ())
     figures = []
@@ -55,6 +44,6 @@ def compute(ctx) -> Result:
     t = table("The paper's figures against gatetherm's", columns, rows, readme="paper",
               note="✓: within the acceptance band (±25 % in 2-D, ±35 % in 3-D, peak time ±8 min). "
                    + (f"3-D on {size * 1e3:g}-mm elements (the model's are "
-                      f"{model({}, 3).model.mesh.size_3d * 1e3:g} mm). " if size else "")
+                      f"{paper_model().model.mesh.size_3d * 1e3:g} mm). " if size else "")
                    + "Wall time: condition 1, model build and march, at the load average stated on this machine.")
     return Result(tables=(t,), figures=tuple(figures))
