@@ -33,12 +33,18 @@ ERRORS = re.compile(r"net::ERR_\w+|ERR_FILE_NOT_FOUND|Failed to load resource|No
 
 @dataclass
 class Check:
+    """What a check found."""
+
     problems: list[str] = field(default_factory=list)
+    """One line each; empty: the page is clean."""
     images: int = 0
+    """``img`` elements in the HTML."""
     links: int = 0
+    """``a href`` elements in the HTML."""
     rendered_images: int | None = None
     """Images the browser counted on the page (None: not rendered)."""
     screenshot: Path | None = None
+    """The PNG written, if any."""
 
 
 class _Page(HTMLParser):

@@ -26,9 +26,14 @@ ISO_NOTE = ("Drift in the manner of ISO 230-3 (thermal effects on machine tools)
 
 @dataclass(frozen=True)
 class Channels:
+    """The columns of a series by role."""
+
     displacement: tuple[str, ...]
+    """``*_um`` columns (δ first), µm."""
     temperature: tuple[str, ...]
+    """``*_degC`` columns that are not inputs, °C."""
     inputs: tuple[str, ...]
+    """Oil, pump, room, piezo stroke and columns in any other unit (powers, switches)."""
 
 
 def channels(ts: TimeSeries) -> Channels:

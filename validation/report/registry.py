@@ -18,6 +18,7 @@ class Section:
     key: str
     """Name after ``--section``, folder under ``DIR/sections`` and anchor on the page."""
     title: str
+    """Heading on the page."""
     compute: str | Callable = ""
     """``module:function`` under ``gatetherm.validation.report.sections`` (or the function):
     Context -> Result."""
@@ -53,6 +54,7 @@ class Context:
     work: Path
     """Its folder: figures and files go here (referred to by name in the Result)."""
     scope: dict
+    """The section's subset or full scope (:attr:`Section.subset`, :attr:`Section.full`)."""
     workers: int
     """Worker processes it may use."""
 

@@ -14,8 +14,11 @@ class Table:
     """A table of preformatted cells."""
 
     title: str
+    """What the table shows (the caption's first sentence)."""
     columns: tuple[str, ...]
+    """Column headings."""
     rows: tuple[tuple[str, ...], ...]
+    """Cells, formatted (numbers with their units where the heading has none)."""
     readme: str = ""
     """Name of the README block (``<!-- report:NAME -->``) this table fills, if any."""
     note: str = ""
@@ -34,6 +37,7 @@ class Figure:
     file: str
     """File name inside the section's folder."""
     caption: str
+    """What it shows (the command, version and date are added on the page)."""
 
 
 @dataclass(frozen=True)
@@ -41,7 +45,9 @@ class Result:
     """A computed section."""
 
     tables: tuple[Table, ...] = ()
+    """In page order."""
     figures: tuple[Figure, ...] = ()
+    """In page order."""
     notes: tuple[str, ...] = ()
     """Paragraphs: the key figures in sentences (`code` in backticks)."""
     files: tuple[tuple[str, str], ...] = ()
