@@ -94,6 +94,8 @@ def test_only_computes_the_named_sections(tmp_path, registry):
     sections, calls, _ = registry
     res = b.build(tmp_path / "R", sections, only={"b"})
     assert calls == ["b"] and res["a"] is None
+    res = b.build(tmp_path / "R", sections, full=True, only={"a"})  # b's subset result stays on the page
+    assert calls == ["b", "a"] and res["b"].tables[0].rows == (("2",),) and not res["b"].stamp["full"]
 
 
 def test_code_digest_covers_the_numerics_not_the_presentation():

@@ -3,10 +3,11 @@
 A section's result is kept in ``DIR/sections/KEY/result.json`` beside its figures, stamped
 with a digest of everything it was made from: the section's key and scope, gatetherm's
 version, the *code digest* (SHA-256 of every source file of the installed package, except
-the modules that only present results: the CLI, this package's page, README and browser
-modules), the bytes of the data files the section names and the version line of the
+the modules that only reuse and present results: the CLI, this module and the report's page,
+README and browser modules), the bytes of the data files the section names and the version line of the
 external programs it runs. A result whose digest matches is reused; anything else is
-recomputed. A default run also accepts a ``--full`` result of the same code and inputs.
+recomputed. A default run also accepts a ``--full`` result of the same code and inputs, and a
+section left out by ``--section`` is shown from either.
 
 A section is computed in ``DIR/sections/.KEY-DIGEST`` and renamed into place when it has
 finished, so an interrupted run leaves the last good result; a sweep study that is
@@ -33,9 +34,10 @@ from gatetherm.validation.report.result import Result, dump, load
 log = logging.getLogger(__name__)
 
 PACKAGES = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.validation")
-PRESENTATION = ("gatetherm/studies/cli/", "gatetherm/validation/report/page.py",
+PRESENTATION = ("gatetherm/studies/cli/", "gatetherm/validation/report/build.py", "gatetherm/validation/report/page.py",
                 "gatetherm/validation/report/readme.py", "gatetherm/validation/report/browser.py")
-"""Source files left out of the code digest: they format results, they do not make them."""
+"""Source files left out of the code digest: they decide what to reuse and format results, they
+do not make them."""
 
 
 def source_files() -> dict[str, Path]:
@@ -142,12 +144,13 @@ def build(out: Path, sections, full: bool = False, workers: int = 1, only=None, 
             continue
         scope = s.scope(full)
         want = digest(s, scope, code)
-        accept = {want} if full or s.full is None else {want, digest(s, s.scope(True), code)}
+        wanted = only is None or s.key in only
+        accept = {want} if s.full is None or (full and wanted) else {digest(s, s.scope(f), code) for f in (0, 1)}
         old = cached(out, s.key)
         if old is not None and old.stamp.get("digest") in accept:
             results[s.key] = old
             _tell(on_section, s.key, "cached", old.stamp.get("seconds", 0.0))
-        elif only is None or s.key in only:
+        elif wanted:
             stamp = {"digest": want, "version": __version__, "code": code[:12], "scope": scope,
                      "full": full or s.full is None}
             log.info("computing section %s", s.key)
