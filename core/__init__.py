@@ -1,33 +1,67 @@
 """gatetherm: finite elements for the thermal deformation of machine-tool frames.
 
 The package root holds what every layer shares and nothing else: the version, the one
-user-facing error type and atomic file output. The layers, each a sub-package, depend
-only on those before them: ``gatetherm.geometry`` → ``gatetherm.solvers`` →
-``gatetherm.studies`` → ``gatetherm.validation`` → ``gatetherm.studies.cli``.
+user-facing error type and atomic file output (``gatetherm.checks``: admissible values,
+``gatetherm.files``: reading input files, ``gatetherm.outdir``: output directories). The
+layers, each a sub-package, depend only on those before them: ``gatetherm.geometry`` →
+``gatetherm.solvers`` → ``gatetherm.studies`` → ``gatetherm.validation`` → ``gatetherm.studies.cli``.
+
+Importing this package is kept cheap (no third-party or slow standard modules), so that the
+console command is inside its own error handling almost at once.
 """
 from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
-from importlib import metadata
 from pathlib import Path
 
-try:
-    __version__ = metadata.version("gatetherm")
-except metadata.PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0+unknown"
+TEMP_PREFIX = ".gatetherm-tmp."
+"""Name prefix of the temporary files of :func:`atomic_path`; a run removes those a killed
+run left in its output directory (:mod:`gatetherm.outdir`)."""
+
+
+def __getattr__(name: str):
+    if name == "__version__":  # looked up on first use: importlib.metadata is slow to import
+        from importlib import metadata
+
+        try:
+            version = metadata.version("gatetherm")
+        except metadata.PackageNotFoundError:  # a source tree that is not installed
+            version = "0+unknown"
+        globals()["__version__"] = version
+        return version
+    raise AttributeError(f"module 'gatetherm' has no attribute {name!r}")
 
 
 class InputError(ValueError):
     """Bad user input. ``str(err)`` is one line naming the field and the fix."""
 
     def __init__(self, field: str, problem: str, fix: str = ""):
-        self.field = field
+        self.field, self.problem, self.fix = field, problem, fix
         msg = f"{field}: {problem}"
         if fix:
             msg += f"; {fix}"
         super().__init__(msg)
+
+    def __reduce__(self):  # picklable, so that a worker process can report it
+        return type(self), (self.field, self.problem, self.fix)
+
+    def at(self, where: str, sep: str = ": ") -> InputError:
+        """The same error with ``where`` (a file, a table) put before the field."""
+        if not where or self.field.startswith(f"{where}{sep}"):
+            return self
+        return type(self)(f"{where}{sep}{self.field}", self.problem, self.fix)
+
+
+def _new_temporary(path: Path) -> Path:
+    """Create an empty file beside ``path`` with a fresh name; the umask sets its mode."""
+    while True:
+        tmp = path.with_name(f"{TEMP_PREFIX}{path.stem}.{os.urandom(4).hex()}{path.suffix}")
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+            return tmp
+        except FileExistsError:
+            continue
 
 
 @contextlib.contextmanager
@@ -35,19 +69,22 @@ def atomic_path(path: str | os.PathLike):
     """Yield a temporary path next to ``path``; rename it onto ``path`` on success.
 
     The suffix is kept so that writers that dispatch on the file extension
-    (meshio, matplotlib) still work. On an exception the temporary file is
-    removed and ``path`` keeps its previous content.
+    (meshio, matplotlib) still work; the file gets the permissions of the umask,
+    as a plain ``open`` would. On an exception (a full disk, Ctrl-C) the temporary
+    file is removed and ``path`` keeps its previous content; an ``OSError`` is raised
+    again naming ``path`` (writers do not always name the file).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
+    tmp = _new_temporary(path)
     try:
-        yield Path(tmp)
+        yield tmp
         os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
+    except BaseException as err:
+        with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(err, OSError) and err.errno is not None:
+            raise OSError(err.errno, err.strerror, str(path)) from err
         raise
 
 

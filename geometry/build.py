@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import signal
+import threading
 
 import numpy as np
 
 from gatetherm.geometry.frame import (FrameParams, MeshParams, part_boxes, sensor_points,
                             tank_box, validate, validate_mesh)
 from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.geometry.sizing import check_mesh_size
 
 log = logging.getLogger(__name__)
 _TOL = 1e-7
@@ -27,6 +30,10 @@ def gmsh_session(name: str = "frame", verbosity: int = 0):
     if gmsh.isInitialized():
         gmsh.finalize()
     gmsh.initialize(interruptible=False)
+    if threading.current_thread() is threading.main_thread():  # gmsh resets SIGTERM: Python's handler back
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            if signal.getsignal(sig) is not None:
+                signal.signal(sig, signal.getsignal(sig))
     try:
         gmsh.option.setNumber("General.Terminal", int(verbosity > 0))
         gmsh.option.setNumber("General.Verbosity", verbosity)
@@ -74,6 +81,7 @@ def build_mesh(p: FrameParams, dim: int = 2, mesh: MeshParams = MeshParams()) ->
     """Mesh the frame in ``dim`` = 2 (plane section) or 3 (solid) dimensions."""
     validate(p, dim)
     validate_mesh(mesh)
+    check_mesh_size(p, mesh, dim)  # before gmsh runs
     boxes = part_boxes(p, dim)
     tank = tank_box(p, dim)
     sensors = sensor_points(p, dim)

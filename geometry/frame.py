@@ -13,10 +13,12 @@ import dataclasses
 from dataclasses import dataclass
 
 from gatetherm import InputError
+from gatetherm.checks import NONNEGATIVE, POSITIVE, Range, admissible, check_fields
 
 Box = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, z0, z1
 
 
+@admissible(POSITIVE, l4_2=NONNEGATIVE)
 @dataclass(frozen=True)
 class FrameParams:
     """Dimensions of the frame, all in metres (areas in m²)."""
@@ -67,6 +69,7 @@ class FrameParams:
         return validate(dataclasses.replace(self, **changes))
 
 
+@admissible(size=POSITIVE, size_3d=POSITIVE, refine=Range(0.0, 1.0, lo_open=True))
 @dataclass(frozen=True)
 class MeshParams:
     """Mesh density controls."""
@@ -159,16 +162,6 @@ def sensor_points(p: FrameParams, dim: int) -> dict[str, tuple[float, float, flo
 TIE_SENSORS = tuple(f"C{i}" for i in range(1, 11))
 
 
-def _positive(p: FrameParams) -> None:
-    for f in dataclasses.fields(p):
-        v = getattr(p, f.name)
-        if f.name == "l4_2":
-            if v < 0:
-                raise InputError(f.name, f"must be 0 (no second tie bar) or positive, got {v}")
-        elif not v > 0:
-            raise InputError(f.name, f"must be positive, got {v}", "give a size in metres")
-
-
 def _overlap(a0: float, a1: float, b0: float, b1: float) -> bool:
     return a0 < b1 and b0 < a1
 
@@ -179,7 +172,7 @@ def validate(p: FrameParams, dim: int | None = None) -> FrameParams:
     ``dim=2`` adds the plane-section check that tie bars and arms do not overlap
     (in 3-D the tie bar sits behind the arms, so any ``l4`` is buildable).
     """
-    _positive(p)
+    check_fields(p)
     if p.l1 > p.l:
         raise InputError("l1", f"heated height {p.l1} m exceeds the cutting-area height l = {p.l} m",
                          "choose l1 <= l")
@@ -222,11 +215,13 @@ def validate(p: FrameParams, dim: int | None = None) -> FrameParams:
 
 def validate_mesh(m: MeshParams) -> MeshParams:
     """Return ``m`` if its sizes are usable, else raise :class:`InputError`."""
-    if not m.size > 0:
-        raise InputError("mesh.size", f"must be positive, got {m.size}", "give an element size in metres")
-    if not m.size_3d > 0:
-        raise InputError("mesh.size_3d", f"must be positive, got {m.size_3d}", "give an element size in metres")
-    if not 0 < m.refine <= 1:
-        raise InputError("mesh.refine", f"must be in (0, 1], got {m.refine}",
-                         "give the refined size as a fraction of mesh.size")
-    return m
+    return check_fields(m, "mesh.")
+
+
+def check_tie_depth(p: FrameParams) -> FrameParams:
+    """Return ``p`` if its tie bars are no deeper than the columns (as a built frame needs;
+    a 2-D beam-theory study may set a deeper plane-section tie bar through ``A_C``)."""
+    if tie_depth(p) > p.depth:
+        raise InputError("A_C", f"tie-bar depth A_C/t_C = {tie_depth(p):g} m exceeds the column depth {p.depth:g} m",
+                         "lower A_C or raise t_C")
+    return p

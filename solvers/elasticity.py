@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -18,8 +17,10 @@ from skfem import BilinearForm, CellBasis, ElementVector, FacetBasis, LinearForm
 from skfem.helpers import ddot, div, sym_grad
 
 from gatetherm import InputError
-from gatetherm.solvers.fem import Field, element
-from gatetherm.solvers.linsolve import rigid_body_modes, spd_solver
+from gatetherm.solvers import p1
+from gatetherm.solvers.fem import Field, dof_basis, element
+from gatetherm.solvers.linsolve import (Factor, expand_order, nd_order, restrict_order, rigid_body_modes,
+                                       spd_solver)
 from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
 
 log = logging.getLogger(__name__)
@@ -67,19 +68,23 @@ class ElasticSystem:
 
     basis: CellBasis
     K: sp.csr_matrix
+    """Stiffness on the free DOFs."""
     B: sp.csr_matrix
+    """Thermal load per unit temperature rise (all DOFs × heat DOFs)."""
     free: np.ndarray
-    solve: Callable[[np.ndarray], np.ndarray]
+    solve: Factor
+    """Solves with the stiffness on the free DOFs (one or more right-hand sides)."""
     plane: str = "stress"
     """2-D: "stress" or "strain"."""
 
     def displacement(self, dT: np.ndarray) -> np.ndarray:
-        """Displacement field (m) for the temperature rise ``dT`` (K) on the heat basis."""
+        """Displacement field (m) for the temperature rise ``dT`` (K) on the heat basis
+        (``dT`` (n, k): k fields in one solve)."""
         return self.from_load(self.B @ dT)
 
     def from_load(self, load: np.ndarray) -> np.ndarray:
         """Displacement field (m) for a load vector (N) on the displacement basis."""
-        u = np.zeros(self.basis.N)
+        u = np.zeros((self.basis.N,) + np.shape(load)[1:])
         u[self.free] = self.solve(load[self.free])
         return u
 
@@ -92,11 +97,9 @@ class ElasticSystem:
         """Temperature weights w with w·dT = g·u(dT) (adjoint solve); ``g`` may be
         (N,) or (outputs, N), giving (n_T,) or (outputs, n_T)."""
         G = np.atleast_2d(g)
-        W = np.empty((G.shape[0], self.B.shape[1]))
-        for i, row in enumerate(G):
-            z = np.zeros(self.basis.N)
-            z[self.free] = self.solve(row[self.free])
-            W[i] = self.B.T @ z
+        Z = np.zeros((self.basis.N, G.shape[0]))
+        Z[self.free] = self.solve(np.ascontiguousarray(G[:, self.free].T))  # all outputs in one solve
+        W = (self.B.T @ Z).T
         return W[0] if np.ndim(g) == 1 else W
 
 
@@ -124,18 +127,27 @@ def free_modes(vb: CellBasis, fixed: np.ndarray, K_found: sp.spmatrix | None) ->
 
 
 def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, alpha: Field,
-                     thickness: Field, supports, plane: str = "stress") -> ElasticSystem:
+                     thickness: Field, supports, plane: str = "stress",
+                     simplices: p1.Simplices | None = None) -> ElasticSystem:
     """Assemble on a scikit-fem mesh with named boundaries; the temperature lives on
     ``T_basis`` (same mesh). ``supports`` are :class:`~gatetherm.solvers.problem.Support`.
-    A rigid-body mode the supports leave free is an :class:`~gatetherm.InputError`."""
+    A rigid-body mode the supports leave free is an :class:`~gatetherm.InputError`.
+    Linear elements use ``simplices`` (:func:`~gatetherm.solvers.p1.simplices` of the
+    mesh, found if not given)."""
     dim = mesh.dim()
     q = 2 * order - 1  # exact for the stiffness and the thermal load on affine simplices
-    vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
-    T_basis = CellBasis(mesh, T_basis.elem, intorder=q)
     lam, mu, b = moduli(E.values, nu.values, alpha.values, dim, plane)
-    t = thickness.at(vb)
-    K = asm(stiffness, vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
-    B = asm(thermal_load, T_basis, vb, b=Field(b).at(vb), t=t)
+    node_order = None
+    if order == 1 and T_basis.elem.maxdeg == 1:  # the same matrices, vectorised (solvers/p1.py)
+        s, th = simplices or p1.simplices(mesh), thickness.values
+        vb, node_order = dof_basis(mesh, ElementVector(element(dim, order))), s.order
+        K = p1.stiffness(s.pattern, s.G, s.vol, lam * th, mu * th)
+        B = p1.thermal_load(s.pattern, s.G, s.vol, b * th)
+    else:
+        vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
+        T_basis, t = CellBasis(mesh, T_basis.elem, intorder=q), thickness.at(vb)
+        K = asm(stiffness, vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
+        B = asm(thermal_load, T_basis, vb, b=Field(b).at(vb), t=t)
     K_found = None
     for s in supports:
         if s.stiffness is not None:
@@ -150,8 +162,12 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     if K_found is not None:
         K = K + K_found
     free = np.setdiff1d(np.arange(vb.N), fixed)
-    Kff = K[free][:, free]
+    K = K.tocsr()
+    dof_order = nd_order(K, dim) if node_order is None else expand_order(node_order, dim)
+    perm = restrict_order(dof_order, free, vb.N)
+    K = K[free][:, free]
     rbm = rigid_body_modes(vb.doflocs, vb.split_indices())[free]
     log.info("elastic system: %d free DOFs (P%d, %d-D%s)", len(free), order, dim,
              f" plane {plane}" if dim == 2 else "")
-    return ElasticSystem(vb, K.tocsr(), B.tocsr(), free, spd_solver(Kff, dim, rbm), plane)
+    solve = Factor(lambda: spd_solver(K, dim, rbm, order=perm))
+    return ElasticSystem(vb, K, B.tocsr(), free, solve, plane)

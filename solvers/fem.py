@@ -14,15 +14,38 @@ _ELEM = {(2, 1): skfem.ElementTriP1, (2, 2): skfem.ElementTriP2,
 _P0 = {2: skfem.ElementTriP0, 3: skfem.ElementTetP0}
 
 
+def _keys(facets: np.ndarray, n: int) -> np.ndarray:
+    """One integer per facet (rows of node numbers, any order within a row)."""
+    key = np.zeros(len(facets), dtype=np.int64)
+    for column in np.sort(facets, axis=1).T:
+        key = key * n + column
+    return key
+
+
 def to_skfem(fm: FrameMesh) -> skfem.Mesh:
     """A scikit-fem mesh with the named regions as subdomains and the named
     boundaries as facet sets."""
     mesh = _MESH[fm.dim](np.ascontiguousarray(fm.points.T), np.ascontiguousarray(fm.cells.T))
-    facet_id = {tuple(f): i for i, f in enumerate(np.sort(mesh.facets.T, axis=1))}
-    boundaries = {name: np.array([facet_id[tuple(f)] for f in np.sort(fac, axis=1)], dtype=np.int64)
-                  for name, fac in fm.boundaries.items()}
-    return mesh.with_boundaries(boundaries).with_subdomains(
-        {k: np.asarray(v) for k, v in fm.regions.items()})
+    n = len(fm.points)
+    keys = _keys(mesh.facets.T, n)  # sorted: scikit-fem's facets are unique, in lexicographic order
+    boundaries = {}
+    for name, fac in fm.boundaries.items():
+        want = _keys(np.asarray(fac), n)
+        ids = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
+        if not np.array_equal(keys[ids], want):
+            raise ValueError(f"boundary {name!r} has facets that are not facets of the mesh")
+        boundaries[name] = ids
+    out = mesh.with_boundaries(boundaries).with_subdomains({k: np.asarray(v) for k, v in fm.regions.items()})
+    out._facets, out._t2f = mesh._facets, mesh._t2f  # the copies would find them again (1 s in 3-D)
+    return out
+
+
+def dof_basis(mesh: skfem.Mesh, elem: skfem.Element) -> skfem.CellBasis:
+    """A basis for DOF numbers, DOF locations and point probes only: no quadrature points,
+    so none of the per-element arrays of a full basis (0.3 GB for the vector P1 basis of
+    the 3-D frame), for matrices assembled by :mod:`gatetherm.solvers.p1`."""
+    d = mesh.dim()
+    return skfem.CellBasis(mesh, elem, quadrature=(np.zeros((d, 0)), np.zeros(0)))
 
 
 def element(dim: int, order: int) -> skfem.Element:

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.checks import CELSIUS, NONNEGATIVE, POSITIVE, Range, admissible
 from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.frame import FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth, width
 from gatetherm.geometry.mesh import FrameMesh
@@ -39,6 +40,8 @@ RELATIVE = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
 """Relative x-displacements (left minus right) of sensor pairs: δ at the tips and at E."""
 
 
+@admissible(T0=CELSIUS, h_air=NONNEGATIVE, h_base=NONNEGATIVE, h_oil_on=NONNEGATIVE, h_oil_off=NONNEGATIVE,
+            oil_rho_c=POSITIVE, flow_rate=NONNEGATIVE, hose_capacity=NONNEGATIVE, hose_loss=NONNEGATIVE)
 @dataclass(frozen=True)
 class ThermalParams:
     """Heat-transfer coefficients of the frame and the oil tank."""
@@ -68,6 +71,7 @@ class ThermalParams:
     8 W/(m² K) outside, 5 mm of rubber (k = 0.2 W/(m K))."""
 
 
+@admissible(order=Range(1, 2, whole=True), k_base=POSITIVE, joint_conductance=POSITIVE, joint_stiffness=POSITIVE)
 @dataclass(frozen=True)
 class ModelConfig:
     """Everything that defines a frame model (the TOML file mirrors it)."""

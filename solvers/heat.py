@@ -25,12 +25,14 @@ from typing import Callable, Iterator, Mapping
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
+from gatetherm.checks import Range, admissible
+from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
-from gatetherm.solvers.fem import Field, element
+from gatetherm.solvers.fem import Field, dof_basis, element
+from gatetherm.solvers.linsolve import Bordered, nd_order, restrict_order
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +62,7 @@ def film_load(v, w):
     return w.h * w.t * v
 
 
+@admissible(theta=Range(0.5, 1.0), restart=Range(1, 1000, whole=True), restart_intervals=Range(0, 1000, whole=True))
 @dataclass(frozen=True)
 class TimeScheme:
     """The θ-method with Rannacher start-up at input switches."""
@@ -134,6 +137,9 @@ class HeatSystem:
     """Index of every fluid and hose unknown, by name."""
     T0: float
     """Initial temperature, °C."""
+    order: np.ndarray | None = None
+    """A fill-reducing order of the solid's unknowns, shared with the other factors on the
+    mesh (None: found from the first step matrix)."""
 
     @property
     def n(self) -> int:
@@ -181,9 +187,12 @@ class HeatSolver:
     def __init__(self, system: HeatSystem):
         self.system = system
         self.free = np.setdiff1d(np.arange(system.n), system.fixed_dofs)
-        """Unknowns not held by a fixed temperature."""
+        """Unknowns not held by a fixed temperature (the solid's first, then the lumped ones)."""
+        self.n_inner = int(np.sum(self.free < system.n_solid))
+        """Free unknowns of the solid: the SPD block of every step matrix."""
         self._K: dict[Mode, sp.csr_matrix] = {}
-        self._lu: dict[tuple[float, Mode], tuple[object, sp.csr_matrix | None]] = {}
+        self._lu: dict[tuple[float, Mode], tuple[Bordered, sp.csr_matrix | None]] = {}
+        self._order: list = []
         self.factor_seconds = 0.0
         """Seconds spent factorising so far."""
 
@@ -200,26 +209,31 @@ class HeatSolver:
     def solve(self, dt: float, theta: float, mode: Mode, rhs: np.ndarray, held: np.ndarray) -> np.ndarray:
         """Solve ``(M/dt + θ K) U = rhs`` with ``U[fixed] = held``, by the factor of
         ``M/(θ dt) + K`` on the free unknowns, which backward Euler over dt/2 and
-        Crank–Nicolson over dt share."""
+        Crank–Nicolson over dt share: a sparse Cholesky of its SPD solid block (one METIS
+        order for all, the matrices share a pattern) bordered by the lumped unknowns."""
         key = (round(theta * dt, 9), mode)
+        fixed = self.system.fixed_dofs
         if key not in self._lu:
             t0 = time.perf_counter()
             A = (self.system.M / (theta * dt) + self.K(mode)).tocsr()
-            if held.size:
-                lu = splu(A[self.free][:, self.free].tocsc(), permc_spec="COLAMD")
-                coupling = A[self.free][:, self.system.fixed_dofs]
-            else:
-                lu, coupling = splu(A.tocsc(), permc_spec="COLAMD"), None
-            self._lu[key] = (lu, coupling)
+            coupling = None
+            if fixed.size:
+                coupling, A = A[self.free][:, fixed], A[self.free][:, self.free]
+            if not self._order:
+                inner = A[:self.n_inner, :self.n_inner]
+                self._order.append(nd_order(inner) if self.system.order is None else
+                                   restrict_order(self.system.order, self.free[:self.n_inner], self.system.n_solid))
+            self._lu[key] = (Bordered(A, self.n_inner, self._order[0]), coupling)
             seconds = time.perf_counter() - t0
             self.factor_seconds += seconds
-            log.debug("factorised heat matrix for θdt=%g s, mode=%s in %.2f s", theta * dt, mode, seconds)
-        lu, coupling = self._lu[key]
+            log.debug("factorised heat matrix for θdt=%g s, mode=%s in %.2f s (%s)", theta * dt, mode, seconds,
+                      self._lu[key][0].backend)
+        solve, coupling = self._lu[key]
         if coupling is None:
-            return lu.solve(rhs / theta)
+            return solve(rhs / theta)
         U = np.empty(self.system.n)
-        U[self.system.fixed_dofs] = held
-        U[self.free] = lu.solve(rhs[self.free] / theta - coupling @ held)
+        U[fixed] = held
+        U[self.free] = solve(rhs[self.free] / theta - coupling @ held)
         return U
 
     def steady(self, env) -> np.ndarray:
@@ -294,37 +308,52 @@ def _facets(mesh, name: str, e, q: int):
     return FacetBasis(mesh, e, facets=mesh.boundaries[name], intorder=q)
 
 
-def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None) -> HeatSystem:
+def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None,
+                  simplices: p1.Simplices | None = None) -> HeatSystem:
     """Assemble the heat system of ``problem`` (a :class:`~gatetherm.solvers.problem.Problem`)
     on a scikit-fem ``mesh`` with its named boundaries and subdomains; ``fields`` holds the
-    element-wise ``k``, ``rho_c`` and ``thickness``."""
+    element-wise ``k``, ``rho_c`` and ``thickness``. Linear elements use ``simplices``
+    (:func:`~gatetherm.solvers.p1.simplices` of the mesh, found if not given)."""
     order = problem.order
     e = element(mesh.dim(), order)
     q = intorder or 2 * order
-    basis = CellBasis(mesh, e, intorder=q)
-    t = fields["thickness"].at(basis)
-    M = asm(capacity, basis, rc=fields["rho_c"].at(basis), t=t)
-    K = asm(conduction, basis, k=fields["k"].at(basis), t=t)
+    th = fields["thickness"]
+    node_order = None
+    if order == 1:  # the same matrices, vectorised (solvers/p1.py)
+        s = simplices or p1.simplices(mesh)
+        M = s.pattern.scalar(p1.mass(s.G, s.vol, fields["rho_c"].values * th.values))
+        K = s.pattern.scalar(p1.conduction(s.G, s.vol, fields["k"].values * th.values))
+        basis, node_order = dof_basis(mesh, e), s.order
+    else:
+        basis = CellBasis(mesh, e, intorder=q)
+        M = asm(capacity, basis, rc=fields["rho_c"].at(basis), t=th.at(basis))
+        K = asm(conduction, basis, k=fields["k"].at(basis), t=th.at(basis))
+
+    def cells():  # a basis with quadrature, made only where a volume integral needs it
+        return CellBasis(mesh, e, intorder=q) if order == 1 else basis
+
     loads: list[tuple[np.ndarray, Value, str]] = []
     for fl in problem.films:
         fb = _facets(mesh, fl.boundary, e, q)
-        tf = fields["thickness"].at(fb)
+        tf = th.at(fb)
         K = K + asm(film, fb, h=fl.h, t=tf)
         loads.append((asm(film_load, fb, h=fl.h, t=tf), fl.ambient, "film"))
     for fx in problem.fluxes:
         fb = _facets(mesh, fx.boundary, e, q)
-        loads.append((asm(film_load, fb, h=1.0, t=fields["thickness"].at(fb)), fx.value, "flux"))
+        loads.append((asm(film_load, fb, h=1.0, t=th.at(fb)), fx.value, "flux"))
     if problem.faces is not None and mesh.dim() == 2:
-        K = K + asm(film, basis, h=problem.faces.h, t=2.0)
-        loads.append((asm(film_load, basis, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
-    for s in problem.sources:
-        on = Field.by_region(mesh, {s.region: 1.0}, 0.0)
-        loads.append((asm(film_load, basis, h=on.at(basis), t=t), s.density, "source"))
+        cb = cells()
+        K = K + asm(film, cb, h=problem.faces.h, t=2.0)
+        loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
+    for src in problem.sources:
+        cb = cells()
+        on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
+        loads.append((asm(film_load, cb, h=on.at(cb), t=th.at(cb)), src.density, "source"))
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
     for fluid in problem.fluids:
         wb = _facets(mesh, fluid.boundary, e, q)
-        tw = fields["thickness"].at(wb)
+        tw = th.at(wb)
         lumped[fluid.name] = n_solid + len(caps)
         caps.append(fluid.capacity)
         losses.append((0.0, None))
@@ -363,4 +392,4 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     fixed = tuple((basis.get_dofs(mesh.boundaries[c.boundary]).all(), c.value) for c in problem.fixed)
     log.info("heat system: %d unknowns (P%d), %d fixed", n, order, len(np.unique(np.concatenate(
         [d for d, _ in fixed]))) if fixed else 0)
-    return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0)
+    return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, node_order)

@@ -3,7 +3,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from gatetherm.checks import POSITIVE, Range, admissible
 
+
+@admissible(E=POSITIVE, nu=Range(0.0, 0.5, hi_open=True), alpha=Range(-1e-4, 1e-3), k=POSITIVE,
+            rho=POSITIVE, c=POSITIVE)
 @dataclass(frozen=True)
 class Material:
     """An isotropic, linear thermoelastic solid.

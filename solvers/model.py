@@ -20,7 +20,8 @@ from skfem import CellBasis, FacetBasis, asm
 
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, moduli, thermal_load_at
-from gatetherm.solvers.fem import Field, element, to_skfem
+from gatetherm.solvers import p1
+from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
 from gatetherm.solvers.heat import HeatSystem, assemble_heat, film_load
 from gatetherm.solvers.problem import AXES, Problem
 from gatetherm.solvers.stress import Recovery, recovery, von_mises
@@ -83,6 +84,8 @@ class Model:
     """What the problem was generated from, if anything (the frame's ModelConfig)."""
     timings: dict[str, float] = field(default_factory=dict, compare=False)
     """Seconds spent building: mesh, heat_assembly, elastic_setup, adjoint_solves."""
+    simplices: p1.Simplices | None = field(default=None, compare=False)
+    """Linear elements: what all P1 matrices and factors on the mesh share."""
 
     @property
     def dim(self) -> int:
@@ -97,12 +100,14 @@ class Model:
         return U[:self.heat.n_solid] - self.problem.T_ref
 
     def displacement_field(self, U: np.ndarray) -> np.ndarray:
-        """Full displacement field (m) on the elastic basis: one elastic solve."""
+        """Full displacement field (m) on the elastic basis: one elastic solve (``U`` (n, k): k fields)."""
         return self.elastic.displacement(self.rise(U))
 
-    def stress_field(self, u: np.ndarray, U: np.ndarray | None = None) -> dict[str, np.ndarray]:
-        """Stress components and von Mises (Pa) at the nodes, projected over the whole mesh."""
-        rec = _field_recovery(self)
+    def stress_field(self, u: np.ndarray, U: np.ndarray | None = None,
+                     rec: Recovery | None = None) -> dict[str, np.ndarray]:
+        """Stress components and von Mises (Pa) at the nodes, projected over the whole mesh
+        (``rec``: :func:`field_recovery` of this model, set up once for many states)."""
+        rec = rec or field_recovery(self)
         rhs = rec.thermal_rhs(self.rise(U)) if U is not None else rec.thermal_rhs(np.ones(1))
         comps = rec.field(u, rhs)
         nodal = {c: v[rec.scalar.nodal_dofs[0]] for c, v in comps.items()}
@@ -183,14 +188,15 @@ def _recovery_for(model: Model, elements) -> Recovery:
     p = model.problem
     T_elem = model.heat.basis.elem if model.heat is not None else None
     T_at = None if model.heat is not None else _prescribed_rise(model)
-    return recovery(model.mesh, p.order, model.fields, model.dim, p.plane, T_elem, elements, T_at)
+    return recovery(model.mesh, p.order, model.fields, model.dim, p.plane, T_elem, elements, T_at, model.simplices)
 
 
 def _probe_recovery(model: Model, region: str | None) -> Recovery:
     return _recovery_for(model, None if region is None else model.mesh.subdomains[region])
 
 
-def _field_recovery(model: Model) -> Recovery:
+def field_recovery(model: Model) -> Recovery:
+    """The stress projection over the whole mesh (set up once, used for every field state)."""
     return _recovery_for(model, None)
 
 
@@ -249,16 +255,17 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
 
     mesh = to_skfem(fmesh)
     f = region_fields(problem, mesh)
-    heat = assemble_heat(mesh, problem, f) if problem.heat else None
+    s = p1.simplices(mesh) if problem.order == 1 else None
+    heat = assemble_heat(mesh, problem, f, simplices=s) if problem.heat else None
     lap("heat_assembly")
     el = None
     if problem.elastic:
-        T_basis = heat.basis if heat is not None else CellBasis(mesh, element(problem.dim, problem.order))
+        T_basis = heat.basis if heat is not None else dof_basis(mesh, element(problem.dim, problem.order))
         el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
-                              problem.supports, problem.plane)
+                              problem.supports, problem.plane, simplices=s)
     lap("elastic_setup")
-    model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings)
+    model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s)
     if heat is not None:
-        model = Model(problem, fmesh, mesh, f, heat, el, _readout(model), config, timings)
+        model = Model(problem, fmesh, mesh, f, heat, el, _readout(model), config, timings, s)
     lap("adjoint_solves")
     return model

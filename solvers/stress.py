@@ -12,12 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 from skfem import BilinearForm, CellBasis, LinearForm, asm
 from skfem.helpers import div, sym_grad
 
 from gatetherm.solvers.elasticity import moduli
-from gatetherm.solvers.fem import Field, element
+from gatetherm.solvers.fem import Field, dof_basis, element
 
 COMPONENTS = {(2, "stress"): ("xx", "yy", "xy"), (2, "strain"): ("xx", "yy", "zz", "xy"),
               (3, "stress"): ("xx", "yy", "zz", "xy", "yz", "xz"), (3, "strain"): ("xx", "yy", "zz", "xy", "yz", "xz")}
@@ -95,13 +94,10 @@ class Recovery:
     def field(self, u: np.ndarray, rhs_T: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Projected components (on ``scalar``) for displacement ``u`` and the thermal
         right-hand sides ``rhs_T`` (per normal component, see :meth:`thermal_rhs`)."""
-        out = {}
-        for c in self.components:
-            b = self.S[c] @ u + rhs_T.get(c, 0.0)
-            s = np.zeros(self.scalar.N)
-            s[self.active] = self.lu.solve(b[self.active])
-            out[c] = s
-        return out
+        b = np.column_stack([(self.S[c] @ u + rhs_T.get(c, 0.0))[self.active] for c in self.components])
+        s = np.zeros((self.scalar.N, len(self.components)))
+        s[self.active] = self.lu.solve(b).reshape(b.shape)  # every component in one solve
+        return dict(zip(self.components, s.T))
 
     def thermal_rhs(self, dT: np.ndarray) -> dict[str, np.ndarray]:
         """The thermal right-hand sides for a nodal temperature rise."""
@@ -109,29 +105,91 @@ class Recovery:
 
 
 def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T_elem,
-             elements: np.ndarray | None = None, T_at=None) -> Recovery:
+             elements: np.ndarray | None = None, T_at=None, simplices=None) -> Recovery:
     """Set up the projection on ``elements`` (all if None). ``T_elem`` is the element of
     the nodal temperature rise; when the rise is prescribed instead, ``T_elem`` is None and
     ``T_at(basis)`` gives it at a basis's quadrature points: ``Q`` then holds one column,
-    the thermal right-hand side itself (``thermal_rhs(np.ones(1))``)."""
+    the thermal right-hand side itself (``thermal_rhs(np.ones(1))``). ``simplices``: the
+    mesh's :class:`~gatetherm.solvers.p1.Simplices`, if found already (linear elements)."""
     from skfem import ElementVector
 
     q = 2 * order
+    comps = COMPONENTS[(dim, plane)]
+    normal = [c for c in comps if c[0] == c[1] and not (dim == 2 and plane == "stress" and c == "zz")]
+    lam_e, mu_e, b_e = moduli(fields["E"].values, fields["nu"].values, fields["alpha"].values, dim, plane)
+    if order == 1:
+        return _p1_recovery(mesh, dim, comps, normal, lam_e, mu_e, b_e, elements, T_at, simplices)
     kw = {"intorder": q} if elements is None else {"intorder": q, "elements": elements}
     sb = CellBasis(mesh, element(dim, order), **kw)
     ub = CellBasis(mesh, ElementVector(element(dim, order)), **kw)
-    lam, mu, b = moduli(fields["E"].values, fields["nu"].values, fields["alpha"].values, dim, plane)
-    lam, mu, b = (Field(v).at(sb) for v in (lam, mu, b))
+    lam, mu, b = (Field(v).at(sb) for v in (lam_e, mu_e, b_e))
     M = asm(mass, sb).tocsr()
     active = np.unique(sb.element_dofs)
-    comps = COMPONENTS[(dim, plane)]
     S = {c: asm(stress_of_u, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr()
          for c in comps}
-    normal = [c for c in comps if c[0] == c[1] and not (dim == 2 and plane == "stress" and c == "zz")]
     if T_elem is not None:
         tb = CellBasis(mesh, T_elem, **kw)
         Q = {c: asm(stress_of_T, tb, sb, b=b).tocsr() for c in normal}
     else:
         Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=b, T=T_at(sb))[:, None]) for c in normal}
     full = sb if elements is None else CellBasis(mesh, element(dim, order), intorder=q)
-    return Recovery(sb, full, active, splu(M[active][:, active].tocsc()), S, Q, comps)
+    return Recovery(sb, full, active, _factor(M[active][:, active]), S, Q, comps)
+
+
+def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simplices) -> Recovery:
+    """:func:`recovery` for linear elements, vectorised (solvers/p1.py): the element stress
+    is constant, so ``∫ σ_c(φ_jb) ψ_i = vol σ_c(φ_jb) / (d+1)`` and the thermal part is the
+    mass matrix times ``−b``."""
+    from gatetherm.solvers import p1
+    from gatetherm.solvers.linsolve import restrict_order
+
+    if elements is None:
+        s = simplices or p1.simplices(mesh)
+        cells, G, vol, pattern = mesh.t.T, s.G, s.vol, s.pattern
+        active = np.arange(mesh.nvertices)
+        order = s.order
+    else:
+        cells = mesh.t.T[elements]
+        G, vol = p1.gradients(mesh.p.T, cells)
+        lam, mu, b = lam[elements], mu[elements], b[elements]
+        pattern, active, order = p1.Pattern(cells, mesh.nvertices), np.unique(cells), None
+    k = dim + 1
+    M = pattern.scalar(p1.mass(G, vol, np.ones(len(vol))))[active][:, active]
+    order = None if order is None else restrict_order(order, active, mesh.nvertices)
+
+    def s_entry(i, j):  # σ_ij of the trial function of node (last axis), component b, per element
+        def entry(_, bb):
+            s = mu[:, None] * ((j == bb) * G[:, :, i] + (i == bb) * G[:, :, j]) if i < dim and j < dim else 0.0
+            s = s + (lam[:, None] * G[:, :, bb] if i == j else 0.0)
+            return np.broadcast_to((vol / k)[:, None, None] * s[:, None, :], (len(vol), k, k))
+        return entry
+
+    S = {c: pattern.blocks(s_entry(*_INDEX[c]), 1, dim) for c in comps}
+    if T_at is None:
+        Q = {c: pattern.scalar(p1.mass(G, vol, -b)) for c in normal}
+    else:
+        from skfem import CellBasis as _CB
+
+        sb = _CB(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))
+        Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=Field(b_full(b, elements, mesh)).at(sb),
+                                  T=T_at(sb))[:, None]) for c in normal}
+    full = dof_basis(mesh, element(dim, 1))
+    return Recovery(full, full, active, _factor(M, order), S, Q, comps)
+
+
+def _factor(M: sp.spmatrix, order: np.ndarray | None = None):
+    """The mass matrix's factor as an object with ``solve`` (sparse Cholesky, METIS order)."""
+    from types import SimpleNamespace
+
+    from gatetherm.solvers.linsolve import nd_order, spd_factor
+
+    return SimpleNamespace(solve=spd_factor(M, nd_order(M) if order is None else order)[0])
+
+
+def b_full(b_sel: np.ndarray, elements, mesh) -> np.ndarray:
+    """An element field given on ``elements`` as a field on all elements (0 elsewhere)."""
+    if elements is None:
+        return b_sel
+    out = np.zeros(mesh.nelements)
+    out[elements] = b_sel
+    return out

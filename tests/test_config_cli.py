@@ -36,7 +36,7 @@ def test_user_file_overlays_the_paper_model(tmp_path):
     ({"thermal": {"h_air": "high"}}, "thermal.h_air"),
     ({"thermal": {"out_of_plane": 1}}, "thermal.out_of_plane"),
     ({"model": {"order": 3}}, "model.order"),
-    ({"geometry": {"l1": 0.9}}, "l1"),
+    ({"geometry": {"l1": 0.9}}, "geometry.l1"),
     ({"colour": {}}, "colour"),
 ])
 def test_bad_model_files_name_the_field(doc, field):
@@ -63,7 +63,7 @@ def test_bad_parameter_is_one_line_exit_2(tmp_path, capsys):
     cfg.write_text("[geometry]\nl4 = 2.0\n")
     assert main(["mesh", "--dim", "2", "--config", str(cfg), "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and err.startswith("gatetherm: error: l4: ") and "Traceback" not in err
+    assert err.count("\n") == 1 and err.startswith(f"gatetherm: error: {cfg}: geometry.l4: ") and "Traceback" not in err
     assert not (tmp_path / "x").exists()
 
 

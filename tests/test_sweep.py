@@ -237,18 +237,29 @@ def test_unreachable_scheduler_is_an_input_error(study_dir, capsys, monkeypatch)
 
 
 def test_killed_sweep_restarts_to_the_same_table(study_dir):
-    """Kill a sweep (SIGKILL) once two points are stored, restart it, compare with a clean run."""
+    """Kill a 2-worker sweep (SIGKILL) once two points are stored: its workers die with it;
+    restart it, compare with a clean run."""
+    from test_faults import alive, children, group
+
     study = study_dir / "study.toml"
     study.write_text(STUDY.replace('"derived.beta" = [0.1]', '"derived.beta" = [0.03, 0.3]'))
     out = study_dir / "killed"
-    cmd = [sys.executable, "-m", "gatetherm.studies.cli", "sweep", str(study), "--out", str(out), "--workers", "1",
+    cmd = [sys.executable, "-m", "gatetherm.studies.cli", "sweep", str(study), "--out", str(out), "--workers", "2",
            "--no-plots"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.monotonic() + 60
     while len(_stored(out)) < 2 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.01)
+    workers = children(proc.pid)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
+    deadline = time.monotonic() + 10
+    while any(map(alive, workers)) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    left = group(proc.pid)
+    for pid in left:
+        os.kill(pid, signal.SIGKILL)
+    assert len(workers) == 2 and not left
     assert 2 <= len(_stored(out)) < 8 and not (out / "table.csv").exists()
     for p in _stored(out):  # every stored result is whole (a stray temporary .name is never read)
         assert json.loads(p.read_text())["key"] == p.stem

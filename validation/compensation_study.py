@@ -42,9 +42,10 @@ from gatetherm.studies.control import actuator as piezo
 from gatetherm.solvers.beam import theory_coefficients
 from gatetherm.solvers.reduced import tip_coefficients_um
 from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction,
-                                                   extrapolate, predict, summarize)
+                                                   predict, summarize)
 from gatetherm.studies.run.conditions import condition
-from gatetherm.studies.control.regression import THETAS, LinearModel, apply_regression, fit_coefficients, fit_regression
+from gatetherm.studies.control.regression import (THETAS, LinearModel, apply_regression, fit_coefficients,
+                                                  fit_regression, regression_forecast)
 from gatetherm.studies.run.simulate import delta_figures
 
 log = logging.getLogger(__name__)
@@ -106,10 +107,8 @@ class Baseline:
 def _prediction(ts, predictor, params: CompensatorParams):
     if not isinstance(predictor, Baseline):
         return predict(ts, *predictor, params)
-    now = apply_regression(predictor.model, ts)
-    if predictor.forecast:  # the model is linear: extrapolating its inputs extrapolates its output
-        now = np.r_[np.nan, np.nan, extrapolate(now[:-2], now[1:-1])]
-    return external_prediction(ts, now, params)
+    forecast = regression_forecast if predictor.forecast else apply_regression
+    return external_prediction(ts, forecast(predictor.model, ts), params)
 
 
 def _band(x: np.ndarray, mask: np.ndarray) -> float:

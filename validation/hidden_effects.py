@@ -28,7 +28,6 @@ import logging
 import multiprocessing
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,6 +41,7 @@ from gatetherm.studies.diagnosis.replay import DELTA, resolution
 from gatetherm.studies.run.scenario import condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
+from gatetherm.studies.sweeps.pool import worker_pool
 
 log = logging.getLogger(__name__)
 
@@ -275,7 +275,7 @@ def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")  # one thread per worker process
     rows = []
-    with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+    with worker_pool(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
         for row in pool.map(_worker, [(c, mesh_size) for c in todo]):
             rows.append(row)
             if on_row:

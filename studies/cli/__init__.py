@@ -1,20 +1,79 @@
-"""The ``gatetherm`` console command: argument parsing and error reporting only."""
+"""The ``gatetherm`` console command: argument parsing and error reporting only.
+
+Exit codes: 0 done; 1 an I/O failure (a full disk, an output directory that cannot be
+written or that another run is writing into) or failed sweep points; 2 bad input; 130
+Ctrl-C; 143 SIGTERM. Each failure is one line on stderr, never a traceback; argument
+errors too (the usage is printed by ``--help``). Only ``os``, ``signal``, ``sys`` and
+``threading`` are imported before :func:`main` runs, so that a Ctrl-C while the command
+modules are imported ends in that one line as well.
+"""
 from __future__ import annotations
 
-import argparse
-import importlib
-import logging
+import os
+import signal
 import sys
-
-from gatetherm import InputError
+import threading
 
 #: Sub-command modules of this package, in ``--help`` order.
-COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "compensate", "sweep", "validate", "diagnose", "export",
-                   "report")
+COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
+                   "export", "report")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that a run cleans up (temporaries, lock) on its way out."""
+
+
+class _Signals:
+    """SIGINT and SIGTERM while a command runs (main thread only): KeyboardInterrupt or
+    :class:`Terminated` in the main thread, so that the run cleans up on its way out. Some
+    extension modules swallow or convert an exception raised while they load; so a signal is
+    also remembered (the command then ends with its line however it unwinds) and, should the
+    command go on regardless, ends the process after :attr:`GRACE_S`. A signal ignored when
+    the command starts (SIGINT of a background job) stays ignored."""
+
+    GRACE_S = 5.0
+    CODES = {signal.SIGINT: ("interrupted", 130), signal.SIGTERM: ("terminated", 143)}
+
+    def __init__(self):
+        self.seen = None
+        """(message, exit code) of the first signal received."""
+        self.timer = None
+        self.previous = {}
+        if threading.current_thread() is threading.main_thread():
+            self.previous = {sig: signal.signal(sig, self._received) for sig in self.CODES
+                             if signal.getsignal(sig) is not signal.SIG_IGN}
+
+    def _received(self, signum, frame):
+        if self.seen is None:
+            self.seen = self.CODES[signum]
+            self.timer = threading.Timer(self.GRACE_S, self._exit_now)
+            self.timer.daemon = True
+            self.timer.start()
+        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated
+
+    def _exit_now(self) -> None:
+        os.write(2, f"gatetherm: {self.seen[0]}\n".encode())
+        os._exit(self.seen[1])
+
+    def report(self) -> int:
+        """Print the signal's one line (ignoring another meanwhile); its exit code."""
+        for sig in self.previous:
+            signal.signal(sig, signal.SIG_IGN)
+        return _say(*self.seen)
+
+    def restore(self) -> None:
+        if self.timer:
+            self.timer.cancel()
+        for sig, handler in self.previous.items():
+            signal.signal(sig, handler)
+
+
+def build_parser():
+    import importlib
+
+    from gatetherm.studies.cli.options import Parser
+
+    parser = Parser(
         prog="gatetherm",
         description="Thermal deformation of gate-type machine-tool frames: "
         "FE, beam theory and compensation.",
@@ -26,11 +85,29 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _say(message: str, code: int) -> int:
+    print(f"gatetherm: {message}", file=sys.stderr)
+    return code
 
 
-def main(argv: list[str] | None = None) -> int:
+def _os_message(err: OSError) -> str:
+    return f"{err.filename}: {err.strerror}" if err.filename and err.strerror else str(err)
+
+
+def _run(argv: list[str] | None) -> int:
+    import logging
+
+    from gatetherm import InputError
+    from gatetherm.studies.cli.options import UsageError
+
     parser = build_parser()
-    args = parser.parse_args(argv)  # argparse itself exits 2 with a one-line usage error
+    try:
+        args = parser.parse_args(argv)
+    except UsageError as err:
+        print(err, file=sys.stderr)
+        return 2
+    except SystemExit as done:  # --help
+        return done.code if isinstance(done.code, int) else 0
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
@@ -38,17 +115,34 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from gatetherm.studies.cli.process import configure
+    from gatetherm.studies.sweeps.runner import PointsFailed
+
+    configure()
     try:
         return int(args.func(args) or 0)
     except InputError as err:
-        print(f"gatetherm: error: {err}", file=sys.stderr)
-        return 2
-    except (FileNotFoundError, IsADirectoryError, PermissionError) as err:
-        print(f"gatetherm: error: {err.filename}: {err.strerror}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("gatetherm: interrupted", file=sys.stderr)
-        return 130
+        return _say(f"error: {err}", 2)
+    except PointsFailed as err:
+        return _say(f"error: {err}", 1)
+    except OSError as err:
+        return _say(f"error: {_os_message(err)}", 1)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns the exit code (see the module docstring)."""
+    signals = _Signals()
+    try:
+        try:
+            code = _run(argv)
+        except BaseException as err:
+            if signals.seen is None and isinstance(err, KeyboardInterrupt):  # not raised by our handler
+                signals.seen = _Signals.CODES[signal.SIGINT]
+            if signals.seen is None:
+                raise
+        return code if signals.seen is None else signals.report()
+    finally:
+        signals.restore()
 
 
 if __name__ == "__main__":

@@ -12,14 +12,17 @@ import argparse
 import dataclasses
 import json
 import logging
-import math
 from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.solvers.effects import CATALOGUE, catalogue_json
-from gatetherm.studies.cli.options import add_model_options
+from gatetherm.checks import POSITIVE
+from gatetherm.studies.cli.options import add_model_options, number
 
 log = logging.getLogger(__name__)
+
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "report.md", "diagnosis.json")
 
 
 def register(sub) -> None:
@@ -33,7 +36,7 @@ def register(sub) -> None:
     p.add_argument("--train-fraction", type=float, default=0.6, metavar="F",
                    help="fit on the first F of the run, score on the rest (default 0.6: 3 h of 5 h)")
     p.add_argument("--effects", metavar="NAME,...", help="candidate effects (default: the whole catalogue)")
-    p.add_argument("--mesh-size", type=float, metavar="M",
+    p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M",
                    help="element size of the diagnosis mesh, m (default: the model file's)")
     p.add_argument("--list-effects", action="store_true", help="list the effect catalogue and exit")
     p.add_argument("--json", action="store_true", help="with --list-effects: print JSON")
@@ -66,23 +69,18 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")
     if not args.data or not args.out:
         raise InputError("--data/--out", "both are required", "e.g. gatetherm diagnose --data run.csv --out diag")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError("--out", f"{out} exists and is not a directory", "give a directory path")
+    from gatetherm.outdir import output_dir
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.diagnosis.discrepancy import adopted_config, diagnose
     from gatetherm.studies.run.timeseries import read_timeseries
 
     settings = settings_from(args)
     cfg = load_config(args.config)
-    mesh = cfg.model.mesh
-    if args.mesh_size is not None:
-        if not (math.isfinite(args.mesh_size) and args.mesh_size > 0):
-            raise InputError("--mesh-size", f"must be a positive size in m, got {args.mesh_size}", "e.g. 0.012")
-        mesh = dataclasses.replace(mesh, size=args.mesh_size)
+    mesh = cfg.model.mesh if args.mesh_size is None else dataclasses.replace(cfg.model.mesh, size=args.mesh_size)
     ts = read_timeseries(args.data)
-    diag = diagnose(cfg, ts, args.dim, mesh, settings)
-    _write(args, cfg, diag, adopted_config(cfg, diag), out)
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data)) as out:
+        diag = diagnose(cfg, ts, args.dim, mesh, settings)
+        _write(args, cfg, diag, adopted_config(cfg, diag), out)
     s = diag.summary()
     print(f"verdict: {diag.verdict}" + (f" ({diag.named_effect})" if diag.named_effect else "")
           + f"; runner-up {diag.runner_up}, margin {s['margin'] if s['margin'] is None else round(s['margin'], 1)}")

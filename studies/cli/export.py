@@ -8,6 +8,9 @@ from pathlib import Path
 from gatetherm import InputError, write_text_atomic
 from gatetherm.studies.cli.options import add_model_options
 
+#: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
+OUTPUTS = ("job.inp", "gatetherm.json")
+
 
 def register(sub) -> None:
     p = sub.add_parser("export", help="export a state for another code (ccx: CalculiX input deck)",
@@ -24,7 +27,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from gatetherm.studies.run.ccx import export_state
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.ccx import check_time, export_state
     from gatetherm.studies.run.scenario import case_schedule, condition_schedule
 
     if (args.case is None) == (args.condition is None):
@@ -40,9 +44,11 @@ def run(args) -> int:
         cfg = load_config(args.config)
         schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
-    inp, info = export_state(cfg, dim, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
-    write_text_atomic(Path(args.out) / "job.inp", inp)
-    write_text_atomic(Path(args.out) / "gatetherm.json", json.dumps(info, indent=2) + "\n")
+    check_time(schedule, t)
+    with output_dir(args.out, OUTPUTS, keep=(args.case, args.config)) as out:
+        inp, info = export_state(cfg, dim, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
+        write_text_atomic(out / "job.inp", inp)
+        write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")
     print(f"wrote {args.out}/job.inp ({info['vertices']} vertices) and gatetherm.json; run: cd {args.out} && ccx job")
     for name, v in info["relative_m"].items():
         print(f"gatetherm {name}: {v * 1e6:.6g} um")

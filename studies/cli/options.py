@@ -5,6 +5,8 @@ import argparse
 import os
 import sys
 
+from gatetherm.checks import Range
+
 
 def add_model_options(p: argparse.ArgumentParser, dims=(2, 3)) -> None:
     """``--dim`` and ``--config``, shared by the commands that build a model."""
@@ -14,7 +16,7 @@ def add_model_options(p: argparse.ArgumentParser, dims=(2, 3)) -> None:
 
 def add_parallel_options(p: argparse.ArgumentParser) -> None:
     """``--workers`` and ``--scheduler``, shared by the commands that run many points."""
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
+    p.add_argument("--workers", type=number(WORKERS), default=os.cpu_count() or 1, metavar="N",
                    help="local worker processes (default: the CPU count; 1 = in this process)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run the points on an existing Dask cluster, e.g. tcp://10.0.0.5:8786")
@@ -35,3 +37,33 @@ class Progress:
         if i == n:
             self.stream.write("\n")
         self.stream.flush()
+
+
+class UsageError(Exception):
+    """A command-line error found by argparse; ``str(err)`` is the one line to print."""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (exit code 2); the usage is printed by ``--help`` only.
+    Sub-command parsers are of the same class."""
+
+    def error(self, message):
+        raise UsageError(f"{self.prog}: error: {message} (see '{self.prog} --help')")
+
+
+def number(rng: Range):
+    """An argparse ``type``: a number (a whole one if ``rng.whole``) admissible in ``rng``."""
+    def parse(text: str):
+        try:
+            value = int(text) if rng.whole else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {'a whole number' if rng.whole else 'a number'}, "
+                                             f"got {text!r}") from None
+        if not rng.admits(value):
+            raise argparse.ArgumentTypeError(f"got {text}, must be {rng}")
+        return value
+    return parse
+
+
+WORKERS = Range(1, whole=True)
+"""Worker processes."""

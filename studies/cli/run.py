@@ -6,6 +6,10 @@ from pathlib import Path
 
 from gatetherm.studies.cli.options import Progress
 
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5",
+           "channels.png", "deformed.png")
+
 
 def register(sub) -> None:
     p = sub.add_parser("run", help="run a case file (any frame): time series, summary, fields",
@@ -19,22 +23,29 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from gatetherm.outdir import output_dir
     from gatetherm.studies.run.case import load_case
-    from gatetherm.studies.run.output import probe_summary, write_json, write_run
-    from gatetherm.studies.run.scenario import case_schedule, run_scenario
 
     t0 = time.perf_counter()
     case = load_case(args.case)
+    inputs = (args.case, case.time.schedule if case.time else None)
+    with output_dir(args.out, OUTPUTS, keep=inputs) as out:
+        return _run(args, case, out, t0)
+
+
+def _run(args, case, out: Path, t0: float) -> int:
+    from gatetherm.studies.run.output import probe_summary, write_json, write_run
+    from gatetherm.studies.run.scenario import case_schedule, run_scenario
+
     schedule = case_schedule(case)
     every = case.time.fields if case.time else 1.0
     fields = {float(t) for t in schedule.times if abs(t / every - round(t / every)) < 1e-9} | {float(schedule.times[-1])}
     res = run_scenario(case, case.mesh.dim, schedule, keep_times=sorted(fields), on_step=Progress(case.name))
-    out = Path(args.out)
-    write_run(out, res, {"source": "gatetherm run", "case": str(args.case), "name": case.name}, fields)
+    solved = write_run(out, res, {"source": "gatetherm run", "case": str(args.case), "name": case.name}, fields)
     if not args.no_pictures:
         from gatetherm.validation.plots.run import plot_case
 
-        plot_case(res, out, case.name)
+        plot_case(res, out, case.name, solved)
     p = case.problem
     summary = {"case": case.name, "file": str(args.case), "dim": p.dim, "order": p.order,
                "analysis": "prescribed temperature" if not p.heat else ("transient" if case.time else "steady"),

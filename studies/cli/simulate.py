@@ -4,7 +4,12 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from gatetherm.studies.cli.options import Progress, add_model_options
+from gatetherm.checks import POSITIVE
+from gatetherm.studies.cli.options import Progress, add_model_options, number
+
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5",
+           "oil_temperatures.png", "response.png", "deformed.png")
 
 
 def register(sub) -> None:
@@ -15,7 +20,7 @@ def register(sub) -> None:
                      help="inputs (time_s, oil_degC, pump[, ambient_degC]) in the gatetherm time-series format")
     add_model_options(p)
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
-    p.add_argument("--fields-every", type=float, default=60.0, metavar="MIN",
+    p.add_argument("--fields-every", type=number(POSITIVE), default=60.0, metavar="MIN",
                    help="write temperature/displacement fields every MIN minutes (default 60)")
     p.add_argument("--effect", action="append", default=[], metavar="NAME:PARAM=VALUE",
                    help="switch on a catalogue effect (see 'gatetherm diagnose --list-effects')")
@@ -24,16 +29,23 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from gatetherm.outdir import output_dir
     from gatetherm.solvers.effects import parse_effect_options
     from gatetherm.studies.run.config import load_config
-    from gatetherm.studies.run.output import write_json, write_run
-    from gatetherm.studies.run.scenario import condition_schedule, file_schedule, run_scenario
-    from gatetherm.studies.run.simulate import delta_figures
+    from gatetherm.studies.run.scenario import condition_schedule, file_schedule
 
     cfg = load_config(args.config)
     effects = parse_effect_options(args.effect).values  # on top of the model file's
     schedule = file_schedule(args.schedule, cfg) if args.schedule else condition_schedule(args.condition, cfg)
-    out = Path(args.out)
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.schedule)) as out:
+        return _simulate(args, cfg, effects, schedule, out)
+
+
+def _simulate(args, cfg, effects, schedule, out: Path) -> int:
+    from gatetherm.studies.run.output import write_json, write_run
+    from gatetherm.studies.run.scenario import run_scenario
+    from gatetherm.studies.run.simulate import delta_figures
+
     t_start = time.perf_counter()
     every = max(args.fields_every, 1.0) * 60.0
     field_times = {float(t) for t in schedule.times if t % every < 1e-6}
@@ -45,13 +57,14 @@ def run(args) -> int:
     meta = {"source": "gatetherm simulate", "schedule": schedule.label, "dim": str(args.dim), "config": cfg.source}
     if args.condition:
         meta["condition"] = str(args.condition)
-    write_run(out, res, meta, field_times)
-    if not args.no_pictures:
-        from gatetherm.validation.plots.run import plot_run
-
+    pictures = not args.no_pictures
+    if pictures:
+        from gatetherm.validation.plots.run import picture_time, plot_run
+    solved = write_run(out, res, meta, field_times, (picture_time(figs),) if pictures else ())
+    if pictures:
         title = f"gatetherm {args.dim}-D, " + (f"condition {args.condition}" if args.condition
                                                else Path(args.schedule).name)
-        plot_run(res, figs, out, title)
+        plot_run(res, figs, out, title, solved)
     model = res.model
     summary = {**figs, "wall_time_s": round(time.perf_counter() - t_start, 2),
                "build_s": round(res.seconds - res.result.seconds, 2), "march_s": round(res.result.seconds, 2),

@@ -7,11 +7,13 @@ from the point files after every run), ``DIR/study.json`` and the PNGs of the st
 from __future__ import annotations
 
 import json
-import sys
-from pathlib import Path
 
-from gatetherm import write_text_atomic
+from gatetherm import InputError, write_text_atomic
 from gatetherm.studies.cli.options import Progress, add_parallel_options
+
+#: What a run writes into --out besides the point files (kept: a rerun resumes from them);
+#: a rerun replaces all of it.
+OUTPUTS = ("table.csv", "study.json", "*_vs_*.png")
 
 
 def register(sub) -> None:
@@ -26,13 +28,27 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from gatetherm.studies.sweeps.runner import PointStore, run_studies, write_table
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.sweeps.runner import PointsFailed
     from gatetherm.studies.sweeps.studyfile import load_study
-    from gatetherm.studies.sweeps.sweep import plan, table
+    from gatetherm.studies.sweeps.sweep import plan
 
     study = load_study(args.study)
-    tasks = plan(study)
-    out = Path(args.out)
+    try:
+        tasks = plan(study)
+    except InputError as err:
+        raise err.at(args.study) from None
+    with output_dir(args.out, OUTPUTS, keep=(args.study,)) as out:
+        failed = _sweep(args, study, tasks, out)
+    if failed:
+        raise PointsFailed(failed, len(tasks))
+    return 0
+
+
+def _sweep(args, study, tasks, out) -> list:
+    from gatetherm.studies.sweeps.runner import PointStore, run_studies, write_table
+    from gatetherm.studies.sweeps.sweep import table
+
     (records,), failed = run_studies([(tasks, PointStore(out))], args.workers, args.scheduler,
                                      Progress(f"sweep {study.name}"))
     columns, rows = table(tasks, records)
@@ -51,6 +67,4 @@ def run(args) -> int:
             others = [k for k, _ in study.grid if k not in (spec.x, spec.hue)]
             plot_xy(rows, spec.x, spec.y, spec.hue, path, study.name, lines_by=others)
             print(f"wrote {path}")
-    for t, err in failed:
-        print(f"gatetherm: point {dict(t.params)} failed: {err}", file=sys.stderr)
-    return 1 if failed else 0
+    return failed

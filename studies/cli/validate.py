@@ -6,10 +6,12 @@ arguments and prints what they return.
 """
 from __future__ import annotations
 
-import sys
+import argparse
 from pathlib import Path
 
-from gatetherm.studies.cli.options import Progress, add_model_options, add_parallel_options
+from gatetherm import InputError
+from gatetherm.checks import POSITIVE, Range
+from gatetherm.studies.cli.options import WORKERS, Progress, add_model_options, add_parallel_options, number
 
 
 def register(sub) -> None:
@@ -20,19 +22,17 @@ def register(sub) -> None:
         t = targets.add_parser(name, help=text, description=text)
         add_arguments(t)
         t.add_argument("--out", required=True, metavar="DIR", help="output directory")
-        t.set_defaults(func=_guarded(run))
+        t.set_defaults(func=_in_output_dir(run))
 
 
-def _guarded(run):
-    """A target's run(args) that reports failed sweep points on stderr with exit code 1."""
+def _in_output_dir(run):
+    """A target's run(args) inside its output directory (checked, locked, stale temporaries
+    removed; a study's own files are rewritten or resumed by the study)."""
     def wrapped(args) -> int:
-        from gatetherm.studies.sweeps.runner import PointsFailed
+        from gatetherm.outdir import output_dir
 
-        try:
+        with output_dir(args.out):
             return run(args)
-        except PointsFailed as err:
-            print(f"gatetherm: {err}", file=sys.stderr)
-            return 1
     return wrapped
 
 
@@ -82,22 +82,49 @@ def run_compensation(args) -> int:
     return 0
 
 
-def _hidden_arguments(p) -> None:
-    from gatetherm.validation.hidden_effects import ALL_CASES
+def _conditions(text: str) -> tuple[int, ...]:
+    """An argparse ``type``: the paper's condition numbers, comma separated."""
+    items = tuple(x.strip() for x in text.split(","))
+    if not all(x in ("1", "2", "3") for x in items):
+        raise argparse.ArgumentTypeError(f"got {text!r}, must be numbers of 1, 2, 3 separated by commas")
+    return tuple(map(int, items))
 
-    p.add_argument("--workers", type=int, default=2, metavar="N", help="worker processes (default 2)")
+
+def _rom_arguments(p) -> None:
+    p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
+    p.add_argument("--dims", type=int, nargs="+", choices=(2, 3), default=[2, 3], help="dimensions (default 2 3)")
+
+
+def run_rom(args) -> int:
+    from gatetherm.studies.run.config import load_config
+    from gatetherm.validation.rom_study import write_rom_study
+
+    print(write_rom_study(Path(args.out), load_config(args.config), args.dims,
+                          on_row=lambda r: print(f"{r.case}, condition {r.condition}, {r.data}: paper {r.paper_um:.2f}, "
+                                                 f"MLR {r.mlr_um:.2f}, rom {r.rom_5min_um:.2f} / {r.rom_event_um:.2f} "
+                                                 f"µm ({r.rom_updates} updates)", flush=True)), end="")
+    return 0
+
+
+def _hidden_arguments(p) -> None:
+    p.add_argument("--workers", type=number(WORKERS), default=2, metavar="N", help="worker processes (default 2)")
     p.add_argument("--seed", type=int, default=6, help="seed of the strengths and the noise (default 6)")
-    p.add_argument("--conditions", default="1,2,3", help="conditions, comma separated (default 1,2,3)")
-    p.add_argument("--effects", default=",".join(ALL_CASES), metavar="NAME,...",
+    p.add_argument("--conditions", type=_conditions, default=(1, 2, 3),
+                   help="conditions, comma separated (default 1,2,3)")
+    p.add_argument("--effects", metavar="NAME,...",
                    help="catalogue effects, outside-catalogue cases, mismatches and 'none' (default: all)")
-    p.add_argument("--mesh-size", type=float, metavar="M", help="diagnosis element size, m (default: the model's)")
+    p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M",
+                   help="diagnosis element size, m (default: the model's)")
 
 
 def run_hidden(args) -> int:
-    from gatetherm.validation.hidden_effects import row_line, write_hidden_effects
+    from gatetherm.validation.hidden_effects import ALL_CASES, row_line, write_hidden_effects
 
-    acc = write_hidden_effects(Path(args.out), args.workers, args.seed,
-                               tuple(int(x) for x in args.conditions.split(",")), set(args.effects.split(",")),
+    effects = set(args.effects.split(",")) if args.effects else set(ALL_CASES)
+    if effects - set(ALL_CASES):
+        raise InputError("--effects", f"unknown {', '.join(sorted(effects - set(ALL_CASES)))}",
+                         f"choose from {', '.join(ALL_CASES)}")
+    acc = write_hidden_effects(Path(args.out), args.workers, args.seed, args.conditions, effects,
                                args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
     for k, v in acc.items():
         if k != "rows":
@@ -106,8 +133,10 @@ def run_hidden(args) -> int:
 
 
 def _calibrate_arguments(p) -> None:
-    p.add_argument("--evals", type=int, default=150, help="objective evaluations (default 150)")
-    p.add_argument("--mesh-size", type=float, default=0.012, metavar="M", help="element size, m (default 0.012)")
+    p.add_argument("--evals", type=number(Range(1, whole=True)), default=150,
+                   help="objective evaluations (default 150)")
+    p.add_argument("--mesh-size", type=number(POSITIVE), default=0.012, metavar="M",
+                   help="element size, m (default 0.012)")
 
 
 def run_calibrate(args) -> int:
@@ -127,6 +156,8 @@ TARGETS = {
               run_paper),
     "compensation": ("the paper's compensator, the regression baseline and the piezo on conditions 1-3",
                      add_model_options, run_compensation),
+    "rom": ("paper vs regression vs reduced-model compensation: conditions 1-3 in 2-D/3-D, hidden effects",
+            _rom_arguments, run_rom),
     "hidden-effects": ("diagnose runs with a hidden catalogue effect, noise only, outside effects, mismatches",
                        _hidden_arguments, run_hidden),
     "calibrate": ("refit the default paper model to the paper's figures (a record of the procedure)",

@@ -44,7 +44,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.studies.control import actuator as piezo
-from gatetherm.studies.run.timeseries import TimeSeries, rises, validate_complete
+from gatetherm.studies.run.timeseries import TimeSeries, check_steps, rises, validate_complete
 
 log = logging.getLogger(__name__)
 
@@ -101,6 +101,8 @@ class Prediction:
     """Grid index j of the first positive peak of delta, None if not recognised."""
     resampled: bool
     """True if the input was linearly resampled onto the grid."""
+    updates: np.ndarray | None = None
+    """Grid indices of the piezo updates; None: every ``update_interval_s`` from the first sample."""
 
 
 @dataclass(frozen=True)
@@ -148,23 +150,28 @@ def held_ratio(numerator: float, denominator: float, previous: float, threshold_
     return (float(np.clip(ratio, *limits)) if limits else ratio), False
 
 
-def controller_grid(ts: TimeSeries, params: CompensatorParams) -> tuple[TimeSeries, bool]:
-    """The needed columns on the sampling grid from the first sample; linear resampling if off it."""
+def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=()) -> tuple[TimeSeries, bool]:
+    """The needed columns and ``extra`` ones on the sampling grid from the first sample; linear
+    resampling if off it (``pump`` held from the sample before)."""
     validate_complete(ts, NEEDED)
     t, dt = ts.time_s, params.sample_interval_s
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         raise InputError(f"data row {back[0] + 2}, column time_s", "time does not increase",
                          "sort the rows or remove the duplicate")
+    check_steps(t[-1] - t[0], dt, "time_s")
     grid = t[0] + dt * np.arange(int(np.floor((t[-1] - t[0]) / dt + 1e-9)) + 1)
     if len(grid) < 3:
         raise InputError("time_s", f"the run covers fewer than 3 samples of {dt:g} s",
                          "the one-step extrapolation needs at least 3")
+    names = NEEDED + tuple(n for n in extra if n not in NEEDED)
     if len(grid) == len(t) and np.allclose(t, grid, rtol=0, atol=1e-6 * dt):
-        return TimeSeries({n: ts[n] for n in NEEDED}), False
+        return TimeSeries({n: ts[n] for n in names}), False
     log.info("data not on a %g s grid (%d samples, spacing %.4g..%.4g s): resampled linearly to %d",
              dt, len(t), np.diff(t).min(), np.diff(t).max(), len(grid))
-    return TimeSeries({"time_s": grid, **{n: np.interp(grid, t, ts[n]) for n in NEEDED[1:]}}), True
+    before = np.clip(np.searchsorted(t, grid + 1e-9 * dt, side="right") - 1, 0, len(t) - 1)
+    return TimeSeries({"time_s": grid, **{n: ts[n][before] if n == "pump" else np.interp(grid, t, ts[n])
+                                          for n in names[1:]}}), True
 
 
 def _peak_confirmed(delta: np.ndarray, c: int, best: int, drop_um: float) -> bool:
@@ -233,7 +240,7 @@ def close_loop(ts: TimeSeries, pr: Prediction, params: CompensatorParams,
                actuator: piezo.ActuatorParams | None = None) -> ClosedLoop:
     """Drive the piezo (ideal if ``actuator`` is None) with a prediction's held commands."""
     every = round(params.update_interval_s / params.sample_interval_s)
-    updates = np.arange(0, len(pr.t_s), every)
+    updates = np.arange(0, len(pr.t_s), every) if pr.updates is None else pr.updates
     if actuator is None:
         volts, stroke, saturated = np.full(updates.size, np.nan), pr.u_um[updates], 0
     else:
@@ -278,4 +285,5 @@ def summarize(loop: ClosedLoop, settle_s: float = 600.0) -> dict[str, float | No
         "peak_time_s": None if pr.peak_index is None else float(pr.t_s[pr.peak_index]),
         "peak_delta_um": None if pr.peak_index is None else float(pr.delta_um[pr.peak_index]),
         "piezo_saturated_updates": loop.saturated_updates,
+        "updates": int(loop.update_t_s.size),
     }

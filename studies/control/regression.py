@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.studies.control.compensator import extrapolate
 from gatetherm.studies.run.timeseries import TimeSeries, rises
 
 log = logging.getLogger(__name__)
@@ -99,3 +100,10 @@ def fit_regression(ts: TimeSeries, features=None) -> LinearModel:
 def apply_regression(model: LinearModel, ts: TimeSeries) -> np.ndarray:
     """Predicted delta (um) for another run (rises from its own first sample)."""
     return _design(ts, model.features) @ np.r_[model.intercept_um, model.coefficients]
+
+
+def regression_forecast(model: LinearModel, ts: TimeSeries) -> np.ndarray:
+    """One-sample-ahead forecast of delta (um) from temperatures extrapolated one step (eq 33):
+    the model is linear, so extrapolating its inputs extrapolates its output (NaN for the first two)."""
+    now = apply_regression(model, ts)
+    return np.r_[np.nan, np.nan, extrapolate(now[:-2], now[1:-1])]

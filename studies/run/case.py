@@ -19,12 +19,15 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.checks import CELSIUS, Range, ranges
+from gatetherm.files import read_text
 from gatetherm.geometry.gmshfile import CAD, SCRIPT, BoxGroup, MeshSpec, Refinement, mesh_geometry
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
-from gatetherm.solvers.expr import ExpressionError, Value
+from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
+from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
                                        Relative, Signals, Source, Support)
 
@@ -32,8 +35,12 @@ SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "f
             "supports", "probes", "relative", "means", "signals", "time")
 MATERIAL_KEYS = {"k": "W/(m K)", "rho": "kg/m³", "c": "J/(kg K)", "E": "Pa", "nu": "1", "alpha": "1/K",
                  "thickness": "m"}
+MATERIAL = ranges(Material)
+"""Admissible values of the material keys (those of the model file's [material])."""
+SCHEME = ranges(TimeScheme)
+METRES, SECONDS = Range(0.0, lo_open=True, unit="m"), Range(0.0, lo_open=True, unit="s")
+FILM = Range(0.0, unit="W/(m² K)")
 QUANTITIES = ("T", "u", "sigma")
-ABSOLUTE_ZERO = -273.15
 
 
 @dataclass(frozen=True)
@@ -70,75 +77,7 @@ class Case:
         return str(self.path)
 
 
-class _Table:
-    """One table of the case file; remembers where it is for the error messages."""
-
-    def __init__(self, file: Path, where: str, data, known=None):
-        self.file, self.where = file, where
-        if not isinstance(data, dict):
-            raise InputError(f"{file}: {where}", f"expected a table, got {data!r}", f"write [{where}] with key = value")
-        self.data = data
-        if known is not None:
-            for key in data:
-                if key not in known:
-                    raise InputError(f"{file}: {where}.{key}", "unknown key", f"known keys: {', '.join(known)}")
-
-    def key(self, k: str) -> str:
-        return f"{self.file}: {self.where}.{k}"
-
-    def fail(self, k: str, problem: str, fix: str = ""):
-        raise InputError(self.key(k), problem, fix)
-
-    def number(self, k: str, default=None, lo: float = -math.inf, hi: float = math.inf, open_lo=False,
-               unit: str = ""):
-        if k not in self.data:
-            if default is None:
-                self.fail(k, "missing", f"give it{' in ' + unit if unit else ''}")
-            return default
-        v = self.data[k]
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            self.fail(k, f"expected a finite number, got {v!r}", f"give it{' in ' + unit if unit else ''}")
-        if v < lo or v > hi or (open_lo and v == lo):
-            rng = f"{'(' if open_lo else '['}{lo:g}, {hi:g}]" if math.isfinite(hi) else \
-                f"{'>' if open_lo else '>='} {lo:g}"
-            self.fail(k, f"{v!r} is not admissible", f"give a value {rng}{' ' + unit if unit else ''}")
-        return float(v)
-
-    def string(self, k: str, default=None, choices=None) -> str:
-        if k not in self.data:
-            if default is None:
-                self.fail(k, "missing", f"choose one of {', '.join(choices)}" if choices else "give a name")
-            return default
-        v = self.data[k]
-        if not isinstance(v, str) or (choices and v not in choices):
-            self.fail(k, f"{v!r} is not admissible", f"choose one of {', '.join(choices)}" if choices else "give a string")
-        return v
-
-    def name(self, k: str, valid, what: str, default=None) -> str:
-        v = self.string(k, default=default)
-        if v and v not in valid:
-            self.fail(k, f"'{v}' is not a {what} of the mesh", f"{what}s: {', '.join(valid) or 'none'}")
-        return v
-
-    def value(self, k: str, names, default=None, unit: str = "") -> Value:
-        if k not in self.data and default is not None:
-            return Value(default)
-        if k not in self.data:
-            self.fail(k, "missing", f"give a number{' in ' + unit if unit else ''} or an expression")
-        try:
-            v = Value.of(self.data[k])
-        except ExpressionError as err:
-            self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
-        unknown = sorted(v.names() - set(names))
-        if unknown:
-            self.fail(k, f"unknown input '{unknown[0]}' in '{v}'", f"inputs here: {', '.join(sorted(names))}")
-        return v
-
-    def sub(self, k: str, known=None) -> "_Table":
-        return _Table(self.file, f"{self.where}.{k}" if self.where else k, self.data.get(k, {}), known)
-
-
-def _mesh(top: _Table, base: Path) -> FrameMesh:
+def _mesh(top: Table, base: Path) -> FrameMesh:
     m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups"))
     path = base / m.string("file")
     if not path.is_file():
@@ -155,22 +94,22 @@ def _mesh(top: _Table, base: Path) -> FrameMesh:
     params = m.sub("parameters")
     refine = []
     for i, r in enumerate(m.data.get("refine", [])):
-        rt = _Table(top.file, f"mesh.refine[{i + 1}]", r, ("near", "size", "distance"))
-        refine.append(Refinement(rt.string("near"), rt.number("size", lo=0, open_lo=True, unit="m"),
-                                 rt.number("distance", lo=0, open_lo=True, unit="m")))
+        rt = Table(top.file, f"mesh.refine[{i + 1}]", r, ("near", "size", "distance"))
+        refine.append(Refinement(rt.string("near"), rt.number("size", METRES),
+                                 rt.number("distance", METRES)))
     groups = []
     for name in m.data.get("groups", {}):
         g = m.sub("groups").sub(name, ("dim", "box"))
         box = g.data.get("box")
         if not (isinstance(box, list) and len(box) == 6 and all(isinstance(b, (int, float)) for b in box)):
             g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax], got {box!r}", "give six numbers in m")
-        groups.append(BoxGroup(name, int(g.number("dim", lo=0, hi=3)), tuple(float(b) for b in box)))
-    size = m.number("size", default=0.0, lo=0, unit="m") or None
+        groups.append(BoxGroup(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(float(b) for b in box)))
+    size = m.number("size", METRES, 0.0) or None
     return mesh_geometry(MeshSpec(path, size, {k: params.number(k) for k in params.data}, tuple(refine),
                                   tuple(groups)))
 
 
-def _materials(top: _Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
+def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
     mats = top.sub("materials", tuple(fm.regions))
     missing = [r for r in fm.regions if r not in mats.data]
     if missing:
@@ -182,18 +121,16 @@ def _materials(top: _Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
         for k in need - set(t.data):
             t.fail(k, "missing", f"give {k} in {MATERIAL_KEYS[k]} (needed for "
                    f"{'elasticity' if k in ('E', 'nu', 'alpha') else 'the heat solve'})")
-        get = {k: t.number(k, default=math.nan if k not in need else None, lo=0, open_lo=k != "alpha",
-                           unit=MATERIAL_KEYS[k]) for k in ("k", "rho", "c", "E", "alpha")}
-        nu = t.number("nu", default=math.nan if "nu" not in need else None, lo=0, hi=0.4999)
-        materials[region] = Material(E=get["E"], nu=nu, alpha=get["alpha"], k=get["k"], rho=get["rho"], c=get["c"])
+        given = {k: t.number(k, MATERIAL[k], math.nan if k not in need else None) for k in MATERIAL}
+        materials[region] = Material(**given)
         if "thickness" in t.data:
             if fm.dim == 3:
                 t.fail("thickness", "applies to 2-D sections only", "remove it")
-            thickness[region] = t.number("thickness", lo=0, open_lo=True, unit="m")
+            thickness[region] = t.number("thickness", METRES)
     return materials, thickness
 
 
-def _boundary_conditions(top: _Table, fm: FrameMesh, names) -> dict:
+def _boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
     th = top.sub("thermal", tuple(fm.boundaries))
     out = {"films": [], "fixed": [], "fluxes": []}
     for b in th.data:
@@ -203,7 +140,7 @@ def _boundary_conditions(top: _Table, fm: FrameMesh, names) -> dict:
             t.fail("/".join(kinds) or "film", "give exactly one condition: film (with ambient), temperature or flux",
                    "a boundary without a condition is adiabatic; leave it out")
         if kinds == ["film"]:
-            out["films"].append(Film(b, t.number("film", lo=0, unit="W/(m² K)"), t.value("ambient", names, unit="°C")))
+            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C")))
         elif "ambient" in t.data:
             t.fail("ambient", "goes with a film only", "remove it or give film")
         elif kinds == ["temperature"]:
@@ -213,34 +150,34 @@ def _boundary_conditions(top: _Table, fm: FrameMesh, names) -> dict:
     return out
 
 
-def _fluids(top: _Table, fm: FrameMesh, names, thickness: dict) -> tuple:
+def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
     out = []
     fl = top.sub("fluids")
     for name in fl.data:
         t = fl.sub(name, ("boundary", "volume", "rho_c", "flow_rate", "capacity", "conductance", "film_on", "film_off",
                           "supply", "pump", "hose_capacity", "hose_loss", "hose_name", "ambient"))
         wall = t.name("boundary", fm.boundaries, "boundary")
-        hose = t.number("hose_capacity", default=0.0, lo=0, unit="J/K")
+        hose = t.number("hose_capacity", Range(0.0, unit="J/K"), 0.0)
         if "capacity" in t.data:  # the lump's own figures
-            capacity = t.number("capacity", lo=0, open_lo=True, unit="J/K")
-            conductance = t.number("conductance", lo=0, unit="W/K")
+            capacity = t.number("capacity", Range(0.0, lo_open=True, unit="J/K"))
+            conductance = t.number("conductance", Range(0.0, unit="W/K"))
         else:  # the fluid's: volume (default: enclosed by the boundary), rho_c and flow
             depths = set(thickness.values()) | ({1.0} if len(thickness) < len(fm.regions) else set())
             if fm.dim == 2 and len(depths) > 1 and "volume" not in t.data:
                 t.fail("volume", "missing: the regions of this 2-D section differ in thickness",
                        "give the volume in m³")
-            volume = t.number("volume", default=0.0, lo=0, unit="m³") or enclosed_volume(fm, wall, min(depths))
-            rho_c = t.number("rho_c", lo=0, open_lo=True, unit="J/(m³ K)")
-            capacity, conductance = rho_c * volume, rho_c * t.number("flow_rate", lo=0, unit="m³/s")
-        out.append(Fluid(name, wall, capacity, t.number("film_on", lo=0, unit="W/(m² K)"),
-                         t.number("film_off", lo=0, unit="W/(m² K)"), conductance, t.value("supply", names, unit="°C"),
-                         t.value("pump", names, default=1.0), hose, t.number("hose_loss", default=0.0, lo=0, unit="W/K"),
+            volume = t.number("volume", Range(0.0, unit="m³"), 0.0) or enclosed_volume(fm, wall, min(depths))
+            rho_c = t.number("rho_c", Range(0.0, lo_open=True, unit="J/(m³ K)"))
+            capacity, conductance = rho_c * volume, rho_c * t.number("flow_rate", Range(0.0, unit="m³/s"))
+        out.append(Fluid(name, wall, capacity, t.number("film_on", FILM),
+                         t.number("film_off", FILM), conductance, t.value("supply", names, unit="°C"),
+                         t.value("pump", names, default=1.0), hose, t.number("hose_loss", Range(0.0, unit="W/K"), 0.0),
                          t.value("ambient", names, default=20.0 if not hose else None, unit="°C"),
                          t.string("hose_name", default="")))
     return tuple(out)
 
 
-def _supports(top: _Table, fm: FrameMesh) -> tuple:
+def _supports(top: Table, fm: FrameMesh) -> tuple:
     sup = top.sub("supports", tuple(fm.boundaries))
     out = []
     for b in sup.data:
@@ -255,14 +192,14 @@ def _supports(top: _Table, fm: FrameMesh) -> tuple:
             comps = tuple(sorted({axes.index(c) for c in raw}))
         if kind == "normal":
             comps = (_normal_axis(t, fm, b),)
-        stiff = t.number("stiffness", lo=0, open_lo=True, unit="N/m³") if kind == "foundation" else None
+        stiff = t.number("stiffness", Range(0.0, lo_open=True, unit="N/m³")) if kind == "foundation" else None
         if kind != "foundation" and "stiffness" in t.data:
             t.fail("stiffness", "goes with type = \"foundation\" only", "remove it")
         out.append(Support(b, comps, stiff))
     return tuple(out)
 
 
-def _normal_axis(t: _Table, fm: FrameMesh, boundary: str) -> int:
+def _normal_axis(t: Table, fm: FrameMesh, boundary: str) -> int:
     """The axis normal to a plane boundary parallel to a coordinate plane."""
     X = fm.points[np.unique(fm.boundaries[boundary])]
     spread = np.ptp(X, axis=0)
@@ -273,7 +210,7 @@ def _normal_axis(t: _Table, fm: FrameMesh, boundary: str) -> int:
     return int(flat[0])
 
 
-def _probes(top: _Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
+def _probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
     pr = top.sub("probes")
     out = []
     finder = None
@@ -307,7 +244,7 @@ def _probes(top: _Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
     return tuple(out)
 
 
-def _relative(top: _Table, probes, dim: int) -> tuple:
+def _relative(top: Table, probes, dim: int) -> tuple:
     rel = top.sub("relative")
     names = [p.name for p in probes if "u" in p.quantities] + [p.name for p in probes if "u" not in p.quantities]
     out = []
@@ -318,7 +255,7 @@ def _relative(top: _Table, probes, dim: int) -> tuple:
     return tuple(out)
 
 
-def _signals(top: _Table, probes, relative) -> Signals:
+def _signals(top: Table, probes, relative) -> Signals:
     s = top.sub("signals", ("theta_A", "theta_B", "theta_C", "delta"))
     temps = [p.name for p in probes if "T" in p.quantities]
     c = s.data.get("theta_C", [])
@@ -329,18 +266,18 @@ def _signals(top: _Table, probes, relative) -> Signals:
                    tuple(c), s.name("delta", [r.name for r in relative], "relative displacement", "") or None)
 
 
-def _time(top: _Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tuple[str, ...]]:
+def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tuple[str, ...]]:
     if "time" not in top.data:
         return None, TimeScheme(), ()
     t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
-    end = t.number("end", lo=0, open_lo=True, unit="s")
-    output = t.number("output", default=min(60.0, end), lo=0, open_lo=True, unit="s")
-    step = t.number("step", default=output, lo=0, open_lo=True, unit="s")
+    end = t.number("end", SECONDS)
+    output = t.number("output", SECONDS, min(60.0, end))
+    step = t.number("step", SECONDS, output)
     if abs(output / step - round(output / step)) > 1e-9:
         t.fail("output", f"{output:g} s is not a whole multiple of the step {step:g} s", "change output or step")
     sch = t.sub("scheme", ("theta", "restart", "restart_intervals"))
-    scheme = TimeScheme(sch.number("theta", 0.5, lo=0.5, hi=1.0), int(sch.number("restart", 4, lo=1)),
-                        int(sch.number("restart_intervals", 3, lo=0)))
+    scheme = TimeScheme(sch.number("theta", SCHEME["theta"], 0.5), int(sch.number("restart", SCHEME["restart"], 4)),
+                        int(sch.number("restart_intervals", SCHEME["restart_intervals"], 3)))
     schedule, columns = None, ()
     if "schedule" in t.data:
         from gatetherm.studies.run.timeseries import read_timeseries
@@ -349,20 +286,19 @@ def _time(top: _Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tup
         if not schedule.is_file():
             t.fail("schedule", f"no such file '{schedule}'", "give a time-series file (docs/data-format.md)")
         columns = tuple(n for n in read_timeseries(schedule, required=("time_s",)).names if n != "time_s")
-    return TimeSettings(end, step, output, t.number("fields", default=end, lo=0, open_lo=True, unit="s"),
+    return TimeSettings(end, step, output, t.number("fields", SECONDS, end),
                         schedule), scheme, columns
 
 
 def load_case(path) -> Case:
     """Read and check a case file (paths inside it are relative to its folder)."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError(str(path), "no such case file", "give the path of a .toml case")
+    text = read_text(path, "CASE.toml", "give the path of a .toml case file")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise InputError(str(path), f"not valid TOML ({err})") from None
-    top = _Table(path, "", data, SECTIONS)
+    top = Table(path, "", data, SECTIONS)
     head = top.sub("case", ("name", "order", "plane"))
     order = head.data.get("order", 1)
     if isinstance(order, bool) or order not in (1, 2):
@@ -376,7 +312,7 @@ def load_case(path) -> Case:
     materials, thickness = _materials(top, fm, need)
     names = ("t", *columns)
     init = top.sub("initial", ("temperature", "reference"))
-    T0 = init.number("temperature", 20.0, lo=ABSOLUTE_ZERO, open_lo=True, unit="°C")
+    T0 = init.number("temperature", CELSIUS, 20.0)
     kw: dict = {}
     if prescribed:
         for s in ("thermal", "faces", "sources", "fluids", "time"):
@@ -389,7 +325,7 @@ def load_case(path) -> Case:
             kw["prescribed"] = tt.value("field", ("x", "y", "z")[:fm.dim], unit="°C")
         else:
             reg = tt.sub("regions", tuple(fm.regions))
-            kw["prescribed_regions"] = {r: reg.number(r, unit="°C") for r in reg.data}
+            kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
     else:
         kw.update(_boundary_conditions(top, fm, names))
         src = top.sub("sources", tuple(fm.regions))
@@ -408,7 +344,7 @@ def load_case(path) -> Case:
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")
             f = top.sub("faces", ("film", "ambient"))
-            kw["faces"] = FaceFilm(f.number("film", lo=0, unit="W/(m² K)"), f.value("ambient", names, unit="°C"))
+            kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C"))
         kw["fluids"] = _fluids(top, fm, names, thickness)
     twice = _twice(kw)
     if twice:
@@ -421,7 +357,7 @@ def load_case(path) -> Case:
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)
     problem = Problem(fm.dim, materials, int(order), thickness,
                       head.string("plane", "stress", ("stress", "strain")),
-                      T0, init.number("reference", T0, lo=ABSOLUTE_ZERO, open_lo=True, unit="°C"),
+                      T0, init.number("reference", CELSIUS, T0),
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
                       signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme, **kw)
     return Case(path, head.string("name", path.stem), problem, fm, time)

@@ -13,12 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.checks import CELSIUS, POSITIVE, admissible
 from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
 from gatetherm.solvers.heat import Drive
 
 HOUR = 3600.0
 
 
+@admissible(T_room=CELSIUS, tau_heat=POSITIVE, tau_cool=POSITIVE)
 @dataclass(frozen=True)
 class SupplyParams:
     """The oil temperature controller feeding the tank."""

@@ -1,9 +1,10 @@
 """TOML model files, read and written from one schema.
 
 Each section of a model file mirrors one parameter dataclass (:data:`SCHEMA`); unknown
-keys and wrong types are errors. ``[effects]`` switches on catalogue effects as
-``NAME = {PARAM = VALUE}``. :func:`config_toml` writes a file that :func:`load_config`
-reads back to the same :class:`Config`.
+keys, wrong types and values outside a parameter's admissible range (declared on its
+dataclass, :mod:`gatetherm.checks`) are errors naming the file and the key. ``[effects]``
+switches on catalogue effects as ``NAME = {PARAM = VALUE}``. :func:`config_toml` writes a
+file that :func:`load_config` reads back to the same :class:`Config`.
 """
 from __future__ import annotations
 
@@ -16,10 +17,11 @@ import types
 import typing
 from dataclasses import dataclass, field
 from importlib import resources
-from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.geometry.frame import FrameParams, MeshParams, validate, validate_mesh
+from gatetherm.checks import check_fields
+from gatetherm.files import read_text
+from gatetherm.geometry.frame import FrameParams, MeshParams, check_tie_depth, validate
 from gatetherm.solvers.effects import effects_from_table, effects_table
 from gatetherm.solvers.frame import ModelConfig, ThermalParams
 from gatetherm.solvers.heat import TimeScheme
@@ -92,9 +94,14 @@ def _coerce(where: str, value, typ):
     if typ in (float, int):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise InputError(where, f"expected a number, got {value!r}")
-        if typ is int and value != int(value):
+        if typ is int and not (isinstance(value, int) or (math.isfinite(value) and value.is_integer())):
             raise InputError(where, f"expected a whole number, got {value!r}")
-        return int(value) if typ is int else float(value)
+        if typ is int:
+            return int(value)
+        try:
+            return float(value)
+        except OverflowError:  # an integer beyond any float: its range refuses it
+            return value
     raise InputError(where, "cannot be set in a model file")
 
 
@@ -133,29 +140,39 @@ def parse_config(data: dict, source: str = "<dict>", base: Config | None = None)
                 continue
             current = _get(cfg, ("model", "material"))
         cfg = _set(cfg, sec.path, _apply(sec, table, current))
-    validate(cfg.model.frame)
-    validate_mesh(cfg.model.mesh)
-    if cfg.model.order not in (1, 2):
-        raise InputError("model.order", f"must be 1 or 2, got {cfg.model.order}")
+    check_config(cfg)
     effects = {**cfg.effects, **effects_from_table(data.get("effects", {}))}
     return dataclasses.replace(cfg, source=source, effects=effects)
 
 
-def load_config(path: str | os.PathLike | None = None) -> Config:
-    """Read a model file; ``None`` gives the shipped paper model."""
+def check_config(cfg: Config) -> Config:
+    """``cfg`` if every parameter of the model file's sections is admissible and the frame
+    can be built with its tie bars inside the columns; else InputError naming ``section.key``."""
+    for sec in SCHEMA:
+        obj = _get(cfg, sec.path)
+        if obj is not None:
+            check_fields(obj, f"{sec.name}.", sec.keys)
+    try:
+        check_tie_depth(validate(cfg.model.frame))
+    except InputError as err:
+        raise err.at("geometry", ".") from None
+    return cfg
+
+
+def load_config(path: str | os.PathLike | None = None, option: str = "--config") -> Config:
+    """Read a model file; ``None`` gives the shipped paper model. Errors name the file
+    (``option``: where its name came from)."""
     if path is None:
         text = resources.files("gatetherm.studies").joinpath("data", PAPER_TOML).read_text(encoding="utf-8")
         source = f"gatetherm:{PAPER_TOML}"
     else:
-        p = Path(path)
-        if not p.is_file():
-            raise InputError("--config", f"no such file '{path}'", "give a TOML model file")
-        text, source = p.read_text(encoding="utf-8"), str(p)
+        text, source = read_text(path, option, "give a TOML model file"), str(path)
     try:
-        data = tomllib.loads(text)
+        return parse_config(tomllib.loads(text), source)
     except tomllib.TOMLDecodeError as err:
         raise InputError(source, f"not valid TOML ({err})") from None
-    return parse_config(data, source)
+    except InputError as err:
+        raise err.at(source) from None
 
 
 def _value(v) -> str:

@@ -8,40 +8,59 @@ import numpy as np
 
 from gatetherm import atomic_path, write_text_atomic
 from gatetherm.geometry.mesh import to_meshio
-from gatetherm.solvers.model import Model, static_fields
+from gatetherm.solvers.model import Model, field_recovery, static_fields
 
 
-def nodal_fields(model: Model, U: np.ndarray | None) -> dict[str, np.ndarray]:
+def nodal_fields(model: Model, U: np.ndarray | None, rec=None, stress: bool = True,
+                 u_dofs: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Temperature (°C), displacement (m, 3 components) and stress (Pa: components
     ``sigma_xx`` … and ``von_mises``) at the mesh nodes, for the heat state ``U`` (None:
-    the prescribed temperature of a problem without a heat solve)."""
+    the prescribed temperature of a problem without a heat solve). ``rec``: the model's
+    :func:`~gatetherm.solvers.model.field_recovery`, to share among states; ``u_dofs``:
+    the displacement of ``U``, if solved already."""
     if U is None:
         return static_fields(model)
     T = U[:model.heat.n_solid][model.heat.basis.nodal_dofs[0]]
     out = {"T": T}
     if model.elastic is not None:
-        u_dofs = model.displacement_field(U)
+        u_dofs = model.displacement_field(U) if u_dofs is None else u_dofs
         u = np.zeros((len(T), 3))
         u[:, : model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
         out["u"] = u
-        out.update({f"sigma_{k}" if k != "von_mises" else k: v for k, v in model.stress_field(u_dofs, U).items()})
+        if stress:
+            out.update({f"sigma_{k}" if k != "von_mises" else k: v
+                        for k, v in model.stress_field(u_dofs, U, rec).items()})
     return out
 
 
-def write_fields(model: Model, states, out: Path) -> list[Path]:
+def displacements(model: Model, states) -> dict[float, np.ndarray]:
+    """The displacement DOFs of the heat states ``[(t, U)]`` by time, in one elastic solve,
+    after which the elastic factor is released: the writers and pictures that follow need
+    memory of their own (in 3-D the factor holds 0.86 GB)."""
+    if model.elastic is None or model.heat is None or not states:
+        return {}
+    u = model.displacement_field(np.column_stack([U for _, U in states]))
+    model.elastic.solve.release()
+    return {t: u[:, k] for k, (t, _) in enumerate(states)}
+
+
+def write_fields(model: Model, states, out: Path, solved: dict[float, np.ndarray] | None = None) -> list[Path]:
     """One ``.vtu`` per saved state (point arrays of :func:`nodal_fields`) with a
-    ``fields.pvd`` collection, and the same as one XDMF time series, ``fields.xdmf`` (one
-    mesh, every step; XML, no HDF5): ParaView opens either as one animated data set."""
+    ``fields.pvd`` collection, and the same as one XDMF time series, ``fields.xdmf`` with
+    ``fields.h5`` (one mesh, every step): ParaView opens either as one animated data set.
+    ``solved``: their :func:`displacements`, if found already."""
     import meshio
 
     out.mkdir(parents=True, exist_ok=True)
     written, entries, steps = [], [], []
     minutes = all(abs(t / 60 - round(t / 60)) < 1e-9 for t, _ in states)
+    solved = displacements(model, states) if solved is None else solved
+    rec = field_recovery(model) if solved else None
     for k, (t, U) in enumerate(states):
         name = f"fields_{int(round(t / 60)):04d}min.vtu" if minutes else f"fields_{k:04d}.vtu"
-        data = nodal_fields(model, U)
+        data = nodal_fields(model, U, rec, u_dofs=solved.get(t))
         with atomic_path(out / name) as tmp:
-            meshio.write(tmp, to_meshio(model.fmesh, data), file_format="vtu")
+            meshio.write(tmp, to_meshio(model.fmesh, data), file_format="vtu", compression=None)  # zlib: 3 s in 3-D
         entries.append(f'    <DataSet timestep="{t:g}" file="{name}"/>')
         written.append(out / name)
         steps.append((t, data))
@@ -49,13 +68,18 @@ def write_fields(model: Model, states, out: Path) -> list[Path]:
            + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
     write_text_atomic(out / "fields.pvd", pvd)
     write_xdmf(model, steps, out / "fields.xdmf")
-    return written + [out / "fields.pvd", out / "fields.xdmf"]
+    return written + [out / "fields.pvd", out / "fields.xdmf", out / "fields.h5"]
+
+
+_XDMF_CELL = {"triangle": ("Triangle", 3), "tetra": ("Tetrahedron", 4)}
 
 
 def write_xdmf(model: Model, steps, path: Path) -> None:
-    """``steps`` [(t, point arrays)] as an XDMF time series on the volume cells (cell
-    array ``region``: the index of the cell's region in the mesh's region order)."""
-    import meshio
+    """``steps`` [(t, point arrays)] as an XDMF time series on the volume cells, the arrays in
+    ``<path stem>.h5`` beside it (HDF5: the ASCII form took 21 s for a 3-D run); cell array
+    ``region``: the index of the cell's region in the mesh's region order. Both files are
+    written under temporary names and renamed, the HDF5 file first."""
+    import h5py
 
     fm = model.fmesh
     pts = np.zeros((len(fm.points), 3))
@@ -63,19 +87,42 @@ def write_xdmf(model: Model, steps, path: Path) -> None:
     region = np.zeros(len(fm.cells), dtype=np.int32)
     for i, idx in enumerate(fm.regions.values()):
         region[idx] = i
-    cell = "triangle" if fm.dim == 2 else "tetra"
-    with atomic_path(path) as tmp:
-        with meshio.xdmf.TimeSeriesWriter(tmp, data_format="XML") as w:
-            w.write_points_cells(pts, [(cell, fm.cells)])
-            for t, data in steps:
-                w.write_data(t, point_data=data, cell_data={"region": [region]})
+    kind, k = _XDMF_CELL["triangle" if fm.dim == 2 else "tetra"]
+    h5 = path.with_suffix(".h5")
+
+    def item(name, a):
+        a = np.asarray(a)
+        dtype = ("Int", "4") if a.dtype.kind in "iu" else ("Float", "8")
+        return (f'<DataItem Dimensions="{" ".join(map(str, a.shape))}" NumberType="{dtype[0]}" '
+                f'Precision="{dtype[1]}" Format="HDF">{h5.name}:/{name}</DataItem>')
+
+    def attribute(name, a, center, key):
+        kind_ = "Vector" if np.ndim(a) == 2 else "Scalar"
+        return f'<Attribute Name="{name}" AttributeType="{kind_}" Center="{center}">{item(key, a)}</Attribute>'
+
+    grids = []
+    with atomic_path(h5) as tmp, h5py.File(tmp, "w") as f:
+        f["points"], f["cells"], f["region"] = pts, fm.cells.astype(np.int64), region
+        for n, (t, data) in enumerate(steps):
+            attrs = [attribute("region", region, "Cell", "region")]
+            for name, a in data.items():
+                f[f"step{n}/{name}"] = np.asarray(a, dtype=float)
+                attrs.append(attribute(name, a, "Node", f"step{n}/{name}"))
+            grids.append(f'<Grid Name="step{n}" GridType="Uniform"><Time Value="{t!r}"/>'
+                         f'<Topology TopologyType="{kind}" NumberOfElements="{len(fm.cells)}" NodesPerElement="{k}">'
+                         f'{item("cells", fm.cells.astype(np.int64))}</Topology>'
+                         f'<Geometry GeometryType="XYZ">{item("points", pts)}</Geometry>{"".join(attrs)}</Grid>')
+    write_text_atomic(path, '<?xml version="1.0"?>\n<Xdmf Version="3.0"><Domain>'
+                      '<Grid Name="fields" GridType="Collection" CollectionType="Temporal">\n'
+                      + "\n".join(grids) + "\n</Grid></Domain></Xdmf>\n")
 
 
-def pyvista_grid(model: Model, U: np.ndarray):
-    """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``."""
+def pyvista_grid(model: Model, U: np.ndarray, u_dofs: np.ndarray | None = None):
+    """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``
+    (``u_dofs``: the displacement of ``U``, if solved already)."""
     import pyvista as pv
 
-    mm = to_meshio(model.fmesh, nodal_fields(model, U))
+    mm = to_meshio(model.fmesh, nodal_fields(model, U, stress=False, u_dofs=u_dofs))
     cell_type = "tetra" if model.dim == 3 else "triangle"
     grid = pv.from_meshio(mm)
     keep = np.flatnonzero(grid.celltypes == {"tetra": 10, "triangle": 5}[cell_type])
@@ -86,20 +133,30 @@ def write_json(path: Path, data: dict) -> None:
     write_text_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
 
 
-def write_run(out: Path, run, metadata: dict[str, str], field_times) -> None:
+def nearest_state(run, t: float) -> tuple[float, np.ndarray]:
+    """The kept ``(time, state)`` of a run nearest ``t`` (s)."""
+    return min(run.result.states, key=lambda s: abs(s[0] - t))
+
+
+def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_times=()) -> dict[float, np.ndarray]:
     """``out/timeseries.csv`` (what the sensors report) and the fields at ``field_times``
-    (``out/fields``) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`."""
+    (``out/fields``) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`; returns the
+    :func:`displacements` of those states and of the states nearest ``picture_times``."""
     from gatetherm.studies.run.timeseries import FORMAT, write_timeseries
 
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
-    write_fields(run.model, [(t, U) for t, U in run.result.states if t in field_times], out / "fields")
+    states = [(t, U) for t, U in run.result.states if t in field_times]
+    extra = {t: U for t, U in (nearest_state(run, tp) for tp in picture_times) if t not in field_times}
+    solved = displacements(run.model, states + list(extra.items()))
+    write_fields(run.model, states, out / "fields", solved)
+    return solved
 
 
-def deformed_grid(run, t_pic: float):
+def deformed_grid(run, t_pic: float, solved: dict[float, np.ndarray] | None = None):
     """(time, pyvista grid with the point arrays of :func:`nodal_fields`) of the kept state
-    nearest ``t_pic`` (s)."""
-    t, U = min(run.result.states, key=lambda s: abs(s[0] - t_pic))
-    return t, pyvista_grid(run.model, U)
+    nearest ``t_pic`` (s); ``solved``: :func:`displacements` that may include it."""
+    t, U = nearest_state(run, t_pic)
+    return t, pyvista_grid(run.model, U, (solved or {}).get(t))
 
 
 def probe_summary(problem, cols: dict[str, np.ndarray]) -> dict:

@@ -28,7 +28,7 @@ from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.conditions import TableDrive, condition, condition_drive, filled, table_drive
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.simulate import RunResult, output_columns, run_model, sample_times
-from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, read_timeseries
+from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, check_steps, read_timeseries
 
 log = logging.getLogger(__name__)
 
@@ -82,9 +82,16 @@ def case_schedule(case: Case) -> Schedule:
 
 
 def file_schedule(path, cfg: Config, step_s: float = 60.0) -> Schedule:
-    """A schedule file (data format, input columns), sampled every ``step_s`` over its length."""
-    s = series_schedule(read_timeseries(path, required=INPUT_COLUMNS), cfg, f"schedule {path}")
-    return Schedule(s.drive, sample_times(float(s.times[-1]), step_s), s.label)
+    """A schedule file (data format, input columns), sampled every ``step_s`` over its length
+    (at least one step, at most :data:`~gatetherm.studies.run.timeseries.MAX_STEPS`)."""
+    ts = read_timeseries(path, required=INPUT_COLUMNS)
+    span = float(ts.time_s[-1] - ts.time_s[0])
+    if span < step_s:
+        raise InputError(str(path), f"the schedule spans {span:g} s, less than one {step_s:g}-s step",
+                         "give at least two rows a step or more apart")
+    check_steps(span, step_s, f"{path}, column time_s")
+    s = series_schedule(ts, cfg, f"schedule {path}")
+    return Schedule(s.drive, sample_times(span, step_s), s.label)
 
 
 class ScenarioCache:

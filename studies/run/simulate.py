@@ -12,7 +12,6 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, march
 from gatetherm.solvers.model import Model
@@ -100,6 +99,8 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     inputs, Y, states = [], [], []
     t0 = _time.perf_counter()
     scheme = model.problem.scheme if scheme is None else scheme
+    if model.elastic is not None:  # outputs come from adjoint weights: room for the heat factors
+        model.elastic.solve.release()
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
         inputs.append({"time_s": t, **drive(t)})
@@ -115,11 +116,36 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     return RunResult(cols, states, secs)
 
 
+def prominent_peaks(x: np.ndarray, prominence: float) -> list[int]:
+    """Indices of the local maxima of ``x`` (a plateau: its middle, rounded down; not the
+    ends) whose prominence is at least ``prominence``, as ``scipy.signal.find_peaks``
+    finds them (``tests/test_peaks.py`` compares), without its 2 s of imports."""
+    n, out, i = len(x), [], 1
+    while i < n - 1:
+        if x[i - 1] < x[i]:
+            ahead = i + 1
+            while ahead < n - 1 and x[ahead] == x[i]:
+                ahead += 1
+            if x[ahead] < x[i]:
+                peak = (i + ahead - 1) // 2
+                lowest = []
+                for step in (-1, 1):  # the lowest point on each side before a higher one
+                    j, low = peak, x[peak]
+                    while 0 <= j < n and x[j] <= x[peak]:
+                        low = min(low, x[j])
+                        j += step
+                    lowest.append(low)
+                if x[peak] - max(lowest) >= prominence:
+                    out.append(peak)
+                i = ahead
+        i += 1
+    return out
+
+
 def delta_figures(time_s: np.ndarray, delta_um: np.ndarray) -> dict[str, float | None]:
     """The paper's figures of a δ history: first and second positive peak (µm)
     and time of the first (min), full swing (µm)."""
-    peaks, _ = find_peaks(np.concatenate([[-np.inf], delta_um, [-np.inf]]),
-                          prominence=PEAK_PROMINENCE_UM)
+    peaks = prominent_peaks(np.concatenate([[-np.inf], delta_um, [-np.inf]]), PEAK_PROMINENCE_UM)
     peaks = [p - 1 for p in peaks if delta_um[p - 1] > 0]
     first = peaks[0] if peaks else None
     return {

@@ -1,7 +1,9 @@
 """The gatetherm time-series file (docs/data-format.md, version 1).
 
 One CSV format for simulated and measured runs: ``# key: value`` metadata lines,
-one header row, then numbers; an empty field is a missing sample (NaN).
+one header row, then numbers; an empty field is a missing sample (NaN). UTF-8, with or
+without a byte-order mark, any line ends. Temperatures, displacements and times must lie in
+their admissible ranges (:data:`COLUMN_RANGES`).
 In memory a run is a :class:`TimeSeries`: named float columns in file order
 plus the metadata. Reading validates the file and reports the first problem
 as one :class:`~geometry.errors.InputError` line naming file, line, data row
@@ -18,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gatetherm import InputError
-from gatetherm import atomic_path
+from gatetherm import InputError, atomic_path
+from gatetherm.checks import CELSIUS, Range, show
+from gatetherm.files import read_text
 
 log = logging.getLogger(__name__)
 
@@ -29,6 +32,21 @@ OUTPUT_COLUMNS = ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
 #: Optional columns of the format; anything else is kept but reported as unknown.
 OPTIONAL_COLUMNS = ("ambient_degC", "u_piezo_um")
 _SENSOR_COLUMN = re.compile(r"^T_\w+_degC$")
+#: Admissible values of the columns whose name matches a pattern (the first that does);
+#: any other column holds finite numbers.
+COLUMN_RANGES = ((re.compile(r"_degC$"), CELSIUS), (re.compile(r"_um$"), Range(-1e6, 1e6, unit="µm")),
+                 (re.compile(r"^time_s$"), Range(-1e10, 1e10, unit="s")))
+MAX_STEPS = 1_000_000
+"""Most time steps a run is simulated or resampled in (694 days of 60-s steps)."""
+
+
+def check_steps(span_s: float, step_s: float, where: str) -> int:
+    """The number of ``step_s`` steps in ``span_s``, if at most :data:`MAX_STEPS`."""
+    n = int(span_s // step_s)
+    if n > MAX_STEPS:
+        raise InputError(where, f"{span_s:g} s are {n} steps of {step_s:g} s, more than {MAX_STEPS}",
+                         "give a shorter run")
+    return n
 
 
 @dataclass(frozen=True)
@@ -126,8 +144,7 @@ def _parse_value(text: str, where: str) -> float:
 def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS) -> TimeSeries:
     """Read and validate a time-series CSV; see the module docstring and docs/data-format.md."""
     path = Path(path)
-    with open(path, encoding="utf-8", newline="") as fh:
-        lines = fh.read().splitlines()
+    lines = read_text(path, fix="give a time-series CSV file (docs/data-format.md)").splitlines()
     metadata: dict[str, str] = {}
     lineno = 0
     while lineno < len(lines) and (not lines[lineno].strip() or lines[lineno].lstrip().startswith("#")):
@@ -187,6 +204,11 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS) -> TimeSeries
         bad = np.flatnonzero(~np.isnan(p) & (p != 0) & (p != 1))
         if bad.size:
             fail(int(bad[0]), "pump", f"value {p[bad[0]]:g} is not 0 or 1", "write 1 (on) or 0 (off)")
+    for name, values in cols.items():
+        rng = next((r for pattern, r in COLUMN_RANGES if pattern.search(name)), None)
+        bad = np.flatnonzero(~np.isnan(values) & ~rng.mask(values)) if rng else ()
+        if len(bad):
+            fail(int(bad[0]), name, f"got {show(values[bad[0]])}, must be {rng}", "check the value and its unit")
     return TimeSeries(cols, metadata)
 
 

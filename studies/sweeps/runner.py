@@ -43,10 +43,25 @@ def executor(workers: int, scheduler: str | None, n_tasks: int):
     if workers == 1 or n_tasks <= 1:
         yield None
         return
-    from concurrent.futures import ProcessPoolExecutor
+    from gatetherm.studies.sweeps.pool import worker_pool
 
-    with ProcessPoolExecutor(max_workers=min(workers, n_tasks)) as ex:
+    with worker_pool(min(workers, n_tasks)) as ex:
         yield ex
+
+
+def _unusable(record, key: str) -> str:
+    """Why a point record read from a file cannot be used ("" if it can)."""
+    if not isinstance(record, dict):
+        return "not a JSON object"
+    if record.get("key") != key:
+        return "its key is not its file name"
+    if record.get("status") not in ("ok", "skipped") or not isinstance(record.get("note"), str):
+        return "no valid status and note"
+    results = record.get("results")
+    if not isinstance(results, dict) or not all(
+            v is None or (isinstance(v, (int, float)) and not isinstance(v, bool)) for v in results.values()):
+        return "its results are not a table of numbers"
+    return ""
 
 
 class PointStore:
@@ -56,14 +71,22 @@ class PointStore:
         self.dir = Path(root) / "points"
 
     def load(self, keys) -> dict[str, dict]:
+        """The usable records of ``keys``; a file that is not one (truncated, binary, edited)
+        is reported and left to be recomputed."""
         out = {}
         for key in keys:
             path = self.dir / f"{key}.json"
-            if path.is_file():
-                try:
-                    out[key] = json.loads(path.read_text(encoding="utf-8"))
-                except (json.JSONDecodeError, UnicodeDecodeError):
-                    log.warning("unreadable point file %s: it will be recomputed", path)
+            if not path.is_file():
+                continue
+            try:
+                record = json.loads(path.read_text(encoding="utf-8"))
+                why = _unusable(record, key)
+            except (OSError, ValueError) as err:  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+                why = f"unreadable: {err}"
+            if why:
+                log.warning("point file %s cannot be used (%s): the point is recomputed", path, why)
+            else:
+                out[key] = record
         return out
 
     def save(self, record: dict) -> None:
@@ -120,7 +143,16 @@ def run_studies(jobs, workers: int, scheduler: str | None, progress=None):
 
 
 class PointsFailed(Exception):
-    """Some points raised; the finished ones are stored, a rerun retries the rest."""
+    """Some points raised; the finished ones are stored, a rerun retries the rest.
+    ``str(err)`` is one line: how many failed, and why the first three did."""
+
+    def __init__(self, failed, total: int):
+        def why(err: BaseException) -> str:
+            text = str(err) if isinstance(err, InputError) else f"{type(err).__name__}: {err}"
+            return " ".join(text.split())
+
+        first = "; ".join(f"point {dict(t.params)}: {why(err)}" for t, err in failed[:3])
+        super().__init__(f"{len(failed)} of {total} points failed ({first}); rerun to retry them")
 
 
 def run_points(named_studies: dict, out: Path, workers: int, scheduler: str | None, progress=None):
@@ -132,6 +164,5 @@ def run_points(named_studies: dict, out: Path, workers: int, scheduler: str | No
     jobs = [(tasks, PointStore(out)) for lst in plans.values() for tasks in lst]
     done, failed = run_studies(jobs, workers, scheduler, progress)
     if failed:
-        raise PointsFailed("; ".join(f"{dict(t.params)}: {err}" for t, err in failed[:3])
-                           + f" ({len(failed)} points failed; rerun to retry them)")
+        raise PointsFailed(failed, sum(len(tasks) for tasks, _ in jobs))
     return plans, {k: v for d in done for k, v in d.items()}

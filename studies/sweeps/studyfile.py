@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gatetherm import InputError
+from gatetherm.files import read_text
 
 if TYPE_CHECKING:
     from gatetherm.studies.run.config import Config
@@ -36,10 +37,12 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None)
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.sweeps.sweep import COMPUTE, PlotSpec, Study
 
-    known = {"study", "set", "grid", "plot"}
-    for key in data:
+    known = {"study": dict, "set": dict, "grid": dict, "plot": list}
+    for key, value in data.items():
         if key not in known:
             raise InputError(key, "unknown table", f"known tables: {', '.join(sorted(known))}")
+        if not isinstance(value, known[key]):
+            raise InputError(key, f"expected {'[[plot]] tables' if key == 'plot' else f'a [{key}] table'}")
     head = dict(data.get("study", {}))
     for key in head:
         if key not in ("name", "dim", "config", "compute", "fit_frame"):
@@ -90,15 +93,21 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None)
 def load_study(path) -> Study:
     """Read a STUDY.toml; a relative ``study.config`` is taken from the study file's folder."""
     p = Path(path)
-    if not p.is_file():
-        raise InputError("STUDY.toml", f"no such file '{path}'", "give a study file")
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        data = tomllib.loads(read_text(p, "STUDY.toml", "give a study file"))
     except tomllib.TOMLDecodeError as err:
         raise InputError(str(p), f"not valid TOML ({err})") from None
     from gatetherm.studies.run.config import load_config
 
-    data.setdefault("study", {}).setdefault("name", p.stem)
-    config = data["study"].pop("config", None)
-    base = load_config(None if config is None else p.parent / config)
-    return parse_study(data, str(p), base)
+    try:
+        head = data.setdefault("study", {})
+        if not isinstance(head, dict):
+            raise InputError("study", "expected a [study] table")
+        head.setdefault("name", p.stem)
+        config = head.pop("config", None)
+        if config is not None and not isinstance(config, str):
+            raise InputError("study.config", f"expected a file name, got {config!r}")
+        base = load_config(None if config is None else p.parent / config, "study.config")
+        return parse_study(data, str(p), base)
+    except InputError as err:
+        raise err.at(str(p)) from None

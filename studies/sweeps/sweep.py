@@ -30,10 +30,10 @@ import json
 from dataclasses import dataclass
 from typing import Any, Callable
 
-import numpy as np
-
 from gatetherm import InputError
+from gatetherm.checks import FINITE
 from gatetherm.geometry.frame import FrameParams, tie_depth, tie_heights, validate
+from gatetherm.geometry.sizing import check_mesh_size
 import gatetherm
 from gatetherm.solvers.beam import beta_area
 from gatetherm.solvers.frame import scheme_digest
@@ -146,8 +146,10 @@ def _number(key: str, value, typ: type):
         if not isinstance(value, bool):
             raise InputError(key, f"expected true/false, got {value!r}")
         return value
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-        raise InputError(key, f"expected a number, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not FINITE.admits(value):
+        raise InputError(key, f"expected a finite number, got {value!r}")
+    if typ is int and not float(value).is_integer():
+        raise InputError(key, f"expected a whole number, got {value!r}")
     return typ(value)
 
 
@@ -211,6 +213,8 @@ def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = Tru
         skip = ""
     except InputError as err:
         skip = str(err)
+    if not skip:
+        check_mesh_size(cfg.model.frame, cfg.model.mesh, dim)  # a point too big for memory fails the study now
     return cfg, condition, tuple(sorted(effects.items())), skip
 
 

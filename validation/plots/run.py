@@ -120,30 +120,36 @@ def _trim(img: np.ndarray, pad: int = 12) -> np.ndarray:
     return img[max(r0 - pad, 0):r1 + pad + 1, max(c0 - pad, 0):c1 + pad + 1]
 
 
-def draw_deformed(run, t: float, path, title: str) -> float:
+def draw_deformed(run, t: float, path, title, solved: dict | None = None) -> float:
     """The kept state of ``run`` nearest ``t`` (s) drawn by :func:`render_deformed`, magnified so
     that the largest displacement shows as about 8 % of the frame's width (a power of ten);
+    ``title``: text or a function of the time drawn; ``solved`` as for :func:`plot_run`;
     returns the time drawn, s."""
     from gatetherm.studies.run.output import deformed_grid
 
-    t, grid = deformed_grid(run, t)
+    t, grid = deformed_grid(run, t, solved)
     umax = float(np.abs(grid["u"]).max()) or 1.0
     scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
     render_deformed(grid, path, title(t) if callable(title) else title, scale)
     return t
 
 
-def plot_run(run, figs: dict, out, title: str) -> None:
+def picture_time(figs: dict) -> float:
+    """When ``deformed.png`` of :func:`plot_run` shows the frame (s): the first peak of δ, else 1 h."""
+    return (figs["first_peak_min"] or 60.0) * 60.0
+
+
+def plot_run(run, figs: dict, out, title: str, solved: dict | None = None) -> None:
     """``oil_temperatures.png`` (Fig. 10), ``response.png`` (Figs. 11–13) and ``deformed.png``
-    (at the first peak of δ, else at 1 h) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`
-    whose kept states include that time."""
+    (at :func:`picture_time`) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`
+    whose kept states include that time; ``solved``: displacements of kept states, by time,
+    if solved already."""
     from pathlib import Path
 
     out = Path(out)
     plot_oil(run.columns, out / "oil_temperatures.png", title)
     plot_response(run.columns, out / "response.png", title)
-    draw_deformed(run, (figs["first_peak_min"] or 60.0) * 60.0, out / "deformed.png",
-                  lambda t: f"{title}, t = {t / 60:.0f} min")
+    draw_deformed(run, picture_time(figs), out / "deformed.png", lambda t: f"{title}, t = {t / 60:.0f} min", solved)
 
 
 def plot_channels(cols: dict, path, title: str) -> None:
@@ -164,9 +170,9 @@ def plot_channels(cols: dict, path, title: str) -> None:
     save(fig, path, tight=False)
 
 
-def plot_case(run, out, title: str) -> None:
+def plot_case(run, out, title: str, solved: dict | None = None) -> None:
     """``channels.png`` (transient runs) and ``deformed.png`` (the last state, when the case
-    has elasticity) of a case run."""
+    has elasticity) of a case run; ``solved`` as for :func:`plot_run`."""
     from pathlib import Path
 
     out = Path(out)
@@ -174,4 +180,4 @@ def plot_case(run, out, title: str) -> None:
         plot_channels(run.columns, out / "channels.png", title)
     if run.model.elastic is not None:
         draw_deformed(run, float(run.columns["time_s"][-1]), out / "deformed.png",
-                      lambda t: f"{title}, t = {t / 3600:.3g} h")
+                      lambda t: f"{title}, t = {t / 3600:.3g} h", solved)

@@ -1,0 +1,126 @@
+"""Admissible values of parameters: declared once per dataclass field, checked where input is read.
+
+A :class:`Range` says what a number may be (always finite; bounds, open or closed; whole
+numbers only). ``@admissible(name=Range, ...)`` attaches ranges to the fields of a parameter
+dataclass, next to its definition; :func:`check_fields` checks an instance against them.
+Every reader of user input (model files, case files, schedules, data files, command-line
+options) calls these, so a parameter has one range everywhere and every refusal states it.
+"""
+from __future__ import annotations
+
+import dataclasses
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from gatetherm import InputError
+
+ABSOLUTE_ZERO_C = -273.15
+"""Absolute zero, °C."""
+MAX_CELSIUS = 1000.0
+"""Highest temperature gatetherm accepts, °C: far above where grey iron and mineral oil
+stay the linear solids and liquids the models assume."""
+
+
+@dataclass(frozen=True)
+class Range:
+    """Finite numbers from ``lo`` to ``hi``."""
+
+    lo: float = -np.inf
+    """Lower bound (-inf: none)."""
+    hi: float = np.inf
+    """Upper bound (inf: none)."""
+    lo_open: bool = False
+    """``lo`` itself is excluded."""
+    hi_open: bool = False
+    """``hi`` itself is excluded."""
+    whole: bool = False
+    """Whole numbers only."""
+    unit: str = ""
+    """Unit named in messages, e.g. ``"°C"``."""
+
+    def mask(self, values) -> np.ndarray:
+        """Element-wise: is each of ``values`` admissible?"""
+        v = np.asarray(values, dtype=float)
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(v) & ((v > self.lo) if self.lo_open else (v >= self.lo))
+            ok &= (v < self.hi) if self.hi_open else (v <= self.hi)
+            if self.whole:
+                ok &= v == np.round(v)
+        return ok
+
+    def admits(self, value) -> bool:
+        """Is ``value`` (a number, not a bool) admissible?"""
+        try:
+            return _number(value) and bool(self.mask(float(value)))
+        except OverflowError:  # an integer beyond any float
+            return False
+
+    def __str__(self) -> str:
+        if self.whole and np.isfinite(self.hi) and self.hi - self.lo <= 1:
+            return " or ".join(str(int(x)) for x in np.arange(self.lo, self.hi + 1))
+        unit = f" {self.unit}" if self.unit else ""
+        lo, hi = f"{self.lo:g}", f"{self.hi:g}"
+        if np.isfinite(self.lo) and np.isfinite(self.hi):
+            bounds = f"{'(' if self.lo_open else '['}{lo}, {hi}{')' if self.hi_open else ']'}"
+            return f"{'a whole number' if self.whole else 'a number'} in {bounds}{unit}"
+        kind = "a whole number" if self.whole else "a finite number"
+        if np.isfinite(self.lo):
+            return f"{kind} {'>' if self.lo_open else '>='} {lo}{unit}"
+        if np.isfinite(self.hi):
+            return f"{kind} {'<' if self.hi_open else '<='} {hi}{unit}"
+        return kind
+
+    def check(self, where: str, value, fix: str = ""):
+        """``value`` if admissible, else :class:`~gatetherm.InputError` naming ``where`` and the range."""
+        if not self.admits(value):
+            raise InputError(where, f"got {show(value)}, must be {self}", fix)
+        return value
+
+
+def _number(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def show(value) -> str:
+    """A value as a message quotes it: numbers in ``%g``, anything else in ``repr``."""
+    try:
+        return f"{float(value):g}" if _number(value) else repr(value)
+    except OverflowError:
+        return str(value)
+
+
+POSITIVE = Range(0.0, lo_open=True)
+NONNEGATIVE = Range(0.0)
+FINITE = Range()
+CELSIUS = Range(ABSOLUTE_ZERO_C, MAX_CELSIUS, lo_open=True, unit="°C")
+"""A temperature: above absolute zero and at most :data:`MAX_CELSIUS`."""
+
+
+def admissible(default: Range | None = None, **ranges: Range):
+    """Class decorator (above ``@dataclass``): the :class:`Range` of each named field, and
+    ``default`` that of every other field."""
+    def attach(cls):
+        names = [f.name for f in dataclasses.fields(cls)]
+        unknown = set(ranges) - set(names)
+        if unknown:
+            raise TypeError(f"{cls.__name__} has no fields {sorted(unknown)}")
+        cls.__admissible__ = {**({n: default for n in names} if default else {}), **ranges}
+        return cls
+    return attach
+
+
+def ranges(cls) -> dict[str, Range]:
+    """The field ranges declared by :func:`admissible` on ``cls`` (empty if none)."""
+    return dict(getattr(cls, "__admissible__", {}))
+
+
+def check_fields(obj, prefix: str = "", names=None):
+    """``obj`` if each field with a declared range (those in ``names``, default all) is
+    admissible or None (not set); else :class:`~gatetherm.InputError` naming ``prefix + field``."""
+    for name, rng in ranges(type(obj)).items():
+        value = getattr(obj, name)
+        if value is not None and (names is None or name in names):
+            rng.check(f"{prefix}{name}", value)
+    return obj

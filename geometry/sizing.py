@@ -1,0 +1,47 @@
+"""How big a frame mesh will be, estimated before gmsh runs, so that a mesh that cannot fit
+in memory is refused at once instead of exhausting the machine."""
+from __future__ import annotations
+
+import math
+import os
+
+from gatetherm import InputError
+from gatetherm.geometry.frame import Box, FrameParams, MeshParams, part_boxes, tank_box
+
+BYTES_PER_ELEMENT = 10_000
+"""Peak memory of a P1 run per element, bytes: measured 6.8 kB per triangle (2-D, 14k to 207k
+elements) and 8.3 kB per tetrahedron (3-D, 12k to 65k), rounded up."""
+FALLBACK_MEMORY = 8e9
+"""Memory assumed where the operating system does not report it, bytes."""
+
+
+def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
+    """Elements of the mesh of ``p`` at ``m``'s size: the frame's area (volume) over that of
+    an equilateral triangle (regular tetrahedron) of the element size. Against gmsh's counts
+    from 3k to 200k elements: up to 25 % low in 2-D (the refinement near the tank and the
+    joints), up to 1.5 times high in 3-D."""
+    def measure(b: Box) -> float:
+        return math.prod(b[2 * i + 1] - b[2 * i] for i in range(dim))
+
+    total = sum(map(measure, part_boxes(p, dim).values())) - measure(tank_box(p, dim))
+    s = m.size if dim == 2 else m.size_3d
+    return total / (math.sqrt(3) / 4 * s ** 2 if dim == 2 else s ** 3 / (6 * math.sqrt(2)))
+
+
+def memory_bytes() -> float:
+    """Physical memory of this machine, bytes."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return FALLBACK_MEMORY
+
+
+def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
+    """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
+    n = element_estimate(p, m, dim)
+    need, have = n * BYTES_PER_ELEMENT, memory_bytes()
+    if need > have:
+        key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
+        raise InputError(key, f"{s:g} m gives about {n:.2g} {'triangles' if dim == 2 else 'tetrahedra'} needing "
+                         f"~{need / 1e9:.3g} GB, more than the {have / 1e9:.3g} GB of memory of this machine",
+                         f"raise it to at least {s * (need / have) ** (1 / dim):.2g} m")

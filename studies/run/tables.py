@@ -1,0 +1,71 @@
+"""One table of a TOML input file, read key by key: typed access whose every refusal is
+one :class:`~gatetherm.InputError` line naming the file, the key and what is admissible
+(ranges from :mod:`gatetherm.checks`)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from gatetherm import InputError
+from gatetherm.checks import FINITE, Range
+from gatetherm.solvers.expr import ExpressionError, Value
+
+
+class Table:
+    """One table of the case file; remembers where it is for the error messages."""
+
+    def __init__(self, file: Path, where: str, data, known=None):
+        self.file, self.where = file, where
+        if not isinstance(data, dict):
+            raise InputError(f"{file}: {where}", f"expected a table, got {data!r}", f"write [{where}] with key = value")
+        self.data = data
+        if known is not None:
+            for key in data:
+                if key not in known:
+                    raise InputError(f"{file}: {where}.{key}", "unknown key", f"known keys: {', '.join(known)}")
+
+    def key(self, k: str) -> str:
+        return f"{self.file}: {self.where}.{k}"
+
+    def fail(self, k: str, problem: str, fix: str = ""):
+        raise InputError(self.key(k), problem, fix)
+
+    def number(self, k: str, rng: Range = FINITE, default=None) -> float:
+        """The number at ``k`` if ``rng`` admits it; ``default`` if absent (None: required)."""
+        if k not in self.data:
+            if default is None:
+                self.fail(k, "missing", f"give {rng}")
+            return default
+        return float(rng.check(self.key(k), self.data[k]))
+
+    def string(self, k: str, default=None, choices=None) -> str:
+        if k not in self.data:
+            if default is None:
+                self.fail(k, "missing", f"choose one of {', '.join(choices)}" if choices else "give a name")
+            return default
+        v = self.data[k]
+        if not isinstance(v, str) or (choices and v not in choices):
+            self.fail(k, f"{v!r} is not admissible", f"choose one of {', '.join(choices)}" if choices else "give a string")
+        return v
+
+    def name(self, k: str, valid, what: str, default=None) -> str:
+        v = self.string(k, default=default)
+        if v and v not in valid:
+            self.fail(k, f"'{v}' is not a {what} of the mesh", f"{what}s: {', '.join(valid) or 'none'}")
+        return v
+
+    def value(self, k: str, names, default=None, unit: str = "") -> Value:
+        if k not in self.data and default is not None:
+            return Value(default)
+        if k not in self.data:
+            self.fail(k, "missing", f"give a number{' in ' + unit if unit else ''} or an expression")
+        try:
+            v = Value.of(self.data[k])
+        except ExpressionError as err:
+            self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
+        unknown = sorted(v.names() - set(names))
+        if unknown:
+            self.fail(k, f"unknown input '{unknown[0]}' in '{v}'", f"inputs here: {', '.join(sorted(names))}")
+        return v
+
+    def sub(self, k: str, known=None) -> "Table":
+        return Table(self.file, f"{self.where}.{k}" if self.where else k, self.data.get(k, {}), known)

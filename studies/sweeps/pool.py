@@ -1,0 +1,73 @@
+"""Local worker processes that leave Ctrl-C to their parent, die with it (even when it is
+killed with SIGKILL) and are stopped when the block using them ends with an exception.
+
+A worker would otherwise see the terminal's Ctrl-C and print its own traceback, and would
+live on, orphaned, after its parent was killed. Signals are blocked while the workers start
+(in :meth:`submit`), so that none arrives before a worker's initializer has set it up.
+"""
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+PR_SET_PDEATHSIG = 1
+"""prctl(2) option: the signal a Linux process gets when its parent dies."""
+_SIGNALS = {signal.SIGINT, signal.SIGTERM}
+
+
+def _mask(how: str, signals=_SIGNALS) -> set:
+    """``signal.pthread_sigmask(signal.<how>, signals)`` where there is one (not on Windows)."""
+    return signal.pthread_sigmask(getattr(signal, how), signals) if hasattr(signal, "pthread_sigmask") else set()
+
+
+def _watch(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(0.5)
+    os._exit(1)
+
+
+def _die_with(parent: int | None) -> None:
+    """Worker initializer: ignore Ctrl-C, end on SIGTERM, be killed when the parent dies."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    _mask("SIG_UNBLOCK")
+    try:
+        if ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL) != 0:
+            raise OSError(ctypes.get_errno(), "prctl failed")
+    except (OSError, AttributeError, TypeError):  # not Linux: poll the parent instead
+        if parent is not None:
+            threading.Thread(target=_watch, args=(parent,), daemon=True).start()
+    if parent is not None and os.getppid() != parent:  # the parent died before the above
+        os._exit(1)
+
+
+class _Pool(ProcessPoolExecutor):
+    def submit(self, fn, /, *args, **kwargs):
+        old = _mask("SIG_BLOCK")  # workers start here and inherit the mask
+        try:
+            return super().submit(fn, *args, **kwargs)
+        finally:
+            _mask("SIG_SETMASK", old)
+
+
+@contextlib.contextmanager
+def worker_pool(workers: int, mp_context=None):
+    """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes as above;
+    on an exception (Ctrl-C included) its workers are terminated at once, not awaited."""
+    ctx = mp_context or multiprocessing.get_context()
+    parent = os.getpid() if ctx.get_start_method() in ("fork", "spawn") else None  # else a server forks them
+    pool = _Pool(workers, mp_context=ctx, initializer=_die_with, initargs=(parent,))
+    try:
+        yield pool
+    except BaseException:
+        for proc in list((getattr(pool, "_processes", None) or {}).values()):
+            proc.terminate()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)

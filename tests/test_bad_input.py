@@ -1,0 +1,463 @@
+"""Bad input, as a new user meets it (issue 11): refused in one line on stderr naming the file,
+the key (or row and column) and the admissible range, exit code 2 (input) or 1 (I/O), never
+a traceback, never exit 0. Valid files in their many shapes still run. In-process, through
+the command's ``main``; signals, kills and real I/O failures are in test_faults.py."""
+from __future__ import annotations
+
+import dataclasses
+import errno
+import json
+import math
+import os
+import typing
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gatetherm import InputError
+from gatetherm.checks import ranges
+from gatetherm.outdir import LOCK, output_dir
+from gatetherm.studies.cli import main
+from gatetherm.studies.run.config import SCHEMA, parse_config
+from gatetherm.studies.run.timeseries import read_timeseries
+from gatetherm.studies.sweeps import evaluate as sweep_evaluate
+from test_compensator import HAND
+
+COARSE = "[mesh]\nsize = 0.02\nsize_3d = 0.03\n"
+SCHEDULE = "# format: gatetherm-timeseries/1\ntime_s,oil_degC,pump\n0,40,1\n3600,40,0\n7200,40,1\n"
+DATA = "".join(line for line in HAND.splitlines(keepends=True) if not line.startswith("# note"))
+"""A format line, the header and six rows a minute apart: delta = 2 (theta_A - theta_B) - theta_C."""
+
+
+def refused(capsys, code: int, argv, *needles: str) -> str:
+    """Run the command; assert exit ``code``, exactly one line on stderr holding every needle."""
+    got = main([str(a) for a in argv])
+    err = capsys.readouterr().err
+    assert got == code, err
+    assert err.count("\n") == 1 and err.endswith("\n") and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+def _write(path, body: str | bytes):
+    path.write_bytes(body if isinstance(body, bytes) else body.encode())
+    return path
+
+
+# ---- model files -------------------------------------------------------------------------------
+
+MODEL_FILES = {
+    "h inf": ("[geometry]\nh = inf\n", "geometry.h: got inf, must be a finite number > 0"),
+    "depth inf": ("[geometry]\ndepth = inf\n", "geometry.depth: got inf, must be a finite number > 0"),
+    "tie bar deeper than the column": ("[geometry]\nA_C = 0.01\n",
+                                       "geometry.A_C: tie-bar depth A_C/t_C = 0.25 m exceeds the column depth"),
+    "h_oil_on nan": ("[thermal]\nh_oil_on = nan\n", "thermal.h_oil_on: got nan, must be a finite number >= 0"),
+    "h_air < 0": ("[thermal]\nh_air = -8\n", "thermal.h_air: got -8, must be a finite number >= 0"),
+    "flow_rate < 0": ("[thermal]\nflow_rate = -3e-5\n", "thermal.flow_rate: got -3e-05, must be a finite number >= 0"),
+    "T0 below absolute zero": ("[thermal]\nT0 = -300\n",
+                               "thermal.T0: got -300, must be a number in (-273.15, 1000] °C"),
+    "tie-bar E = 0": ("[material.tie_bar]\nE = 0\n", "material.tie_bar.E: got 0, must be a finite number > 0"),
+    "E < 0": ("[material]\nE = -1.2e11\n", "material.E: got -1.2e+11, must be a finite number > 0"),
+    "k = -48": ("[material]\nk = -48\n", "material.k: got -48, must be a finite number > 0"),
+    "k = 0": ("[material]\nk = 0\n", "material.k: got 0, must be a finite number > 0"),
+    "rho = 0": ("[material]\nrho = 0\n", "material.rho: got 0, must be a finite number > 0"),
+    "nu = 0.7": ("[material]\nnu = 0.7\n", "material.nu: got 0.7, must be a number in [0, 0.5)"),
+    "alpha nan": ("[material]\nalpha = nan\n", "material.alpha: got nan, must be a number in [-0.0001, 0.001]"),
+    "alpha inf": ("[material]\nalpha = inf\n", "material.alpha: got inf"),
+    "alpha in um/(m K)": ("[material]\nalpha = 10.5\n", "material.alpha: got 10.5"),
+    "tau_heat = 0": ("[supply]\ntau_heat = 0\n", "supply.tau_heat: got 0, must be a finite number > 0"),
+    "T_room nan": ("[supply]\nT_room = nan\n", "supply.T_room: got nan, must be a number in (-273.15, 1000] °C"),
+    "mesh size inf": ("[mesh]\nsize = inf\n", "mesh.size: got inf, must be a finite number > 0"),
+    "order 1.5": ("[model]\norder = 1.5\n", "model.order: expected a whole number, got 1.5"),
+    "order 3": ("[model]\norder = 3\n", "model.order: got 3, must be 1 or 2"),
+    "order inf": ("[model]\norder = inf\n", "model.order: expected a whole number, got inf"),
+    "theta below CN": ("[model.scheme]\ntheta = 0.2\n", "model.scheme.theta: got 0.2, must be a number in [0.5, 1]"),
+    "restart 0": ("[model.scheme]\nrestart = 0\n", "model.scheme.restart: got 0, must be a whole number in [1, 1000]"),
+    "joint conductance 0": ("[model]\njoint_conductance = 0\n", "model.joint_conductance: got 0"),
+    "a string": ('[thermal]\nh_air = "high"\n', "thermal.h_air: expected a number, got 'high'"),
+    "unknown key": ("[geometry]\nheight = 1\n", "geometry.height: unknown key"),
+    "effect nan": ("[effects]\npiezo_heat = {power = nan}\n", "effects.piezo_heat.power"),
+    "latin-1 degree sign in a comment": (b"# oil at 40 \xb0C\n[mesh]\nsize = 0.02\n",
+                                         "bad.toml, line 1: byte 0xb0 is not UTF-8 text; save it as UTF-8"),
+    "binary": (b"\x89PNG\r\n\x1a\n\x00\x00", "bad.toml, line 3: holds a NUL byte: a binary file, not text"),
+    "latin-1 key": (b"[geometry]\nl\xe4nge = 1\n", "bad.toml, line 2: byte 0xe4 is not UTF-8 text"),
+    "NUL bytes": (b"[mesh]\x00\x00\n", "bad.toml, line 1: holds a NUL byte"),
+    "not TOML": ("[mesh\nsize = 1\n", "not valid TOML"),
+}
+
+
+@pytest.mark.parametrize("body, needle", MODEL_FILES.values(), ids=MODEL_FILES)
+def test_model_file_values_refused_where_read(tmp_path, capsys, body, needle):
+    cfg = _write(tmp_path / "bad.toml", body)
+    refused(capsys, 2, ["simulate", "--condition", "1", "--config", cfg, "--out", tmp_path / "o"], str(cfg), needle)
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("make, needle", [
+    (lambda d: d, "--config: 'DIR' is a directory; give a TOML model file"),
+    (lambda d: d / "nope.toml", "--config: no such file 'DIR/nope.toml'"),
+    (lambda d: os.mkfifo(d / "fifo") or d / "fifo", "--config: 'DIR/fifo' is not a regular file"),
+], ids=["directory", "missing", "fifo"])
+def test_model_file_paths(tmp_path, capsys, make, needle):
+    path = make(tmp_path)
+    refused(capsys, 2, ["mesh", "--config", path, "--out", tmp_path / "o"], needle.replace("DIR", str(tmp_path)))
+
+
+def test_model_file_with_bom_and_crlf_is_read(tmp_path):
+    """As a Windows editor writes it."""
+    cfg = _write(tmp_path / "m.toml", b"\xef\xbb\xbf# model\r\n[geometry]\r\nl4 = 0.3\r\n")
+    from gatetherm.studies.run.config import load_config
+
+    assert load_config(cfg).model.frame.l4 == 0.3
+
+
+def _sections():
+    for sec in SCHEMA:
+        for name, rng in ranges(sec.cls).items():
+            if sec.keys is None or name in sec.keys:
+                yield sec, name, rng
+
+
+def _doc(section: str, key: str, value) -> dict:
+    doc: dict = {key: value}
+    for part in reversed(section.split(".")):
+        doc = {part: doc}
+    return doc
+
+
+@pytest.mark.parametrize("sec, name, rng", list(_sections()), ids=[f"{s.name}.{n}" for s, n, _ in _sections()])
+def test_every_parameter_refuses_nan_and_values_out_of_its_range(sec, name, rng):
+    """Each declared range, read through the model-file reader: nan, inf and the first values
+    outside either end are refused in one line naming the key."""
+    bad = [math.nan, math.inf, -math.inf]
+    bad += [rng.lo if rng.lo_open else rng.lo - 1] if np.isfinite(rng.lo) else []
+    bad += [rng.hi if rng.hi_open else rng.hi + 1] if np.isfinite(rng.hi) else []
+    for value in bad:
+        with pytest.raises(InputError) as err:
+            parse_config(_doc(sec.name, name, value))
+        assert str(err.value).startswith(f"{sec.name}.{name}: "), err.value
+        assert "\n" not in str(err.value)
+
+
+def test_every_number_of_the_model_file_has_a_range():
+    """A field added to a model-file section without an admissible range fails here."""
+    for sec in SCHEMA:
+        hints = typing.get_type_hints(sec.cls)
+        for f in dataclasses.fields(sec.cls):
+            numeric = hints[f.name] in (float, int, float | None)
+            if numeric and (sec.keys is None or f.name in sec.keys):
+                assert f.name in ranges(sec.cls), f"{sec.name}.{f.name} has no admissible range"
+
+
+def test_a_mesh_that_cannot_fit_in_memory_is_refused_before_gmsh(tmp_path, capsys, monkeypatch):
+    import gmsh
+
+    monkeypatch.setattr(gmsh, "initialize", lambda *a, **k: pytest.fail("gmsh ran"))
+    cfg = _write(tmp_path / "fine.toml", "[mesh]\nsize = 1e-6\n")
+    refused(capsys, 2, ["mesh", "--config", cfg, "--out", tmp_path / "o"],
+            "gatetherm: error: mesh.size: 1e-06 m gives about 8e+11 triangles", "raise it to at least")
+    assert not (tmp_path / "o").exists()
+
+
+# ---- schedules and data files ------------------------------------------------------------------
+
+def _sched(old: str, new: str) -> bytes:
+    return SCHEDULE.replace(old, new).encode()
+
+
+SCHEDULES = {
+    "latin-1": (SCHEDULE.replace("# format", "# oil at 40 °C\n# format").encode("latin-1"),
+                "s.csv, line 1: byte 0xb0 is not UTF-8 text; save it as UTF-8 (a spreadsheet's 'CSV UTF-8')"),
+    "0xff in a cell": (_sched("3600,40,0", "3600,4\xff0,0").replace(b"\xc3\xbf", b"\xff"),
+                       "s.csv, line 4: byte 0xff is not UTF-8 text"),
+    "binary": (bytes(range(256)) * 8, "s.csv, line 1: holds a NUL byte"),
+    "oil at 1e6 degC": (_sched("3600,40,0", "3600,1e6,0"),
+                        "line 4 (data row 2), column oil_degC: got 1e+06, must be a number in (-273.15, 1000] °C"),
+    "oil below absolute zero": (_sched("3600,40,0", "3600,-300,0"), "column oil_degC: got -300"),
+    "ambient nan": (_sched("time_s,oil_degC,pump\n0,40,1", "time_s,oil_degC,pump,ambient_degC\n0,40,1,nan")
+                    .replace(b"3600,40,0", b"3600,40,0,20").replace(b"7200,40,1", b"7200,40,1,20"),
+                    "column ambient_degC: non-numeric value 'nan'"),
+    "one row": (_sched("3600,40,0\n7200,40,1\n", ""), "the schedule spans 0 s, less than one 60-s step"),
+    "time 1e300": (_sched("7200,", "1e300,"), "column time_s: got 1e+300, must be a number in [-1e+10, 1e+10] s"),
+    "thirty years": (_sched("7200,", "1e9,"), "column time_s: 1e+09 s are 16666666 steps of 60 s, more than 1000000"),
+    "pump 2": (_sched("3600,40,0", "3600,40,2"), "column pump: value 2 is not 0 or 1"),
+    "time backwards": (_sched("3600,", "9000,"), "column time_s: time 7200 s is not after the previous 9000 s"),
+    "no oil column": (_sched("oil_degC", "oil"), "missing required column 'oil_degC'"),
+    "empty": (b"", "no header row"),
+    "header only": (_sched("0,40,1\n3600,40,0\n7200,40,1\n", ""), "no data rows"),
+}
+
+
+@pytest.mark.parametrize("body, needle", SCHEDULES.values(), ids=SCHEDULES)
+def test_schedule_files(tmp_path, capsys, body, needle):
+    sched = _write(tmp_path / "s.csv", body)
+    refused(capsys, 2, ["simulate", "--schedule", sched, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def _with_column(text: str, name: str, value: str) -> str:
+    head, header, *rows = text.splitlines()
+    return "\n".join([head, f"{header},{name}", *(f"{r},{value}" for r in rows)]) + "\n"
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda s: s.replace("180,40,1,29,21.5,23,12", "180,40,1,29,21.5,23,1e300"),
+     "line 6 (data row 4), column delta_um: got 1e+300, must be a number in [-1e+06, 1e+06] µm"),
+    (lambda s: _with_column(s, "delta_pred_um", "1"), "column delta_pred_um: compensate writes a column of this name"),
+    (lambda s: s.replace("60,40,1,23,", "60,40,1,-280,"), "column theta_A_degC: got -280"),
+    (lambda s: s.encode("utf-16"), "d.csv: is UTF-16 text; save it as UTF-8 (a spreadsheet's 'CSV UTF-8')"),
+], ids=["delta 1e300", "an input column delta_pred_um", "theta below absolute zero", "UTF-16"])
+def test_compensate_data_files(tmp_path, capsys, edit, needle):
+    data = _write(tmp_path / "d.csv", edit(DATA))
+    refused(capsys, 2, ["compensate", "--data", data, "--Ki", 2, "--Kc", 1, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def test_valid_files_in_many_shapes_still_run(tmp_path, capsys):
+    """CRLF line ends and a BOM (a spreadsheet), columns reordered, extra columns (kept),
+    irregular sampling and empty cells as missing samples."""
+    rows = [line.split(",") for line in DATA.splitlines()[1:]]
+    order = [6, 0, 3, 4, 5, 2, 1]  # delta_um first, time_s second, ...
+    lines = [",".join([rows[0][i] for i in order] + ["rig_note", "T_spindle_degC"])]
+    for k, r in enumerate(rows[1:]):
+        r = list(r)
+        r[0] = str(int(r[0]) + (7 if k % 2 else 0))  # irregular sampling
+        lines.append(",".join([r[i] for i in order] + [str(k), "" if k == 2 else "21.5"]))  # a missing sample
+    data = _write(tmp_path / "d.csv", "\ufeff# rig: 3\r\n" + "\r\n".join(lines) + "\r\n")
+    assert main(["compensate", "--data", str(data), "--Ki", "2", "--Kc", "1", "--no-actuator",
+                 "--out", str(tmp_path / "o")]) == 0, capsys.readouterr().err
+    out = read_timeseries(tmp_path / "o" / "compensated.csv")
+    assert out.names[:9] == ("delta_um", "time_s", "theta_A_degC", "theta_B_degC", "theta_C_degC", "pump",
+                             "oil_degC", "rig_note", "T_spindle_degC")
+    assert np.isnan(out["T_spindle_degC"][2]) and out.metadata["rig"] == "3"
+    assert json.loads((tmp_path / "o" / "summary.json").read_text())["resampled"]
+    sched = "\r\n".join(["\ufefftime_s,pump,note,oil_degC", "0,1,11,40", "90,1,12,", "3700,0,13,41", "7200,1,14,40"])
+    _write(tmp_path / "s.csv", sched + "\r\n")
+    cfg = _write(tmp_path / "c.toml", COARSE)
+    assert main(["simulate", "--schedule", str(tmp_path / "s.csv"), "--config", str(cfg), "--no-pictures",
+                 "--out", str(tmp_path / "r")]) == 0, capsys.readouterr().err
+    ts = read_timeseries(tmp_path / "r" / "timeseries.csv")
+    assert ts.time_s[-1] == 7200.0 and ts["oil_degC"][1] == pytest.approx(40.0 + 60 / 3700, rel=1e-12)
+
+
+# ---- command-line arguments --------------------------------------------------------------------
+
+@pytest.mark.parametrize("argv, needle", [
+    (["simulate", "--condition", "1", "--fields-every", "-5"],
+     "argument --fields-every: got -5, must be a finite number > 0"),
+    (["simulate", "--condition", "1", "--fields-every", "nan"], "argument --fields-every: got nan"),
+    (["simulate", "--condition", "x"], "argument --condition: invalid int value: 'x'"),
+    (["simulate", "--condition", "1", "--dim", "4"], "argument --dim: invalid choice: 4"),
+    (["simulate", "--condition", "1", "--schedule", "s.csv"], "not allowed with argument"),
+    (["simulate", "--condition", "1", "--colour", "red"], "unrecognized arguments: --colour red"),
+    (["simulate", "--condition", "1", "--out"], "argument --out: expected one argument"),
+    (["sweep", "s.toml", "--workers", "0"], "argument --workers: got 0, must be a whole number >= 1"),
+    (["sweep", "s.toml", "--workers", "1.5"], "argument --workers: expected a whole number, got '1.5'"),
+    (["validate"], "argument TARGET: invalid choice"),
+    (["validate", "calibrate", "--evals", "0"], "argument --evals: got 0"),
+    (["validate", "hidden-effects", "--conditions", "1,x"], "argument --conditions: got '1,x'"),
+    (["validate", "hidden-effects", "--mesh-size", "-1"], "argument --mesh-size: got -1"),
+    (["diagnose", "--data", "d.csv", "--mesh-size", "0"], "argument --mesh-size: got 0"),
+    (["frobnicate"], "argument COMMAND: invalid choice: 'frobnicate'"),
+])
+def test_argument_errors_are_one_line(tmp_path, capsys, argv, needle):
+    err = refused(capsys, 2, [*argv, *(["--out", tmp_path / "o"] if argv[-1] != "--out" else [])], needle)
+    assert "usage:" not in err and err.startswith("gatetherm") and "--help" in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_no_command_prints_the_help_and_exits_2(capsys):
+    assert main([]) == 2
+    io_ = capsys.readouterr()
+    assert io_.out.startswith("usage: gatetherm") and "simulate" in io_.out and io_.err == ""
+    assert main(["simulate", "--help"]) == 0
+    assert "--fields-every" in capsys.readouterr().out
+
+
+# ---- output directories ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("where, needle", [
+    (lambda d: _write(d / "afile", "x"), "--out: 'DIR/afile' exists and is not a directory"),
+    (lambda d: _write(d / "afile", "x") / "sub",
+     "--out: 'DIR/afile/sub' lies below 'DIR/afile', which is not a directory"),
+], ids=["a file", "below a file"])
+def test_out_is_checked_before_the_run(tmp_path, capsys, monkeypatch, where, needle):
+    from gatetherm.studies.run import scenario
+
+    monkeypatch.setattr(scenario, "run_scenario", lambda *a, **k: pytest.fail("the run started"))
+    refused(capsys, 2, ["simulate", "--condition", "1", "--out", where(tmp_path)], needle.replace("DIR", str(tmp_path)))
+    assert (tmp_path / "afile").read_text() == "x"
+
+
+def test_a_second_run_into_a_locked_directory_is_refused(tmp_path, capsys):
+    with output_dir(tmp_path / "o") as out:
+        (out / "timeseries.csv").write_text("the first run's\n")
+        refused(capsys, 1, ["simulate", "--condition", "1", "--out", out],
+                f"gatetherm: error: {out}: another gatetherm run (pid {os.getpid()}) is writing into this directory")
+        assert (out / "timeseries.csv").read_text() == "the first run's\n"
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["timeseries.csv"]  # the lock is gone
+
+
+def test_unwritable_output_and_unreadable_input(tmp_path, capsys, monkeypatch):
+    """A read-only output directory (exit 1, before the run) and a model file without read
+    permission (exit 2). Root is not bound by file permissions: there the file system's
+    refusals are made at the os level."""
+    ro, secret = tmp_path / "ro", _write(tmp_path / "secret.toml", COARSE)
+    ro.mkdir()
+    if os.geteuid() == 0:
+        def refuse(real, code, where):
+            def call(path, *args, **kwargs):
+                if Path(path).parent == where:
+                    raise OSError(code, os.strerror(code), str(path))
+                return real(path, *args, **kwargs)
+            return call
+        monkeypatch.setattr(os, "open", refuse(os.open, errno.EROFS, ro))  # creating files in ro
+        monkeypatch.setattr(os, "mkdir", refuse(os.mkdir, errno.EROFS, ro))
+        monkeypatch.setattr(Path, "read_bytes", refuse(Path.read_bytes, errno.EACCES, tmp_path))
+        problem = os.strerror(errno.EROFS)
+    else:
+        ro.chmod(0o555)
+        secret.chmod(0)
+        problem = os.strerror(errno.EACCES)
+    try:
+        for out in (ro, ro / "new"):
+            refused(capsys, 1, ["simulate", "--condition", "1", "--out", out],
+                    f"gatetherm: error: {out}: cannot write into this directory ({problem})")
+        refused(capsys, 2, ["simulate", "--condition", "1", "--config", secret, "--out", tmp_path / "o"],
+                f"gatetherm: error: --config: cannot read '{secret}' (Permission denied); check its permissions")
+    finally:
+        ro.chmod(0o755)
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("umask, mode", [(0o022, 0o644), (0o077, 0o600), (0o002, 0o664)])
+def test_files_get_the_umask_permissions(tmp_path, capsys, umask, mode):
+    cfg = _write(tmp_path / "c.toml", COARSE)
+    old = os.umask(umask)
+    try:
+        assert main(["mesh", "--config", str(cfg), "--out", str(tmp_path / "o")]) == 0
+    finally:
+        os.umask(old)
+    assert {oct(p.stat().st_mode & 0o777) for p in (tmp_path / "o").iterdir()} == {oct(mode)}
+
+
+def test_a_rerun_replaces_the_whole_output_set(tmp_path, capsys):
+    """Stale field files of an earlier run with more fields, and the temporaries of a killed
+    run, are gone after a rerun; other files are left alone."""
+    cfg = _write(tmp_path / "c.toml", COARSE)
+    run = ["simulate", "--condition", "1", "--config", str(cfg), "--no-pictures", "--out"]
+    assert main([*run, str(tmp_path / "fresh")]) == 0
+    assert main([*run, str(tmp_path / "o"), "--fields-every", "30"]) == 0
+    assert len(list((tmp_path / "o" / "fields").glob("*.vtu"))) == 11
+    for stale in ("fields/.gatetherm-tmp.fields_0042min.0badf00d.vtu", ".gatetherm-tmp.summary.deadbeef.json",
+                  "response.png", LOCK):
+        _write(tmp_path / "o" / stale, "stale")
+    _write(tmp_path / "o" / "my_notes.txt", "mine")
+    assert main([*run, str(tmp_path / "o")]) == 0
+
+    def files(d):
+        return sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())
+    assert files(tmp_path / "o") == sorted(files(tmp_path / "fresh") + ["my_notes.txt"])
+
+
+def test_a_rerun_keeps_its_input_files(tmp_path):
+    """diagnose --config DIR/model.toml --out DIR: the model file read is not removed as a
+    file of the previous run (it is replaced only if the run writes a new one)."""
+    _write(tmp_path / "model.toml", "[geometry]\n")
+    _write(tmp_path / "report.md", "old")
+    with output_dir(tmp_path, ("model.toml", "report.md"), keep=(str(tmp_path / "model.toml"), None)):
+        pass
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml"]
+
+
+def test_disk_full_ends_in_one_line_and_keeps_the_finished_files(tmp_path, capsys, monkeypatch):
+    """The disk fills while the fields are written: exit 1, one line naming the file; the
+    time series written before is complete, no partial file under a final name, no temporary."""
+    import meshio
+
+    def full(path, *args, **kwargs):
+        with open(path, "wb") as fh:
+            fh.write(b"<VTKFile partial")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(meshio, "write", full)
+    cfg = _write(tmp_path / "c.toml", COARSE)
+    out = tmp_path / "o"
+    refused(capsys, 1, ["simulate", "--condition", "1", "--config", cfg, "--no-pictures", "--out", out],
+            f"gatetherm: error: {out}/fields/fields_0000min.vtu: No space left on device")
+    assert len(read_timeseries(out / "timeseries.csv")) == 301
+    assert sorted(p.name for p in out.rglob("*") if p.is_file()) == ["timeseries.csv"]
+
+
+# ---- sweeps ------------------------------------------------------------------------------------
+
+STUDY = """[study]
+name = "two"
+compute = ["coefficients"]
+[set]
+"mesh.size" = 0.03
+[grid]
+"geometry.l4" = [0.25, 0.3]
+"""
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda s: s.replace("[0.25, 0.3]", "[0.25, 0.3]\n\"material.E\" = [0, 1.2e11]").encode(),
+     "study.toml: material.E: got 0, must be a finite number > 0"),
+    (lambda s: s.replace('"mesh.size" = 0.03', '"mesh.size" = 1e-6').encode(), "study.toml: mesh.size: 1e-06 m gives"),
+    (lambda s: s.replace('"mesh.size" = 0.03', "condition = 1.5").encode(),
+     "study.toml: condition: expected a whole number, got 1.5"),
+    (lambda s: s.replace('"mesh.size" = 0.03', '"thermal.h_oil_on" = nan').encode(), "thermal.h_oil_on: got nan"),
+    (lambda s: ("# ° \n" + s).encode("latin-1"), "study.toml, line 1: byte 0xb0 is not UTF-8 text"),
+    (lambda s: s.replace("[study]\n", "study = 3\n[x]\n").encode(), "study.toml: study: expected a [study] table"),
+    (lambda s: s.replace("[study]\n", '[study]\nconfig = "nope.toml"\n').encode(),
+     "study.toml: study.config: no such file"),
+], ids=["E = 0", "mesh too fine", "condition 1.5", "nan", "latin-1", "study not a table", "missing config"])
+def test_study_files(tmp_path, capsys, edit, needle):
+    study = _write(tmp_path / "study.toml", edit(STUDY))
+    refused(capsys, 2, ["sweep", study, "--workers", "1", "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def _fake_evaluate(task):
+    """A point in no time: the store and the table, not the numbers, are under test."""
+    return {"key": task.key, "params": dict(task.params), "status": "ok", "note": "",
+            "results": {"nodes": 7, "Ki_E_fe": dict(task.params)["geometry.l4"]}, "seconds": 0.0,
+            "version": "x", "scheme": "y"}
+
+
+def test_corrupted_point_files_of_any_shape_are_recomputed(tmp_path, caplog, monkeypatch):
+    calls = []
+    monkeypatch.setattr(sweep_evaluate, "evaluate", lambda t: calls.append(t.key) or _fake_evaluate(t))
+    study = _write(tmp_path / "study.toml", STUDY.replace("[0.25, 0.3]", "[0.2, 0.25, 0.3, 0.35, 0.4, 0.45]"))
+    argv = ["sweep", str(study), "--workers", "1", "--out", str(tmp_path / "o")]
+    assert main(argv) == 0
+    table = (tmp_path / "o" / "table.csv").read_bytes()
+    points = sorted((tmp_path / "o" / "points").glob("*.json"))
+    shapes = [lambda k: "{}", lambda k: f'{{"key": "{k}", "status": "ok", "note": "", "results": "oops"}}',
+              lambda k: points[2].read_text()[:40], lambda k: bytes(range(256)), lambda k: "[1, 2]",
+              lambda k: f'{{"key": "{k}", "status": "ok", "note": "", "results": {{"x": "1"}}}}']
+    for path, shape in zip(points, shapes):
+        _write(path, shape(path.stem))
+    calls.clear()
+    caplog.clear()
+    assert main(argv) == 0
+    assert sorted(calls) == sorted(p.stem for p in points)
+    assert sum("cannot be used" in r.getMessage() and r.levelname == "WARNING" for r in caplog.records) == 6
+    assert (tmp_path / "o" / "table.csv").read_bytes() == table
+
+
+def test_a_failed_point_is_one_line_naming_the_field(tmp_path, capsys, monkeypatch):
+    def evaluate(task):
+        if dict(task.params)["geometry.l4"] == 0.3:
+            raise InputError("thermal.h_air", "got -1, must be a finite number >= 0")
+        return _fake_evaluate(task)
+
+    monkeypatch.setattr(sweep_evaluate, "evaluate", evaluate)
+    study = _write(tmp_path / "study.toml", STUDY)
+    refused(capsys, 1, ["sweep", study, "--workers", "1", "--out", tmp_path / "o"],
+            "gatetherm: error: 1 of 2 points failed (point {'geometry.l4': 0.3}: thermal.h_air: got -1")
+    assert [row.split(",")[1] for row in (tmp_path / "o" / "table.csv").read_text().splitlines()[1:]] == \
+        ["ok", "pending"]

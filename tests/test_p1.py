@@ -1,0 +1,70 @@
+"""The vectorised P1 matrices equal scikit-fem's forms to round-off, in 2-D and 3-D,
+with element-wise coefficients (the frame's regions) and thickness."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from skfem import CellBasis, ElementVector, asm
+
+from gatetherm.solvers import p1
+from gatetherm.solvers.elasticity import moduli, stiffness, thermal_load
+from gatetherm.solvers.fem import Field, element, to_skfem
+from gatetherm.solvers.heat import capacity, conduction
+
+
+def _close(A, B) -> float:
+    return abs(A - B).max() / abs(B).max()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_p1_matrices_equal_the_forms(dim, frame_2d, frame_3d):
+    fm = frame_2d if dim == 2 else frame_3d
+    mesh = to_skfem(fm)
+    rng = np.random.default_rng(dim)
+    c, k, E = (Field(rng.uniform(1.0, 2.0, mesh.nelements) * s) for s in (3e6, 48.0, 1.2e11))
+    nu, t = Field(rng.uniform(0.2, 0.3, mesh.nelements)), Field(rng.uniform(0.05, 0.2, mesh.nelements))
+    sb = CellBasis(mesh, element(dim, 1), intorder=2)
+    vb = CellBasis(mesh, ElementVector(element(dim, 1)), intorder=1)
+    tb = CellBasis(mesh, element(dim, 1), intorder=1)
+    lam, mu, b = moduli(E.values, nu.values, np.full(mesh.nelements, 1e-5), dim)
+    G, vol = p1.gradients(mesh.p.T, mesh.t.T)
+    pattern = p1.Pattern(mesh.t.T, mesh.nvertices)
+    th = t.values
+    pairs = [
+        (pattern.scalar(p1.mass(G, vol, c.values * th)), asm(capacity, sb, rc=c.at(sb), t=t.at(sb))),
+        (pattern.scalar(p1.conduction(G, vol, k.values * th)), asm(conduction, sb, k=k.at(sb), t=t.at(sb))),
+        (p1.stiffness(pattern, G, vol, lam * th, mu * th),
+         asm(stiffness, vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t.at(vb))),
+        (p1.thermal_load(pattern, G, vol, b * th), asm(thermal_load, tb, vb, b=Field(b).at(vb), t=t.at(vb))),
+    ]
+    for fast, reference in pairs:
+        assert fast.shape == reference.shape
+        assert _close(fast, reference) < 1e-13
+
+
+@pytest.mark.parametrize("dim, plane", [(2, "stress"), (2, "strain"), (3, "stress")])
+def test_p1_stress_projection_equals_the_forms(dim, plane, frame_2d, frame_3d):
+    from gatetherm.solvers.stress import COMPONENTS, _INDEX, recovery, stress_of_T, stress_of_u
+    from skfem.helpers import div  # noqa: F401  (the forms' helpers)
+    from skfem.assembly import BilinearForm  # noqa: F401
+    from gatetherm.solvers.stress import mass
+
+    fm = frame_2d if dim == 2 else frame_3d
+    mesh = to_skfem(fm)
+    rng = np.random.default_rng(1)
+    f = {"E": Field(rng.uniform(1e11, 2e11, mesh.nelements)), "nu": Field(rng.uniform(0.2, 0.3, mesh.nelements)),
+         "alpha": Field(rng.uniform(1e-5, 2e-5, mesh.nelements))}
+    region = mesh.subdomains["column_L"]
+    for elements in (None, region):
+        rec = recovery(mesh, 1, f, dim, plane, element(dim, 1), elements)
+        kw = {"intorder": 2} if elements is None else {"intorder": 2, "elements": elements}
+        sb, ub = CellBasis(mesh, element(dim, 1), **kw), CellBasis(mesh, ElementVector(element(dim, 1)), **kw)
+        lam, mu, b = (Field(v).at(sb) for v in moduli(f["E"].values, f["nu"].values, f["alpha"].values, dim, plane))
+        assert _close(rec.Q[COMPONENTS[(dim, plane)][0]], asm(stress_of_T, sb, sb, b=b)) < 1e-13
+        for c in COMPONENTS[(dim, plane)]:
+            ref = asm(stress_of_u, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim)
+            assert _close(rec.S[c], ref) < 1e-13, c
+        M = asm(mass, sb)
+        a = np.unique(sb.element_dofs)
+        x = rng.normal(size=len(a))
+        np.testing.assert_allclose(rec.lu.solve(M[a][:, a] @ x), x, rtol=1e-9)
