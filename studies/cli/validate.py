@@ -102,7 +102,7 @@ def run_rom(args) -> int:
     print(write_rom_study(Path(args.out), load_config(args.config), args.dims,
                           on_row=lambda r: print(f"{r.case}, condition {r.condition}, {r.data}: paper {r.paper_um:.2f}, "
                                                  f"MLR {r.mlr_um:.2f}, rom {r.rom_5min_um:.2f} / {r.rom_event_um:.2f} "
-                                                 f"µm ({r.rom_updates} updates)", flush=True)), end="")
+                                                 f"µm ({r.rom_updates} updates)", flush=True)).markdown, end="")
     return 0
 
 
