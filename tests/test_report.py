@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -156,12 +157,40 @@ def test_readme_blocks_take_the_full_tables_only(tmp_path, registry):
 
 
 def test_shipped_readme_blocks_are_known_tables():
-    from pathlib import Path
-
     text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
     names = readme.blocks(text)
-    assert {"verification", "nafems", "paper", "compensation"} <= set(names)
+    assert {"verification", "nafems", "paper", "compensation", "rom-check", "rom"} <= set(names)
     readme.check_names(names, {n for s in SECTIONS for n in s.readme}, "README.md")
+
+
+def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypatch):
+    """Absent files are "not measured yet"; a result file is one table of its columns and rows,
+    captioned with its command, machine and date, its notes under it; a file that is not a
+    table is said to be one; the digest follows the files (absent, then present)."""
+    from gatetherm.validation.report.registry import Context, section
+    from gatetherm.validation.report.sections import speed
+
+    monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)
+    res = speed.compute(Context(tmp_path, {}, 1))
+    assert res.tables == () and len(res.notes) == 2 and all("not measured yet" in n for n in res.notes)
+    assert "`python benchmarks/peer.py --rounds 3` writes it" in res.notes[0]
+    (tmp_path / "peer.json").write_text(json.dumps(
+        {"date": "2026-11-26", "machine": "2 cores", "command": "python benchmarks/peer.py --rounds 3",
+         "columns": ["case", "gatetherm s", "ratio"], "rows": [["3-D heat", 1.23456, 0.5], ["3-D elastic", 2, None]],
+         "notes": ["median of 3 rounds"]}))
+    (tmp_path / "scaling.json").write_text("[1, 2]")
+    res = speed.compute(Context(tmp_path, {}, 1))
+    (t,), notes = res.tables, res.notes
+    assert t.columns == ("case", "gatetherm s", "ratio") and t.rows == (("3-D heat", "1.235", "0.5"),
+                                                                        ("3-D elastic", "2", "—"))
+    assert t.title == "peer.json: measured by `python benchmarks/peer.py --rounds 3` on 2 cores, 2026-11-26"
+    assert t.note == "median of 3 rounds" and len(notes) == 1
+    assert notes[0].startswith("`benchmarks/results/scaling.json` is not a benchmark table (AttributeError: ")
+    assert notes[0].endswith("rerun `python benchmarks/scaling.py`.")
+    monkeypatch.setattr(b, "input_files", lambda patterns: {p: tmp_path / Path(p).name for p in patterns})
+    with_files = b.digest(section("speed"), {}, "code")
+    (tmp_path / "peer.json").unlink()
+    assert b.digest(section("speed"), {}, "code") != with_files
 
 
 def _drift_series() -> TimeSeries:
@@ -246,3 +275,20 @@ def test_browser_renders_the_report(tmp_path):
     assert "browser: image 'sections/c-frame/drift.png' did not load" in bad.problems
     summary = json.loads((tmp_path / "R/sections/nafems/result.json").read_text())["stamp"]
     assert summary["full"] and summary["digest"]
+
+
+@pytest.mark.slow
+def test_rom_section_is_the_rom_study(tmp_path):
+    """The report's ROM tables are the rows of ``gatetherm validate rom``'s own table
+    (rom_study.md, the same run), its figures written; the reduced model is within 0.1 µm of
+    the FE run."""
+    from gatetherm.validation.report.registry import Context
+    from gatetherm.validation.report.sections import rom
+
+    res = rom.compute(Context(tmp_path, {"dims": [2], "conditions": [1], "effects": ["joint_resistance"]}, 1))
+    checks, study = res.tables
+    md = (tmp_path / "rom_study.md").read_text()
+    for t in (checks, study):
+        assert "\n".join("| " + " | ".join(r) + " |" for r in t.rows) in md
+    assert [r[:3] for r in study.rows] == [("model", "1", "2-D FE"), ("measured", "1", study.rows[1][2])]
+    assert float(checks.rows[0][2]) < 0.1 and all((tmp_path / f.file).stat().st_size > 1e4 for f in res.figures)

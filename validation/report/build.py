@@ -88,7 +88,8 @@ def tool_version(name: str) -> str:
 
 
 def digest(section: Section, scope: dict, code: str) -> str:
-    files = {k: hashlib.sha256(p.read_bytes()).hexdigest() for k, p in input_files(section.inputs).items()}
+    files = {k: hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else "absent"
+             for k, p in input_files(section.inputs).items()}
     payload = {"section": section.key, "scope": scope, "version": __version__, "code": code, "inputs": files,
                "tools": {t: tool_version(t) for t in section.tools}}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]

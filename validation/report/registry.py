@@ -29,7 +29,7 @@ class Section:
     about: str = ""
     """What the default run leaves out, in words (shown beside the scope)."""
     inputs: tuple[str, ...] = ()
-    """Data files it reads, ``package:glob`` or absolute paths (their bytes are in the digest)."""
+    """Data files it reads, ``package:glob`` or absolute paths (their bytes, or their absence, are in the digest)."""
     tools: tuple[str, ...] = ()
     """External programs it runs (their version line is in the digest)."""
     also: str = ""
@@ -60,6 +60,11 @@ class Context:
 
 
 PAPER_MODEL = "gatetherm.studies:data/paper.toml"
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks" / "results"
+"""Where the benchmark scripts of a source checkout write their results (absent in an installed wheel)."""
+BENCHMARK_FILES = {"peer.json": "python benchmarks/peer.py --rounds 3",
+                   "scaling.json": "python benchmarks/scaling.py"}
+"""Result files of the benchmark scripts the speed section shows, with the command that measures each."""
 
 SECTIONS: tuple[Section, ...] = (
     Section("verification", "Verification: convergence orders and exact cases", "verification:compute",
@@ -104,11 +109,16 @@ SECTIONS: tuple[Section, ...] = (
             about="15-mm elements instead of the model's 9 mm",
             inputs=(PAPER_MODEL,), tools=("ccx",),
             also="gatetherm export ccx --condition 1 --time 15 --dim 3 --out X && (cd X && ccx job)"),
-    Section("rom", "Reduced-order model, observer and predictive compensation",
-            pending="issue 13 (gatetherm reduce, compensate --method rom, the paper / MLR / ROM table)"),
-    Section("compound", "Compound diagnosis", pending="issue 14 (gatetherm validate compound)"),
-    Section("performance", "Performance against a peer code", pending="issue 12 (benchmarks/, DOLFINx peer)"),
-    Section("scaling", "Scaling", pending="issue 12 (the scaling benchmark)"),
+    Section("rom", "Reduced-order model, observer and predictive compensation", "rom:compute",
+            subset={"dims": [2], "conditions": [1, 2, 3], "effects": "all"},
+            full={"dims": [2, 3], "conditions": [1, 2, 3], "effects": "all"},
+            about="2-D only: no 3-D reduced model and no 3-D data on the 2-D model (the 3-D reduction took "
+                  "25 min and 13 GB)",
+            inputs=(PAPER_MODEL,), also="gatetherm validate rom --out DIR", readme=("rom-check", "rom")),
+    Section("compound", "Compound diagnosis", pending="issue 14 (gatetherm validate compound): a compute function "
+            "'compound:compute' calling validation.compound_study.write_compound, its subset and full scopes"),
+    Section("speed", "Speed and scaling", "speed:compute", inputs=tuple(str(BENCHMARKS / f) for f in BENCHMARK_FILES),
+            also="python benchmarks/peer.py --rounds 3; python benchmarks/scaling.py"),
 )
 
 
