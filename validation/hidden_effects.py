@@ -264,10 +264,13 @@ def row_line(row: dict) -> str:
 
 
 def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=(1, 2, 3), wanted=ALL_CASES,
-                         mesh_size: float | None = None, on_row=None) -> dict:
+                         mesh_size: float | None = None, on_row=None, per_kind: int | None = None) -> dict:
     """Run the study on ``workers`` processes, write ``hidden_effects.md`` and ``.csv``;
-    returns the acceptance figures. ``on_row(row)`` is called as each case finishes."""
+    returns the acceptance figures and, under "rows", the rows. ``on_row(row)`` is called as
+    each case finishes; ``per_kind``: only the first so many cases of each effect."""
     todo = [c for c in cases(seed, tuple(conditions)) if c.effect in set(wanted)]
+    if per_kind:
+        todo = [c for i, c in enumerate(todo) if sum(d.effect == c.effect for d in todo[:i]) < per_kind]
     t0 = time.perf_counter()
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")  # one thread per worker process
@@ -281,4 +284,4 @@ def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=
     out = Path(out)
     write_text_atomic(out / "hidden_effects.md", table_markdown(rows, acc))
     write_text_atomic(out / "hidden_effects.csv", table_csv(rows))
-    return {k: _fmt(v) for k, v in acc.items()}
+    return {**{k: _fmt(v) for k, v in acc.items()}, "rows": rows}
