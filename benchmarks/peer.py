@@ -34,6 +34,8 @@ from datetime import date
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+LOAD_AT_START = os.getloadavg()[0]
+"""Load average (1 min) when the benchmark started: these cores are shared."""
 MATERIAL = {"k": 48.0, "rho": 7250.0, "c": 510.0, "E": 1.2e11, "nu": 0.26, "alpha": 1.05e-5}
 
 
@@ -142,6 +144,7 @@ def rusage_run(cmd, env=None) -> dict:
 def write_table(path: Path, columns: list, rows: list, notes: list[str]) -> None:
     """Print a table and write it with the date, machine and command as JSON to ``path``
     (``gatetherm report`` shows it)."""
+    notes = [*notes, f"load average {LOAD_AT_START:.1f} at the start, {os.getloadavg()[0]:.1f} at the end"]
     widths = [max(len(str(c)), *(len(str(r[i])) for r in rows)) for i, c in enumerate(columns)]
     print("\n" + "  ".join(f"{c:>{w}}" for c, w in zip(columns, widths)))
     for r in rows:

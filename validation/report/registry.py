@@ -63,8 +63,11 @@ PAPER_MODEL = "gatetherm.studies:data/paper.toml"
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks" / "results"
 """Where the benchmark scripts of a source checkout write their results (absent in an installed wheel)."""
 BENCHMARK_FILES = {"peer.json": "python benchmarks/peer.py --rounds 3",
-                   "scaling.json": "python benchmarks/scaling.py"}
-"""Result files of the benchmark scripts the speed section shows, with the command that measures each."""
+                   "scaling.json": "python benchmarks/scaling.py",
+                   "backends.json": "python benchmarks/backends.py --rounds 3",
+                   "blas_threads.json": "python benchmarks/blas_threads.py --rounds 3"}
+"""Result files of the benchmark scripts the speed section shows, with the command that measures
+each; each fills the README block ``speed-NAME`` (NAME: the file's stem)."""
 
 SECTIONS: tuple[Section, ...] = (
     Section("verification", "Verification: convergence orders and exact cases", "verification:compute",
@@ -118,7 +121,7 @@ SECTIONS: tuple[Section, ...] = (
     Section("compound", "Compound diagnosis", pending="issue 14 (gatetherm validate compound): a compute function "
             "'compound:compute' calling validation.compound_study.write_compound, its subset and full scopes"),
     Section("speed", "Speed and scaling", "speed:compute", inputs=tuple(str(BENCHMARKS / f) for f in BENCHMARK_FILES),
-            also="python benchmarks/peer.py --rounds 3; python benchmarks/scaling.py"),
+            also="; ".join(BENCHMARK_FILES.values()), readme=tuple(f"speed-{Path(f).stem}" for f in BENCHMARK_FILES)),
 )
 
 

@@ -5,6 +5,7 @@ they take long and want a quiet machine."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from gatetherm.validation.report.registry import BENCHMARK_FILES, BENCHMARKS
 from gatetherm.validation.report.result import Result, cell, table
@@ -12,11 +13,12 @@ from gatetherm.validation.report.result import Result, cell, table
 
 def benchmark_table(name: str, data: dict, command: str):
     """The table of one benchmark result file: its columns and rows as they are, captioned with the
-    command, date and machine it records."""
+    command, date and machine it records; it fills the README block ``speed-<stem of name>``."""
     cmd = data.get("command") or command
     return table(f"{name}: measured by `{cmd}` on {data.get('machine', 'an unrecorded machine')}, "
                  f"{data.get('date', 'undated')}", data["columns"], [[cell(v) for v in r] for r in data["rows"]],
-                 note=" ".join(str(n) for n in data.get("notes", ())))
+                 note=" ".join(str(n) for n in data.get("notes", ())), readme=f"speed-{Path(name).stem}",
+                 captioned=True)
 
 
 def compute(ctx) -> Result:
