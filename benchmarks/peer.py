@@ -1,6 +1,6 @@
 """gatetherm against DOLFINx on gatetherm's own 3-D frame mesh, interleaved.
 
-    python benchmarks/peer.py [--rounds 3] [--dolfinx /tmp/venv_dolfinx/bin/python] [--size M]
+    python benchmarks/peer.py [--rounds 3] [--dolfinx /tmp/venv_dolfinx/bin/python] [--json FILE]
 
 Three jobs, each a fresh process, run in turn ``--rounds`` times (the order rotating), so
 that the load of these shared cores falls on all of them alike:
@@ -16,20 +16,26 @@ Prints per job the medians of wall time, CPU time and peak memory (``wait4`` of 
 process), the ratios gatetherm / DOLFINx (end to end: ``simulate`` over ``dolfinx``; equal
 work: ``equal`` over ``dolfinx``) and the agreement of T_A, T_B and δ between ``equal`` and
 DOLFINx. BLAS threads are whatever each process sets (gatetherm: one, see studies/cli).
+The table is also written to ``--json`` (default ``benchmarks/results/peer.json``), which
+``gatetherm report`` shows.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
+import platform
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
+from datetime import date
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+LOAD_AT_START = os.getloadavg()[0]
+"""Load average (1 min) when the benchmark started: these cores are shared."""
 MATERIAL = {"k": 48.0, "rho": 7250.0, "c": 510.0, "E": 1.2e11, "nu": 0.26, "alpha": 1.05e-5}
 
 
@@ -79,6 +85,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--dolfinx", default="/tmp/venv_dolfinx/bin/python", help="python of setup_dolfinx.sh")
+    ap.add_argument("--json", type=Path, default=HERE / "results" / "peer.json", help="table written here")
     ap.add_argument("--equal", metavar="CASE.toml", help=argparse.SUPPRESS)  # the equal-work job itself
     args = ap.parse_args()
     if args.equal:
@@ -104,26 +111,26 @@ def main() -> None:
                   f"peak {res['rss_gb']:.2f} GB  load {os.getloadavg()[0]:.1f}  ({time.perf_counter() - t0:.0f} s)",
                   flush=True)
     med = {k: {m: statistics.median(r[m] for r in v) for m in ("wall", "cpu", "rss_gb")} for k, v in results.items()}
-    print(f"\n{'job':10s} {'wall s':>8s} {'CPU s':>8s} {'peak GB':>8s}   (medians of {args.rounds})")
-    for k, m in med.items():
-        print(f"{k:10s} {m['wall']:8.1f} {m['cpu']:8.1f} {m['rss_gb']:8.2f}")
-    for label, k in (("end to end (simulate / dolfinx)", "simulate"), ("equal work (equal / dolfinx)", "equal")):
-        print(f"{label:34s} wall {med[k]['wall'] / med['dolfinx']['wall']:.2f}  "
-              f"CPU {med[k]['cpu'] / med['dolfinx']['cpu']:.2f}  memory {med[k]['rss_gb'] / med['dolfinx']['rss_gb']:.2f}")
+    rows = [[k, round(m["wall"], 1), round(m["cpu"], 1), round(m["rss_gb"], 2)] for k, m in med.items()]
+    rows += [[f"ratio {k} / dolfinx", *(round(med[k][m] / med["dolfinx"][m], 2) for m in ("wall", "cpu", "rss_gb"))]
+             for k in ("simulate", "equal")]
     d, g = results["dolfinx"][-1], results["equal"][-1]
-    print(f"agreement: T_A {abs(d['T_A'] - g['T_A']):.1e} K, T_B {abs(d['T_B'] - g['T_B']):.1e} K, "
-          f"delta {abs(d['delta_um'] - g['delta_um']):.1e} um (DOLFINx delta {d['delta_um']:.6f} um, "
-          f"gatetherm {g['delta_um']:.6f} um)")
-    print("parts, last round (s): dolfinx " + ", ".join(f"{k} {v}" for k, v in d.items() if isinstance(v, float)
-                                                      and k not in ("T_A", "T_B", "delta_um", "wall")))
-    print("                       gatetherm " + ", ".join(f"{k} {v}" for k, v in g.items() if isinstance(v, float)
-                                                        and k not in ("T_A", "T_B", "delta_um", "wall")))
 
+    def parts(res):
+        return ", ".join(f"{k} {v}" for k, v in res.items() if isinstance(v, float)
+                         and k not in ("T_A", "T_B", "delta_um", "wall", "cpu", "rss_gb"))
 
-def rusage_run(cmd) -> dict:
+    notes = [f"medians of {args.rounds} interleaved rounds; simulate: gatetherm simulate --condition 1 --dim 3 end "
+             "to end; equal: the DOLFINx problem (300 backward-Euler steps + 1 elastic solve) through gatetherm's API",
+             f"agreement: T_A {abs(d['T_A'] - g['T_A']):.1e} K, T_B {abs(d['T_B'] - g['T_B']):.1e} K, delta "
+             f"{abs(d['delta_um'] - g['delta_um']):.1e} um (DOLFINx {d['delta_um']:.6f} um, gatetherm {g['delta_um']:.6f} um)",
+             f"parts, last round (s): DOLFINx {parts(d)}", f"parts, last round (s): gatetherm {parts(g)}"]
+    write_table(args.json, ["job", "wall s", "CPU s", "peak GB"], rows, notes)
+
+def rusage_run(cmd, env=None) -> dict:
     """Run ``cmd`` to its end: wall and CPU seconds, peak resident memory (GB), last JSON line."""
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     out = p.stdout.read()
     err = p.stderr.read()
     _, status, usage = os.wait4(p.pid, 0)
@@ -132,6 +139,31 @@ def rusage_run(cmd) -> dict:
         raise RuntimeError(f"{' '.join(cmd[:4])} failed: {err[-2000:]}")
     line = next((ln for ln in reversed(out.splitlines()) if ln.startswith("{")), "{}")
     return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "rss_gb": usage.ru_maxrss / 1e6, **json.loads(line)}
+
+
+def write_table(path: Path, columns: list, rows: list, notes: list[str]) -> None:
+    """Print a table and write it with the date, machine and command as JSON to ``path``
+    (``gatetherm report`` shows it)."""
+    notes = [*notes, f"load average {LOAD_AT_START:.1f} at the start, {os.getloadavg()[0]:.1f} at the end"]
+    widths = [max(len(str(c)), *(len(str(r[i])) for r in rows)) for i, c in enumerate(columns)]
+    print("\n" + "  ".join(f"{c:>{w}}" for c, w in zip(columns, widths)))
+    for r in rows:
+        print("  ".join(f"{str(v):>{w}}" for v, w in zip(r, widths)))
+    for n in notes:
+        print(n)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps({"date": date.today().isoformat(), "machine": machine(),
+                                "command": f"python benchmarks/{Path(sys.argv[0]).name} " + " ".join(sys.argv[1:]),
+                                "columns": columns, "rows": rows, "notes": notes}, indent=1) + "\n")
+    print(f"wrote {path}")
+
+
+def machine() -> str:
+    """CPU model, cores and memory of this machine, one line."""
+    cpu = next((ln.split(":", 1)[1].strip() for ln in Path("/proc/cpuinfo").read_text().splitlines()
+                if ln.startswith("model name")), platform.processor())
+    mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    return f"{cpu}, {os.cpu_count()} cores, {mem:.0f} GiB, Python {platform.python_version()}"
 
 
 if __name__ == "__main__":

@@ -8,9 +8,11 @@ import os
 from gatetherm import InputError
 from gatetherm.geometry.frame import Box, FrameParams, MeshParams, part_boxes, tank_box
 
-BYTES_PER_ELEMENT = 10_000
-"""Peak memory of a P1 run per element, bytes: measured 6.8 kB per triangle (2-D, 14k to 207k
-elements) and 8.3 kB per tetrahedron (3-D, 12k to 65k), rounded up."""
+BYTES_PER_ELEMENT = {2: 10_000, 3: 5_000}
+"""Peak memory of a P1 condition per *estimated* element (:func:`element_estimate`), bytes, by
+dimension: measured 6.8 kB per triangle (2-D, 14k to 207k elements), rounded up; in 3-D
+3.3-3.4 kB per estimated tetrahedron from 53k to 177k nodes (``benchmarks/scaling.py``: 1.47 GB
+at 52 812 nodes, 6.18 GB at 177 283), with room for the factor's faster growth on finer meshes."""
 FALLBACK_MEMORY = 8e9
 """Memory assumed where the operating system does not report it, bytes."""
 
@@ -19,7 +21,7 @@ def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
     """Elements of the mesh of ``p`` at ``m``'s size: the frame's area (volume) over that of
     an equilateral triangle (regular tetrahedron) of the element size. Against gmsh's counts
     from 3k to 200k elements: up to 25 % low in 2-D (the refinement near the tank and the
-    joints), up to 1.5 times high in 3-D."""
+    joints), 1.5 to 2.1 times high in 3-D."""
     def measure(b: Box) -> float:
         return math.prod(b[2 * i + 1] - b[2 * i] for i in range(dim))
 
@@ -39,7 +41,7 @@ def memory_bytes() -> float:
 def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
     """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
     n = element_estimate(p, m, dim)
-    need, have = n * BYTES_PER_ELEMENT, memory_bytes()
+    need, have = n * BYTES_PER_ELEMENT[dim], memory_bytes()
     if need > have:
         key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
         raise InputError(key, f"{s:g} m gives about {n:.2g} {'triangles' if dim == 2 else 'tetrahedra'} needing "

@@ -155,9 +155,10 @@ BACKENDS = {"pardiso": _pardiso, "cholmod": _cholmod, "superlu": _superlu}
 
 def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACKENDS)) -> tuple[Solve, str]:
     """Factor the SPD matrix ``A`` (in ``order``, from :func:`nd_order`, where the backend
-    takes one) with the first backend of ``allow`` that works; ``(solve, backend name)``."""
+    takes one) with the first backend of ``allow`` that works (only the one forced by
+    ``GATETHERM_SPD_BACKEND``, if that names one); ``(solve, backend name)``."""
     forced = os.environ.get(BACKEND_ENV)
-    names = [forced] if forced in allow else list(allow)
+    names = [forced] if forced in allow else [] if forced in BACKENDS else list(allow)
     for name in names:
         try:
             solve = BACKENDS[name](A, order)
@@ -230,7 +231,7 @@ def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.nd
 def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None, rtol: float = RTOL,
                order: np.ndarray | None = None) -> Solve:
     """Return ``solve(b)`` for the SPD elastic matrix ``A``, set up once: a Cholesky factor
-    (pardiso or cholmod; ``order`` a fill-reducing order of A, as :func:`free_order` gives);
+    (pardiso or cholmod; ``order`` a fill-reducing order of A, as :func:`restrict_order` gives);
     else SuperLU for 2-D and small 3-D systems; else AMG-CG on the rigid-body modes ``near_null``."""
     A = A.tocsr()
     small = dim == 2 or A.shape[0] <= DIRECT_LIMIT_3D or near_null is None

@@ -5,16 +5,10 @@ from __future__ import annotations
 import pytest
 
 from gatetherm.geometry.build import build_mesh
-from gatetherm.geometry.frame import FrameParams, MeshParams
-from gatetherm.solvers.frame import ModelConfig
-
-COARSE = MeshParams(size=0.02, size_3d=0.02)
-"""Mesh density of the shared frame fixtures (about 1.6k triangles / 24k tetrahedra)."""
-FIXED = FrameParams(h=0.12, column_height=0.53, l=0.50, l4=0.25, A_C=2.4e-3, tank_wall=0.015, tank_width=0.05)
-"""A fixed frame (not the calibrated defaults), so that hand values in tests stay valid."""
-
-FIXED_MODEL = ModelConfig(frame=FIXED, mesh=COARSE)
-"""The model whose mesh the fixtures :func:`frame_2d`, :func:`frame_3d` are (a matching pair)."""
+# The verification frame (validation/verification_time.py, also run by `gatetherm report`):
+# FIXED, a fixed frame (not the calibrated defaults) so that hand values in tests stay valid,
+# COARSE its mesh density, FIXED_MODEL the model whose meshes frame_2d, frame_3d are.
+from gatetherm.validation.verification_time import COARSE_MESH as COARSE, FIXED_FRAME as FIXED, FIXED_MODEL
 
 _ORDERS = pytest.StashKey[list]()
 

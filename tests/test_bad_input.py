@@ -161,6 +161,15 @@ def test_a_mesh_that_cannot_fit_in_memory_is_refused_before_gmsh(tmp_path, capsy
     assert not (tmp_path / "o").exists()
 
 
+
+@pytest.mark.parametrize("value", ["x", "0", "-2", "1.5"])
+def test_a_bad_blas_thread_count_is_refused(tmp_path, capsys, monkeypatch, value):
+    monkeypatch.setenv("GATETHERM_BLAS_THREADS", value)
+    refused(capsys, 2, ["mesh", "--out", tmp_path / "o"],
+            f"gatetherm: error: environment variable GATETHERM_BLAS_THREADS: {value!r} is not a thread count",
+            "or unset it")
+    assert not (tmp_path / "o").exists()
+
 # ---- schedules and data files ------------------------------------------------------------------
 
 def _sched(old: str, new: str) -> bytes:

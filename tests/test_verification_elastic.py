@@ -6,16 +6,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from skfem import MeshTet, MeshTri
 from skfem.models.elasticity import plane_stress as skfem_plane_stress
 
 from gatetherm.solvers.elasticity import moduli
 from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
-from gatetherm.validation.verification import (clamped_bar_tip, dofs_where, elastic_mms_error, spatial_study,
-                                     thermoelastic_solve)
+from gatetherm.validation.verification import (BLOCK, SPATIAL_ELASTIC, at_point, block, clamped_bar_tip,
+                                               component_values, dofs_where, elastic_mms_error, free_expansion,
+                                               linear_temperature, spatial_study, thermoelastic_solve)
 
 E, NU, ALPHA = 1.2e11, 0.26, 1.05e-5
-L, H, D = 0.3, 0.1, 0.05  # test block, m
+L, H, D = BLOCK  # test block, m
 
 
 def test_plane_stress_constants():
@@ -37,49 +37,12 @@ def test_plane_stress_constants():
     assert skfem_plane_stress(E, NU) == pytest.approx((lam_ps, mu), rel=1e-14)
 
 
-def _box(dim: int, n: int = 6):
-    x, y, z = np.linspace(0, L, n + 1), np.linspace(0, H, 3), np.linspace(0, D, 3)
-    return MeshTri.init_tensor(x, y) if dim == 2 else MeshTet.init_tensor(x, y, z)
-
-
-def _at(point):
-    return lambda x: np.all(np.abs(x - np.reshape(point, (-1, 1))) < 1e-12, axis=0)
-
-
-def _statically_determinate(dim: int):
-    """Supports that remove only the rigid motions: origin fixed, (L, 0[, 0]) held in
-    y[, z], and in 3-D (0, H, 0) held in z."""
-    o = np.zeros(dim)
-    def fixed(vb):
-        d = [dofs_where(vb, _at(o), range(dim)),
-             dofs_where(vb, _at(np.r_[L, o[1:]]), range(1, dim))]
-        if dim == 3:
-            d.append(dofs_where(vb, _at([0.0, H, 0.0]), [2]))
-        return np.concatenate(d)
-    return fixed
-
-
-def _component_values(vb, U):
-    """Displacement components (dim, nodes) and the node coordinates (dim, nodes)."""
-    idx = vb.split_indices()
-    x = vb.doflocs[:, idx[0]]
-    assert all(np.array_equal(vb.doflocs[:, i], x) for i in idx)
-    return np.array([U[i] for i in idx]), x
-
-
 @pytest.mark.parametrize("dim, order", [(2, 1), (2, 2), (3, 1), (3, 2)])
 def test_free_expansion(dim, order):
     """Uniform ΔT on a block held only against rigid motion: u = α ΔT x exactly
     (the length grows by α ΔT L) and no stress, to round-off."""
-    dT = 30.0
-    vb, U, sig = thermoelastic_solve(_box(dim), order, 1, lambda x: np.full(x.shape[1], dT),
-                                     _statically_determinate(dim))
-    u, x = _component_values(vb, U)
-    np.testing.assert_allclose(u, ALPHA * dT * x, rtol=0, atol=1e-10 * ALPHA * dT * L)
-    tip = dofs_where(vb, _at(np.r_[L, np.zeros(dim - 1)]), [0])
-    assert U[tip] == pytest.approx(ALPHA * dT * L, rel=1e-10)
-    b = moduli(E, NU, ALPHA, dim)[2]
-    assert np.abs(sig).max() < 1e-10 * b * dT
+    e = free_expansion(dim, order)
+    assert e["u"] < 1e-10 and e["tip"] < 1e-10 and e["stress"] < 1e-10
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -87,14 +50,10 @@ def test_free_expansion(dim, order):
 def test_linear_temperature_is_stress_free(dim, T_order):
     """A linear temperature field gives the compatible strain α T I, whose displacement is
     quadratic: P2 reproduces it, so the stress at the quadrature points vanishes."""
-    g = np.array([100.0, -60.0, 40.0])[:dim]
-    T = lambda x: 10.0 + g @ x  # noqa: E731
-    vb, U, sig = thermoelastic_solve(_box(dim), 2, T_order, T, _statically_determinate(dim))
-    b = moduli(E, NU, ALPHA, dim)[2]
-    T_max = 10.0 + np.abs(g) @ np.array([L, H, D])[:dim]
-    assert np.abs(sig).max() < 1e-10 * b * T_max
+    e = linear_temperature(dim, T_order)
+    assert e["stress"] < 1e-10
     # the strain really is α T I (not zero): u_x grows like α T x
-    assert np.abs(U).max() > 0.5 * ALPHA * 10.0 * L
+    assert e["u_max"] > 0.5 * ALPHA * 10.0 * L
 
 
 def _faces(mesh, x0):
@@ -104,13 +63,13 @@ def _faces(mesh, x0):
 def test_uniaxial_tension_plane_stress():
     """Traction s on x = L, u_x = 0 on x = 0: ε_xx = s/E, ε_yy = −ν s/E (plane stress,
     σ_zz = 0) exactly with P1."""
-    s, m = 1.0e7, _box(2)
+    s, m = 1.0e7, block(2)
     def fixed(vb):
         return np.concatenate([dofs_where(vb, lambda x: np.abs(x[0]) < 1e-12, [0]),
-                               dofs_where(vb, _at([0.0, 0.0]), [1])])
+                               dofs_where(vb, at_point([0.0, 0.0]), [1])])
     vb, U, sig = thermoelastic_solve(m, 1, 1, lambda x: np.zeros(x.shape[1]), fixed,
                                      traction=(_faces(m, L), [s, 0.0]))
-    u, x = _component_values(vb, U)
+    u, x = component_values(vb, U)
     np.testing.assert_allclose(u, [s / E * x[0], -NU * s / E * x[1]], rtol=0, atol=1e-10 * s / E * L)
     np.testing.assert_allclose(sig[0, 0], s, rtol=1e-10)
     assert np.abs(sig[1]).max() < 1e-10 * s
@@ -119,23 +78,21 @@ def test_uniaxial_tension_plane_stress():
 def test_restrained_bar_plane_stress():
     """Uniform ΔT, u_x = 0 on both ends, free in y: σ_xx = −E α ΔT = −3.78e7 Pa for
     ΔT = 30 K, σ_yy = 0 and ε_yy = (1 + ν) α ΔT (plane stress) exactly with P1."""
-    dT, m = 30.0, _box(2)
+    dT, m = 30.0, block(2)
     def fixed(vb):
         return np.concatenate([dofs_where(vb, lambda x: (np.abs(x[0]) < 1e-12) | (np.abs(x[0] - L) < 1e-12), [0]),
-                               dofs_where(vb, _at([0.0, 0.0]), [1])])
+                               dofs_where(vb, at_point([0.0, 0.0]), [1])])
     vb, U, sig = thermoelastic_solve(m, 1, 1, lambda x: np.full(x.shape[1], dT), fixed)
     np.testing.assert_allclose(sig[0, 0], -3.78e7, rtol=1e-10)
     assert np.abs(sig[1]).max() < 1e-10 * 3.78e7
-    u, x = _component_values(vb, U)
+    u, x = component_values(vb, U)
     np.testing.assert_allclose(u[1], (1 + NU) * ALPHA * dT * x[1], rtol=0, atol=1e-10 * ALPHA * dT * H)
 
 
-# (dimension, element order, refinement levels), meshes as in validation.verification.unit_mesh
-SPATIAL = {"2D-P1": (2, 1, (3, 4, 5, 6, 7)), "2D-P2": (2, 2, (2, 3, 4, 5, 6)),
-           "3D-P1": (3, 1, (6, 8, 12, 16, 20)), "3D-P2": (3, 2, (2, 3, 4, 6, 8))}
+SPATIAL = SPATIAL_ELASTIC  # label -> (dimension, element order, refinement levels)
 
 
-@pytest.mark.parametrize("case", [pytest.param(k, id=k, marks=[pytest.mark.slow] if "3D" in k else [])
+@pytest.mark.parametrize("case", [pytest.param(k, id=k, marks=[pytest.mark.slow] if k.startswith("3-D") else [])
                                   for k in SPATIAL])
 def test_spatial_order(case, record_order):
     """Manufactured displacement and temperature (body force by hand, traction face,

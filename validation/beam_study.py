@@ -38,10 +38,11 @@ def _fe_curves(rows):
 
 
 def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, scheduler: str | None = None,
-                     progress=None) -> dict:
-    """Run the beam-vs-FE studies (resumable, points under ``out/points``), write the
-    tables, figures and ``report.md``; returns the summary (also ``summary.json``) with
-    ``lines``, the key figures as sentences."""
+                     progress=None, a_every: int = 1, series: bool = True) -> dict:
+    """Run the beam-vs-FE studies (resumable, points under ``out/points``; ``a_every``,
+    ``series``: a subset, see :func:`beam_vs_fe.studies`), write the tables, figures and
+    ``report.md``; returns the summary (also ``summary.json``) with ``lines``, the key figures
+    as sentences, ``by_beta`` (the error summary per coefficient and beta) and ``effective``."""
     from gatetherm.solvers.beam import normalised
     from gatetherm.validation import beam_vs_fe as bv
     from gatetherm.validation import beam_vs_fe_report as bv_report
@@ -51,7 +52,7 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
 
     t0, c0 = time.perf_counter(), cpu_seconds()
     out = Path(out)
-    plans, records = run_points(bv.studies(base, dim), out, workers, scheduler, progress)
+    plans, records = run_points(bv.studies(base, dim, a_every, series), out, workers, scheduler, progress)
     rows = {name: [bv.collect(tasks, records) for tasks in lst] for name, lst in plans.items()}
     main, no_tank = rows["sweep"][0], rows["no_tank"][0]
 
@@ -68,12 +69,12 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
                       + (bv_report.md_table(gaps) if gaps else "none") + "\n")
     slender = bv.series_rows([r for rs in rows["slenderness"] for r in rs], "l_over_h")
     tie = bv.series_rows([r for rs in rows["tie_height"] for r in rs], "geometry.t_C")
-    for series, x, name in ((slender, "l_over_h", "slenderness"), (tie, "geometry.t_C", "tie_height")):
-        if not series:
+    for srows, x, name in ((slender, "l_over_h", "slenderness"), (tie, "geometry.t_C", "tie_height")):
+        if not srows:
             continue
-        write_table(out / f"{name}.csv", *columns_of(series))
+        write_table(out / f"{name}.csv", *columns_of(srows))
         for k in ("Ki", "Kc"):
-            plot_xy(series, x, f"{k}_fe_rel_error", "point", out / f"{name}_{k}.png",
+            plot_xy(srows, x, f"{k}_fe_rel_error", "point", out / f"{name}_{k}.png",
                     f"{k}: (FE - theory)/theory, no tank cavity", logx=(name == "slenderness"), hline=0.0)
     conv = bv.convergence(rows["mesh"], dim)
     write_table(out / "mesh.csv", *columns_of(conv))
@@ -101,4 +102,4 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
         "gaps": len(gaps), "within_tolerance_no_tank": sum(e["within_tolerance"] for e in errors_nt),
         "zero_crossings_fe": {str(b): z for b, z in zc_fe.items()}}
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=2) + "\n")
-    return {**summary, "lines": lines}
+    return {**summary, "lines": lines, "by_beta": bv_report.summary_by_beta(errors), "effective": effective}

@@ -67,19 +67,20 @@ def _study(name, base, dim, fixed, grid) -> Study:
                  ("coefficients",))
 
 
-def studies(base: Config, dim: int) -> dict[str, list[Study]]:
+def studies(base: Config, dim: int, a_every: int = 1, series: bool = True) -> dict[str, list[Study]]:
     """All studies of ``gatetherm validate beam`` by name; the controlled series are 2-D only
-    (a 3-D point costs about ten 2-D ones)."""
+    (a 3-D point costs about ten 2-D ones). A subset: every ``a_every``-th l/l4 value, and
+    without the controlled and mesh series unless ``series``."""
     n = ELEMENTS_ACROSS[dim]
-    sweep = {"derived.beta": BETAS, "derived.l_over_l4": A_VALUES[dim]}
+    sweep = {"derived.beta": BETAS, "derived.l_over_l4": A_VALUES[dim][::a_every]}
     series = {"derived.beta": SERIES_BETA, "derived.l_over_l4": SERIES_A}
     out = {"sweep": [_study("sweep", base, dim, _fixed(base, dim, SLENDERNESS, n), sweep)],
            "no_tank": [_study("no_tank", base, dim, _fixed(base, dim, SLENDERNESS, n, tank=False), sweep)],
            "slenderness": [], "tie_height": [],
            "mesh": [_study(f"mesh h/{m}", base, dim, _fixed(base, dim, SLENDERNESS, m),
                            {"derived.beta": (b,), "derived.l_over_l4": (a,)})
-                    for m in MESH_ACROSS[dim] for a, b in MESH_POINTS[dim]]}
-    if dim == 2:
+                    for m in MESH_ACROSS[dim] for a, b in MESH_POINTS[dim]] if series else []}
+    if dim == 2 and series:
         out["slenderness"] = [_study(f"slenderness l/h={s:g}", base, dim, _fixed(base, dim, s, n, tank=False),
                                      series) for s in SERIES_L_OVER_H]
         out["tie_height"] = [_study("tie_height", base, dim, _fixed(base, dim, SLENDERNESS, n, tank=False),

@@ -224,8 +224,25 @@ def table_csv(st: Study) -> str:
     return buf.getvalue()
 
 
-def write_compensation_study(out: Path, cfg, dim: int = 2) -> str:
-    """Run the study, write the figures, ``compensation_table.md`` and ``.csv``; returns the markdown."""
+def summary_rows(st: Study) -> tuple[list[str], list[list[str]]]:
+    """(columns, rows) of the README's compensation table: per condition the swing, the
+    prediction-error bands of the paper's procedure with K from theory, FE and the fit, and
+    the residual bands of the K-theory loop (5-min updates, at the update instants, 1-min)."""
+    paper = [p for p in dict.fromkeys(r.predictor for r in st.rows) if p.startswith("paper")]
+    rows = []
+    for n in sorted({r.condition for r in st.rows}):
+        by = {r.predictor: r for r in st.rows if r.condition == n}
+        main = by[paper[0]]
+        rows.append([str(n), f"{main.swing_um:.2f} µm",
+                     " / ".join(f"{by[p].prediction_error_band_um:.2f}" for p in paper) + " µm",
+                     f"{main.residual_band_um:.2f} µm", f"{main.residual_at_updates_um:.2f} µm",
+                     f"{main.residual_band_1min_um:.2f} µm", "±6–7 µm"])
+    return (["cond.", "swing before", "prediction error band (K theory / FE / fit)", "residual band, 5-min updates",
+             "residual at the 5-min update instants", "residual, 1-min updates", "paper"], rows)
+
+
+def write_compensation_study(out: Path, cfg, dim: int = 2) -> Study:
+    """Run the study, write the figures, ``compensation_table.md`` and ``.csv``; returns the study."""
     from gatetherm.validation.plots.compensation import plot_condition_study, plot_piezo_loops
 
     quiet = logging.getLogger("gatetherm.studies.control.actuator")
@@ -241,6 +258,5 @@ def write_compensation_study(out: Path, cfg, dim: int = 2) -> str:
                              out / FIGURES.get(n, f"condition{n}.png"), PAPER_BAND_UM)
     plot_piezo_loops(piezo.ActuatorParams(), out / "piezo_loops.png")
     write_text_atomic(out / "compensation_table.csv", table_csv(st))
-    text = markdown(st)
-    write_text_atomic(out / "compensation_table.md", text)
-    return text
+    write_text_atomic(out / "compensation_table.md", markdown(st))
+    return st

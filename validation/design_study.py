@@ -13,27 +13,32 @@ from gatetherm.validation.beam_study import columns_of, cpu_seconds
 
 
 def write_design_study(out: Path, base: Config, dim: int, workers: int = 1, scheduler: str | None = None,
-                       progress=None) -> list[str]:
+                       progress=None, positions: int | None = None, refine: int | None = None,
+                       second_above=None) -> list[str]:
     """Run the design studies (resumable), write the tables, figures and ``report.md``;
-    returns the key figures as sentences."""
+    returns the key figures as sentences. ``positions``, ``refine``, ``second_above``: a
+    coarser grid than studies/sweeps/design.py's (first grid, refined points, second-bar
+    heights as fractions of l)."""
     from gatetherm.studies.sweeps import design as ds
     from gatetherm.studies.sweeps.sweep import table
     from gatetherm.validation.plots.sweep import plot_histories, plot_positions, plot_second
 
     t0, c0 = time.perf_counter(), cpu_seconds()
     out = Path(out)
-    grid = ds.first_grid(base, dim)
+    positions, refine = positions or ds.N_POSITIONS, refine or ds.N_REFINE
+    second_above = tuple(second_above or ds.SECOND_ABOVE)
+    grid = ds.first_grid(base, dim, positions)
 
-    def positions(values):
+    def run_positions(values):
         plans, records = run_points({"p": [ds.position_study(base, dim, values)]}, out, workers, scheduler, progress)
         return table(plans["p"][0], records)[1]
 
-    rows = positions(grid)
-    rows += positions(ds.refined_grid(grid, ds.optimum(rows)["l4"]))
+    rows = run_positions(grid)
+    rows += run_positions(ds.refined_grid(grid, ds.optimum(rows)["l4"], refine))
     best = ds.optimum(rows)
-    paper_rows = positions([base.model.frame.l4])
+    paper_rows = run_positions([base.model.frame.l4])
     first = (base.model.frame.l4, best["l4"])
-    plans, records = run_points({"s": [ds.second_study(base, dim, first)]}, out, workers, scheduler,
+    plans, records = run_points({"s": [ds.second_study(base, dim, first, second_above)]}, out, workers, scheduler,
                                 progress)
     second = ds.second_summary(table(plans["s"][0], records)[1])
     columns = list(dict.fromkeys(k for r in rows for k in r))
@@ -52,7 +57,7 @@ def write_design_study(out: Path, base: Config, dim: int, workers: int = 1, sche
     paper_swing = ds.swings(paper_rows)[round(first[0], 6)]
     timing = {"wall s": round(time.perf_counter() - t0, 1), "CPU s": round(cpu_seconds() - c0, 1),
               "workers": scheduler or workers}
-    write_text_atomic(out / "report.md", ds.report(dim, base, best, paper_swing, second, timing))
+    write_text_atomic(out / "report.md", ds.report(dim, base, best, paper_swing, second, timing, (positions, refine)))
     return [f"wrote {out}/report.md, positions.csv, second_tie_bar.csv and design_*.png",
             f"optimal l4 = {best['l4']:.4g} m: worst swing {best['worst_swing_um']:.1f} um "
           f"(model's l4 = {first[0]:.4g} m: {max(paper_swing.values()):.1f} um)",

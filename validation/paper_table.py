@@ -31,9 +31,18 @@ def within(key: str, got: float | None, want: float, dim: int) -> bool:
     return abs(got - want) <= BAND[dim] * want
 
 
-def run_all(out: Path, cfg: Config, dims, reuse: bool) -> dict:
+def run_condition(cfg: Config, dim: int, c: int, cache=None, keep_times=()):
+    """(the run, its summary: the figures of :data:`PAPER`, wall time, nodes) of condition ``c``."""
     from gatetherm.studies.run.scenario import condition_schedule, run_scenario
     from gatetherm.studies.run.simulate import delta_figures
+
+    run = run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache, keep_times=keep_times)
+    cols = run.columns
+    return run, {**delta_figures(cols["time_s"], cols["delta_um"]), "wall_time_s": round(run.seconds, 2),
+                 "dim": dim, "nodes": len(run.model.fmesh.points), "config": cfg.source, "condition": c}
+
+
+def run_all(out: Path, cfg: Config, dims, reuse: bool) -> dict:
     from gatetherm.validation.plots.run import plot_response
 
     res = {}
@@ -41,29 +50,35 @@ def run_all(out: Path, cfg: Config, dims, reuse: bool) -> dict:
         for c in (1, 2, 3):
             d = out / f"c{c}_d{dim}"
             if not (reuse and (d / "summary.json").exists()):
-                run = run_scenario(cfg, dim, condition_schedule(c, cfg))
-                cols = run.columns
-                summary = {**delta_figures(cols["time_s"], cols["delta_um"]), "wall_time_s": round(run.seconds, 2),
-                           "dim": dim, "nodes": len(run.model.fmesh.points), "config": cfg.source, "condition": c}
+                run, summary = run_condition(cfg, dim, c)
                 write_text_atomic(d / "summary.json", json.dumps(summary, indent=2, sort_keys=True) + "\n")
-                plot_response(cols, d / "response.png", f"gatetherm {dim}-D, condition {c}")
+                plot_response(run.columns, d / "response.png", f"gatetherm {dim}-D, condition {c}")
             res[(c, dim)] = json.loads((d / "summary.json").read_text())
     return res
 
 
-def table(res: dict, dims) -> str:
-    head = "| cond. | figure | paper | " + " | ".join(f"{d}-D" for d in dims) + " |"
-    lines = [head, "|" + " --- |" * (3 + len(dims))]
+def table_rows(res: dict, dims, load: float | None = None) -> tuple[list[str], list[list[str]]]:
+    """(columns, rows) of the table of ``res`` {(condition, dim): summary}: every figure against
+    the paper with ✓/✗ for its band, the mesh nodes and the wall time of condition 1 (``load``:
+    the machine's load average when it was timed)."""
+    rows = []
     for c, key, want, label in PAPER:
         cells = []
         for d in dims:
             got = res[(c, d)].get(key)
-            mark = "✓" if within(key, got, want, d) else "✗"
-            cells.append("—" if got is None else f"{got:.1f} {mark}")
-        lines.append(f"| {c} | {label} | {want:g} | " + " | ".join(cells) + " |")
-    walls = " | ".join(f"{res[(1, d)]['wall_time_s']:.1f} s" for d in dims)
-    lines.append(f"| 1 | wall time of the run (build and march) | — | {walls} |")
-    return "\n".join(lines)
+            cells.append("—" if got is None else f"{got:.1f} {'✓' if within(key, got, want, d) else '✗'}")
+        rows.append([str(c), label, f"{want:g}", *cells])
+    rows.append(["—", "mesh nodes", "—", *(str(res[(1, d)]["nodes"]) for d in dims)])
+    busy = f"; load {load:.1f}" if load is not None else ""
+    rows.append(["1", f"wall time of the run (build and march{busy})", "—",
+                 *(f"{res[(1, d)]['wall_time_s']:.1f} s" for d in dims)])
+    return ["cond.", "figure", "paper", *(f"{d}-D" for d in dims)], rows
+
+
+def table(res: dict, dims) -> str:
+    """:func:`table_rows` as markdown."""
+    columns, rows = table_rows(res, dims)
+    return "\n".join("| " + " | ".join(r) + " |" for r in [columns, ["---"] * len(columns), *rows])
 
 
 def write_paper_table(out: Path, cfg: Config, dims=(2, 3), reuse: bool = False) -> str:

@@ -20,7 +20,7 @@ event-triggered within the 60-update budget. Cases:
   model's, which knows nothing of the effect.
 
 Residual bands count every 1-min sample after the first 10 min. Writes DIR/rom_study.md and
-.csv (the reduced models are kept in DIR as rom_2d.npz, rom_3d.npz) and returns the markdown.
+.csv (the reduced models are kept in DIR as rom_2d.npz, rom_3d.npz).
 """
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ from gatetherm.studies.control.compensator import CompensatorParams, close_loop,
 from gatetherm.studies.control.observer import ObserverParams
 from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
 from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
-from gatetherm.studies.run.reduce import cached_rom, check_run
+from gatetherm.studies.run.reduce import cached_rom, check_run, rom_run
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.validation.hidden_effects import Case, measured, truth
 
@@ -102,10 +102,11 @@ def compare(ts, rom, mlr, K, T_room: float, params: CompensatorParams = Compensa
 
 
 def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATALOGUE), on_row=None,
-          checks: list | None = None) -> list[Row]:
+          checks: list | None = None, errors: dict | None = None) -> list[Row]:
     """Run every case (see the module docstring); ``on_row(row)`` as each finishes; each reduced
     model's check against the FE runs is appended to ``checks`` as (dim, seconds to build or
-    None if reused, :class:`~gatetherm.studies.run.reduce.Check`)."""
+    None if reused, :class:`~gatetherm.studies.run.reduce.Check`), and its δ error against
+    time put in ``errors[dim, condition]`` as (time s, δ_rom − δ_FE µm)."""
     rows: list[Row] = []
     K = theory_coefficients(cfg.model)
     roms, mlrs, runs = {}, {}, {}
@@ -117,9 +118,13 @@ def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATAL
         for n in conditions:
             fe = run_scenario(cfg, dim, condition_schedule(n, cfg), cache=cache)
             runs[dim, n] = fe.series({})
+            cols = fe.result.columns
             if checks is not None:
                 checks.append((dim, built if built > 1.0 else None,
-                               check_run(roms[dim], n, fe.result.columns, fe.result.seconds, cfg.supply.T_room)))
+                               check_run(roms[dim], n, cols, fe.result.seconds, cfg.supply.T_room)))
+            if errors is not None:
+                y, _ = rom_run(roms[dim], cols, cfg.supply.T_room)
+                errors[dim, n] = (cols["time_s"], y[:, roms[dim].output("delta_um")] - cols["delta_um"])
         first = runs[dim, 1] if 1 in conditions else run_scenario(cfg, dim, condition_schedule(1, cfg), cache=cache).series({})
         mlrs[dim] = fit_regression(first, THETAS)
 
@@ -150,49 +155,83 @@ def _f(v) -> str:
     return f"{v:.2f}" if isinstance(v, float) else str(v)
 
 
-def markdown(rows: list[Row], checks=()) -> str:
-    lines = ["# Compensation on a reduced model (gatetherm, issue 13)", ""]
-    if checks:
-        lines += ["| reduced model (built in: assembly + reduction) | cond. | max abs(δ_rom − δ_FE) µm | max θ error K | 5-h run ms | FE run s |",
-                  "|---|---|---|---|---|---|"]
-        lines += [f"| {dim}-D, {STATES} states{'' if built is None else f' (built in {built:.0f} s)'} | "
-                  f"{c.condition} | {c.max_delta_error_um:.3f} | {c.max_theta_error_K:.3f} | {c.rom_ms:.2f} | "
-                  f"{c.fe_seconds:.1f} |" for dim, built, c in checks]
-        lines += [""]
-    lines += [
-             f"Residual band: largest |compensated δ| at every 1-min sample after the first 10 min, µm; piezo "
-             f"model in the loop. paper: K theory, 5-min updates; MLR: θ_A θ_B θ_C fitted on condition 1 of the "
-             f"model, 1-min forecast, 5-min updates; rom: Kalman filter on θ_A θ_B θ_C and δ, forecast over the "
-             f"hold, fixed 5-min updates or event-triggered within {BUDGET} updates.", ""]
-    head = ("case", "cond.", "data", "reduced model", "swing", "paper", "MLR", "rom, 5-min", "rom, event",
-            "updates", "threshold", "rom 1-min forecast error")
-    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    lines += ["| " + " | ".join(_f(v) for v in asdict(r).values()) + " |" for r in rows]
+CHECK_COLUMNS = ("reduced model (built in: assembly + reduction)", "cond.", "max abs(δ_rom − δ_FE) µm",
+                 "max θ error K", "5-h run ms", "FE run s")
+COLUMNS = ("case", "cond.", "data", "reduced model", "swing", "paper", "MLR", "rom, 5-min", "rom, event",
+           "updates", "threshold", "rom 1-min forecast error")
+LEGEND = (f"Residual band: largest |compensated δ| at every 1-min sample after the first 10 min, µm; piezo "
+          f"model in the loop. paper: K theory, 5-min updates; MLR: θ_A θ_B θ_C fitted on condition 1 of the "
+          f"model, 1-min forecast, 5-min updates; rom: Kalman filter on θ_A θ_B θ_C and δ, forecast over the "
+          f"hold, fixed 5-min updates or event-triggered within {BUDGET} updates.")
+
+
+def check_rows(checks) -> list[tuple[str, ...]]:
+    """Rows under :data:`CHECK_COLUMNS` of the checks of :func:`study`."""
+    return [(f"{dim}-D, {STATES} states{'' if built is None else f' (built in {built:.0f} s)'}", str(c.condition),
+             f"{c.max_delta_error_um:.3f}", f"{c.max_theta_error_K:.3f}", f"{c.rom_ms:.2f}", f"{c.fe_seconds:.1f}")
+            for dim, built, c in checks]
+
+
+def rows_text(rows: list[Row]) -> list[tuple[str, ...]]:
+    """Rows under :data:`COLUMNS`."""
+    return [tuple(_f(v) for v in asdict(r).values()) for r in rows]
+
+
+def verdicts(rows: list[Row]) -> list[str]:
+    """Per group of cases: the rom's worst event-triggered band against its target, the others' ranges."""
+    out = []
     model = [r for r in rows if r.case == "model" and r.data.startswith("2-D")]
     hidden = [r for r in rows if r.case == "measured"]
-    lines += [""]
     for label, sel, target in (("default 2-D model, conditions 1-3", model, 3.0),
                                ("hidden-effect runs", hidden, 5.0),
                                ("default 3-D model", [r for r in rows if r.case == "model" and r.data.startswith("3-D")], 3.0),
                                ("3-D data, 2-D reduced model", [r for r in rows if r.case.startswith("3-D data")], 3.0)):
         if sel:
             worst = max(r.rom_event_um for r in sel)
-            lines.append(f"- {label}: rom (event) residual band at most {worst:.2f} µm (target {target:g}: "
-                         f"{'met' if worst <= target else 'NOT met'}), at most {max(r.rom_updates for r in sel)} "
-                         f"updates; paper {min(r.paper_um for r in sel):.2f}-{max(r.paper_um for r in sel):.2f} µm, "
-                         f"MLR {min(r.mlr_um for r in sel):.2f}-{max(r.mlr_um for r in sel):.2f} µm")
+            out.append(f"{label}: rom (event) residual band at most {worst:.2f} µm (target {target:g}: "
+                       f"{'met' if worst <= target else 'NOT met'}), at most {max(r.rom_updates for r in sel)} "
+                       f"updates; paper {min(r.paper_um for r in sel):.2f}-{max(r.paper_um for r in sel):.2f} µm, "
+                       f"MLR {min(r.mlr_um for r in sel):.2f}-{max(r.mlr_um for r in sel):.2f} µm")
+    return out
+
+
+def _md(columns, rows) -> list[str]:
+    return ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns), *("| " + " | ".join(r) + " |" for r in rows)]
+
+
+def markdown(rows: list[Row], checks=()) -> str:
+    lines = ["# Compensation on a reduced model (gatetherm, issue 13)", ""]
+    if checks:
+        lines += [*_md(CHECK_COLUMNS, check_rows(checks)), ""]
+    lines += [LEGEND, "", *_md(COLUMNS, rows_text(rows)), "", *(f"- {v}" for v in verdicts(rows))]
     return "\n".join(lines) + "\n"
 
 
-def write_rom_study(out: Path, cfg, dims=(2, 3), on_row=None) -> str:
-    """Run the study, write ``rom_study.md`` and ``.csv``; returns the markdown."""
+@dataclass(frozen=True)
+class RomStudy:
+    """What :func:`write_rom_study` computed."""
+
+    rows: list
+    """:class:`Row` per case."""
+    checks: list
+    """(dim, build seconds or None, Check) per reduced model and condition (:func:`study`)."""
+    errors: dict
+    """{(dim, condition): (time s, δ_rom − δ_FE µm)}."""
+    markdown: str
+    """The text of ``rom_study.md``."""
+
+
+def write_rom_study(out: Path, cfg, dims=(2, 3), on_row=None, conditions=(1, 2, 3),
+                    effects=tuple(CATALOGUE)) -> RomStudy:
+    """Run the study (``conditions`` and catalogue ``effects``: a subset of its cases), write
+    ``rom_study.md`` and ``.csv``."""
     out = Path(out)
     quiet = logging.getLogger("gatetherm.studies.control.actuator")
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # clipped commands are counted by the compensators' own summaries
     try:
-        checks: list = []
-        rows = study(cfg, out, tuple(dims), on_row=on_row, checks=checks)
+        checks, errors = [], {}
+        rows = study(cfg, out, tuple(dims), tuple(conditions), tuple(effects), on_row, checks, errors)
     finally:
         quiet.setLevel(level)
     buf = io.StringIO()
@@ -202,4 +241,4 @@ def write_rom_study(out: Path, cfg, dims=(2, 3), on_row=None) -> str:
     write_text_atomic(out / "rom_study.csv", buf.getvalue())
     text = markdown(rows, checks)
     write_text_atomic(out / "rom_study.md", text)
-    return text
+    return RomStudy(rows, checks, errors, text)

@@ -12,11 +12,19 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import brentq
 
+from gatetherm.geometry.frame import FrameParams, MeshParams
 from gatetherm.solvers.expr import Value
-from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY, ThermalParams, paper_heat
+from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY, ModelConfig, ThermalParams, build_model, paper_heat
 from gatetherm.solvers.heat import HeatSolver, HeatSystem, TimeScheme, assemble_heat, environment, march
 from gatetherm.solvers.problem import Film, Problem
-from gatetherm.validation.verification import uniform_fields, rectangle
+from gatetherm.validation.verification import observed_order, rectangle, uniform_fields
+
+FIXED_FRAME = FrameParams(h=0.12, column_height=0.53, l=0.50, l4=0.25, A_C=2.4e-3, tank_wall=0.015, tank_width=0.05)
+"""The verification frame: fixed (not the calibrated defaults), so that hand values stay valid."""
+COARSE_MESH = MeshParams(size=0.02, size_3d=0.02)
+"""Mesh density of the verification frame (about 1.6k triangles / 24k tetrahedra)."""
+FIXED_MODEL = ModelConfig(frame=FIXED_FRAME, mesh=COARSE_MESH)
+"""The verification frame's model (the tests' fixtures ``frame_2d``, ``frame_3d`` are its meshes)."""
 
 
 @dataclass(frozen=True)
@@ -197,3 +205,74 @@ def energy_balance(sys: HeatSystem, drive, times: np.ndarray, theta: float) -> d
         for key, v in terms.items():
             out.setdefault(key, []).append(float(v))
     return {key: np.array(v) for key, v in out.items()}
+
+
+SMOOTH = HarmonicDrive(amb0=20.0, amb1=3.0, sup0=40.0, sup1=5.0, omega=2.0)
+"""Harmonic room and supply, the pump always on."""
+SWITCHED = HarmonicDrive(amb0=20.0, amb1=3.0, sup0=40.0, sup1=5.0, omega=2.0, period=1.0)
+"""The same with the pump stopping at t = 1."""
+TIME_CASES = {
+    "BE": (TimeScheme(1.0, 1), SMOOTH, (10, 20, 40, 80, 160), False),
+    "CN": (TimeScheme(0.5, 1), SMOOTH, (10, 20, 40, 80, 160), False),
+    "BE pump off at t=1": (TimeScheme(1.0, 1), SWITCHED, (10, 20, 40, 80, 160), True),
+    "CN pump off at t=1": (TimeScheme(0.5, 1), SWITCHED, (80, 160, 320, 640), True),
+    "CN+Rannacher pump off at t=1": (TimeScheme(0.5, 2, 1), SWITCHED, (10, 20, 40, 80, 160), True),
+}
+"""Time-order studies on :func:`unit_heat_system` over t = 0..2: label -> (scheme, drive, step
+counts, error at t = 2 only). Without switching the error is the max over all steps."""
+
+
+def time_order(label: str):
+    """(dt, errors, observed order, expected order) of :data:`TIME_CASES` ``label``, started in
+    equilibrium with the inputs at t = 0."""
+    scheme, drive, steps, final_only = TIME_CASES[label]
+    sys = unit_heat_system()
+    dt, err = time_errors(sys, drive, 2.0, steps, scheme, steady_state(sys, drive), final_only)
+    return dt, err, observed_order(dt, err), 1.0 if scheme.theta == 1.0 else 2.0
+
+
+FRAME_SOURCE = 2.0e4
+"""Heat source in arm_L of the energy-balance run, W/m³."""
+
+
+def frame_drive(t: float) -> dict[str, float]:
+    """Pump on for the first 20 min of every 40, supply and room both varying."""
+    return {SUPPLY: 40.0 + 5.0 * np.sin(t / 900.0), PUMP: float((t // 1200.0) % 2 == 0),
+            AMBIENT: 20.0 + 2.0 * np.sin(t / 1500.0)}
+
+
+FRAME_TIMES = np.concatenate([np.arange(0.0, 3600.0, 60.0), np.arange(3600.0, 10800.0 + 1, 150.0)])
+"""3 h in uneven steps: 60 s, then 150 s."""
+
+
+def frame_energy(theta: float, fmesh=None) -> dict[str, np.ndarray]:
+    """:func:`energy_balance` of the 2-D verification frame with :data:`FRAME_SOURCE` in arm_L
+    under :func:`frame_drive` over :data:`FRAME_TIMES` (``fmesh``: its mesh, if built)."""
+    import dataclasses
+
+    model = build_model(dataclasses.replace(FIXED_MODEL, source={"arm_L": FRAME_SOURCE}), 2, fmesh=fmesh)
+    return energy_balance(model.heat, frame_drive, FRAME_TIMES, theta)
+
+
+def imbalances(e: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Per step, relative to the largest term of the step: the solid's, the oil's and the hose's
+    account (``wall + source − stored − lost``, ``supply − oil_stored − wall``,
+    ``hose_in − hose_stored − hose_lost``)."""
+    scale = np.max(np.abs(np.array(list(e.values()))), axis=0)
+    return {"solid": (e["wall"] + e["source"] - e["stored"] - e["lost"]) / scale,
+            "oil": (e["supply"] - e["oil_stored"] - e["wall"]) / scale,
+            "hose": (e["hose_in"] - e["hose_stored"] - e["hose_lost"]) / scale}
+
+
+def pump_switch_errors(fmesh=None) -> dict[str, float]:
+    """Condition 2 on the verification frame sampled every minute: the largest |δ − δ_ref| (µm)
+    of the default scheme and of backward Euler at 60 s, δ_ref by CN at 3.75 s."""
+    from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+    from gatetherm.studies.run.simulate import run_model, sample_times
+
+    model = build_model(FIXED_MODEL, 2, fmesh=fmesh)
+    drive, times = condition_drive(CONDITIONS[2], SupplyParams()), sample_times(5 * 3600.0)
+    ref = run_model(model, drive, sample_times(5 * 3600.0, 3.75), scheme=TimeScheme(0.5, 1)).columns["delta_um"][::16]
+    default = run_model(model, drive, times).columns["delta_um"]
+    be = run_model(model, drive, times, scheme=TimeScheme(1.0, 1)).columns["delta_um"]
+    return {"default": float(np.abs(default - ref).max()), "backward Euler 60 s": float(np.abs(be - ref).max())}

@@ -16,7 +16,7 @@ import threading
 
 #: Sub-command modules of this package, in ``--help`` order.
 COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
-                   "export")
+                   "export", "report")
 
 
 class Terminated(BaseException):
@@ -118,8 +118,8 @@ def _run(argv: list[str] | None) -> int:
     from gatetherm.studies.cli.process import configure
     from gatetherm.studies.sweeps.runner import PointsFailed
 
-    configure()
     try:
+        configure()
         return int(args.func(args) or 0)
     except InputError as err:
         return _say(f"error: {err}", 2)

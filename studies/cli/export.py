@@ -27,7 +27,9 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from gatetherm.studies.run.scenario import case_schedule, condition_schedule, run_scenario
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.ccx import check_time, export_state
+    from gatetherm.studies.run.scenario import case_schedule, condition_schedule
 
     if (args.case is None) == (args.condition is None):
         raise InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
@@ -42,29 +44,12 @@ def run(args) -> int:
         cfg = load_config(args.config)
         schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
-    if not any(abs(t - s) < 1e-6 for s in schedule.times):
-        raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
-    from gatetherm.outdir import output_dir
-
+    check_time(schedule, t)
     with output_dir(args.out, OUTPUTS, keep=(args.case, args.config)) as out:
-        run_ = run_scenario(cfg, dim, schedule, keep_times=[t])
-        (_, U), = [s for s in run_.result.states if abs(s[0] - t) < 1e-6]
-        _write(out, run_.model, U, f"gatetherm {what}, t = {t / 60:g} min", t, args)
-    return 0
-
-
-def _write(out: Path, model, U, title: str, t: float, args) -> None:
-    from gatetherm.studies.run.ccx import job_inp, probe_set
-
-    write_text_atomic(out / "job.inp", job_inp(model, U, title))
-    u = {}
-    if U is not None:
-        values = dict(zip(model.readout.keys, model.read(U)))
-        u = {k[1]: v for k, v in values.items() if k[0] == "relative"}
-    probes = {pr.name: probe_set(pr.name) for pr in model.problem.probes}
-    rel = {r.name: {"a": probes[r.a], "b": probes[r.b], "axis": r.axis} for r in model.problem.relative}
-    write_text_atomic(out / "gatetherm.json", json.dumps(
-        {"title": title, "time_s": t, "relative_m": u, "relative": rel, "probe_sets": probes}, indent=2) + "\n")
-    print(f"wrote {args.out}/job.inp ({len(model.fmesh.points)} vertices) and gatetherm.json; run: cd {args.out} && ccx job")
-    for name, v in u.items():
+        inp, info = export_state(cfg, dim, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
+        write_text_atomic(out / "job.inp", inp)
+        write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")
+    print(f"wrote {args.out}/job.inp ({info['vertices']} vertices) and gatetherm.json; run: cd {args.out} && ccx job")
+    for name, v in info["relative_m"].items():
         print(f"gatetherm {name}: {v * 1e6:.6g} um")
+    return 0

@@ -1,5 +1,5 @@
 """Process-wide settings a command makes before its numerics, each measured on the 3-D
-frame (``benchmarks/peer.py``; README, Speed):
+frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; README, Speed):
 
 * BLAS threads: :data:`BLAS_THREADS` (``GATETHERM_BLAS_THREADS`` overrides), through
   threadpoolctl;
@@ -15,10 +15,13 @@ import ctypes
 import logging
 import os
 
+from gatetherm import InputError
+
 log = logging.getLogger(__name__)
 
 BLAS_THREADS = 1
 """BLAS threads of a command; see README, Speed, for the measurement."""
+THREADS_ENV = "GATETHERM_BLAS_THREADS"
 _M_MMAP_THRESHOLD = -3
 
 
@@ -30,6 +33,10 @@ def configure() -> None:
         log.debug("no glibc: malloc settings left as they are")
     from threadpoolctl import threadpool_limits
 
-    threads = int(os.environ.get("GATETHERM_BLAS_THREADS", BLAS_THREADS))
+    threads = os.environ.get(THREADS_ENV, str(BLAS_THREADS))
+    if not threads.isdigit() or int(threads) < 1:
+        raise InputError(f"environment variable {THREADS_ENV}", f"{threads!r} is not a thread count",
+                         "give a whole number of at least 1, or unset it")
+    threads = int(threads)
     threadpool_limits(threads, user_api="blas")
     log.debug("BLAS threads: %d", threads)

@@ -76,9 +76,9 @@ def run_paper(args) -> int:
 
 def run_compensation(args) -> int:
     from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.compensation_study import write_compensation_study
+    from gatetherm.validation.compensation_study import markdown, write_compensation_study
 
-    print(write_compensation_study(Path(args.out), load_config(args.config), args.dim), end="")
+    print(markdown(write_compensation_study(Path(args.out), load_config(args.config), args.dim)), end="")
     return 0
 
 
@@ -102,7 +102,7 @@ def run_rom(args) -> int:
     print(write_rom_study(Path(args.out), load_config(args.config), args.dims,
                           on_row=lambda r: print(f"{r.case}, condition {r.condition}, {r.data}: paper {r.paper_um:.2f}, "
                                                  f"MLR {r.mlr_um:.2f}, rom {r.rom_5min_um:.2f} / {r.rom_event_um:.2f} "
-                                                 f"µm ({r.rom_updates} updates)", flush=True)), end="")
+                                                 f"µm ({r.rom_updates} updates)", flush=True)).markdown, end="")
     return 0
 
 
@@ -127,7 +127,8 @@ def run_hidden(args) -> int:
     acc = write_hidden_effects(Path(args.out), args.workers, args.seed, args.conditions, effects,
                                args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
     for k, v in acc.items():
-        print(f"{k}: {v}")
+        if k != "rows":
+            print(f"{k}: {v}")
     return 0
 
 

@@ -118,3 +118,34 @@ def probe_set(name: str) -> str:
     """The node set of a probe in ``job.inp``."""
     return f"P_{_set(name)}"
 
+
+def check_time(schedule, t: float) -> None:
+    """InputError unless ``t`` (s) is a step of ``schedule``."""
+    if not any(abs(t - s) < 1e-6 for s in schedule.times):
+        raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
+
+
+def export_state(config, dim: int, schedule, t: float, title: str) -> tuple[str, dict]:
+    """Run ``config`` (a model file's Config or a Case) through ``schedule`` and export the state
+    at ``t`` (s, a step of the run): (``job.inp`` text, ``gatetherm.json`` content: gatetherm's
+    relative displacements in m, the probe sets they compare and the mesh size)."""
+    from gatetherm.studies.run.scenario import run_scenario
+
+    check_time(schedule, t)
+    run = run_scenario(config, dim, schedule, keep_times=[t])
+    (_, U), = [s for s in run.result.states if abs(s[0] - t) < 1e-6]
+    model = run.model
+    u = {}
+    if U is not None:
+        u = {k[1]: float(v) for k, v in zip(model.readout.keys, model.read(U)) if k[0] == "relative"}
+    probes = {pr.name: probe_set(pr.name) for pr in model.problem.probes}
+    rel = {r.name: {"a": probes[r.a], "b": probes[r.b], "axis": r.axis} for r in model.problem.relative}
+    return job_inp(model, U, title), {"title": title, "time_s": t, "relative_m": u, "relative": rel,
+                                      "probe_sets": probes, "vertices": len(model.fmesh.points),
+                                      "elements": len(model.fmesh.cells), "order": model.problem.order}
+
+
+def relative_from_dat(dat: str, info: dict) -> dict[str, float]:
+    """The relative displacements (m) of ``info`` (:func:`export_state`) from CalculiX's ``job.dat``."""
+    d = read_dat(dat)
+    return {name: float(d[r["a"]][r["axis"]] - d[r["b"]][r["axis"]]) for name, r in info["relative"].items()}

@@ -92,14 +92,20 @@ class Check:
     """Wall time of the reduced run (5 h of 1-min steps, discretisation excluded), ms."""
 
 
-def check_run(rom: ReducedModel, number: int, cols, fe_seconds: float = float("nan"), T_room: float = 20.0) -> Check:
-    """The reduced model over the inputs of a full run's columns (sample spacing as the run's),
-    against the run's δ and θ_A, θ_B, θ_C."""
+def rom_run(rom: ReducedModel, cols, T_room: float = 20.0) -> tuple[np.ndarray, float]:
+    """(outputs of ``rom`` over the inputs of a full run's columns, one row per sample and a
+    column per :attr:`ReducedModel.outputs`, temperatures as rises; wall time of the march, ms)."""
     u, modes = series_inputs(rom, cols, T_room)
     disc = discretise(rom, float(cols["time_s"][1] - cols["time_s"][0]))
     t0 = time.perf_counter()
     y = march_rom(disc, u, modes) @ rom.C.T
-    ms = 1e3 * (time.perf_counter() - t0)
+    return y, 1e3 * (time.perf_counter() - t0)
+
+
+def check_run(rom: ReducedModel, number: int, cols, fe_seconds: float = float("nan"), T_room: float = 20.0) -> Check:
+    """The reduced model over the inputs of a full run's columns (sample spacing as the run's),
+    against the run's δ and θ_A, θ_B, θ_C."""
+    y, ms = rom_run(rom, cols, T_room)
     err = {o: float(np.max(np.abs(y[:, rom.output(o)] + (0 if o.endswith("_um") else rom.T0) - cols[column_of(o)])))
            for o in ("delta_um", "theta_A_K", "theta_B_K", "theta_C_K")}
     log.info("condition %d: max |δ_rom − δ_FE| = %.3f µm", number, err["delta_um"])

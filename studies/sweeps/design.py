@@ -53,17 +53,17 @@ def position_study(cfg: Config, dim: int, l4_values) -> Study:
     return _study("tie-bar position", cfg, dim, {}, {"geometry.l4": [round(float(v), 6) for v in l4_values]})
 
 
-def first_grid(cfg: Config, dim: int) -> np.ndarray:
+def first_grid(cfg: Config, dim: int, n: int = N_POSITIONS) -> np.ndarray:
     lo, hi = position_range(cfg, dim)
-    return np.linspace(lo, hi, N_POSITIONS)
+    return np.linspace(lo, hi, n)
 
 
-def refined_grid(grid, best: float) -> np.ndarray:
-    """``N_REFINE`` points strictly between the grid neighbours of ``best``."""
+def refined_grid(grid, best: float, n: int = N_REFINE) -> np.ndarray:
+    """``n`` points strictly between the grid neighbours of ``best``."""
     grid = np.sort(np.asarray(grid, float))
     i = int(np.argmin(np.abs(grid - best)))
     lo, hi = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
-    return np.linspace(lo, hi, N_REFINE + 2)[1:-1]
+    return np.linspace(lo, hi, n + 2)[1:-1]
 
 
 def swings(rows) -> dict[float, dict[int, float]]:
@@ -84,18 +84,19 @@ def optimum(rows) -> dict:
             "per_condition": {c: min(s, key=lambda l4: s[l4][c]) for c in CONDITIONS}}
 
 
-def second_heights(cfg: Config) -> tuple[float, ...]:
-    """Heights (m) of the second tie bar: from just clear of the arms upwards."""
+def second_heights(cfg: Config, above=SECOND_ABOVE) -> tuple[float, ...]:
+    """Heights (m) of the second tie bar: from just clear of the arms upwards (``above``: as a
+    fraction of l)."""
     p = cfg.model.frame
     low = p.l + 0.5 * (p.t_C + p.arm_thickness) + MARGIN
-    return tuple(round(low + f * p.l, 6) for f in SECOND_ABOVE)
+    return tuple(round(low + f * p.l, 6) for f in above)
 
 
-def second_study(cfg: Config, dim: int, first: tuple[float, ...]) -> Study:
+def second_study(cfg: Config, dim: int, first: tuple[float, ...], above=SECOND_ABOVE) -> Study:
     """First tie bar at each of ``first`` (m), with no second bar (``l4_2 = 0``) or one at
     each of :func:`second_heights`; the column raised to hold the highest."""
     p = cfg.model.frame
-    heights = second_heights(cfg)
+    heights = second_heights(cfg, above)
     top = max(p.column_height, max(heights) + 0.5 * p.t_C)
     return _study("second tie bar", cfg, dim, {"geometry.column_height": round(top, 6)},
                   {"geometry.l4": [round(float(v), 6) for v in first], "geometry.l4_2": (0.0,) + heights})
@@ -139,7 +140,8 @@ def _versus(r: dict) -> str:
     return f"{-r['reduction_vs_one_bar']:+.0%}" if r["l4_2"] else "reference"
 
 
-def report(dim: int, cfg: Config, best: dict, paper_swing: dict, second: list[dict], timing: dict) -> str:
+def report(dim: int, cfg: Config, best: dict, paper_swing: dict, second: list[dict], timing: dict,
+           points: tuple[int, int] = (N_POSITIONS, N_REFINE)) -> str:
     """report.md of ``gatetherm validate design``."""
     p = cfg.model.frame
     lo, hi = position_range(cfg, dim)
@@ -155,7 +157,7 @@ def report(dim: int, cfg: Config, best: dict, paper_swing: dict, second: list[di
              "max(delta) - min(delta) at the tips F.", "",
              "## One tie bar", "",
              f"l4 scanned from {lo:.3g} to {hi:.3g} m ({where}), "
-             f"{N_POSITIONS} points and {N_REFINE} more around the best (`positions.csv`, `design_position.png`).", "",
+             f"{points[0]} points and {points[1]} more around the best (`positions.csv`, `design_position.png`).", "",
              f"- model's l4 = {p.l4:g} m: swing {at_model} um "
              f"(conditions 1-3), worst {pw:.1f} um.",
              f"- optimum (smallest worst swing): l4 = {best['l4']:.4g} m (l/l4 = {p.l / best['l4']:.3g}): swing "

@@ -6,7 +6,11 @@ import os
 from gatetherm import atomic_path
 
 
-def save(fig, path: str | os.PathLike, dpi: int = 120, tight: bool = True) -> None:
+DPI = 200
+"""Resolution of every PNG, dots per inch (print quality)."""
+
+
+def save(fig, path: str | os.PathLike, dpi: int = DPI, tight: bool = True) -> None:
     """Write ``fig`` as a PNG at ``path`` atomically and release it (pyplot figures are closed)."""
     if tight:
         fig.tight_layout()

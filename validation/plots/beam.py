@@ -25,16 +25,19 @@ def _plot_one(theory_a, curves: Mapping, fe_points: Mapping | None, ylabel: str,
     a = np.asarray(theory_a, dtype=float)
     for i, (b, y) in enumerate(sorted(curves.items())):
         colour = f"C{i}"
-        ax.plot(a, np.asarray(y, dtype=float), color=colour, label=rf"theory, $\beta$ = {b:g}")
+        ax.plot(a, np.asarray(y, dtype=float), color=colour, label=rf"$\beta$ = {b:g}")
         if fe_points and b in fe_points:
             fa, fy = fe_points[b]
-            ax.plot(fa, fy, "o", color=colour, mfc="none", label=rf"FE, $\beta$ = {b:g}")
+            ax.plot(fa, fy, "o", color=colour, mfc="none")
     if zero_line:
         ax.axhline(0.0, color="0.4", lw=0.8, ls="--")
     ax.set_xlim(*A_RANGE)
     ax.set_xlabel(A_LABEL)
     ax.set_ylabel(ylabel)
     ax.grid(True, lw=0.3)
+    ax.plot([], [], color="0.3", label="beam theory")
+    if fe_points:
+        ax.plot([], [], "o", color="0.3", mfc="none", label="FE")
     ax.legend(fontsize="small", ncol=2)
     save(fig, path)
 

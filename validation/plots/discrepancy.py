@@ -99,3 +99,23 @@ def plot_scores(diag, path: Path, shown: int = 12) -> None:
                  f"dotted: margin {diag.margin_min:g})", fontsize=9)
     fig.tight_layout()
     save(fig, path, dpi=110, tight=False)
+
+
+def plot_hidden_study(rows: list[dict], path) -> None:
+    """Held-out RMS of δ before (the baseline model) and after the diagnosis, one pair of bars
+    per case of the hidden-effect study, labelled with the true effect and the verdict."""
+    labels = [f"{r['effect']} (c{r['condition']}) → {r['named'] or r['verdict']}" for r in rows]
+    y = np.arange(len(rows))
+    fig, ax = plt.subplots(figsize=(7.5, 1.2 + 0.32 * len(rows)))
+    before = [r["rms_before_um"] for r in rows]
+    after = [r["rms_after_um"] if r["rms_after_um"] is not None else np.nan for r in rows]
+    ax.barh(y - 0.2, before, 0.4, color="0.7", label="baseline model")
+    ax.barh(y + 0.2, after, 0.4, color="C0", label="after the diagnosis")
+    ax.axvline(0.1, color="C3", lw=0.8, ls="--", label="δ sensor resolution 0.1 µm")
+    ax.set_yticks(y, labels, fontsize="small")
+    ax.invert_yaxis()
+    ax.set_xscale("log")
+    ax.set_xlabel("held-out RMS of δ [µm]")
+    ax.legend(fontsize="small", loc="lower right")
+    ax.grid(axis="x", which="both", lw=0.3)
+    save(fig, path)

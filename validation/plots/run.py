@@ -7,76 +7,131 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from gatetherm import atomic_path  # noqa: E402
 from gatetherm.validation.plots import save  # noqa: E402
 
 
-def _pump_shading(ax, t_min, pump) -> None:
-    on = np.asarray(pump) > 0.5
+def pump_phases(t, on) -> list[tuple[float, float]]:
+    """(start, end) of the runs of ``on`` (booleans at the times ``t``): the last sample of a
+    phase ends it at the next sample."""
+    on = np.asarray(on, bool)
     edges = np.flatnonzero(np.diff(np.r_[0, on.astype(int), 0]))
-    for a, b in zip(edges[::2], edges[1::2]):
-        ax.axvspan(t_min[a], t_min[min(b, len(t_min) - 1)], color="0.92", lw=0)
+    return [(t[a], t[min(b, len(t) - 1)]) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def shade(ax, t, on, label: str = "pump on") -> None:
+    """Grey bands where ``on``; the first band carries ``label`` for the legend."""
+    for k, (a, b) in enumerate(pump_phases(t, on)):
+        ax.axvspan(a, b, color="0.9", lw=0, label=label if k == 0 else None, zorder=0)
 
 
 def plot_oil(cols: dict, path, title: str) -> None:
     """Fig. 10 analogue: supply oil, tank oil and tank-wall temperature."""
     t = cols["time_s"] / 60.0
     fig, ax = plt.subplots(figsize=(7, 4))
-    _pump_shading(ax, t, cols["pump"])
+    shade(ax, t, cols["pump"] > 0.5)
     ax.plot(t, cols["oil_degC"], label="supply oil")
     if "T_tank_oil_degC" in cols:
         ax.plot(t, cols["T_tank_oil_degC"], label="oil in tank")
         ax.plot(t, cols["T_tank_wall_degC"], label="tank wall (mean)")
-    ax.set(xlabel="time [min]", ylabel="temperature [°C]", title=f"{title}\n(grey: pump on)")
+    ax.set(xlabel="time [min]", ylabel="temperature [°C]", title=title)
     ax.legend()
     ax.grid(alpha=0.3)
-    save(fig, path, tight=False)
+    save(fig, path, tight=True)
 
 
 def plot_response(cols: dict, path, title: str) -> None:
-    """Figs. 11–13 analogue: θ_A, θ_B, θ_C rises and δ against time."""
-    t = cols["time_s"] / 60.0
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
-    _pump_shading(a1, t, cols["pump"])
-    for key, lab in (("theta_A_degC", "θ_A"), ("theta_B_degC", "θ_B"), ("theta_C_degC", "θ_C")):
-        a1.plot(t, cols[key] - cols[key][0], label=lab)
-    a1.set(ylabel="temperature rise [K]", title=f"{title}\n(grey: pump on)")
-    a1.legend()
-    a1.grid(alpha=0.3)
-    _pump_shading(a2, t, cols["pump"])
-    a2.plot(t, cols["delta_um"], "k", label="δ at tool/workpiece tips")
-    if "delta_E_um" in cols:
-        a2.plot(t, cols["delta_E_um"], "k--", lw=0.8, label="δ at E_L/E_R (beam theory point)")
+    """Figs. 11–13 analogue: θ_A, θ_B, θ_C rises and δ against time, pump phases shaded."""
+    plot_responses({"": cols}, path, title)
+
+
+def plot_responses(runs: dict, path, title: str) -> None:
+    """Figs. 11–13 analogue for one or more runs of the same schedule ({label: columns}: solid
+    lines for the first, dashed for the second, …): θ_A, θ_B, θ_C rises and δ against time,
+    pump phases shaded."""
+    first = next(iter(runs.values()))
+    t0 = first["time_s"] / 60.0
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True)
+    for ax in (a1, a2):
+        shade(ax, t0, first["pump"] > 0.5)
+    for k, (name, cols) in enumerate(runs.items()):
+        t, ls, tag = cols["time_s"] / 60.0, ("-", "--", ":")[k % 3], f" {name}" if name else ""
+        for i, (key, lab) in enumerate((("theta_A_degC", "θ_A"), ("theta_B_degC", "θ_B"), ("theta_C_degC", "θ_C"))):
+            a1.plot(t, cols[key] - cols[key][0], ls=ls, color=f"C{i}", label=lab + tag)
+        a2.plot(t, cols["delta_um"], ls=ls, color="k", label="δ at the tips F" + tag)
+        if "delta_E_um" in cols and k == 0:
+            a2.plot(t, cols["delta_E_um"], ls=":", color="0.4", lw=0.9, label="δ at E (beam theory point)" + tag)
+    a1.set(ylabel="temperature rise [K]", title=title)
     a2.axhline(0, color="0.5", lw=0.5)
     a2.set(xlabel="time [min]", ylabel="δ [µm] (+ = approach)")
-    a2.legend()
-    a2.grid(alpha=0.3)
-    save(fig, path, tight=False)
+    for ax in (a1, a2):
+        ax.legend(fontsize="small", ncol=2 if len(runs) > 1 else 1)
+        ax.grid(alpha=0.3)
+    save(fig, path, tight=True)
 
 
 def render_deformed(grid, path, title: str, scale: float) -> None:
-    """Temperature on the frame deformed by ``scale`` × displacement (pyvista, off screen).
+    """Temperature on the frame deformed by ``scale`` × displacement, the undeformed outline
+    in grey (pyvista, off screen), framed by matplotlib with a labelled colour bar.
 
     ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components).
     """
     import pyvista as pv
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
     from vtkmodules.vtkCommonCore import vtkLogger
 
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)  # no X display: VTK falls back quietly
     pv.OFF_SCREEN = True
-    warped = grid.warp_by_vector("u", factor=scale)
-    p = pv.Plotter(off_screen=True, window_size=(900, 700))
-    p.add_mesh(warped, scalars="T", cmap="inferno", show_edges=False,
-               scalar_bar_args={"title": "T [°C]"})
-    p.add_mesh(grid.outline(), color="grey")
-    p.add_text(f"{title}\ndisplacement magnified ×{scale:.0f}", font_size=10)
-    if grid.bounds[5] - grid.bounds[4] < 1e-12:
+    T = np.asarray(grid["T"])
+    clim = (float(T.min()), float(T.max()) if T.max() > T.min() else float(T.min()) + 1.0)
+    flat = grid.bounds[5] - grid.bounds[4] < 1e-12
+    outline = grid.extract_surface(algorithm="dataset_surface").extract_feature_edges(feature_angle=30.0, boundary_edges=flat,
+                                                           feature_edges=not flat, manifold_edges=False,
+                                                           non_manifold_edges=False)
+    p = pv.Plotter(off_screen=True, window_size=(1600, 1200))
+    p.set_background("white")
+    p.add_mesh(grid.warp_by_vector("u", factor=scale), scalars="T", cmap=CMAP, clim=clim, show_scalar_bar=False)
+    p.add_mesh(outline, color="#8c8c8c", line_width=2)
+    if flat:
         p.view_xy()
     else:  # y is up; seen from behind and above, so the tool side stays on the left
         p.view_vector((0.35, 0.45, 1.0), viewup=(0.0, 1.0, 0.0))
-    with atomic_path(path) as tmp:
-        p.screenshot(str(tmp))
+    img = _trim(p.screenshot(return_img=True))
     p.close()
+    fig, ax = plt.subplots(figsize=(7.5, 6.0))
+    ax.imshow(img, interpolation="lanczos")
+    ax.set_axis_off()
+    bar = fig.colorbar(ScalarMappable(Normalize(*clim), CMAP), ax=ax, fraction=0.04, pad=0.02, shrink=0.85)
+    bar.set_label("temperature T [°C]")
+    ax.set_title(f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges", fontsize="medium")
+    save(fig, path, tight=True)
+
+
+CMAP = "coolwarm"
+"""Colour map of temperature on the frame (no black end: every part of the frame stays visible)."""
+
+
+def _trim(img: np.ndarray, pad: int = 12) -> np.ndarray:
+    """The image cropped to its non-white content plus ``pad`` pixels."""
+    ink = np.flatnonzero(img.min(axis=2).min(axis=1) < 250), np.flatnonzero(img.min(axis=2).min(axis=0) < 250)
+    if not len(ink[0]):
+        return img
+    (r0, r1), (c0, c1) = (ink[0][[0, -1]], ink[1][[0, -1]])
+    return img[max(r0 - pad, 0):r1 + pad + 1, max(c0 - pad, 0):c1 + pad + 1]
+
+
+def draw_deformed(run, t: float, path, title, solved: dict | None = None) -> float:
+    """The kept state of ``run`` nearest ``t`` (s) drawn by :func:`render_deformed`, magnified so
+    that the largest displacement shows as about 8 % of the frame's width (a power of ten);
+    ``title``: text or a function of the time drawn; ``solved`` as for :func:`plot_run`;
+    returns the time drawn, s."""
+    from gatetherm.studies.run.output import deformed_grid
+
+    t, grid = deformed_grid(run, t, solved)
+    umax = float(np.abs(grid["u"]).max()) or 1.0
+    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
+    render_deformed(grid, path, title(t) if callable(title) else title, scale)
+    return t
 
 
 def picture_time(figs: dict) -> float:
@@ -91,15 +146,10 @@ def plot_run(run, figs: dict, out, title: str, solved: dict | None = None) -> No
     if solved already."""
     from pathlib import Path
 
-    from gatetherm.studies.run.output import deformed_grid
-
     out = Path(out)
     plot_oil(run.columns, out / "oil_temperatures.png", title)
     plot_response(run.columns, out / "response.png", title)
-    t, grid = deformed_grid(run, picture_time(figs), solved)
-    umax = float(np.abs(grid["u"]).max()) or 1.0
-    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
-    render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 60:.0f} min", scale)
+    draw_deformed(run, picture_time(figs), out / "deformed.png", lambda t: f"{title}, t = {t / 60:.0f} min", solved)
 
 
 def plot_channels(cols: dict, path, title: str) -> None:
@@ -125,14 +175,9 @@ def plot_case(run, out, title: str, solved: dict | None = None) -> None:
     has elasticity) of a case run; ``solved`` as for :func:`plot_run`."""
     from pathlib import Path
 
-    from gatetherm.studies.run.output import deformed_grid
-
     out = Path(out)
     if len(run.columns["time_s"]) > 1:
         plot_channels(run.columns, out / "channels.png", title)
-    if run.model.elastic is None:
-        return
-    t, grid = deformed_grid(run, float(run.columns["time_s"][-1]), solved)
-    umax = float(np.abs(grid["u"]).max()) or 1.0
-    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
-    render_deformed(grid, out / "deformed.png", f"{title}, t = {t / 3600:.3g} h", scale)
+    if run.model.elastic is not None:
+        draw_deformed(run, float(run.columns["time_s"][-1]), out / "deformed.png",
+                      lambda t: f"{title}, t = {t / 3600:.3g} h", solved)

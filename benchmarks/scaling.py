@@ -1,0 +1,111 @@
+"""How the cost of a condition grows with the mesh: time per part and peak memory.
+
+    python benchmarks/scaling.py [--dims 3 2] [--factors 1 2 4 8] [--rounds 1] [--json FILE]
+
+For each dimension and node factor f, condition 1 of the paper (5 h, 60-s steps) runs in a
+fresh process on the default frame meshed with the element size divided by f^(1/dim), so
+that the node count grows about f-fold: meshing, heat assembly, elastic set-up, adjoint
+solves (the δ and θ read-out), heat factorisations, time stepping, and the elastic solves
+of the six output times (one batch, as ``gatetherm simulate`` does); files and pictures are
+not included. Peak memory is the process's (``wait4``). With ``--rounds N`` the sizes are
+run N times in turn and medians are printed. Last, the fitted growth exponent of each part:
+the slope of log(time) against log(nodes), least squares over the sizes.
+
+The table is also written to ``--json`` (default ``benchmarks/results/scaling.json``),
+which ``gatetherm report`` shows.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from peer import rusage_run, write_table  # noqa: E402  (benchmarks/ is not a package)
+
+PARTS = ("mesh", "heat_assembly", "elastic_setup", "adjoint_solves", "heat_factor", "steps", "output_solves")
+DEFAULT_SIZE = {2: "size", 3: "size_3d"}
+
+
+def job(dim: int, factor: float) -> dict:
+    """Condition 1 on the refined mesh; part times (s) and node counts."""
+    from gatetherm.geometry.frame import MeshParams
+    from gatetherm.studies.cli.process import configure
+    from gatetherm.studies.run.config import load_config
+    from gatetherm.studies.run.output import displacements
+    from gatetherm.studies.run.scenario import condition_schedule, prepare
+    from gatetherm.studies.run.simulate import run_model
+
+    key = DEFAULT_SIZE[dim]
+    size = getattr(MeshParams(), key) / factor ** (1.0 / dim)
+    configure()  # the process settings of a command
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "mesh.toml").write_text(f"[mesh]\n{key} = {size!r}\n")
+        cfg = load_config(Path(tmp) / "mesh.toml")
+        schedule = condition_schedule(1, cfg)
+        p = prepare(cfg, dim, schedule.drive)
+        out_times = schedule.times[::60]
+        res = run_model(p.model, p.drive, schedule.times, keep_times=out_times, solver=p.solver)
+        model, factor = p.model, p.solver.factor_seconds
+        del p  # the heat factors go, as in ``simulate``, before the output-time elastic solves
+        t = time.perf_counter()
+        displacements(model, res.states)
+        parts = dict(model.timings, heat_factor=factor, steps=res.seconds - factor,
+                     output_solves=time.perf_counter() - t)
+    el = model.elastic
+    return {"nodes": len(model.fmesh.points), "elastic_dofs": 0 if el is None else int(el.K.shape[0]),
+            "size_m": size, **{k: round(parts[k], 3) for k in PARTS}}
+
+
+def exponent(nodes, seconds) -> float:
+    """Slope of log(seconds) against log(nodes)."""
+    return float(np.polyfit(np.log(nodes), np.log(np.maximum(seconds, 1e-3)), 1)[0])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--dims", type=int, nargs="+", default=[3, 2])
+    ap.add_argument("--factors", type=float, nargs="+", default=[1, 2, 4, 8])
+    ap.add_argument("--rounds", type=int, default=1)
+    ap.add_argument("--json", type=Path, default=HERE / "results" / "scaling.json")
+    ap.add_argument("--job", nargs=2, type=float, metavar=("DIM", "FACTOR"), help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.job:
+        print(json.dumps(job(int(args.job[0]), args.job[1])))
+        return
+    runs = {(d, f): [] for d in args.dims for f in args.factors}
+    for r in range(args.rounds):
+        for d, f in runs:
+            res = rusage_run([sys.executable, __file__, "--job", str(d), str(f)])
+            runs[d, f].append(res)
+            print(f"round {r + 1} {d}-D x{f:g}: {res['nodes']} nodes, total {sum(res[k] for k in PARTS):.1f} s, "
+                  f"peak {res['rss_gb']:.2f} GB", flush=True)
+    columns = ["dim", "nodes", "elastic DOFs", *PARTS, "total s", "wall s", "peak GB"]
+    rows, notes = [], []
+    for d in args.dims:
+        med = [{k: statistics.median(x[k] for x in runs[d, f]) for k in (*PARTS, "wall", "rss_gb")}
+               | {"nodes": runs[d, f][0]["nodes"], "elastic_dofs": runs[d, f][0]["elastic_dofs"]}
+               for f in args.factors]
+        for m in med:
+            rows.append([d, m["nodes"], m["elastic_dofs"], *(round(m[k], 2) for k in PARTS),
+                         round(sum(m[k] for k in PARTS), 2), round(m["wall"], 1), round(m["rss_gb"], 2)])
+        if len(med) > 1:
+            n = [m["nodes"] for m in med]
+            fits = {k: exponent(n, [m[k] for m in med]) for k in (*PARTS, "wall", "rss_gb")}
+            rows.append([d, "exponent", "", *(f"{fits[k]:.2f}" for k in PARTS),
+                         f"{exponent(n, [sum(m[k] for k in PARTS) for m in med]):.2f}",
+                         f"{fits['wall']:.2f}", f"{fits['rss_gb']:.2f}"])
+    notes.append(f"medians of {args.rounds} round(s); times in s; 'exponent': slope of log(part) against "
+                 "log(nodes); condition 1 (5 h, 300 steps of 60 s), six output-time elastic solves, no files")
+    write_table(args.json, columns, rows, notes)
+
+
+if __name__ == "__main__":
+    main()

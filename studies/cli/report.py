@@ -1,0 +1,85 @@
+"""``gatetherm report``: every validation result on one page, or the thermal drift report of
+one time series (``--data``)."""
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+from gatetherm import InputError, write_text_atomic
+from gatetherm.studies.cli.options import WORKERS, number
+
+PAGE = ("index.html",)
+"""What a report run replaces in --out; the sections' folders (the cache) are kept."""
+DRIFT = ("index.html", "drift.png")
+"""What a drift report writes into --out."""
+
+
+def register(sub) -> None:
+    from gatetherm.validation.report.registry import SECTIONS
+
+    p = sub.add_parser("report", help="every validation result on one page (DIR/index.html); --data: a drift report",
+                       description="Compute (or reuse from DIR) every section of the validation report and write "
+                       "DIR/index.html with its figures beside it. The long studies run a stated subset unless "
+                       "--full. With --data FILE.csv: the thermal drift report of one time series instead.")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory (also the cache of the results)")
+    p.add_argument("--full", action="store_true", help="run every study in full (default: the stated subsets)")
+    p.add_argument("--section", nargs="+", choices=[s.key for s in SECTIONS], metavar="KEY",
+                   help="compute only these sections (others are shown if cached): " + ", ".join(s.key for s in SECTIONS))
+    p.add_argument("--workers", type=number(WORKERS), default=os.cpu_count() or 1, metavar="N",
+                   help="worker processes for the sweeps (default: the CPU count)")
+    p.add_argument("--readme", metavar="README.md",
+                   help="rewrite the README's <!-- report:NAME --> blocks from the full results (needs --full)")
+    p.add_argument("--data", metavar="FILE.csv", help="thermal drift report of this time series (data format)")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    t0 = time.perf_counter()
+    if args.data:
+        return _drift(args)
+    from gatetherm.outdir import output_dir
+    from gatetherm.validation.report import readme as rd
+    from gatetherm.validation.report.build import build, code_digest
+    from gatetherm.validation.report.page import report_html
+    from gatetherm.validation.report.registry import SECTIONS
+
+    text = None
+    if args.readme:
+        if not args.full:
+            raise InputError("--readme", "the README quotes the full studies", "add --full")
+        text = Path(args.readme).read_text(encoding="utf-8")
+        rd.check_names(rd.blocks(text), {n for s in SECTIONS for n in s.readme}, args.readme)
+
+    def tell(key, status, seconds):
+        print(f"{key:<16} {status}" + (f" ({seconds:.0f} s)" if status in ("computed", "cached") else ""), flush=True)
+
+    with output_dir(args.out, PAGE) as out:  # the sections' folders are the cache: kept
+        results = build(out, SECTIONS, args.full, args.workers, set(args.section) if args.section else None, tell)
+        write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code_digest()))
+    print(f"wrote {out}/index.html in {time.perf_counter() - t0:.0f} s")
+    if text is not None:
+        tables, partial = rd.full_tables(results)
+        new, done = rd.rewrite(text, tables)
+        write_text_atomic(args.readme, new)
+        kept = [n for n in rd.blocks(text) if n not in done]
+        print(f"{args.readme}: rewrote {', '.join(done) or 'no block'}"
+              + (f"; kept {', '.join(kept)} (no full result in {out}: compute it with --full)" if kept else ""))
+    return 0
+
+
+def _drift(args) -> int:
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.timeseries import read_timeseries
+    from gatetherm.validation.report.drift import compute
+    from gatetherm.validation.report.page import drift_html
+
+    ts = read_timeseries(args.data, required=("time_s",))
+    with output_dir(args.out, DRIFT, keep=(args.data,)) as out:
+        result = compute(ts, out, Path(args.data).name)
+        write_text_atomic(out / "index.html", drift_html(result, args.data, f"gatetherm report --data {args.data} "
+                                                                            f"--out {args.out}"))
+    print(f"wrote {out}/index.html and drift.png")
+    for line in result.notes[:-1]:
+        print(line)
+    return 0
