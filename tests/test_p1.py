@@ -68,3 +68,19 @@ def test_p1_stress_projection_equals_the_forms(dim, plane, frame_2d, frame_3d):
         a = np.unique(sb.element_dofs)
         x = rng.normal(size=len(a))
         np.testing.assert_allclose(rec.lu.solve(M[a][:, a] @ x), x, rtol=1e-9)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_p1_fixed_dofs_equal_scikit_fem_facet_dofs(dim, frame_2d, frame_3d):
+    """The nodal shortcut of ``fixed_dofs`` gives scikit-fem's facet DOFs, for every component
+    set of a support (a sliding support holds one component)."""
+    from gatetherm.solvers.elasticity import fixed_dofs
+    from gatetherm.solvers.problem import Support
+
+    mesh = to_skfem(frame_2d if dim == 2 else frame_3d)
+    vb = CellBasis(mesh, ElementVector(element(dim, 1)), intorder=1)
+    names = [f"u^{c + 1}" for c in range(dim)]
+    for comps in [(1,), tuple(range(dim))]:
+        want = np.unique(vb.get_dofs(mesh.boundaries["mounting_face"]).all([names[c] for c in comps]))
+        got = fixed_dofs(vb, mesh, [Support("mounting_face", comps)])
+        assert len(want) > 0 and np.array_equal(got, want)
