@@ -153,7 +153,7 @@ def write_table(path: Path, columns: list, rows: list, notes: list[str]) -> None
         print(n)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps({"date": date.today().isoformat(), "machine": machine(),
-                                "command": f"python benchmarks/{Path(sys.argv[0]).name} " + " ".join(sys.argv[1:]),
+                                "command": " ".join(["python", f"benchmarks/{Path(sys.argv[0]).name}", *sys.argv[1:]]),
                                 "columns": columns, "rows": rows, "notes": notes}, indent=1) + "\n")
     print(f"wrote {path}")
 

@@ -25,7 +25,8 @@ log = logging.getLogger(__name__)
 OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "report.md", "diagnosis.json")
 
 DIM_HELP = ("2-D section (default) or 3-D solid. A 3-D diagnosis replays the 3-D model for every hypothesis "
-            "(about 100 runs of about 50 s each at the default 3-D mesh, README 'Speed': over an hour). A 2-D diagnosis of a 3-D "
+            "(about 100 runs, each up to a 3-D condition's build and march, about 25 s at the default 3-D mesh by the "
+            "scaling table in README 'Speed': tens of minutes, not timed). A 2-D diagnosis of a 3-D "
             "measurement also sees the 2-D/3-D model-form difference as a significant residual; the pieces it "
             "names then make the section model fit, they are not faults of the machine (README, 'Discrepancy "
             "diagnosis')")

@@ -146,7 +146,8 @@ def run_compound(args) -> int:
     figures = write_compound(Path(args.out), args.workers, args.seed, args.pairs, not args.no_single,
                              args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
     for k, v in figures.items():
-        print(f"{k}: {v}")
+        if k != "rows":
+            print(f"{k}: {v}")
     return 0
 
 

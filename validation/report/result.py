@@ -68,13 +68,16 @@ def table(title: str, columns, rows, **kw) -> Table:
 
 
 def cell(v) -> str:
-    """A table cell: numbers to 4 significant digits, booleans yes/no, None and NaN as a dash."""
+    """A table cell: whole numbers as they are, other numbers to 4 significant digits, booleans
+    yes/no, None and NaN as a dash."""
     if isinstance(v, bool):
         return "yes" if v else "no"
     if v is None or (isinstance(v, float) and math.isnan(v)):
         return "—"
-    if isinstance(v, (float, int)) and not isinstance(v, bool):
-        return f"{float(v):.4g}".replace("-", "−")
+    if isinstance(v, int):
+        return str(v).replace("-", "−")
+    if isinstance(v, float):
+        return f"{v:.4g}".replace("-", "−")
     return str(v)
 
 

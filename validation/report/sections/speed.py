@@ -14,10 +14,10 @@ from gatetherm.validation.report.result import Result, cell, table
 def benchmark_table(name: str, data: dict, command: str):
     """The table of one benchmark result file: its columns and rows as they are, captioned with the
     command, date and machine it records; it fills the README block ``speed-<stem of name>``."""
-    cmd = data.get("command") or command
+    cmd = (data.get("command") or command).strip()
     return table(f"{name}: measured by `{cmd}` on {data.get('machine', 'an unrecorded machine')}, "
                  f"{data.get('date', 'undated')}", data["columns"], [[cell(v) for v in r] for r in data["rows"]],
-                 note=" ".join(str(n) for n in data.get("notes", ())), readme=f"speed-{Path(name).stem}",
+                 note="; ".join(str(n) for n in data.get("notes", ())), readme=f"speed-{Path(name).stem}",
                  captioned=True)
 
 
