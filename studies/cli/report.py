@@ -59,6 +59,7 @@ def run(args) -> int:
         write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code_digest()))
     print(f"wrote {out}/index.html in {time.perf_counter() - t0:.0f} s")
     if text is not None:
+        text = Path(args.readme).read_text(encoding="utf-8")  # as it is now: it may have been edited meanwhile
         tables, partial = rd.full_tables(results)
         new, done = rd.rewrite(text, tables)
         write_text_atomic(args.readme, new)
