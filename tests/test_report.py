@@ -293,3 +293,26 @@ def test_rom_section_is_the_rom_study(tmp_path):
         assert "\n".join("| " + " | ".join(r) + " |" for r in t.rows) in md
     assert [r[:3] for r in study.rows] == [("model", "1", "2-D FE"), ("measured", "1", study.rows[1][2])]
     assert float(checks.rows[0][2]) < 0.1 and all((tmp_path / f.file).stat().st_size > 1e4 for f in res.figures)
+
+
+def test_readme_edits_made_during_a_run_are_kept(tmp_path, monkeypatch, capsys):
+    """``report --full --readme`` rewrites its blocks in the README as it is when the run ends."""
+    from gatetherm.studies.cli import main
+    from gatetherm.validation.report.sections import speed
+
+    monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)
+    (tmp_path / "peer.json").write_text(json.dumps({"date": "2026-11-26", "machine": "m", "command": "c",
+                                                    "columns": ["job", "s"], "rows": [["x", 1.5]], "notes": []}))
+    doc = tmp_path / "README.md"
+    doc.write_text("intro\n<!-- report:speed-peer -->\nold\n<!-- /report -->\n")
+    shown = speed.compute
+
+    def compute_while_edited(ctx):
+        doc.write_text(doc.read_text() + "added during the run\n")
+        return shown(ctx)
+
+    monkeypatch.setattr(speed, "compute", compute_while_edited)
+    assert main(["report", "--full", "--section", "speed", "--out", str(tmp_path / "R"), "--readme", str(doc)]) == 0
+    text = doc.read_text()
+    assert "added during the run" in text and "| x | 1.5 |" in text and "old" not in text
+    assert "rewrote speed-peer" in capsys.readouterr().out
