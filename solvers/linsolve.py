@@ -12,12 +12,12 @@ workhorse. The backend is the first of :data:`BACKENDS` that is installed and wo
   reordering), or its minimum degree without pymetis. Always there.
 
 Which backend runs, and why a better one was skipped, is logged once (with the pip command);
-``GATETHERM_SPD_BACKEND`` forces one (``amg``: the iterative elastic solve below). For elasticity without pardiso or cholmod the 3-D
-systems use conjugate gradients preconditioned by smoothed-aggregation AMG (pyamg) on the
-rigid-body modes instead of SuperLU (which took 25 s and 3.3 GB on the 156k-DOF frame):
-an iterative solve that does not converge raises :class:`SolverError`. Measured on the 3-D
-frame (CPU s, 1 thread): heat factor 4.6 (SuperLU COLAMD) → 0.9 (PARDISO + METIS), solve
-0.053 → 0.019; elastic set-up 6.2 (AMG) → 5.4, solve 2.4 → 0.14 (benchmarks/peer.py).
+``GATETHERM_SPD_BACKEND`` forces one (``amg``: the iterative elastic solve below). For
+elasticity without pardiso or cholmod the 3-D systems use conjugate gradients preconditioned by smoothed-aggregation AMG (pyamg) on the
+rigid-body modes instead of SuperLU: an iterative solve that does not converge raises
+:class:`SolverError`. ``benchmarks/backends.py`` measures the backends on the 3-D frame
+(medians of 3, s): heat factor 0.37 (PARDISO) against 1.1 (SuperLU); 300 heat steps 7.7
+against 13.6; elastic set-up 5.7 (PARDISO) against 8.4 (AMG); the elastic solve 0.2 against 2.9.
 """
 from __future__ import annotations
 
