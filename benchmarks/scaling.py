@@ -53,11 +53,11 @@ def job(dim: int, factor: float) -> dict:
         p = prepare(cfg, dim, schedule.drive)
         out_times = schedule.times[::60]
         res = run_model(p.model, p.drive, schedule.times, keep_times=out_times, solver=p.solver)
-        model, factor = p.model, p.solver.factor_seconds
+        model, factor_s = p.model, p.solver.factor_seconds
         del p  # the heat factors go, as in ``simulate``, before the output-time elastic solves
         t = time.perf_counter()
         displacements(model, res.states)
-        parts = dict(model.timings, heat_factor=factor, steps=res.seconds - factor,
+        parts = dict(model.timings, heat_factor=factor_s, steps=res.seconds - factor_s,
                      output_solves=time.perf_counter() - t)
     el = model.elastic
     return {"nodes": len(model.fmesh.points), "elastic_dofs": 0 if el is None else int(el.K.shape[0]),
