@@ -94,8 +94,8 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
     needed, writable, locked against other runs, with stale temporaries and the files
     matching the glob patterns ``owns`` (the command's output set, relative to ``path``)
     removed, except the run's input files ``keep`` (None entries are skipped). A directory
-    this call created is removed again if the run fails before writing anything into it.
-    Raises InputError (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
+    this call created is removed again if the run fails before writing anything into it;
+    temporaries left by a failed or interrupted run are removed at once. Raises InputError (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
     out = Path(path)
     created = _check_path(out, option)
     try:
@@ -110,6 +110,8 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
         _clean(out, owns, keep)
         yield out
     except BaseException:
+        with contextlib.suppress(OSError):
+            _clean(out, (), ())  # temporaries of writers cut short (a worker terminated mid-write)
         _unlock(out, fd)
         fd = None
         for d in reversed(created):
