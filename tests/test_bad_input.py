@@ -309,6 +309,19 @@ def test_a_second_run_into_a_locked_directory_is_refused(tmp_path, capsys):
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["timeseries.csv"]  # the lock is gone
 
 
+
+def test_an_interrupted_run_leaves_no_temporary(tmp_path):
+    """A writer cut short (a terminated worker) leaves its temporary; the run's output
+    directory removes it as the interruption passes, and keeps the finished files."""
+    from gatetherm import _new_temporary
+
+    with pytest.raises(KeyboardInterrupt), output_dir(tmp_path / "o") as out:
+        (out / "points").mkdir()
+        (out / "points" / "a.json").write_text("{}")
+        _new_temporary(out / "points" / "b.json")
+        raise KeyboardInterrupt
+    assert sorted(str(p.relative_to(out)) for p in out.rglob("*")) == ["points", "points/a.json"]
+
 def test_unwritable_output_and_unreadable_input(tmp_path, capsys, monkeypatch):
     """A read-only output directory (exit 1, before the run) and a model file without read
     permission (exit 2). Root is not bound by file permissions: there the file system's
