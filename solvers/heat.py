@@ -186,7 +186,9 @@ class HeatSolver:
 
     def __init__(self, system: HeatSystem):
         self.system = system
-        self.free = np.setdiff1d(np.arange(system.n), system.fixed_dofs)
+        self.fixed = system.fixed_dofs
+        """Unknowns held by a fixed temperature (found once, not at every step)."""
+        self.free = np.setdiff1d(np.arange(system.n), self.fixed)
         """Unknowns not held by a fixed temperature (the solid's first, then the lumped ones)."""
         self.n_inner = int(np.sum(self.free < system.n_solid))
         """Free unknowns of the solid: the SPD block of every step matrix."""
@@ -212,7 +214,7 @@ class HeatSolver:
         Crank–Nicolson over dt share: a sparse Cholesky of its SPD solid block (one METIS
         order for all, the matrices share a pattern) bordered by the lumped unknowns."""
         key = (round(theta * dt, 9), mode)
-        fixed = self.system.fixed_dofs
+        fixed = self.fixed
         if key not in self._lu:
             t0 = time.perf_counter()
             A = (self.system.M / (theta * dt) + self.K(mode)).tocsr()
