@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import BilinearForm, CellBasis, LinearForm, asm
+from skfem import BilinearForm, CellBasis, ElementVector, LinearForm, asm
 from skfem.helpers import div, sym_grad
 
 from gatetherm.solvers.elasticity import moduli
@@ -111,8 +111,6 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
     ``T_at(basis)`` gives it at a basis's quadrature points: ``Q`` then holds one column,
     the thermal right-hand side itself (``thermal_rhs(np.ones(1))``). ``simplices``: the
     mesh's :class:`~gatetherm.solvers.p1.Simplices`, if found already (linear elements)."""
-    from skfem import ElementVector
-
     q = 2 * order
     comps = COMPONENTS[(dim, plane)]
     normal = [c for c in comps if c[0] == c[1] and not (dim == 2 and plane == "stress" and c == "zz")]
@@ -143,6 +141,7 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
     from gatetherm.solvers import p1
     from gatetherm.solvers.linsolve import restrict_order
 
+    b_all = b
     if elements is None:
         s = simplices or p1.simplices(mesh)
         cells, G, vol, pattern = mesh.t.T, s.G, s.vol, s.pattern
@@ -168,11 +167,8 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
     if T_at is None:
         Q = {c: pattern.scalar(p1.mass(G, vol, -b)) for c in normal}
     else:
-        from skfem import CellBasis as _CB
-
-        sb = _CB(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))
-        Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=Field(b_full(b, elements, mesh)).at(sb),
-                                  T=T_at(sb))[:, None]) for c in normal}
+        sb = CellBasis(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))
+        Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=Field(b_all).at(sb), T=T_at(sb))[:, None]) for c in normal}
     full = dof_basis(mesh, element(dim, 1))
     return Recovery(full, full, active, _factor(M, order), S, Q, comps)
 
@@ -185,11 +181,3 @@ def _factor(M: sp.spmatrix, order: np.ndarray | None = None):
 
     return SimpleNamespace(solve=spd_factor(M, nd_order(M) if order is None else order)[0])
 
-
-def b_full(b_sel: np.ndarray, elements, mesh) -> np.ndarray:
-    """An element field given on ``elements`` as a field on all elements (0 elsewhere)."""
-    if elements is None:
-        return b_sel
-    out = np.zeros(mesh.nelements)
-    out[elements] = b_sel
-    return out
