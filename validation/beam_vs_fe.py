@@ -73,7 +73,7 @@ def studies(base: Config, dim: int, a_every: int = 1, series: bool = True) -> di
     without the controlled and mesh series unless ``series``."""
     n = ELEMENTS_ACROSS[dim]
     sweep = {"derived.beta": BETAS, "derived.l_over_l4": A_VALUES[dim][::a_every]}
-    series = {"derived.beta": SERIES_BETA, "derived.l_over_l4": SERIES_A}
+    controlled = {"derived.beta": SERIES_BETA, "derived.l_over_l4": SERIES_A}
     out = {"sweep": [_study("sweep", base, dim, _fixed(base, dim, SLENDERNESS, n), sweep)],
            "no_tank": [_study("no_tank", base, dim, _fixed(base, dim, SLENDERNESS, n, tank=False), sweep)],
            "slenderness": [], "tie_height": [],
@@ -82,9 +82,9 @@ def studies(base: Config, dim: int, a_every: int = 1, series: bool = True) -> di
                     for m in MESH_ACROSS[dim] for a, b in MESH_POINTS[dim]] if series else []}
     if dim == 2 and series:
         out["slenderness"] = [_study(f"slenderness l/h={s:g}", base, dim, _fixed(base, dim, s, n, tank=False),
-                                     series) for s in SERIES_L_OVER_H]
+                                     controlled) for s in SERIES_L_OVER_H]
         out["tie_height"] = [_study("tie_height", base, dim, _fixed(base, dim, SLENDERNESS, n, tank=False),
-                                    {**series, "geometry.t_C": SERIES_T_C})]
+                                    {**controlled, "geometry.t_C": SERIES_T_C})]
     return out
 
 
