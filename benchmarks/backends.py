@@ -14,7 +14,9 @@ needs cvxopt (GPL-3, not a dependency).
 from __future__ import annotations
 
 import argparse
+import atexit
 import os
+import shutil
 import statistics
 import subprocess
 import sys
@@ -35,6 +37,7 @@ def main() -> None:
     ap.add_argument("--json", type=Path, default=HERE / "results" / "backends.json")
     args = ap.parse_args()
     work = Path(tempfile.mkdtemp(prefix="backends-"))
+    atexit.register(shutil.rmtree, work, True)
     subprocess.run([sys.executable, "-m", "gatetherm.studies.cli", "mesh", "--dim", "3", "--out", str(work)],
                    check=True, stdout=subprocess.DEVNULL)
     from gatetherm.geometry.mesh import load_mesh

@@ -9,7 +9,9 @@ Prints the medians of wall time, CPU time and peak memory per thread count; the 
 from __future__ import annotations
 
 import argparse
+import atexit
 import os
+import shutil
 import statistics
 import sys
 import tempfile
@@ -27,6 +29,7 @@ def main() -> None:
     ap.add_argument("--json", type=Path, default=HERE / "results" / "blas_threads.json")
     args = ap.parse_args()
     work = Path(tempfile.mkdtemp(prefix="blas-"))
+    atexit.register(shutil.rmtree, work, True)
     runs = {n: [] for n in args.threads}
     for r in range(args.rounds):
         k = r % len(args.threads)

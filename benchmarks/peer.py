@@ -22,9 +22,11 @@ The table is also written to ``--json`` (default ``benchmarks/results/peer.json`
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
 import os
 import platform
+import shutil
 import statistics
 import subprocess
 import sys
@@ -92,6 +94,7 @@ def main() -> None:
         print(json.dumps(equal_work(args.equal)))
         return
     work = Path(tempfile.mkdtemp(prefix="peer-"))
+    atexit.register(shutil.rmtree, work, True)
     gt = [sys.executable, "-m", "gatetherm.studies.cli"]
     subprocess.run([*gt, "mesh", "--dim", "3", "--out", str(work / "m")], check=True, stdout=subprocess.DEVNULL)
     from gatetherm.geometry.mesh import load_mesh
@@ -127,16 +130,16 @@ def main() -> None:
              f"parts, last round (s): DOLFINx {parts(d)}", f"parts, last round (s): gatetherm {parts(g)}"]
     write_table(args.json, ["job", "wall s", "CPU s", "peak GB"], rows, notes)
 
+
 def rusage_run(cmd, env=None) -> dict:
     """Run ``cmd`` to its end: wall and CPU seconds, peak resident memory (GB), last JSON line."""
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
-    out = p.stdout.read()
-    err = p.stderr.read()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
+    out = p.stdout.read()  # stderr too: one pipe cannot fill while the other is read
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
     if os.waitstatus_to_exitcode(status):
-        raise RuntimeError(f"{' '.join(cmd[:4])} failed: {err[-2000:]}")
+        raise RuntimeError(f"{' '.join(cmd[:4])} failed: {out[-2000:]}")
     line = next((ln for ln in reversed(out.splitlines()) if ln.startswith("{")), "{}")
     return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "rss_gb": usage.ru_maxrss / 1e6, **json.loads(line)}
 

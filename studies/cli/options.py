@@ -65,5 +65,7 @@ def number(rng: Range):
     return parse
 
 
+FIELD_FILES = ("fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5")
+"""The field files of a run in its --out (studies.run.output.write_fields)."""
 WORKERS = Range(1, whole=True)
 """Worker processes."""

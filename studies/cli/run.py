@@ -4,11 +4,10 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from gatetherm.studies.cli.options import Progress
+from gatetherm.studies.cli.options import FIELD_FILES, Progress
 
 #: What a run writes into --out; a rerun replaces all of it.
-OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5",
-           "channels.png", "deformed.png")
+OUTPUTS = ("timeseries.csv", "summary.json", *FIELD_FILES, "channels.png", "deformed.png")
 
 
 def register(sub) -> None:

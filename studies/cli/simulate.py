@@ -5,11 +5,10 @@ import time
 from pathlib import Path
 
 from gatetherm.checks import POSITIVE
-from gatetherm.studies.cli.options import Progress, add_model_options, number
+from gatetherm.studies.cli.options import FIELD_FILES, Progress, add_model_options, number
 
 #: What a run writes into --out; a rerun replaces all of it.
-OUTPUTS = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5",
-           "oil_temperatures.png", "response.png", "deformed.png")
+OUTPUTS = ("timeseries.csv", "summary.json", *FIELD_FILES, "oil_temperatures.png", "response.png", "deformed.png")
 
 
 def register(sub) -> None:

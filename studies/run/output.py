@@ -100,9 +100,9 @@ def write_xdmf(model: Model, steps, path: Path) -> None:
         kind_ = "Vector" if np.ndim(a) == 2 else "Scalar"
         return f'<Attribute Name="{name}" AttributeType="{kind_}" Center="{center}">{item(key, a)}</Attribute>'
 
-    grids = []
+    grids, cells = [], fm.cells.astype(np.int64)
     with atomic_path(h5) as tmp, h5py.File(tmp, "w") as f:
-        f["points"], f["cells"], f["region"] = pts, fm.cells.astype(np.int64), region
+        f["points"], f["cells"], f["region"] = pts, cells, region
         for n, (t, data) in enumerate(steps):
             attrs = [attribute("region", region, "Cell", "region")]
             for name, a in data.items():
@@ -110,7 +110,7 @@ def write_xdmf(model: Model, steps, path: Path) -> None:
                 attrs.append(attribute(name, a, "Node", f"step{n}/{name}"))
             grids.append(f'<Grid Name="step{n}" GridType="Uniform"><Time Value="{t!r}"/>'
                          f'<Topology TopologyType="{kind}" NumberOfElements="{len(fm.cells)}" NodesPerElement="{k}">'
-                         f'{item("cells", fm.cells.astype(np.int64))}</Topology>'
+                         f'{item("cells", cells)}</Topology>'
                          f'<Geometry GeometryType="XYZ">{item("points", pts)}</Geometry>{"".join(attrs)}</Grid>')
     write_text_atomic(path, '<?xml version="1.0"?>\n<Xdmf Version="3.0"><Domain>'
                       '<Grid Name="fields" GridType="Collection" CollectionType="Temporal">\n'

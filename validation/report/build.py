@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime
+import functools
 import hashlib
 import importlib
 import json
@@ -74,6 +75,7 @@ def input_files(patterns) -> dict[str, Path]:
     return out
 
 
+@functools.cache
 def tool_version(name: str) -> str:
     """The first line a program prints for ``-v``, or "absent"."""
     exe = shutil.which(name)

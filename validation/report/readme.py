@@ -36,7 +36,8 @@ def full_tables(results: dict) -> tuple[dict, set]:
 
 def rewrite(text: str, tables: dict[str, str]) -> tuple[str, list[str]]:
     """``text`` with every block whose table is in ``tables`` replaced; returns (new text, the
-    names rewritten). A block naming no table of the report is an error."""
+    names rewritten); a block whose table is not in ``tables`` stays as it is
+    (:func:`check_names` refuses a block naming no table of the report)."""
     done = []
 
     def sub(m):
