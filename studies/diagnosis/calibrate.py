@@ -77,10 +77,6 @@ class Scored:
     approx: bool = False
     """Scored from superposed earlier runs (screening), not from a run of the set itself."""
 
-    @property
-    def k(self) -> int:
-        return len(self.values)
-
 
 class Objective:
     """Residuals of hypotheses on the training and held-out windows of a measured run.

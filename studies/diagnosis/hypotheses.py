@@ -20,8 +20,6 @@ from gatetherm.solvers.effects import CATALOGUE
 from gatetherm.solvers.sensors import compose, faults_of
 from gatetherm.studies.run.config import Config
 
-KINDS = ("effect", "parameter", "sensor")
-
 
 @dataclass(frozen=True)
 class Piece:

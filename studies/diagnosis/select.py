@@ -63,8 +63,6 @@ class Selection:
     rounds: list[Round] = field(default_factory=list)
     removed: list[Piece] = field(default_factory=list)
     """Pieces chosen, then dropped by the removal check or swapped out."""
-    swaps: list[tuple[Piece, Piece]] = field(default_factory=list)
-    """(piece swapped out, piece swapped in)."""
     alternatives: dict = field(default_factory=dict)
     """{piece: [pieces that explain the data as well in its place]}."""
     best_rejected: tuple[Piece, Scored] | None = None
@@ -83,9 +81,8 @@ def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: d
     if not ctx:
         singles = [(p, obj.scored(fit_one(obj, {}, p))) for p in pool]
         fits.update({frozenset([p]): s for p, s in singles})
-        sur = Surrogate(obj, ctx)
-    else:
-        sur = Surrogate(obj, ctx)
+    sur = Surrogate(obj, ctx)
+    if ctx:
         screened = sorted(((p, screen(sur, ctx, {p: None})) for p in pool if sur.usable(p)),
                           key=lambda ps: ps[1].score)
         singles = [(p, obj.scored(fit_one(obj, ctx, p))) for p in pool if not sur.usable(p)]
@@ -174,7 +171,6 @@ def _swap(obj: Objective, sel: Selection, current: Scored, candidates, margin: f
             log.info("swap: %s for %s (gain %.1f)", q.label, p.label, current.score - real.score)
             sel.removed.append(p)
             sel.order[sel.order.index(p)] = q
-            sel.swaps.append((p, q))
             return real
     return None
 

@@ -40,7 +40,6 @@ MATERIAL = ranges(Material)
 SCHEME = ranges(TimeScheme)
 METRES, SECONDS = Range(0.0, lo_open=True, unit="m"), Range(0.0, lo_open=True, unit="s")
 FILM = Range(0.0, unit="W/(m² K)")
-QUANTITIES = ("T", "u", "sigma")
 
 
 @dataclass(frozen=True)
