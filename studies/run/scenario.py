@@ -120,10 +120,8 @@ class ScenarioCache:
         return value
 
     def model(self, cfg: ModelConfig | Case, dim: int) -> tuple[Model, HeatSolver | None]:
-        def make():
-            model = build(cfg.problem, cfg.mesh) if isinstance(cfg, Case) else build_model(cfg, dim, self.fmesh)
-            return model, HeatSolver(model.heat) if model.heat is not None else None
-        return self._lru(self._models, (repr(cfg.problem if isinstance(cfg, Case) else cfg), dim), make)
+        return self._lru(self._models, (repr(cfg.problem if isinstance(cfg, Case) else cfg), dim),
+                         lambda: _build(cfg, dim, self.fmesh))
 
     def result(self, key, make: Callable[[], tuple[RunResult, Model]]) -> tuple[RunResult, Model]:
         def counted():
@@ -137,7 +135,7 @@ class Prepared:
     """A model ready to run: effects applied and assembled."""
 
     model: Model
-    solver: HeatSolver
+    solver: HeatSolver | None
     drive: Drive
     """The schedule's drive with the drive-side effects applied."""
     effects: ActiveEffects
@@ -154,16 +152,17 @@ def prepare(config: Config | Case, dim: int, drive: Drive, effects: Mapping[str,
             raise InputError("--effect", f"{frame_only[0]} acts on the paper frame's model, not on a case file",
                              "model it in the case (materials, supports, sources) instead")
         model_cfg, drive = config, drive_effects(drive, eff)
-        if cache is None:
-            model = build(config.problem, config.mesh)
-            return Prepared(model, HeatSolver(model.heat) if model.heat is not None else None, drive, eff)
     else:
         model_cfg, drive = apply_effects(config.model, drive, eff)
-        if cache is None:
-            model = build_model(model_cfg, dim, mesh)
-            return Prepared(model, HeatSolver(model.heat), drive, eff)
-    model, solver = cache.model(model_cfg, dim)
+    model, solver = _build(model_cfg, dim, mesh) if cache is None else cache.model(model_cfg, dim)
     return Prepared(model, solver, drive, eff)
+
+
+def _build(cfg: ModelConfig | Case, dim: int, fmesh: FrameMesh | None) -> tuple[Model, HeatSolver | None]:
+    """The model of a case, or of a frame configuration on ``fmesh`` (None: its own mesh),
+    with a heat solver of its own."""
+    model = build(cfg.problem, cfg.mesh) if isinstance(cfg, Case) else build_model(cfg, dim, fmesh)
+    return model, HeatSolver(model.heat) if model.heat is not None else None
 
 
 def _once(p: Prepared, schedule: Schedule) -> RunResult:
