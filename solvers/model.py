@@ -10,6 +10,7 @@ has no heat state: it is solved once (:meth:`Model.static`).
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass, field
@@ -124,13 +125,16 @@ class Model:
         if self.elastic is None:
             return out
         u = self.elastic.from_load(_prescribed_load(self))
+        stresses = {}  # per region: its recovery and the projected components
         for pr in p.probes:
             if "u" in pr.quantities:
                 for c in range(self.dim):
                     out[("u", pr.name, AXES[c])] = float(self.elastic.point_functional(pr.xyz, c) @ u)
             if "sigma" in pr.quantities:
-                rec = _probe_recovery(self, pr.region)
-                comps = rec.field(u, rec.thermal_rhs(np.ones(1)))
+                if pr.region not in stresses:
+                    rec = _probe_recovery(self, pr.region)
+                    stresses[pr.region] = rec, rec.field(u, rec.thermal_rhs(np.ones(1)))
+                rec, comps = stresses[pr.region]
                 phi = rec.at(pr.xyz)
                 out.update({("sigma", pr.name, c): float(phi @ v) for c, v in comps.items()})
         for r in p.relative:
@@ -218,7 +222,7 @@ def _readout(model: Model) -> Readout:
         rows.append(sp.csr_matrix(np.r_[w, np.zeros(heat.n - heat.n_solid)][None, :]))
     L = sp.vstack(rows).tocsr() if rows else sp.csr_matrix((0, heat.n))
     n_L = len(keys)
-    G, GT = [], []
+    G, GT, recoveries = [], [], {}
     if el is not None:
         xyz = {pr.name: pr.xyz for pr in p.probes}
         for r in p.relative:
@@ -232,7 +236,9 @@ def _readout(model: Model) -> Readout:
                     G.append(el.point_functional(pr.xyz, c))
                     GT.append(None)
             if "sigma" in pr.quantities:
-                for c, (gu, gT) in _probe_recovery(model, pr.region).point(pr.xyz).items():
+                if pr.region not in recoveries:
+                    recoveries[pr.region] = _probe_recovery(model, pr.region)
+                for c, (gu, gT) in recoveries[pr.region].point(pr.xyz).items():
                     keys.append(("sigma", pr.name, c))
                     G.append(gu)
                     GT.append(gT)
@@ -266,6 +272,6 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
     lap("elastic_setup")
     model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s)
     if heat is not None:
-        model = Model(problem, fmesh, mesh, f, heat, el, _readout(model), config, timings, s)
+        model = dataclasses.replace(model, readout=_readout(model))
     lap("adjoint_solves")
     return model
