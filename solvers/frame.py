@@ -155,8 +155,7 @@ def frame_problem(cfg: ModelConfig, fm: FrameMesh) -> Problem:
     heat = paper_heat(th, enclosed_volume(fm, "tank_wall", p.depth if dim == 2 else 1.0))
     sources = tuple(Source(r, Value(q)) for r, q in cfg.source.items())
     sources += tuple(Source(r, Value(w / region_volume(fm, r, thickness.get(r, 1.0)))) for r, w in cfg.power.items())
-    support = (Support("mounting_face", tuple(range(dim))) if cfg.k_base is None
-               else Support("mounting_face", tuple(range(dim)), cfg.k_base))
+    support = Support("mounting_face", tuple(range(dim)), cfg.k_base)  # None: clamped
     probes = tuple(Probe(name, tuple(fm.points[node])) for name, node in fm.sensors.items())
     return Problem(dim, frame_materials(cfg, fm.regions), cfg.order, thickness, T0=th.T0, T_ref=th.T0,
                    sources=sources, supports=(support,), probes=probes,
