@@ -206,9 +206,8 @@ def row_line(row: dict) -> str:
 
 
 def write_compound(out: Path, workers: int = 2, seed: int = 14, n_pairs: int = 48, with_single: bool = True,
-                   mesh_size: float | None = None, on_row=None) -> dict:
-    """Run the study, write ``compound.md`` and ``.csv``; returns the figures and, under
-    "rows", the pairs' rows."""
+                   mesh_size: float | None = None, on_row=None) -> tuple[dict, list[dict]]:
+    """Run the study, write ``compound.md`` and ``.csv``; returns the figures and the pairs' rows."""
     t0 = time.perf_counter()
     config = single.study_config(mesh_size)
     shows = visible(config)
@@ -228,4 +227,4 @@ def write_compound(out: Path, workers: int = 2, seed: int = 14, n_pairs: int = 4
     write_text_atomic(out / "compound.csv", single.table_csv(rows, COLUMNS, _fmt))
     if single_rows:
         write_text_atomic(out / "hidden_effects.csv", single.table_csv(single_rows))
-    return {**{k: _fmt(v) for k, v in figures.items()}, "rows": rows}
+    return {k: _fmt(v) for k, v in figures.items()}, rows

@@ -316,9 +316,9 @@ def run_pool(worker, items, workers: int, on_row=None) -> list[dict]:
 
 
 def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=(1, 2, 3), wanted=ALL_CASES,
-                         mesh_size: float | None = None, on_row=None, per_kind: int | None = None) -> dict:
+                         mesh_size: float | None = None, on_row=None, per_kind: int | None = None) -> tuple[dict, list[dict]]:
     """Run the study on ``workers`` processes, write ``hidden_effects.md`` and ``.csv``;
-    returns the acceptance figures and, under "rows", the rows. ``on_row(row)`` is called as
+    returns the acceptance figures and the rows. ``on_row(row)`` is called as
     each case finishes; ``per_kind``: only the first so many cases of each effect."""
     todo = [c for c in cases(seed, tuple(conditions)) if c.effect in set(wanted)]
     if per_kind:
@@ -329,4 +329,4 @@ def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=
     out = Path(out)
     write_text_atomic(out / "hidden_effects.md", table_markdown(rows, acc))
     write_text_atomic(out / "hidden_effects.csv", table_csv(rows))
-    return {**{k: fmt(v) for k, v in acc.items()}, "rows": rows}
+    return {k: fmt(v) for k, v in acc.items()}, rows

@@ -124,11 +124,10 @@ def run_hidden(args) -> int:
     if effects - set(ALL_CASES):
         raise InputError("--effects", f"unknown {', '.join(sorted(effects - set(ALL_CASES)))}",
                          f"choose from {', '.join(ALL_CASES)}")
-    acc = write_hidden_effects(Path(args.out), args.workers, args.seed, args.conditions, effects,
+    acc, _ = write_hidden_effects(Path(args.out), args.workers, args.seed, args.conditions, effects,
                                args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
     for k, v in acc.items():
-        if k != "rows":
-            print(f"{k}: {v}")
+        print(f"{k}: {v}")
     return 0
 
 
@@ -143,11 +142,10 @@ def _compound_arguments(p) -> None:
 def run_compound(args) -> int:
     from gatetherm.validation.compound_study import row_line, write_compound
 
-    figures = write_compound(Path(args.out), args.workers, args.seed, args.pairs, not args.no_single,
+    figures, _ = write_compound(Path(args.out), args.workers, args.seed, args.pairs, not args.no_single,
                              args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
     for k, v in figures.items():
-        if k != "rows":
-            print(f"{k}: {v}")
+        print(f"{k}: {v}")
     return 0
 
 

@@ -9,8 +9,7 @@ def compute(ctx) -> Result:
     from gatetherm.validation.compound_study import COLUMNS, write_compound
 
     s = ctx.scope
-    figures = write_compound(ctx.work, max(ctx.workers, 1), s["seed"], s["pairs"], s["single"], s["mesh_size"])
-    rows = figures.pop("rows")
+    figures, rows = write_compound(ctx.work, max(ctx.workers, 1), s["seed"], s["pairs"], s["single"], s["mesh_size"])
     pairs = from_dicts("Every pair: hidden pieces, verdict, pieces named and the held-out RMS of δ", rows, COLUMNS,
                        note="Held-out window: the last 40 % of each 5-h, 1-min run; noise at the sensors' resolution "
                             "(0.1 µm, 0.05 K); strengths in each hypothesis' unit.")

@@ -11,9 +11,8 @@ def compute(ctx) -> Result:
 
     s = ctx.scope
     wanted = ALL_CASES if s["effects"] == "all" else tuple(s["effects"])
-    acc = write_hidden_effects(ctx.work, max(ctx.workers, 1), s["seed"], tuple(s["conditions"]), wanted,
+    acc, rows = write_hidden_effects(ctx.work, max(ctx.workers, 1), s["seed"], tuple(s["conditions"]), wanted,
                                per_kind=s.get("per_kind"))
-    rows = acc.pop("rows")
     plot_hidden_study(rows, ctx.work / "hidden_effects.png")
     cases = from_dicts("Every case: true effect, verdict, named effect and the held-out RMS", rows,
                        [c for c in COLUMNS if c != "reason"],
