@@ -69,11 +69,13 @@ def table(title: str, columns, rows, **kw) -> Table:
 
 def cell(v) -> str:
     """A table cell: whole numbers as they are, other numbers to 4 significant digits, booleans
-    yes/no, None and NaN as a dash."""
+    yes/no, None and NaN as a dash, a list as its cells joined by " + "."""
     if isinstance(v, bool):
         return "yes" if v else "no"
     if v is None or (isinstance(v, float) and math.isnan(v)):
         return "—"
+    if isinstance(v, (list, tuple)):
+        return " + ".join(map(cell, v)) or "—"
     if isinstance(v, int):
         return str(v).replace("-", "−")
     if isinstance(v, float):
