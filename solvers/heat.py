@@ -18,6 +18,7 @@ is a sum of fixed vectors times input values.
 """
 from __future__ import annotations
 
+import functools
 import logging
 import time
 from dataclasses import dataclass
@@ -145,7 +146,7 @@ class HeatSystem:
     def n(self) -> int:
         return self.M.shape[0]
 
-    @property
+    @functools.cached_property
     def fixed_dofs(self) -> np.ndarray:
         return np.unique(np.concatenate([d for d, _ in self.fixed])) if self.fixed else np.zeros(0, int)
 
@@ -246,8 +247,8 @@ class HeatSolver:
         mode = sys.mode(env)
         K, f, held = self.K(mode), sys.f(env, mode), sys.boundary_values(env)
         U = np.empty(sys.n)
-        U[sys.fixed_dofs] = held
-        D = sys.fixed_dofs
+        D = self.fixed
+        U[D] = held
         rhs = f[self.free] - (K[self.free][:, D] @ held if D.size else 0.0)
         U[self.free] = spsolve(K[self.free][:, self.free].tocsc(), rhs)
         return U
