@@ -15,9 +15,9 @@ import logging
 import numpy as np
 from scipy.optimize import minimize
 
-from gatetherm.studies.run.config import load_config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import delta_figures
+from gatetherm.validation import paper_model
 
 log = logging.getLogger(__name__)
 
@@ -75,9 +75,7 @@ def misfit(figs: dict[int, dict]) -> float:
 def calibrate(evals: int = 150, mesh_size: float = 0.012, on_better=None) -> list[str]:
     """Nelder–Mead on :func:`misfit` from the shipped model; ``on_better(line)`` hears of
     each improvement. Returns the best parameters as ``[section] name = value`` lines."""
-    base = load_config()
-    base = dataclasses.replace(base, model=dataclasses.replace(
-        base.model, mesh=dataclasses.replace(base.model.mesh, size=mesh_size)))
+    base = paper_model(size=mesh_size)
     get = {"geometry": base.model.frame, "thermal": base.model.thermal, "supply": base.supply}
     x0 = np.array([getattr(get[s], n) for s, n, *_ in FREE])
     scale = x0.copy()

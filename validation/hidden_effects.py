@@ -43,6 +43,7 @@ from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_sce
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
 from gatetherm.studies.sweeps.pool import worker_pool
+from gatetherm.validation import paper_model
 
 log = logging.getLogger(__name__)
 
@@ -200,11 +201,7 @@ def cases(seed: int = 6, conditions=(1, 2, 3), effects=tuple(CATALOGUE), noise_s
 
 def study_config(mesh_size: float | None = None) -> Config:
     """The shipped paper model, with the diagnosis element size ``mesh_size`` if given."""
-    config = load_config()
-    if mesh_size:
-        config = dataclasses.replace(config, model=dataclasses.replace(
-            config.model, mesh=dataclasses.replace(config.model.mesh, size=mesh_size)))
-    return config
+    return paper_model(size=mesh_size)
 
 
 def case_worker(args):

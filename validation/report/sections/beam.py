@@ -3,7 +3,7 @@ and β (Figs. 7-8 analogues: theory curves, FE markers), the error table per coe
 β, and the effective coefficients of the transient runs (``gatetherm validate beam``)."""
 from __future__ import annotations
 
-from gatetherm.validation.report.sections import paper_model
+from gatetherm.validation import paper_model
 from gatetherm.validation.report.result import Figure, Result, from_dicts
 
 

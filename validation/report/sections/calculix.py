@@ -10,7 +10,7 @@ import subprocess
 import time
 
 from gatetherm.validation.report.result import Result, table
-from gatetherm.validation.report.sections import paper_model
+from gatetherm.validation import paper_model
 
 TOLERANCE = 5e-3
 """Acceptance of the issue: |δ_ccx / δ − 1| within 0.5 %."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from gatetherm.validation.report.sections import paper_model
+from gatetherm.validation import paper_model
 from gatetherm.validation.report.result import Figure, Result, from_dicts, table
 
 

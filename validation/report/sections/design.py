@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 
 from gatetherm.validation.report.result import Figure, Result, table
-from gatetherm.validation.report.sections import paper_model
+from gatetherm.validation import paper_model
 
 
 def compute(ctx) -> Result:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 
 from gatetherm.validation.report.result import Figure, Result, table
-from gatetherm.validation.report.sections import paper_model
+from gatetherm.validation import paper_model
 
 CONDITIONS = (1, 2, 3)
 

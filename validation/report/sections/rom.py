@@ -3,7 +3,7 @@ reduced-model compensation table of ``gatetherm validate rom``, with its figures
 from __future__ import annotations
 
 from gatetherm.validation.report.result import Figure, Result, table
-from gatetherm.validation.report.sections import paper_model
+from gatetherm.validation import paper_model
 
 
 def compute(ctx) -> Result:
