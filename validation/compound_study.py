@@ -33,12 +33,12 @@ from gatetherm import write_text_atomic
 from gatetherm.geometry.build import build_mesh
 from gatetherm.studies.diagnosis.calibrate import coordinate
 from gatetherm.studies.diagnosis.discrepancy import diagnose
-from gatetherm.studies.diagnosis.hypotheses import Piece, catalogue
-from gatetherm.studies.diagnosis.hypotheses import configure
+from gatetherm.studies.diagnosis.hypotheses import Piece, catalogue, configure
 from gatetherm.studies.diagnosis.replay import DELTA
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
+from gatetherm.studies.sweeps.pool import run_pool
 from gatetherm.validation import hidden_effects as single
 
 log = logging.getLogger(__name__)
@@ -214,11 +214,11 @@ def write_compound(out: Path, workers: int = 2, seed: int = 14, n_pairs: int = 4
     hidden = sorted(f"{k}(c{c})" for (c, k), v in shows.items() if not v)
     log.info("not drawn (below the visibility criterion at the weak end of the middle half): %s", hidden)
     todo = pairs(config, n_pairs, seed, shows=shows)
-    rows = single.run_pool(_pair_worker, [(p, mesh_size) for p in todo], workers, on_row)
+    rows = run_pool(_pair_worker, [(p, mesh_size) for p in todo], workers, on_row)
     acc = acceptance(rows)
     single_rows, single_acc = [], None
     if with_single:
-        single_rows = single.run_pool(single.case_worker, [(c, mesh_size) for c in single.cases()], workers, on_row)
+        single_rows = run_pool(single.case_worker, [(c, mesh_size) for c in single.cases()], workers, on_row)
         single_acc = single.acceptance(single_rows)
     figures = {"not_drawn_invisible": hidden, **acc, **({f"single.{k}": v for k, v in single_acc.items()} if single_acc else {}),
                "study_wall_time_s": round(time.perf_counter() - t0, 1)}

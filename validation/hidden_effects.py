@@ -25,8 +25,6 @@ import csv
 import dataclasses
 import io
 import logging
-import multiprocessing
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,7 +40,7 @@ from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
-from gatetherm.studies.sweeps.pool import worker_pool
+from gatetherm.studies.sweeps.pool import run_pool
 from gatetherm.validation import paper_model
 
 log = logging.getLogger(__name__)
@@ -297,19 +295,6 @@ def row_line(row: dict) -> str:
     return ("%-17s %-10.4g c%d -> %-16s %-40s δ RMS %s -> %s  (%.0f s)"
             % (row["effect"], row["strength"], row["condition"], row["verdict"], fmt(row["pieces"]),
                fmt(row["rms_before_um"]), fmt(row["rms_after_um"]), row["seconds"]))
-
-
-def run_pool(worker, items, workers: int, on_row=None) -> list[dict]:
-    """``worker(item)`` for every item on ``workers`` processes (one BLAS thread each), in order."""
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    rows = []
-    with worker_pool(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        for row in pool.map(worker, items):
-            rows.append(row)
-            if on_row:
-                on_row(row)
-    return rows
 
 
 def write_hidden_effects(out: Path, workers: int = 2, seed: int = 6, conditions=(1, 2, 3), wanted=ALL_CASES,

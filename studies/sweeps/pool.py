@@ -74,3 +74,16 @@ def worker_pool(workers: int, mp_context=None):
         pool.shutdown(wait=False, cancel_futures=True)
         raise
     pool.shutdown(wait=True)
+
+
+def run_pool(worker, items, workers: int, on_row=None) -> list[dict]:
+    """``worker(item)`` for every item on ``workers`` processes (one BLAS thread each), in order."""
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+    rows = []
+    with worker_pool(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        for row in pool.map(worker, items):
+            rows.append(row)
+            if on_row:
+                on_row(row)
+    return rows
