@@ -193,3 +193,11 @@ class Problem:
     def heat(self) -> bool:
         """The temperature is solved for (not prescribed)."""
         return self.prescribed is None and not self.prescribed_regions
+
+
+def inputs(problem: Problem) -> set[str]:
+    """The schedule columns the problem's values read (not time ``t``)."""
+    values = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
+    values += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    values += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
+    return set().union(*(v.names() for v in values)) - {"t"}

@@ -39,7 +39,7 @@ from gatetherm.studies.diagnosis.replay import DELTA, resolution
 from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times
-from gatetherm.studies.run.timeseries import FORMAT, TimeSeries
+from gatetherm.studies.run.timeseries import FORMAT, OUTPUT_COLUMNS, TimeSeries
 from gatetherm.studies.sweeps.pool import run_pool
 from gatetherm.validation import paper_model
 
@@ -144,15 +144,22 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
 
 def measured(cols: dict[str, np.ndarray], seed: int, condition: int) -> TimeSeries:
     """The rig's channels of ``cols`` with sensor noise at the resolution, rounded to it."""
+    return recorded(cols, MEASURED, OUTPUT_COLUMNS, seed,
+                    {"source": "hidden-effect study", "condition": str(condition)})
+
+
+def recorded(cols: dict[str, np.ndarray], keep, sensors, seed: int, metadata: dict) -> TimeSeries:
+    """The columns ``keep`` of ``cols``, the ``sensors`` among them with Gaussian noise at
+    their resolution, rounded to it."""
     rng = np.random.default_rng(seed)
     out = {}
-    for c in MEASURED:
+    for c in keep:
         v = np.asarray(cols[c], dtype=float)
-        if c in ("theta_A_degC", "theta_B_degC", "theta_C_degC", DELTA):
+        if c in sensors:
             r = resolution(c)
             v = np.round(np.round((v + rng.normal(0.0, r, len(v))) / r) * r, 6)
         out[c] = v
-    return TimeSeries(out, {"format": FORMAT, "source": "hidden-effect study", "condition": str(condition)})
+    return TimeSeries(out, {"format": FORMAT, **metadata})
 
 
 def diagnosis_row(d) -> dict:

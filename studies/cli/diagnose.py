@@ -5,7 +5,9 @@ it gets with them.
 Writes, once everything is computed: ``DIR/residuals.png``, ``DIR/scores.png``,
 ``DIR/before_after.png`` and ``DIR/model.toml`` (when pieces were found),
 ``DIR/report.md``, and last ``DIR/diagnosis.json``. ``--list-effects [--json]``
-prints the hypotheses instead.
+prints the hypotheses instead. ``--case CASE.toml`` replays the run through a case file's
+frame (any frame) instead of the paper model; no ``model.toml`` is written then (the
+report lists the values to put into the case file).
 """
 from __future__ import annotations
 
@@ -39,6 +41,9 @@ def register(sub) -> None:
                        "catalogue effects, existing parameters and sensor faults that explain them.")
     p.add_argument("--data", metavar="MEASURED.csv", help="measured run in the gatetherm time-series format")
     add_model_options(p, dim_help=DIM_HELP)
+    p.add_argument("--case", metavar="CASE.toml",
+                   help="replay through a case file's frame instead of the paper model: the file gives the inputs the "
+                   "case reads and the channels its [signals] and probes produce (the case needs [time])")
     p.add_argument("--out", metavar="DIR", help="output directory")
     p.add_argument("--train-fraction", type=float, default=0.6, metavar="F",
                    help="fit on the first F of the run, score on the rest (default 0.6: 3 h of 5 h)")
@@ -48,6 +53,9 @@ def register(sub) -> None:
     p.add_argument("--no-sensors", action="store_true", help="do not try sensor faults")
     p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M",
                    help="element size of the diagnosis mesh (2-D or 3-D, as --dim), m (default: the model file's)")
+    p.add_argument("--mesh-factor", type=number(POSITIVE), metavar="F",
+                   help="with --case: mesh the case's geometry with its element sizes times F (e.g. 0.5 when the "
+                   "discretisation check of the report exceeds the resolution)")
     p.add_argument("--list-effects", action="store_true",
                    help="list the hypotheses (effects, parameters, sensor faults) and exit")
     p.add_argument("--json", action="store_true", help="with --list-effects: print JSON")
@@ -78,19 +86,35 @@ def _names(text: str | None, default: tuple) -> tuple:
 
 def settings_from(args):
     """Workflow settings from the command line (checked by :func:`diagnose`)."""
-    from gatetherm.solvers.effects import CATALOGUE
     from gatetherm.studies.diagnosis.discrepancy import Settings
-    from gatetherm.studies.diagnosis.hypotheses import PARAMETER_DEFS
 
-    return Settings(train_fraction=args.train_fraction, effects=_names(args.effects, tuple(CATALOGUE)),
-                    parameters=_names(args.parameters, tuple(PARAMETER_DEFS)), sensors=not args.no_sensors)
+    return Settings(train_fraction=args.train_fraction, effects=_names(args.effects, None),
+                    parameters=_names(args.parameters, None), sensors=not args.no_sensors)
+
+
+def load_model(args):
+    """The paper model of --config, or the case of --case (checked against the other options)."""
+    from gatetherm.studies.run.case import load_case
+    from gatetherm.studies.run.config import load_config
+
+    if args.case is None:
+        if args.mesh_factor is not None:
+            raise InputError("--mesh-factor", "goes with --case only", "give --mesh-size for the paper model")
+        return load_config(args.config)
+    if args.config is not None:
+        raise InputError("--case/--config", "give one model, a case file or a model file", "drop one of the two")
+    if args.dim != 2 or args.mesh_size is not None:
+        raise InputError("--dim/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
+    case = load_case(args.case, args.mesh_factor or 1.0)
+    if case.time is None:
+        raise InputError(f"{args.case}: time", "a diagnosed case needs [time] (a transient run)",
+                         "add [time] with end and step; the run's times come from --data")
+    return case
 
 
 def run(args: argparse.Namespace) -> int:
-    from gatetherm.studies.run.config import load_config
-
     if args.list_effects:
-        print(list_effects(load_config(args.config), args.json))
+        print(list_effects(load_model(args), args.json))
         return 0
     if args.json:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")
@@ -98,14 +122,19 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--data/--out", "both are required", "e.g. gatetherm diagnose --data run.csv --out diag")
     from gatetherm.outdir import output_dir
     from gatetherm.studies.diagnosis.discrepancy import adopted_config, diagnose
+    from gatetherm.studies.run.scenario import case_series_schedule
     from gatetherm.studies.run.timeseries import read_timeseries
 
     settings = settings_from(args)
-    cfg = load_config(args.config)
-    mesh = cfg.model.mesh if args.mesh_size is None else dataclasses.replace(
-        cfg.model.mesh, **{"size" if args.dim == 2 else "size_3d": args.mesh_size})
-    ts = read_timeseries(args.data)
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data)) as out:
+    cfg = load_model(args)
+    ts = read_timeseries(args.data, **({} if args.case is None else {"required": ("time_s",)}))
+    if args.case is not None:
+        mesh = None
+        case_series_schedule(cfg, ts, str(args.data))  # every input the case reads is in the file
+    else:
+        mesh = cfg.model.mesh if args.mesh_size is None else dataclasses.replace(
+            cfg.model.mesh, **{"size" if args.dim == 2 else "size_3d": args.mesh_size})
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out:
         diag = diagnose(cfg, ts, args.dim, mesh, settings)
         _write(args, cfg, diag, adopted_config(cfg, diag), out)
     s = diag.summary()
@@ -118,6 +147,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"best rejected: {s['best_rejected']} (gain {s['margin']:.1f} < margin {diag.margin_min:g})")
     if s["rms_after_um"] is not None:
         print(f"held-out RMS of delta: {s['rms_before_um']:.3g} um -> {s['rms_after_um']:.3g} um")
+    if diag.too_coarse:
+        print(f"warning: the model's discretisation error (P2 - P1) exceeds the resolution on "
+              f"{', '.join(diag.too_coarse)}; refine the mesh (--mesh-factor) or set order = 2 (report.md, 1. Replay)")
     print(f"wrote {out}/report.md, diagnosis.json ({diag.runs} model runs, {diag.seconds:.0f} s)")
     return 0
 
@@ -137,10 +169,12 @@ def _write(args, cfg, diag, adopted, out: Path) -> None:
     if adopted is not None:
         files["before_after"] = "before_after.png"
         plot_before_after(diag, out / files["before_after"])
+    if adopted is not None and args.case is None:
         files["model"] = str(out / "model.toml")
         head = (f"gatetherm diagnose of {args.data}: verdict {diag.verdict}, pieces "
                 + ", ".join(r.piece.label for r in diag.pieces) + f"\nbase model: {cfg.source}")
         write_text_atomic(out / "model.toml", config_toml(adopted, head))
     write_text_atomic(out / "report.md", report_markdown(diag, str(args.data), cfg.source, files))
     write_json(out / "diagnosis.json", {**diag.summary(), "data": str(args.data), "config": cfg.source,
-                                        "model_file": files.get("model"), "mesh_size": args.mesh_size})
+                                        "case": args.case, "model_file": files.get("model"),
+                                        "mesh_size": args.mesh_size, "mesh_factor": args.mesh_factor})

@@ -149,6 +149,21 @@ def run_compound(args) -> int:
     return 0
 
 
+def _case_diagnosis_arguments(p) -> None:
+    p.add_argument("--case", metavar="CASE.toml", help="case file (default: the C-frame example)")
+    p.add_argument("--seed", type=int, default=10, help="seed of the noise (default 10)")
+
+
+def run_case_diagnosis(args) -> int:
+    from gatetherm.validation.case_diagnosis import C_FRAME, write_case_diagnosis
+
+    line, _ = write_case_diagnosis(Path(args.out), Path(args.case) if args.case else C_FRAME, args.seed,
+                                   on_row=lambda r: print(f"{r['scenario']}: {r['verdict']}, "
+                                                          f"{' + '.join(r['pieces']) or 'nothing'} named", flush=True))
+    print(line)
+    return 0
+
+
 def _calibrate_arguments(p) -> None:
     p.add_argument("--evals", type=number(Range(1, whole=True)), default=150,
                    help="objective evaluations (default 150)")
@@ -179,6 +194,8 @@ TARGETS = {
                        _hidden_arguments, run_hidden),
     "compound": ("diagnose runs with two hidden pieces at once (effects, parameters off, sensor faults), "
                  "then the hidden-effect cases", _compound_arguments, run_compound),
+    "case-diagnosis": ("diagnose runs of a case file's frame (the C-frame) with hidden pieces of the case",
+                       _case_diagnosis_arguments, run_case_diagnosis),
     "calibrate": ("refit the default paper model to the paper's figures (a record of the procedure)",
                   _calibrate_arguments, run_calibrate),
 }

@@ -16,6 +16,7 @@
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass
@@ -26,11 +27,11 @@ from gatetherm import InputError
 from gatetherm.solvers.effects import CATALOGUE
 from gatetherm.solvers.frame import PUMP, SUPPLY
 from gatetherm.studies.diagnosis.calibrate import Objective, Scored, uncertainty
-from gatetherm.studies.diagnosis.hypotheses import (PARAMETER_DEFS, Piece, configure, effect_pieces,
-                                                    parameter_pieces, sensor_pieces)
-from gatetherm.studies.diagnosis.locate import Finding, Phase, locate, noise_sd, phases
+from gatetherm.studies.diagnosis.hypotheses import Piece, configure, effect_pieces, parameter_pieces, sensor_pieces
+from gatetherm.studies.diagnosis.locate import Finding, Phase, input_phases, locate, noise_sd, phases
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
 from gatetherm.studies.diagnosis.select import Round, Selection, select
+from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.timeseries import TimeSeries
 
@@ -47,10 +48,10 @@ class Settings:
     """Fraction of the run (from its start) used for fitting; the rest is held out, 1."""
     margin_min: float = 10.0
     """Score units (log-likelihood) by which an addition must lower the held-out score, penalty included."""
-    effects: tuple[str, ...] = tuple(CATALOGUE)
-    """Candidate catalogue effects."""
-    parameters: tuple[str, ...] = tuple(PARAMETER_DEFS)
-    """Candidate existing parameters."""
+    effects: tuple[str, ...] | None = None
+    """Candidate catalogue effects (None: every one that can act on the model)."""
+    parameters: tuple[str, ...] | None = None
+    """Candidate existing parameters (None: all of the model file's or the case's)."""
     sensors: bool = True
     """Try sensor faults of every compared channel."""
     max_pieces: int = 4
@@ -111,6 +112,16 @@ class Diagnosis:
     margin_min: float = Settings.margin_min
     dim: int = 2
     """Dimension of the replayed model."""
+    inputs: tuple[str, ...] | None = None
+    """The columns of the file that drove a case file's frame (None: the paper frame)."""
+    discretisation: dict[str, float] | None = None
+    """A P1 case: the largest |P2 − P1| of the baseline per channel, in units of its resolution
+    (above 1, the model's own discretisation error shows in the data)."""
+
+    @property
+    def too_coarse(self) -> list[str]:
+        """Channels on which the discretisation check exceeds the resolution."""
+        return [c for c, v in (self.discretisation or {}).items() if v > 1.0]
 
     @property
     def named_effects(self) -> list[str]:
@@ -146,18 +157,30 @@ class Diagnosis:
             "significant": [f.sentence() for f in self.findings if f.significant],
             "remaining": [f.sentence() for f in self.remaining if f.significant],
             "model_runs": self.runs, "wall_time_s": round(self.seconds, 1), "dim": self.dim,
+            "discretisation_p2_minus_p1_in_resolutions": self.discretisation,
         }
 
 
-def candidates(config: Config, channels, has_ambient: bool, settings: Settings) -> list[Piece]:
+def candidates(config: Config | Case, channels, has_ambient: bool, settings: Settings) -> list[Piece]:
     """The hypotheses a diagnosis tries (those that can act on the file)."""
-    unknown = [e for e in settings.effects if e not in CATALOGUE]
-    unknown += [p for p in settings.parameters if p not in PARAMETER_DEFS]
-    if unknown:
-        raise InputError("--effects", f"unknown hypothesis {', '.join(unknown)}",
-                         f"choose from {', '.join((*CATALOGUE, *PARAMETER_DEFS))}")
-    return (effect_pieces(settings.effects, has_ambient) + parameter_pieces(config, settings.parameters)
-            + (sensor_pieces(channels, config) if settings.sensors else []))
+    case = isinstance(config, Case)
+    asked = tuple(CATALOGUE) if settings.effects is None else settings.effects
+    bad = [n for n in asked if n not in CATALOGUE]
+    if bad:
+        raise InputError("--effects", f"unknown effect {', '.join(bad)}", f"choose from {', '.join(CATALOGUE)}")
+    effects = effect_pieces(asked, has_ambient, config if case else None)
+    if case and settings.effects is not None and len(effects) < len(asked):
+        n = next(n for n in asked if n not in {p.name for p in effects})
+        raise InputError("--effects", f"{n} acts on the paper frame's model or room, or needs a [means] entry "
+                         "'base', not on this case", "model it in the case (materials, supports, sources) instead")
+    params = parameter_pieces(config)
+    known = [p.name for p in params]
+    bad = [n for n in settings.parameters or () if n not in known]
+    if bad:
+        raise InputError("--parameters", f"unknown parameter {', '.join(bad)}", f"choose from {', '.join(known)}")
+    if settings.parameters is not None:
+        params = [p for p in params if p.name in settings.parameters]
+    return effects + params + (sensor_pieces(channels, config) if settings.sensors else [])
 
 
 def _shares(obj: Objective, sel) -> list[float]:
@@ -182,9 +205,10 @@ def _verdict(discrepant: bool, sel) -> tuple[str, str]:
     return "partly-explained", f"{names} lower the held-out score, but a significant residual remains"
 
 
-def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
+def diagnose(config: Config | Case, ts: TimeSeries, dim: int = 2, mesh=None,
              settings: Settings = Settings()) -> Diagnosis:
-    """Run the whole workflow on a measured series ``ts``."""
+    """Run the whole workflow on a measured series ``ts``, replayed through a model file's
+    frame (at ``dim`` on ``mesh``) or a case file's frame (its own mesh)."""
     if not 0.2 <= settings.train_fraction <= 0.9:
         raise InputError("--train-fraction", f"must be between 0.2 and 0.9, got {settings.train_fraction}",
                          "e.g. 0.6: fit on the first 3 h of a 5-h run, score on the last 2 h")
@@ -192,14 +216,16 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     rep = Replayer(config, ts, dim, mesh)
     t = rep.times
     base_cols = rep.run()
-    channels = compared_channels(ts, base_cols)
+    inputs = tuple(rep.drive.columns) if rep.case else None
+    channels = compared_channels(ts, base_cols, inputs or ())
     pool = candidates(config, channels, rep.has_ambient, settings)
     res0 = residuals(ts, base_cols, channels)
     scale = {c: max(resolution(c), noise_sd(res0[c])) for c in channels}
     train = t <= settings.train_fraction * t[-1]
     if (~train).sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
-    run_phases = phases(t, rep.drive.columns[SUPPLY], rep.drive.columns[PUMP])
+    run_phases = (input_phases(t, rep.drive.columns) if rep.case
+                  else phases(t, rep.drive.columns[SUPPLY], rep.drive.columns[PUMP]))
     findings = locate(t, res0, run_phases)
     obj = Objective(rep, ts, channels, scale, train)
     discrepant = any(f.significant for f in findings)
@@ -213,14 +239,23 @@ def diagnose(config: Config, ts: TimeSeries, dim: int = 2, mesh=None,
     pieces = tuple(PieceResult(p, sel.final.values[p], sigma[p], share, tuple(sel.alternatives.get(p, ())))
                    for p, share in zip(sel.order, _shares(obj, sel)))
     after = obj.residuals(sel.final.values, solve=False)[0] if pieces else None
+    check = discretisation(rep, base_cols, channels) if rep.case and config.problem.order == 1 else None
     log.info("diagnosis: %s (%s), %d model runs", verdict, reason, rep.runs)
     return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, sel.final, tuple(sel.rounds),
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
                      tuple(locate(t, after, run_phases)) if after else (), res0, after, rep.runs,
-                     time.perf_counter() - t0, rep.has_ambient, settings.margin_min, dim)
+                     time.perf_counter() - t0, rep.has_ambient, settings.margin_min, rep.dim, inputs, check)
 
 
-def adopted_config(config: Config, diag: Diagnosis) -> Config | None:
+def discretisation(rep: Replayer, base: dict, channels) -> dict[str, float]:
+    """The largest |P2 − P1| of the baseline case's run per channel, in units of its resolution:
+    an estimate of the P1 model's own discretisation error (one run with P2 elements)."""
+    case = rep.config
+    p2 = rep.run(dataclasses.replace(case, problem=dataclasses.replace(case.problem, order=2)))
+    return {c: float(np.max(np.abs(p2[c] - base[c]))) / resolution(c) for c in channels}
+
+
+def adopted_config(config: Config | Case, diag: Diagnosis) -> Config | Case | None:
     """The model with every chosen piece in it (parameters changed, effects on, sensor faults set)."""
     if not diag.pieces:
         return None

@@ -1,7 +1,7 @@
 """Where and when a model and a measurement disagree.
 
 A run is split into phases from its inputs (pump off, heating, oil steady,
-forced cooling). A residual is *significant* where its systematic part (a
+forced cooling; on a case file's frame, where an input steps). A residual is *significant* where its systematic part (a
 centred moving average over ``SMOOTH_S``) exceeds the sensor resolution with
 confidence: by more than ``Z`` standard errors of that average, the
 sample-to-sample noise being estimated from first differences (at least the
@@ -21,6 +21,8 @@ SMOOTH_S = 900.0
 """Length of the moving average that separates the systematic residual from noise, s."""
 OIL_RATE_K_PER_H = 2.0
 """Supply-oil rate that counts as heating or cooling rather than steady, K/h."""
+STEP_FRACTION = 0.1
+"""A change of an input between two samples by more than this fraction of its range is a step."""
 MIN_PHASE_S = 600.0
 """Shorter phases are merged into the one before, s."""
 Z = 3.0
@@ -61,6 +63,35 @@ def phases(t: np.ndarray, oil: np.ndarray, pump: np.ndarray) -> list[Phase]:
         rate[-1] = rate[-2]
     kinds = np.where(pump < 0.5, "pump off", np.where(rate > OIL_RATE_K_PER_H, "heating",
                      np.where(rate < -OIL_RATE_K_PER_H, "forced cooling", "pump on, oil steady")))
+    out = []
+    for kind, a, b in _merged(t, kinds):
+        if kind == "pump on, oil steady":
+            kind = f"pump on, oil steady ({np.mean(oil[a:b]):.0f} °C)"
+        out.append(Phase(str(kind), float(t[a]), float(t[b] if b < n else t[-1]), closed=b >= n))
+    return out
+
+
+def input_phases(t: np.ndarray, columns: dict[str, np.ndarray]) -> list[Phase]:
+    """Phases of a case's run from the inputs that drive it: cut where an input steps (changes
+    between two samples by more than :data:`STEP_FRACTION` of its range), each named by the median
+    values of the stepping inputs ("spindle_W 120"); one phase, "whole run", if none steps."""
+    n = len(t)
+    jumps = {k: np.abs(np.diff(v)) > STEP_FRACTION * np.ptp(v) for k, v in columns.items() if np.ptp(v) > 0}
+    stepping = [k for k, j in jumps.items() if j.any()]
+    if not stepping or n < 2:
+        return [Phase("whole run", float(t[0]), float(t[-1]), closed=True)]
+    ids = np.concatenate([[0], np.cumsum(np.any([jumps[k] for k in stepping], axis=0))])
+    out = []
+    for _, a, b in _merged(t, ids):
+        name = ", ".join(f"{k} {np.median(columns[k][a:b]):.3g}" for k in stepping)
+        out.append(Phase(name, float(t[a]), float(t[b] if b < n else t[-1]), closed=b >= n))
+    return out
+
+
+def _merged(t: np.ndarray, kinds) -> list[list]:
+    """Runs of equal ``kinds`` as [kind, first, end] sample ranges, those shorter than
+    :data:`MIN_PHASE_S` merged into the one before (a short first one into the next)."""
+    n = len(t)
     cuts = [0] + [i for i in range(1, n) if kinds[i] != kinds[i - 1]] + [n]
     segs = [[kinds[a], a, b] for a, b in zip(cuts[:-1], cuts[1:])]
 
@@ -76,12 +107,7 @@ def phases(t: np.ndarray, oil: np.ndarray, pump: np.ndarray) -> list[Phase]:
     if len(merged) > 1 and short(merged[0]):
         merged[1][1] = 0
         merged.pop(0)
-    out = []
-    for kind, a, b in merged:
-        if kind == "pump on, oil steady":
-            kind = f"pump on, oil steady ({np.mean(oil[a:b]):.0f} °C)"
-        out.append(Phase(str(kind), float(t[a]), float(t[b] if b < n else t[-1]), closed=b >= n))
-    return out
+    return merged
 
 
 def _window(t: np.ndarray, window_s: float) -> int:

@@ -1,8 +1,9 @@
 """Replay a measured run through a model and line the outputs up with the measurement.
 
-The model is driven by the file's own inputs (oil, pump, ambient when present)
-at the file's sample times; every measured output channel that the model also
-produces is compared. A :class:`Replayer` meshes the frame once and re-assembles
+The model is driven by the file's own inputs (oil, pump, ambient when present; for a
+case file, the schedule columns its values read) at the file's sample times; every
+measured output channel that the model also produces is compared. A :class:`Replayer`
+meshes the frame once (a case brings its mesh) and re-assembles
 only when a hypothesis changes the model itself, and reruns the model only when a
 hypothesis changes the model or the drive (sensor-side effects act on a kept run), so
 the hundred-odd runs of a diagnosis cost well under a second each with the 2-D model.
@@ -21,8 +22,9 @@ import numpy as np
 from gatetherm.geometry.build import build_mesh
 from gatetherm import InputError
 from gatetherm.geometry.frame import MeshParams
+from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.scenario import ScenarioCache, run_scenario, series_schedule
+from gatetherm.studies.run.scenario import ScenarioCache, case_series_schedule, run_scenario, series_schedule
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, TimeSeries
 
 log = logging.getLogger(__name__)
@@ -51,11 +53,12 @@ def label(column: str) -> str:
     return stem.replace("theta_", "θ_")
 
 
-def compared_channels(ts: TimeSeries, model_columns) -> tuple[str, ...]:
+def compared_channels(ts: TimeSeries, model_columns, inputs=()) -> tuple[str, ...]:
     """Measured output channels the model also produces: δ, θ_A, θ_B, θ_C, then
-    further sensors in file order; at least one sample each."""
+    further sensors in file order (not the ``inputs`` that drive the model); at least one
+    sample each."""
     first = [c for c in OUTPUT_COLUMNS if c in ts]
-    rest = [c for c in ts.names if c not in first and c not in NOT_COMPARED
+    rest = [c for c in ts.names if c not in first and c not in NOT_COMPARED and c not in inputs
             and c.endswith(tuple(RESOLUTION))]
     out = tuple(c for c in first + rest if c in model_columns and np.isfinite(ts[c]).any())
     if not out:
@@ -65,21 +68,30 @@ def compared_channels(ts: TimeSeries, model_columns) -> tuple[str, ...]:
 
 
 class Replayer:
-    """Runs ``config`` through the inputs of the measured series ``ts`` (the scenario
-    path, one mesh and one :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all
-    hypotheses)."""
+    """Runs ``config`` (a model file at ``dim`` on ``mesh``, or a case on its own mesh)
+    through the inputs of the measured series ``ts`` (the scenario path, one mesh and one
+    :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all hypotheses)."""
 
-    def __init__(self, config: Config, ts: TimeSeries, dim: int = 2, mesh: MeshParams | None = None,
+    def __init__(self, config: Config | Case, ts: TimeSeries, dim: int = 2, mesh: MeshParams | None = None,
                  cache: int = 4):
-        self.config = dataclasses.replace(config, model=dataclasses.replace(
-            config.model, mesh=mesh or config.model.mesh))
-        self.dim = dim
-        self.schedule = series_schedule(ts, config, "measured inputs")
+        if isinstance(config, Case):
+            self.config, self.dim, self.fmesh = config, config.mesh.dim, config.mesh
+            self.schedule = case_series_schedule(config, ts, "measured inputs")
+        else:
+            self.config = dataclasses.replace(config, model=dataclasses.replace(
+                config.model, mesh=mesh or config.model.mesh))
+            self.dim = dim
+            self.schedule = series_schedule(ts, config, "measured inputs")
+            self.fmesh = build_mesh(self.config.model.frame, dim, self.config.model.mesh)
         self.times = self.schedule.times
         self.drive = self.schedule.drive
         self.has_ambient = "ambient_degC" in ts
-        self.fmesh = build_mesh(self.config.model.frame, dim, self.config.model.mesh)
         self.cache = ScenarioCache(self.fmesh, cache)
+
+    @property
+    def case(self) -> bool:
+        """The model is a case file's frame."""
+        return isinstance(self.config, Case)
 
     @property
     def runs(self) -> int:

@@ -62,11 +62,20 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
         L += ["", f"Best rejected: {d.best_rejected[0].label} (score gain {_num(d.margin)} < margin {d.margin_min:g})."]
     if d.removed:
         L += ["", f"Chosen, then dropped (removal check or swap): {', '.join(p.label for p in d.removed)}."]
+    drive = (f"the file's columns {', '.join(d.inputs)} (the inputs the case reads)" if d.inputs is not None else
+             "the file's oil temperature and pump state"
+             + (" and room temperature" if d.has_ambient else " (room at the model's constant T_room)"))
     L += ["", "## 1. Replay", "",
-          "The model was driven by the file's oil temperature and pump state"
-          + (" and room temperature" if d.has_ambient else " (room at the model's constant T_room)")
-          + ". Noise scale per channel (the residual weight; at least the resolution 0.1 µm / 0.05 K): "
-          + ", ".join(f"{label(c)} {_num(s, 2)} {unit(c)}" for c, s in d.scale.items()) + ".", "",
+          f"The model was driven by {drive}. Noise scale per channel (the residual weight; at least the resolution 0.1 µm / 0.05 K): "
+          + ", ".join(f"{label(c)} {_num(s, 2)} {unit(c)}" for c, s in d.scale.items()) + "."]
+    if d.discretisation is not None:
+        L += ["", "Discretisation check (the baseline run again with P2 elements; largest |P2 − P1| in units of the "
+              "resolution): " + ", ".join(f"{label(c)} {v:.2f}×" for c, v in d.discretisation.items()) + ". "
+              + (f"**Above the resolution on {', '.join(label(c) for c in d.too_coarse)}**: the model's own "
+                 "discretisation error shows in the data and the pieces below may partly stand in for it; refine "
+                 "the mesh (`--mesh-factor`, or `size` in the case) or set `order = 2`." if d.too_coarse
+                 else "Below the resolution: the mesh is fine enough for these sensors.")]
+    L += ["",
           "## 2. Locate", "",
           "A residual is significant where its 15-min moving average exceeds the sensor resolution by more "
           "than three standard errors of that average (noise estimated from the residual itself).", ""]
@@ -105,6 +114,9 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     if "model" in files:
         L += [f"Model file with every piece: `{files['model']}` — run it with "
               f"`gatetherm simulate --config {files['model']} --schedule {data}`.", ""]
+    elif d.inputs is not None:
+        L += ["To adopt the parameters, put the fitted values into the case file (a `factor` multiplies the "
+              "case's value: a source's power, every region's k, α or c) and run it again with `gatetherm run`.", ""]
     L += ["| channel | held-out RMS before | after | change |", "|---|---|---|---|"]
     for c in d.channels:
         b, af = d.baseline.rms[c], d.final.rms[c]

@@ -78,7 +78,7 @@ class Case:
         return str(self.path)
 
 
-def _mesh(top: Table, base: Path) -> FrameMesh:
+def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
     m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups"))
     path = base / m.string("file")
     if not path.is_file():
@@ -89,6 +89,8 @@ def _mesh(top: Table, base: Path) -> FrameMesh:
             if k in m.data:
                 m.fail(k, f"applies only to a geometry that gatetherm meshes ({SCRIPT}, {', '.join(CAD)})",
                        "mesh the file again in gmsh, or give the .geo")
+        if factor != 1.0:
+            m.fail("file", "a mesh file cannot be refined", "give the .geo or CAD file to mesh it finer")
         return load_mesh(path)
     if suffix not in (SCRIPT, *CAD):
         m.fail("file", f"unknown mesh or geometry format '{suffix}'", f"use .msh, {SCRIPT} or {', '.join(CAD)}")
@@ -96,7 +98,7 @@ def _mesh(top: Table, base: Path) -> FrameMesh:
     refine = []
     for i, r in enumerate(m.data.get("refine", [])):
         rt = Table(top.file, f"mesh.refine[{i + 1}]", r, ("near", "size", "distance"))
-        refine.append(Refinement(rt.string("near"), rt.number("size", METRES),
+        refine.append(Refinement(rt.string("near"), factor * rt.number("size", METRES),
                                  rt.number("distance", METRES)))
     groups = []
     for name in m.data.get("groups", {}):
@@ -105,7 +107,7 @@ def _mesh(top: Table, base: Path) -> FrameMesh:
         if not (isinstance(box, list) and len(box) == 6 and all(isinstance(b, (int, float)) for b in box)):
             g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax], got {box!r}", "give six numbers in m")
         groups.append(BoxGroup(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(float(b) for b in box)))
-    size = m.number("size", METRES, 0.0) or None
+    size = factor * m.number("size", METRES, 0.0) or None
     return mesh_geometry(MeshSpec(path, size, {k: params.number(k) for k in params.data}, tuple(refine),
                                   tuple(groups)))
 
@@ -291,8 +293,9 @@ def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tupl
                         schedule), scheme, columns
 
 
-def load_case(path) -> Case:
-    """Read and check a case file (paths inside it are relative to its folder)."""
+def load_case(path, mesh_factor: float = 1.0) -> Case:
+    """Read and check a case file (paths inside it are relative to its folder); with
+    ``mesh_factor``, a geometry is meshed with its element sizes times that factor."""
     path = Path(path)
     text = read_text(path, "CASE.toml", "give the path of a .toml case file")
     try:
@@ -304,7 +307,7 @@ def load_case(path) -> Case:
     order = head.data.get("order", 1)
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")
-    fm = _mesh(top, path.parent)
+    fm = _mesh(top, path.parent, mesh_factor)
     time, scheme, columns = _time(top, path.parent)
     prescribed = "temperature" in data
     elastic = "supports" in data

@@ -25,6 +25,7 @@ from gatetherm.solvers.effects import CATALOGUE, ActiveEffects, apply_effects, d
 from gatetherm.solvers.frame import ModelConfig, build_model
 from gatetherm.solvers.heat import Drive, HeatSolver, environment
 from gatetherm.solvers.model import Model, build
+from gatetherm.solvers.problem import inputs
 from gatetherm.studies.run.case import Case
 from gatetherm.solvers.sensors import apply_faults
 from gatetherm.studies.run.conditions import TableDrive, condition, condition_drive, filled, table_drive
@@ -76,11 +77,26 @@ def case_schedule(case: Case) -> Schedule:
     if t.schedule is None:
         return Schedule(lambda _: {}, times, "no schedule", every=int(round(t.output / t.step)))
     ts = read_timeseries(t.schedule, required=("time_s",))
+    return Schedule(_case_drive(case, ts, [k for k in ts.names if k != "time_s"]), times, f"schedule {t.schedule}",
+                    every=int(round(t.output / t.step)))
+
+
+def case_series_schedule(case: Case, ts: TimeSeries, label: str) -> Schedule:
+    """The inputs a case reads, from a series (a measured run), sampled at its own times."""
+    need = sorted(inputs(case.problem))
+    missing = [k for k in need if k not in ts]
+    if missing:
+        raise InputError(f"{label}, column {missing[0]}", "missing: the case reads it",
+                         f"record every input of {case.path.name}: {', '.join(need)}")
+    drive = _case_drive(case, ts, need)
+    return Schedule(drive, drive.time, label)
+
+
+def _case_drive(case: Case, ts: TimeSeries, names) -> TableDrive:
+    """The columns ``names`` of ``ts`` as a case's drive (a fluid's pump columns held)."""
     held = {n for f in case.problem.fluids for n in f.pump.names()}
     time = np.asarray(ts.time_s - ts.time_s[0], float)
-    columns = {k: filled(k, time, ts[k], hold=k in held) for k in ts.names if k != "time_s"}
-    return Schedule(TableDrive(time, columns, frozenset(held)), times, f"schedule {t.schedule}",
-                    every=int(round(t.output / t.step)))
+    return TableDrive(time, {k: filled(k, time, ts[k], hold=k in held) for k in names}, frozenset(held))
 
 
 def file_schedule(path, cfg: Config, step_s: float = 60.0) -> Schedule:
