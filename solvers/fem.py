@@ -15,9 +15,14 @@ _P0 = {2: skfem.ElementTriP0, 3: skfem.ElementTetP0}
 
 
 def _keys(facets: np.ndarray, n: int) -> np.ndarray:
-    """One integer per facet (rows of node numbers, any order within a row)."""
-    key = np.zeros(len(facets), dtype=np.int64)
-    for column in np.sort(facets, axis=1).T:
+    """One key per facet (rows of ``n`` node numbers, any order within a row), ordered as the
+    sorted rows are lexicographically: an integer while n**(nodes per facet) fits in int64 (a
+    3-D mesh of up to 2 million nodes), else a record of the sorted row."""
+    rows = np.sort(facets, axis=1).astype(np.int64)
+    if float(n) ** rows.shape[1] >= 2.0 ** 63:
+        return np.ascontiguousarray(rows).view([(f"n{i}", np.int64) for i in range(rows.shape[1])]).ravel()
+    key = np.zeros(len(rows), dtype=np.int64)
+    for column in rows.T:
         key = key * n + column
     return key
 

@@ -29,7 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from gatetherm import InputError, atomic_path
+from gatetherm import InputError
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 
 log = logging.getLogger(__name__)
@@ -131,24 +131,6 @@ class ReducedModel:
         if name not in self.outputs:
             raise InputError("reduced model output", f"no {name!r}", f"choose from {', '.join(self.outputs)}")
         return self.outputs.index(name)
-
-    def save(self, path) -> None:
-        """Write ``rom.npz`` (the arrays of the fields; string arrays for the names)."""
-        arrays = {k: getattr(self, k) for k in ("A_on", "B_on", "A_off", "B_off", "C")}
-        with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, **arrays, T0=np.float64(self.T0), inputs=np.array(self.inputs),
-                     outputs=np.array(self.outputs))
-
-
-def load_rom(path) -> ReducedModel:
-    """Read a ``rom.npz`` written by :meth:`ReducedModel.save`."""
-    try:
-        with np.load(path, allow_pickle=False) as d:
-            return ReducedModel(*(np.array(d[k], float) for k in ("A_on", "B_on", "A_off", "B_off", "C")),
-                                float(d["T0"]), tuple(map(str, d["inputs"])), tuple(map(str, d["outputs"])))
-    except (KeyError, ValueError, OSError) as err:
-        raise InputError(str(path), f"not a reduced model ({err})", "write one with 'gatetherm reduce'") from None
-
 
 @dataclass(frozen=True)
 class Reduction:

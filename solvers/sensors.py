@@ -60,17 +60,27 @@ def faults_of(channel: str) -> dict[str, Fault]:
     return {}
 
 
+LINEAR_IDENTITY = {"gain": 1.0, "offset": 0.0, "drift": 0.0}
+"""The linear faults and the values at which they do nothing."""
+
+
+def linear_basis(t: np.ndarray, x: np.ndarray, fault: str) -> np.ndarray:
+    """The direction of a linear fault: it reports ``x + (value − identity) · basis``."""
+    if fault == "gain":
+        return x - x[0]
+    if fault == "offset":
+        return np.ones_like(x, dtype=float)
+    if fault == "drift":
+        return (t - t[0]) / 3600.0
+    raise ValueError(f"unknown linear sensor fault {fault!r}")
+
+
 def apply_fault(t: np.ndarray, x: np.ndarray, fault: str, value: float) -> np.ndarray:
     """``x`` (a channel sampled at ``t``, s) as a sensor with one fault reports it."""
     if fault == "lag":
         return first_order_lag(t, x, value) if value > 0 else x
-    if fault == "gain":
-        return x + (value - 1.0) * (x - x[0])
-    if fault == "offset":
-        return x + value
-    if fault == "drift":
-        return x + value * (t - t[0]) / 3600.0
-    raise ValueError(f"unknown sensor fault {fault!r}")
+    basis = linear_basis(t, x, fault)
+    return x + (value - LINEAR_IDENTITY[fault]) * basis
 
 
 def apply_faults(cols: dict[str, np.ndarray], faults: dict[str, dict[str, float]]) -> dict[str, np.ndarray]:

@@ -205,3 +205,18 @@ def test_second_tie_bar():
     # the second bar really sits at l4_2: its cells lie within l4_2 ± t_C/2
     y = fm.points[fm.cells[fm.regions["tie_bar_2"]]][..., 1]
     assert y.min() == pytest.approx(0.38, abs=1e-12) and y.max() == pytest.approx(0.42, abs=1e-12)
+
+
+def test_facet_keys_order_rows_alike_past_int64():
+    """Boundary facets are matched by key (``to_skfem``); past 2 million nodes in 3-D the integer
+    key n²a + nb + c would overflow int64, so the key is then a record of the sorted row. Both
+    kinds order rows alike, and each row is found again."""
+    from gatetherm.solvers.fem import _keys
+
+    rows = np.random.default_rng(1).integers(0, 50, (400, 3))
+    small, big = _keys(rows, 50), _keys(rows, 3_000_000)
+    assert small.dtype == np.int64 and big.dtype.names == ("n0", "n1", "n2")
+    assert np.array_equal(np.argsort(small, kind="stable"), np.argsort(big, kind="stable"))
+    ordered = np.sort(big)
+    assert np.array_equal(ordered[np.searchsorted(ordered, big)], big)
+    assert _keys(np.array([[2_999_999] * 3]), 3_000_000)[0].tolist() == (2_999_999,) * 3  # no wrap-around

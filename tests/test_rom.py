@@ -7,7 +7,8 @@ import scipy.sparse as sp
 from gatetherm import InputError
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 from gatetherm.solvers.frame import build_model
-from gatetherm.solvers.rom import INPUTS, KEY_OUTPUTS, ReducedModel, linear_heat_model, load_rom, reduce
+from gatetherm.solvers.rom import INPUTS, KEY_OUTPUTS, ReducedModel, linear_heat_model, reduce
+from gatetherm.studies.run.reduce import load_rom, write_rom
 from gatetherm.solvers.rom_time import discretise, march_rom, simulate_rom
 from gatetherm.studies.control.observer import ObserverParams, kalman, uniform_state
 from gatetherm.studies.control.predictive import PredictiveParams, event_updates, minimax, plan_threshold
@@ -91,7 +92,7 @@ def test_exact_step_for_linear_inputs():
 
 def test_rom_file_round_trip_and_bad_file(coarse, tmp_path):
     rom = coarse[2].rom
-    rom.save(tmp_path / "rom.npz")
+    write_rom(rom, tmp_path / "rom.npz")
     back = load_rom(tmp_path / "rom.npz")
     assert back.inputs == INPUTS and back.outputs == rom.outputs and back.T0 == rom.T0
     assert all(np.array_equal(getattr(back, k), getattr(rom, k)) for k in ("A_on", "B_on", "A_off", "B_off", "C"))

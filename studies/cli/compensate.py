@@ -242,10 +242,9 @@ def _compensate(args, cfg, ts, what, params, model, cache, out_dir: Path) -> int
 
 def _rom_loop(args, ts, cfg, cache, params, actuator):
     """The rom method's closed loop, its summary entries and a label."""
-    from gatetherm.solvers.rom import load_rom
     from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
     from gatetherm.studies.control.observer import ObserverParams
-    from gatetherm.studies.run.reduce import cached_rom
+    from gatetherm.studies.run.reduce import cached_rom, load_rom
 
     if not 2 <= args.states <= 200:
         raise InputError("--states", f"{args.states} is outside 2..200", "e.g. --states 30")

@@ -17,6 +17,8 @@ from gatetherm import InputError
 from gatetherm.studies.cli.options import add_model_options
 
 MAX_STATES = 200
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("rom.npz", "rom.key", "summary.json")
 
 
 def register(sub) -> None:
@@ -30,22 +32,25 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    from gatetherm.outdir import output_dir
     from gatetherm.studies.run.config import load_config
+
+    if not 2 <= args.states <= MAX_STATES:
+        raise InputError("--states", f"{args.states} is outside 2..{MAX_STATES}", "e.g. --states 30")
+    cfg = load_config(args.config)
+    with output_dir(args.out, OUTPUTS, keep=(args.config,)) as out:
+        return _reduce(args, cfg, out)
+
+
+def _reduce(args, cfg, out: Path) -> int:
     from gatetherm.studies.run.output import write_json
     from gatetherm.studies.run.reduce import build_rom, check, rom_key, save_rom
     from gatetherm.studies.run.scenario import ScenarioCache
 
-    if not 2 <= args.states <= MAX_STATES:
-        raise InputError("--states", f"{args.states} is outside 2..{MAX_STATES}", "e.g. --states 30")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError("--out", f"{out} exists and is not a directory", "give a directory path")
-    cfg = load_config(args.config)
     cache = ScenarioCache()
     t0 = time.perf_counter()
     red = build_rom(cfg, args.dim, args.states, cache)
     seconds = time.perf_counter() - t0
-    out.mkdir(parents=True, exist_ok=True)
     save_rom(red.rom, rom_key(cfg, args.dim, args.states), out)
     checks = [] if args.no_check else check(cfg, args.dim, red.rom, cache=cache)
     summary = {"states": red.rom.states, "dim": args.dim, "config": cfg.source,

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 
-from gatetherm.solvers.sensors import ORDER, apply_fault
+from gatetherm.solvers.sensors import ORDER, apply_fault, linear_basis
 from gatetherm.studies.diagnosis.hypotheses import Piece, configure, model_side
 from gatetherm.studies.diagnosis.locate import significant
 from gatetherm.studies.diagnosis.replay import Replayer, resolution
@@ -121,9 +121,8 @@ class Objective:
                 x = apply_fault(self.t, x, "lag", values[mine["lag"]])
             linear = [p for p in mine.values() if p.linear]
             if solve and linear:
-                design = {"gain": x - x[0], "offset": np.ones_like(x), "drift": (self.t - self.t[0]) / 3600.0}
                 m = self.train & np.isfinite(y)
-                A = np.column_stack([design[p.param] for p in linear])
+                A = np.column_stack([linear_basis(self.t, x, p.param) for p in linear])
                 coef = np.linalg.lstsq(A[m], (y - x)[m], rcond=None)[0]
                 for p, a in zip(linear, coef):
                     values[p] = float(np.clip(p.neutral + a, p.lo, p.hi))
@@ -168,22 +167,26 @@ def refit(obj: Objective, values: dict, free=None, max_nfev: int = 8) -> dict:
     """``values`` with the ``free`` pieces (default: all) refitted jointly on the training
     window by bounded least squares from their current values; sensor offsets, gains and
     drifts are solved in closed form inside."""
-    free = list(values if free is None else free)
+    return bounded_fit(obj, values, list(values if free is None else free), obj.residuals, diff_step=0.01,
+                       x_scale=1.0, max_nfev=max_nfev, ftol=1e-4, xtol=1e-3, method="trf")
+
+
+def bounded_fit(obj: Objective, values: dict, free, residuals, **options) -> dict:
+    """``values`` with the non-linear ``free`` pieces fitted jointly on the training window by
+    bounded least squares (``scipy.optimize.least_squares`` with ``options``) in their [0, 1]
+    coordinates, from their current values; ``residuals(values)`` gives (residuals, values
+    with the linear sensor faults solved), from model runs or a surrogate."""
     nl = [p for p in free if not p.linear]
     if not nl:
-        return obj.residuals(values)[1]
+        return residuals(values)[1]
     coords = [coordinate(p) for p in nl]
     x0 = np.clip([to(values[p]) for p, (to, _) in zip(nl, coords)], 1e-6, 1 - 1e-6)
 
     def at(x) -> dict:
         return {**values, **{p: back(float(xi)) for p, (_, back), xi in zip(nl, coords, x)}}
 
-    def fun(x):
-        return obj.vector(obj.residuals(at(x))[0], obj.train)
-
-    sol = least_squares(fun, x0, bounds=(0.0, 1.0), diff_step=0.01, x_scale=1.0, max_nfev=max_nfev,
-                        ftol=1e-4, xtol=1e-3, method="trf")
-    return obj.residuals(at(sol.x))[1]
+    sol = least_squares(lambda x: obj.vector(residuals(at(x))[0], obj.train), x0, bounds=(0.0, 1.0), **options)
+    return residuals(at(sol.x))[1]
 
 
 def fit_one(obj: Objective, context: dict, piece: Piece, start: float | None = None) -> dict:

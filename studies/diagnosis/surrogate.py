@@ -13,10 +13,9 @@ hide the candidate that explains the rest.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from gatetherm.solvers.effects import ActiveEffects
-from gatetherm.studies.diagnosis.calibrate import CHEAP_SCAN, Objective, Scored, coordinate
+from gatetherm.studies.diagnosis.calibrate import CHEAP_SCAN, Objective, Scored, bounded_fit, coordinate
 from gatetherm.studies.diagnosis.hypotheses import Piece
 
 
@@ -82,14 +81,5 @@ def screen(sur: Surrogate, current: dict, adds: dict) -> Scored:
             back = coordinate(piece)[1]
             tried = [{**values, piece: back(x)} for x in np.linspace(0.0, 1.0, CHEAP_SCAN)]
             values = min(tried, key=lambda v: obj.chi2(residuals(v)[0]))
-    free = [p for p in values if not p.linear]
-    coords = [coordinate(p) for p in free]
-    x0 = np.clip([t(values[p]) for p, (t, _) in zip(free, coords)], 1e-6, 1 - 1e-6)
-
-    def at(x) -> dict:
-        return {**values, **{p: b(float(xi)) for p, (_, b), xi in zip(free, coords, x)}}
-
-    sol = least_squares(lambda x: obj.vector(residuals(at(x))[0], obj.train), x0, bounds=(0.0, 1.0),
-                        diff_step=1e-3, max_nfev=30, ftol=1e-5, xtol=1e-5)
-    values = residuals(at(sol.x))[1]
+    values = bounded_fit(obj, values, list(values), residuals, diff_step=1e-3, max_nfev=30, ftol=1e-5, xtol=1e-5)
     return obj.scored(values, sur.columns(values), approx=True)

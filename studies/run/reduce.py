@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gatetherm import __version__, write_text_atomic
-from gatetherm.solvers.rom import Reduction, ReducedModel, linear_heat_model, load_rom, reduce
+from gatetherm import InputError, __version__, atomic_path, write_text_atomic
+from gatetherm.solvers.rom import Reduction, ReducedModel, linear_heat_model, reduce
 from gatetherm.solvers.rom_time import discretise, march_rom
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, prepare, run_scenario
@@ -58,9 +58,26 @@ def rom_key(config: Config, dim: int, states: int) -> str:
     return hashlib.sha256(repr((config.model, config.effects, dim, states, __version__)).encode()).hexdigest()
 
 
+def write_rom(rom: ReducedModel, path) -> None:
+    """Write ``rom.npz`` (the arrays of the fields; string arrays for the names)."""
+    arrays = {k: getattr(rom, k) for k in ("A_on", "B_on", "A_off", "B_off", "C")}
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(fh, **arrays, T0=np.float64(rom.T0), inputs=np.array(rom.inputs), outputs=np.array(rom.outputs))
+
+
+def load_rom(path) -> ReducedModel:
+    """Read a ``rom.npz`` written by :func:`write_rom`."""
+    try:
+        with np.load(path, allow_pickle=False) as d:
+            return ReducedModel(*(np.array(d[k], float) for k in ("A_on", "B_on", "A_off", "B_off", "C")),
+                                float(d["T0"]), tuple(map(str, d["inputs"])), tuple(map(str, d["outputs"])))
+    except (KeyError, ValueError, OSError) as err:
+        raise InputError(str(path), f"not a reduced model ({err})", "write one with 'gatetherm reduce'") from None
+
+
 def save_rom(rom: ReducedModel, key: str, directory: Path, name: str = "rom") -> None:
     """``directory/<name>.npz`` and its key ``<name>.key`` (written last)."""
-    rom.save(Path(directory) / f"{name}.npz")
+    write_rom(rom, Path(directory) / f"{name}.npz")
     write_text_atomic(Path(directory) / f"{name}.key", key + "\n")
 
 
