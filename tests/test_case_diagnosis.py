@@ -127,3 +127,20 @@ def test_case_diagnosis_study(tmp_path):
     assert by["source+expansion"]["alternatives"] == ["expansion"]
     assert by["noise-only, case mesh"]["p2_minus_p1_delta"] > 1.0 > by["noise-only"]["p2_minus_p1_delta"]
     assert line.startswith("6 of 7 scenarios found")
+
+
+@pytest.mark.slow
+def test_the_paper_frame_as_a_case_finds_its_tank_film(tmp_path, capsys):
+    """`gatetherm mesh` writes the paper frame as a case (a fluid with a hose, 23 compared
+    channels, one of them, the hose, unchanged: zero residual); a run with the tank film (pump
+    on) at 150 instead of 260 W/(m² K) is explained by that fluid's film alone."""
+    (tmp_path / "hot.toml").write_text("[thermal]\nh_oil_on = 150.0\n")
+    assert main(["mesh", "--dim", "2", "--out", str(tmp_path / "m")]) == 0
+    assert main(["simulate", "--condition", "1", "--config", str(tmp_path / "hot.toml"), "--out",
+                 str(tmp_path / "s")]) == 0
+    assert main(["diagnose", "--case", str(tmp_path / "m" / "case.toml"), "--data",
+                 str(tmp_path / "s" / "timeseries.csv"), "--out", str(tmp_path / "d")]) == 0
+    d = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    assert d["verdict"] == "explained" and list(d["fitted"]) == ["tank_oil_film_on.film_on"]
+    assert d["fitted"]["tank_oil_film_on.film_on"] == pytest.approx(150.0, rel=0.005)
+    assert d["rms_before"]["T_hose_degC"] == 0.0 and len(d["channels"]) == 23

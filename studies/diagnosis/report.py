@@ -120,7 +120,8 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     L += ["| channel | held-out RMS before | after | change |", "|---|---|---|---|"]
     for c in d.channels:
         b, af = d.baseline.rms[c], d.final.rms[c]
-        L.append(f"| {label(c)} ({unit(c)}) | {_num(b, 3)} | {_num(af, 3)} | {100 * (af - b) / b:+.0f} % |")
+        change = f"{100 * (af - b) / b:+.0f} %" if b > 0 else "—"
+        L.append(f"| {label(c)} ({unit(c)}) | {_num(b, 3)} | {_num(af, 3)} | {change} |")
     if "before_after" in files:
         L += ["", f"![held-out residual before and after]({files['before_after']})"]
     L += ["", "## 5. What remains", ""]
