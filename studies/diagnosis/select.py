@@ -19,7 +19,8 @@ be swapped for one not chosen (the best swaps on the surrogate, refitted for rea
 when they gain the margin), and the rounds go on (at most ``swaps`` times). Last, every
 piece not chosen is put in place of each chosen one on the surrogate; where that scores
 within the margin, the closest are refitted for real, and if they still do, the data
-cannot tell the two apart: the chosen piece lists them as alternatives.
+cannot tell the two apart: the chosen piece lists them as alternatives (the closest one is
+refitted for real whatever the surrogate says).
 """
 from __future__ import annotations
 
@@ -205,17 +206,20 @@ def _removal(obj: Objective, sel: Selection, current: Scored, fits: dict, margin
     return current
 
 
-def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, most: int = 2) -> None:
+def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, most: int = 2,
+                  max_nfev: int = 10) -> None:
     """For every chosen piece, the pieces that, put in its place and refitted, score within the
-    margin of the chosen set (screened on the surrogate, the closest ``most`` refitted for real)."""
+    margin of the chosen set: screened on the surrogate, the closest ``most`` refitted for real
+    (the closest one even beyond the margin: the surrogate adds changes made on the baseline
+    model, so it misses products, such as α scaling the effect of another chosen piece)."""
     final = sel.final
     pool = [q for q in candidates if q not in final.values]
     tried: dict[Piece, int] = {}
     for p, q, s in _replacements(obj, final, pool):
-        if s.score - final.score >= margin or tried.get(p, 0) >= most:
+        if (s.score - final.score >= margin and p in tried) or tried.get(p, 0) >= most:
             continue
         tried[p] = tried.get(p, 0) + 1
-        swapped = obj.scored(refit(obj, s.values, max_nfev=5))
+        swapped = obj.scored(refit(obj, s.values, max_nfev=max_nfev))
         if swapped.score - final.score < margin:
             sel.alternatives.setdefault(p, []).append(q)
             log.info("%s and %s explain the data equally well (scores %.1f, %.1f)", p.label, q.label,
