@@ -1,8 +1,9 @@
 """Where and when a model and a measurement disagree.
 
 A run is split into phases from its inputs (pump off, heating, oil steady,
-forced cooling; on a case file's frame, where an input steps). A residual is *significant* where its systematic part (a
-centred moving average over ``SMOOTH_S``) exceeds the sensor resolution with
+forced cooling; on a case file's frame, where an input steps). A residual is
+*significant* where its systematic part (a centred moving average over
+``SMOOTH_S``) exceeds the sensor resolution with
 confidence: by more than ``Z`` standard errors of that average, the
 sample-to-sample noise being estimated from first differences (at least the
 rounding noise of the resolution, res/√12). A model error below the

@@ -66,8 +66,8 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
              "the file's oil temperature and pump state"
              + (" and room temperature" if d.has_ambient else " (room at the model's constant T_room)"))
     L += ["", "## 1. Replay", "",
-          f"The model was driven by {drive}. Noise scale per channel (the residual weight; at least the resolution 0.1 µm / 0.05 K): "
-          + ", ".join(f"{label(c)} {_num(s, 2)} {unit(c)}" for c, s in d.scale.items()) + "."]
+          f"The model was driven by {drive}. Noise scale per channel (the residual weight; at least the "
+          "resolution 0.1 µm / 0.05 K): " + ", ".join(f"{label(c)} {_num(s, 2)} {unit(c)}" for c, s in d.scale.items()) + "."]
     if d.discretisation is not None:
         L += ["", "Discretisation check (the baseline run again with P2 elements; largest |P2 − P1| in units of the "
               "resolution): " + ", ".join(f"{label(c)} {v:.2f}×" for c, v in d.discretisation.items()) + ". "
