@@ -33,7 +33,7 @@ from gatetherm import write_text_atomic
 from gatetherm.geometry.build import build_mesh
 from gatetherm.studies.diagnosis.calibrate import coordinate
 from gatetherm.studies.diagnosis.discrepancy import diagnose
-from gatetherm.studies.diagnosis.hypotheses import Piece, catalogue, configure
+from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece, catalogue, configure
 from gatetherm.studies.diagnosis.replay import DELTA
 from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
@@ -45,8 +45,6 @@ log = logging.getLogger(__name__)
 
 KIND_PAIRS = (("effect", "effect"), ("effect", "parameter"), ("effect", "sensor"),
               ("parameter", "parameter"), ("parameter", "sensor"), ("sensor", "sensor"))
-INSEPARABLE = (frozenset({"parameter:expansion", "sensor:sensor_gain@delta_um"}),)
-"""Pairs whose signals are proportional: only their product shows in the data."""
 VISIBLE_DELTA_UM, VISIBLE_THETA_K = 0.4, 0.3
 """The catalogue's visibility criterion (``solvers.effects.Effect``)."""
 THERMOCOUPLES = ("theta_A_degC", "theta_B_degC", "theta_C_degC")
@@ -124,7 +122,7 @@ def pairs(config: Config, n: int = 48, seed: int = 14, conditions=(1, 2, 3), sho
         ka, kb = KIND_PAIRS[i % len(KIND_PAIRS)]
         while True:
             a, b = (by_kind[k][rng.integers(len(by_kind[k]))] for k in (ka, kb))
-            if a != b and frozenset({a.key, b.key}) not in INSEPARABLE:
+            if a != b and frozenset({a.key, b.key}) not in PROPORTIONAL:
                 break
         out.append(Pair(((a.key, draw_value(a, rng)), (b.key, draw_value(b, rng))), cond,
                         int(rng.integers(1 << 31))))

@@ -227,6 +227,11 @@ def _scaled(v: Value, factor: float) -> Value:
     return Value(v.constant * factor) if v.is_constant else Value.of(f"{factor!r} * ({v.text})")
 
 
+PROPORTIONAL = (frozenset({"parameter:expansion", "sensor:sensor_gain@delta_um"}),)
+"""Pairs of hypotheses (keys) whose signals are proportional by construction: α of every
+material scales δ and nothing else, and so does a gain of the δ sensor; only their product
+shows in the data (where no other displacement channel is recorded)."""
+
 Assignment = tuple  # ((Piece, value), ...) sorted by key: hashable
 
 

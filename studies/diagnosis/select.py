@@ -19,8 +19,8 @@ be swapped for one not chosen (the best swaps on the surrogate, refitted for rea
 when they gain the margin), and the rounds go on (at most ``swaps`` times). Last, every
 piece not chosen is put in place of each chosen one on the surrogate; where that scores
 within the margin, the closest are refitted for real, and if they still do, the data
-cannot tell the two apart: the chosen piece lists them as alternatives (the closest one is
-refitted for real whatever the surrogate says).
+cannot tell the two apart: the chosen piece lists them as alternatives (a proportional
+partner, such as α for a gain of the δ sensor, is refitted for real whatever the surrogate says).
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ from itertools import combinations
 import numpy as np
 
 from gatetherm.studies.diagnosis.calibrate import Objective, Scored, fit_one, refit
-from gatetherm.studies.diagnosis.hypotheses import Piece
+from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece
 from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.diagnosis.surrogate import Surrogate, screen
 
@@ -209,14 +209,19 @@ def _removal(obj: Objective, sel: Selection, current: Scored, fits: dict, margin
 def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, most: int = 2,
                   max_nfev: int = 10) -> None:
     """For every chosen piece, the pieces that, put in its place and refitted, score within the
-    margin of the chosen set: screened on the surrogate, the closest ``most`` refitted for real
-    (the closest one even beyond the margin: the surrogate adds changes made on the baseline
-    model, so it misses products, such as α scaling the effect of another chosen piece)."""
+    margin of the chosen set: screened on the surrogate, the closest ``most`` refitted for real.
+    A :data:`~gatetherm.studies.diagnosis.hypotheses.PROPORTIONAL` partner is refitted for real
+    first, whatever the surrogate says (it adds changes made on the baseline model, so it misses
+    the product of α with the effect of another chosen piece)."""
     final = sel.final
     pool = [q for q in candidates if q not in final.values]
     tried: dict[Piece, int] = {}
-    for p, q, s in _replacements(obj, final, pool):
-        if (s.score - final.score >= margin and p in tried) or tried.get(p, 0) >= most:
+
+    def partners(p: Piece, q: Piece) -> bool:
+        return frozenset({p.key, q.key}) in PROPORTIONAL
+
+    for p, q, s in sorted(_replacements(obj, final, pool), key=lambda t: not partners(t[0], t[1])):
+        if (s.score - final.score >= margin and not partners(p, q)) or tried.get(p, 0) >= most:
             continue
         tried[p] = tried.get(p, 0) + 1
         swapped = obj.scored(refit(obj, s.values, max_nfev=max_nfev))
