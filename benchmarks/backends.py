@@ -25,7 +25,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from peer import peer_case, rusage_run, write_table  # noqa: E402  (benchmarks/ is not a package)
+from peer import interleaved, peer_case, rusage_run, write_table  # noqa: E402  (benchmarks/ is not a package)
 
 PARTS = ("heat_assembly", "heat_factor", "heat_steps", "elastic_setup", "elastic_solve")
 
@@ -44,14 +44,12 @@ def main() -> None:
 
     (work / "peer.toml").write_text(peer_case(load_mesh(work / "mesh.msh").regions))
     runs = {b: [] for b in args.backends}
-    for r in range(args.rounds):
-        k = r % len(args.backends)
-        for b in args.backends[k:] + args.backends[:k]:
-            env = dict(os.environ, **{"GATETHERM_SPD_BACKEND": b})
-            res = rusage_run([sys.executable, str(HERE / "peer.py"), "--equal", str(work / "peer.toml")], env=env)
-            runs[b].append(res)
-            print(f"round {r + 1} {b:8s} wall {res['wall']:6.1f} s  peak {res['rss_gb']:.2f} GB  "
-                  f"delta {res['delta_um']:.6f} um", flush=True)
+    for r, b in interleaved(args.backends, args.rounds):
+        env = dict(os.environ, **{"GATETHERM_SPD_BACKEND": b})
+        res = rusage_run([sys.executable, str(HERE / "peer.py"), "--equal", str(work / "peer.toml")], env=env)
+        runs[b].append(res)
+        print(f"round {r + 1} {b:8s} wall {res['wall']:6.1f} s  peak {res['rss_gb']:.2f} GB  "
+              f"delta {res['delta_um']:.6f} um", flush=True)
     rows = [[b, *(round(statistics.median(x[p] for x in v), 2) for p in (*PARTS, "wall", "rss_gb")),
              f"{v[-1]['delta_um']:.6f}"] for b, v in runs.items()]
     write_table(args.json, ["backend", *PARTS, "wall s", "peak GB", "delta um"], rows,

@@ -19,7 +19,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from peer import rusage_run, write_table  # noqa: E402  (benchmarks/ is not a package)
+from peer import interleaved, rusage_run, write_table  # noqa: E402  (benchmarks/ is not a package)
 
 
 def main() -> None:
@@ -31,15 +31,13 @@ def main() -> None:
     work = Path(tempfile.mkdtemp(prefix="blas-"))
     atexit.register(shutil.rmtree, work, True)
     runs = {n: [] for n in args.threads}
-    for r in range(args.rounds):
-        k = r % len(args.threads)
-        for n in args.threads[k:] + args.threads[:k]:
-            cmd = [sys.executable, "-m", "gatetherm.studies.cli", "simulate", "--condition", "1", "--dim", "3",
-                   "--out", str(work / f"r{r}-t{n}")]
-            res = rusage_run(cmd, env=dict(os.environ, GATETHERM_BLAS_THREADS=str(n)))
-            runs[n].append(res)
-            print(f"round {r + 1} threads {n}: wall {res['wall']:.1f} s, CPU {res['cpu']:.1f} s, "
-                  f"peak {res['rss_gb']:.2f} GB, load {os.getloadavg()[0]:.1f}", flush=True)
+    for r, n in interleaved(args.threads, args.rounds):
+        cmd = [sys.executable, "-m", "gatetherm.studies.cli", "simulate", "--condition", "1", "--dim", "3",
+               "--out", str(work / f"r{r}-t{n}")]
+        res = rusage_run(cmd, env=dict(os.environ, GATETHERM_BLAS_THREADS=str(n)))
+        runs[n].append(res)
+        print(f"round {r + 1} threads {n}: wall {res['wall']:.1f} s, CPU {res['cpu']:.1f} s, "
+              f"peak {res['rss_gb']:.2f} GB, load {os.getloadavg()[0]:.1f}", flush=True)
     rows = [[n, *(round(statistics.median(x[m] for x in v), 2) for m in ("wall", "cpu", "rss_gb"))]
             for n, v in runs.items()]
     write_table(args.json, ["BLAS threads", "wall s", "CPU s", "peak GB"], rows,

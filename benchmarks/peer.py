@@ -105,14 +105,13 @@ def main() -> None:
             "simulate": [*gt, "simulate", "--condition", "1", "--dim", "3", "--out", str(work / "sim")]}
     results: dict[str, list[dict]] = {k: [] for k in jobs}
     names = list(jobs)
-    for r in range(args.rounds):
-        for name in names[r % len(names):] + names[:r % len(names)]:
-            t0 = time.perf_counter()
-            res = rusage_run(jobs[name])
-            results[name].append(res)
-            print(f"round {r + 1} {name:8s} wall {res['wall']:7.1f} s  CPU {res['cpu']:7.1f} s  "
-                  f"peak {res['rss_gb']:.2f} GB  load {os.getloadavg()[0]:.1f}  ({time.perf_counter() - t0:.0f} s)",
-                  flush=True)
+    for r, name in interleaved(names, args.rounds):
+        t0 = time.perf_counter()
+        res = rusage_run(jobs[name])
+        results[name].append(res)
+        print(f"round {r + 1} {name:8s} wall {res['wall']:7.1f} s  CPU {res['cpu']:7.1f} s  "
+              f"peak {res['rss_gb']:.2f} GB  load {os.getloadavg()[0]:.1f}  ({time.perf_counter() - t0:.0f} s)",
+              flush=True)
     med = {k: {m: statistics.median(r[m] for r in v) for m in ("wall", "cpu", "rss_gb")} for k, v in results.items()}
     rows = [[k, round(m["wall"], 1), round(m["cpu"], 1), round(m["rss_gb"], 2)] for k, m in med.items()]
     rows += [[f"ratio {k} / dolfinx", *(round(med[k][m] / med["dolfinx"][m], 2) for m in ("wall", "cpu", "rss_gb"))]
@@ -129,6 +128,16 @@ def main() -> None:
              f"{abs(d['delta_um'] - g['delta_um']):.1e} um (DOLFINx {d['delta_um']:.6f} um, gatetherm {g['delta_um']:.6f} um)",
              f"parts, last round (s): DOLFINx {parts(d)}", f"parts, last round (s): gatetherm {parts(g)}"]
     write_table(args.json, ["job", "wall s", "CPU s", "peak GB"], rows, notes)
+
+
+def interleaved(names, rounds: int):
+    """``(round, name)`` over ``rounds`` rounds of ``names``, the order rotating each round, so
+    that the load of the shared cores falls on every job alike."""
+    names = list(names)
+    for r in range(rounds):
+        k = r % len(names)
+        for name in names[k:] + names[:k]:
+            yield r, name
 
 
 def rusage_run(cmd, env=None) -> dict:
