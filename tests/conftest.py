@@ -13,6 +13,19 @@ from gatetherm.validation.verification_time import COARSE_MESH as COARSE, FIXED_
 _ORDERS = pytest.StashKey[list]()
 
 
+def fixed_condition(steps: int, condition: int = 1):
+    """The :data:`FIXED_MODEL` as a model file and the first ``steps`` minutes of a paper
+    condition's schedule."""
+    import dataclasses
+
+    from gatetherm.studies.run.config import Config
+    from gatetherm.studies.run.scenario import condition_schedule
+
+    cfg = Config(model=FIXED_MODEL)
+    sched = condition_schedule(condition, cfg)
+    return cfg, dataclasses.replace(sched, times=sched.times[:steps + 1])
+
+
 @pytest.fixture(scope="session")
 def frame_2d():
     """The :data:`FIXED` frame meshed in 2-D at :data:`COARSE`."""

@@ -8,11 +8,11 @@ import json
 import numpy as np
 import pytest
 
-from conftest import COARSE, FIXED, FIXED_MODEL
+from conftest import COARSE, FIXED, FIXED_MODEL, fixed_condition
 from gatetherm import InputError
 from gatetherm.solvers.frame import build_model
 from gatetherm.studies.cli import main
-from gatetherm.studies.run.config import Config, config_toml, load_config
+from gatetherm.studies.run.config import config_toml, load_config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 
 EFFECT = {"compliant_base": 3e10}
@@ -45,9 +45,8 @@ def test_simulate_and_compensate_see_the_model_files_effect(model_toml, tmp_path
 
 
 def test_effects_of_the_file_and_of_the_caller_add_up():
-    cfg = dataclasses.replace(Config(model=FIXED_MODEL), effects={"joint_resistance": 400.0})
-    sched = condition_schedule(2, cfg)
-    sched = dataclasses.replace(sched, times=sched.times[:31])
+    cfg, sched = fixed_condition(30, condition=2)
+    cfg = dataclasses.replace(cfg, effects={"joint_resistance": 400.0})
     both = run_scenario(cfg, 2, sched, {"stand_drift": 1.5})
     assert both.effects.values == {"joint_resistance": 400.0, "stand_drift": 1.5}
     explicit = run_scenario(dataclasses.replace(cfg, effects={}), 2, sched,
@@ -58,9 +57,7 @@ def test_effects_of_the_file_and_of_the_caller_add_up():
 
 
 def test_cache_reuses_the_model_and_the_run():
-    cfg = Config(model=FIXED_MODEL)
-    sched = condition_schedule(1, cfg)
-    sched = dataclasses.replace(sched, times=sched.times[:11])
+    cfg, sched = fixed_condition(10)
     cache = ScenarioCache()
     a = run_scenario(cfg, 2, sched, cache=cache)
     b = run_scenario(cfg, 2, sched, {"thermocouple_lag": 60.0}, cache=cache)  # observation only: no rerun

@@ -7,12 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from conftest import FIXED_MODEL
+from conftest import fixed_condition
 from gatetherm import InputError
 from gatetherm.solvers.effects import first_order_lag
 from gatetherm.solvers.sensors import apply_fault, apply_faults, compose, faults_from_table, faults_of
-from gatetherm.studies.run.config import Config, config_toml, load_config, parse_config
-from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.studies.run.config import config_toml, load_config, parse_config
+from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 
 T = np.arange(0.0, 7200.0 + 1, 60.0)
 X = 20.0 + 5.0 * (1 - np.exp(-T / 900.0))
@@ -65,9 +65,7 @@ def test_model_file_sensors_section(tmp_path):
 
 
 def test_scenario_observes_the_sensor_faults_of_the_model_file():
-    cfg = Config(model=FIXED_MODEL)
-    sched = condition_schedule(1, cfg)
-    sched = dataclasses.replace(sched, times=sched.times[:21])
+    cfg, sched = fixed_condition(20)
     cache = ScenarioCache()
     plain = run_scenario(cfg, 2, sched, cache=cache)
     faults = {"theta_B_degC": {"offset": 0.3, "lag": 60.0}, "delta_um": {"gain": 1.05}}
