@@ -187,9 +187,7 @@ class HeatSolver:
 
     def __init__(self, system: HeatSystem):
         self.system = system
-        self.fixed = system.fixed_dofs
-        """Unknowns held by a fixed temperature (found once, not at every step)."""
-        self.free = np.setdiff1d(np.arange(system.n), self.fixed)
+        self.free = np.setdiff1d(np.arange(system.n), system.fixed_dofs)
         """Unknowns not held by a fixed temperature (the solid's first, then the lumped ones)."""
         self.n_inner = int(np.sum(self.free < system.n_solid))
         """Free unknowns of the solid: the SPD block of every step matrix."""
@@ -215,7 +213,7 @@ class HeatSolver:
         Crank–Nicolson over dt share: a sparse Cholesky of its SPD solid block (one METIS
         order for all, the matrices share a pattern) bordered by the lumped unknowns."""
         key = (round(theta * dt, 9), mode)
-        fixed = self.fixed
+        fixed = self.system.fixed_dofs
         if key not in self._lu:
             t0 = time.perf_counter()
             A = (self.system.M / (theta * dt) + self.K(mode)).tocsr()
@@ -247,7 +245,7 @@ class HeatSolver:
         mode = sys.mode(env)
         K, f, held = self.K(mode), sys.f(env, mode), sys.boundary_values(env)
         U = np.empty(sys.n)
-        D = self.fixed
+        D = sys.fixed_dofs
         U[D] = held
         rhs = f[self.free] - (K[self.free][:, D] @ held if D.size else 0.0)
         U[self.free] = spsolve(K[self.free][:, self.free].tocsc(), rhs)

@@ -39,7 +39,7 @@ from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 from gatetherm.studies.sweeps.pool import run_pool
-from gatetherm.validation import hidden_effects as single
+from gatetherm.validation import hidden_effects as single, paper_model
 
 log = logging.getLogger(__name__)
 
@@ -148,7 +148,7 @@ def run_pair(pair: Pair, config: Config) -> dict:
 def _pair_worker(args):
     pair, mesh_size = args
     logging.basicConfig(level=logging.WARNING)
-    return run_pair(pair, single.study_config(mesh_size))
+    return run_pair(pair, paper_model(size=mesh_size))
 
 
 def acceptance(rows: list[dict]) -> dict:
@@ -207,7 +207,7 @@ def write_compound(out: Path, workers: int = 2, seed: int = 14, n_pairs: int = 4
                    mesh_size: float | None = None, on_row=None) -> tuple[dict, list[dict]]:
     """Run the study, write ``compound.md`` and ``.csv``; returns the figures and the pairs' rows."""
     t0 = time.perf_counter()
-    config = single.study_config(mesh_size)
+    config = paper_model(size=mesh_size)
     shows = visible(config)
     hidden = sorted(f"{k}(c{c})" for (c, k), v in shows.items() if not v)
     log.info("not drawn (below the visibility criterion at the weak end of the middle half): %s", hidden)

@@ -204,15 +204,10 @@ def cases(seed: int = 6, conditions=(1, 2, 3), effects=tuple(CATALOGUE), noise_s
     return out
 
 
-def study_config(mesh_size: float | None = None) -> Config:
-    """The shipped paper model, with the diagnosis element size ``mesh_size`` if given."""
-    return paper_model(size=mesh_size)
-
-
 def case_worker(args):
     case, mesh_size = args
     logging.basicConfig(level=logging.WARNING)
-    return run_case(case, study_config(mesh_size))
+    return run_case(case, paper_model(size=mesh_size))
 
 
 def acceptance(rows: list[dict]) -> dict:
