@@ -193,3 +193,17 @@ def test_visibility_of_the_weakest_drawn_strengths(coarse):
     assert shows[2, "sensor:sensor_offset@theta_B_degC"] and shows[2, "sensor:sensor_drift@delta_um"]
     assert shows[2, "parameter:conductivity"] and shows[2, "effect:joint_resistance"]
     assert not shows[2, "sensor:sensor_lag@theta_C_degC"] and not shows[2, "parameter:oil_film_off"]
+
+
+def test_the_by_kinds_table_counts_each_group_and_all():
+    """compound.md's table by kinds (the README's): one wrong pair of two sensor pieces."""
+    from gatetherm.validation.compound_study import kinds_markdown
+
+    def row(kinds, ok):
+        return {"kinds": kinds, "verdict": "explained", "both_named": ok, "both_named_or_equivalent": True,
+                "wrong_piece": not ok, "wrong_effect": False}
+
+    lines = kinds_markdown([row("effect+effect", True), row("sensor+sensor", False)]).splitlines()
+    assert lines[2] == "| effect + effect | 1 | 1 | 1 | 1 | 0 | 0 |"
+    assert lines[7] == "| sensor + sensor | 1 | 1 | 0 | 1 | 1 | 0 |"
+    assert lines[8] == "| all | 2 | 2 | 1 (50.0 %) | 2 | 1 (50.0 %) | 0 |"

@@ -180,6 +180,23 @@ def _fmt(v) -> str:
     return single.fmt(v)
 
 
+def kinds_markdown(rows: list[dict]) -> str:
+    """The pairs by the kinds of their hidden pieces (README, "Compound diagnosis")."""
+    L = ["| hidden kinds | cases | verdict `explained` | both pieces named | both named, or a stated equivalent "
+         "| a wrong piece named | a wrong catalogue effect |", "|---|---|---|---|---|---|---|"]
+    groups = [(" + ".join(k), [r for r in rows if r["kinds"] == "+".join(k)]) for k in KIND_PAIRS]
+    for name, mine in groups + [("all", rows)]:
+        n = len(mine)
+        counts = [sum(r["verdict"] == "explained" for r in mine)] + [
+            sum(r[k] for r in mine) for k in ("both_named", "both_named_or_equivalent", "wrong_piece", "wrong_effect")]
+        cells = [str(c) for c in counts]
+        if name == "all":
+            cells[1] += f" ({100 * counts[1] / max(n, 1):.1f} %)"
+            cells[3] += f" ({100 * counts[3] / max(n, 1):.1f} %)"
+        L.append(f"| {name} | {n} | " + " | ".join(cells) + " |")
+    return "\n".join(L)
+
+
 def table_markdown(rows: list[dict], acc: dict, single_rows: list[dict], single_acc: dict | None) -> str:
     head = ["hidden pieces", "strengths", "cond.", "noise seed", "verdict", "pieces named", "or equally", "both named",
             "wrong piece", "best rejected", "δ RMS before (µm)", "δ RMS after (µm)", "model runs", "time (s)"]
@@ -188,6 +205,7 @@ def table_markdown(rows: list[dict], acc: dict, single_rows: list[dict], single_
          "Strengths in the hypothesis' unit (`gatetherm diagnose --list-effects`).", "",
          "## Two pieces at once", "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     L += ["| " + " | ".join(_fmt(r[k]) for k in COLUMNS) + " |" for r in rows]
+    L += ["", "### By kinds", "", kinds_markdown(rows)]
     L += ["", "### Figures", ""] + [f"- {k}: {_fmt(v)}" for k, v in acc.items()]
     if single_acc is not None:
         L += ["", "## Single pieces (the hidden-effect study's cases)", "",
