@@ -95,7 +95,8 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
     matching the glob patterns ``owns`` (the command's output set, relative to ``path``)
     removed, except the run's input files ``keep`` (None entries are skipped). A directory
     this call created is removed again if the run fails before writing anything into it;
-    temporaries left by a failed or interrupted run are removed at once. Raises InputError (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
+    temporaries left by a failed or interrupted run are removed at once. Raises InputError
+    (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
     out = Path(path)
     created = _check_path(out, option)
     try:

@@ -23,7 +23,7 @@ from gatetherm.studies.diagnosis.replay import Replayer, compared_channels
 from gatetherm.studies.run.config import config_toml, load_config
 from gatetherm.studies.run.scenario import run_scenario, series_schedule
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
-from gatetherm.validation.compound_study import draw_value, pairs, pieces_by_key, visible
+from gatetherm.validation.compound_study import draw_value, kinds_markdown, pairs, pieces_by_key, visible
 from gatetherm.validation.hidden_effects import measured, truth_with
 
 FAST = dict(mesh_factor=1.0, step_s=120.0)
@@ -197,8 +197,6 @@ def test_visibility_of_the_weakest_drawn_strengths(coarse):
 
 def test_the_by_kinds_table_counts_each_group_and_all():
     """compound.md's table by kinds (the README's): one wrong pair of two sensor pieces."""
-    from gatetherm.validation.compound_study import kinds_markdown
-
     def row(kinds, ok):
         return {"kinds": kinds, "verdict": "explained", "both_named": ok, "both_named_or_equivalent": True,
                 "wrong_piece": not ok, "wrong_effect": False}

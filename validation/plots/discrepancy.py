@@ -93,7 +93,8 @@ def plot_scores(diag, path: Path, shown: int = 12) -> None:
         ax.set_yticks(y, [f"{p.label}" for p, _ in trials], fontsize=7)
         ax.set_xscale("log")
         ax.axvline(1.0 + diag.margin_min, color="k", ls=":", lw=1)
-        ax.set_title(f"round {k}: " + (f"+ {' + '.join(p.label for p in rnd.added)}" if rnd.added else "nothing added"), fontsize=9)
+        added = f"+ {' + '.join(p.label for p in rnd.added)}" if rnd.added else "nothing added"
+        ax.set_title(f"round {k}: {added}", fontsize=9)
         ax.set_xlabel("1 + score gain", fontsize=8)
     fig.suptitle(f"Additions by round (green: explains the held-out data, orange: screened only; "
                  f"dotted: margin {diag.margin_min:g})", fontsize=9)
