@@ -37,10 +37,11 @@ DEFAULT_SIZE = {2: "size", 3: "size_3d"}
 def job(dim: int, factor: float) -> dict:
     """Condition 1 on the refined mesh; part times (s) and node counts."""
     from gatetherm.geometry.frame import MeshParams
-    from gatetherm.studies.cli.process import configure
+    from gatetherm.process import configure
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.run.output import displacements
-    from gatetherm.studies.run.scenario import condition_schedule, prepare
+    from gatetherm.studies.run.frame_case import frame_case
+    from gatetherm.studies.run.scenario import prepare
     from gatetherm.studies.run.simulate import run_model
 
     key = DEFAULT_SIZE[dim]
@@ -49,10 +50,11 @@ def job(dim: int, factor: float) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "mesh.toml").write_text(f"[mesh]\n{key} = {size!r}\n")
         cfg = load_config(Path(tmp) / "mesh.toml")
-        schedule = condition_schedule(1, cfg)
-        p = prepare(cfg, dim, schedule.drive)
+        case = frame_case(cfg, dim)
+        schedule = case.schedule
+        p = prepare(case)
         out_times = schedule.times[::60]
-        res = run_model(p.model, p.drive, schedule.times, keep_times=out_times, solver=p.solver)
+        res = run_model(p.model, schedule.drive, schedule.times, keep_times=out_times, solver=p.solver)
         model, factor_s = p.model, p.solver.factor_seconds
         del p  # the heat factors go, as in ``simulate``, before the output-time elastic solves
         t = time.perf_counter()

@@ -349,7 +349,8 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     for src in problem.sources:
         cb = cells()
         on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
-        loads.append((asm(film_load, cb, h=on.at(cb), t=th.at(cb)), src.density, "source"))
+        vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
     for fluid in problem.fluids:

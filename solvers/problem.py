@@ -52,7 +52,9 @@ class Source:
 
     region: str
     density: Value
-    """Power density, W/m³."""
+    """Power density, W/m³ (times :attr:`per`)."""
+    per: float = 1.0
+    """The density is ``per × density``: 1 for a density, 1/volume (1/m³) for a power (W) in the region."""
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ import pytest
 from gatetherm import InputError
 from gatetherm.checks import ranges
 from gatetherm.outdir import LOCK, output_dir
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.config import SCHEMA, parse_config
 from gatetherm.studies.run.timeseries import read_timeseries
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate
@@ -193,7 +193,7 @@ SCHEDULES = {
     "thirty years": (_sched("7200,", "1e9,"), "column time_s: 1e+09 s are 16666666 steps of 60 s, more than 1000000"),
     "pump 2": (_sched("3600,40,0", "3600,40,2"), "column pump: value 2 is not 0 or 1"),
     "time backwards": (_sched("3600,", "9000,"), "column time_s: time 7200 s is not after the previous 9000 s"),
-    "no oil column": (_sched("oil_degC", "oil"), "missing required column 'oil_degC'"),
+    "no oil column": (_sched("oil_degC", "oil"), "column oil_degC: missing: the case reads it"),
     "empty": (b"", "no header row"),
     "header only": (_sched("0,40,1\n3600,40,0\n7200,40,1\n", ""), "no data rows"),
 }

@@ -12,7 +12,7 @@ import pytest
 from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
 from gatetherm.geometry.mesh import load_mesh
 from gatetherm.solvers.expr import ExpressionError, Value
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 
 NAFEMS = Path(__file__).resolve().parents[1] / "validation" / "nafems"
 DATA = Path(__file__).resolve().parent / "data"
@@ -184,7 +184,7 @@ def test_c_frame_example_runs_end_to_end(tmp_path, capsys):
     assert s["relative"]["drift_x"] == pytest.approx(19.679, abs=2e-3)
     assert s["probes"]["TS"]["T_degC"] == pytest.approx(28.409, abs=2e-3)
     assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["channels.png", "deformed.png", "fields",
-                                                                     "summary.json", "timeseries.csv"]
+                                                                     "response.png", "summary.json", "timeseries.csv"]
     assert len(list((tmp_path / "run" / "fields").glob("*.vtu"))) == 7  # 0 to 6 h
     assert main(["compensate", "--case", str(EXAMPLE / "case.toml"), "--out", str(tmp_path / "c"),
                  "--no-actuator"]) == 0
@@ -193,4 +193,4 @@ def test_c_frame_example_runs_end_to_end(tmp_path, capsys):
     assert c["prediction_error_band_um"] < 0.5
     assert main(["compensate", "--case", str(EXAMPLE / "case.toml"), "--out", str(tmp_path / "t"),
                  "--k-source", "theory"]) == 2
-    assert "a case file has no beam theory" in capsys.readouterr().err
+    assert "needs the paper frame's beam model; this case has none" in capsys.readouterr().err

@@ -11,10 +11,10 @@ import sys
 import time
 from pathlib import Path
 
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.timeseries import read_timeseries
 
-GATETHERM = [sys.executable, "-m", "gatetherm.studies.cli"]
+GATETHERM = [sys.executable, "-m", "gatetherm.cli"]
 INTERRUPTED = {130, -signal.SIGINT}
 """Exit statuses of an interrupted command: 130, or death by SIGINT after its line, which a shell
 also reports as 130 (Python ends that way when a Ctrl-C passed through code that an extension

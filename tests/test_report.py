@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.report import build as b
 from gatetherm.validation.report import drift, readme
@@ -102,7 +102,7 @@ def test_only_computes_the_named_sections(tmp_path, registry):
 def test_code_digest_covers_the_numerics_not_the_presentation():
     files = b.source_files()
     assert "gatetherm/solvers/heat.py" in files and "gatetherm/validation/report/sections/paper.py" in files
-    assert "gatetherm/studies/cli/report.py" not in files and "gatetherm/validation/report/page.py" not in files
+    assert "gatetherm/cli/report.py" not in files and "gatetherm/validation/report/page.py" not in files
     assert len(b.code_digest()) == 64
 
 
@@ -297,7 +297,7 @@ def test_rom_section_is_the_rom_study(tmp_path):
 
 def test_readme_edits_made_during_a_run_are_kept(tmp_path, monkeypatch, capsys):
     """``report --full --readme`` rewrites its blocks in the README as it is when the run ends."""
-    from gatetherm.studies.cli import main
+    from gatetherm.cli import main
     from gatetherm.validation.report.sections import speed
 
     monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)

@@ -18,7 +18,7 @@ import gatetherm
 from gatetherm import InputError
 from gatetherm.solvers import beam
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.sweeps import runner as sweep_runner
 from gatetherm.studies.sweeps.studyfile import parse_study
 from gatetherm.studies.run.config import parse_config
@@ -244,7 +244,7 @@ def test_killed_sweep_restarts_to_the_same_table(study_dir):
     study = study_dir / "study.toml"
     study.write_text(STUDY.replace('"derived.beta" = [0.1]', '"derived.beta" = [0.03, 0.3]'))
     out = study_dir / "killed"
-    cmd = [sys.executable, "-m", "gatetherm.studies.cli", "sweep", str(study), "--out", str(out), "--workers", "2",
+    cmd = [sys.executable, "-m", "gatetherm.cli", "sweep", str(study), "--out", str(out), "--workers", "2",
            "--no-plots"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.monotonic() + 60

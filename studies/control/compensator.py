@@ -150,9 +150,9 @@ def held_ratio(numerator: float, denominator: float, previous: float, threshold_
     return (float(np.clip(ratio, *limits)) if limits else ratio), False
 
 
-def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=()) -> tuple[TimeSeries, bool]:
+def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=(), held=("pump",)) -> tuple[TimeSeries, bool]:
     """The needed columns and ``extra`` ones on the sampling grid from the first sample; linear
-    resampling if off it (``pump`` held from the sample before)."""
+    resampling if off it (the ``held`` ones, pump states, from the sample before)."""
     validate_complete(ts, NEEDED)
     t, dt = ts.time_s, params.sample_interval_s
     back = np.flatnonzero(np.diff(t) <= 0)
@@ -170,7 +170,7 @@ def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=()) -> tupl
     log.info("data not on a %g s grid (%d samples, spacing %.4g..%.4g s): resampled linearly to %d",
              dt, len(t), np.diff(t).min(), np.diff(t).max(), len(grid))
     before = np.clip(np.searchsorted(t, grid + 1e-9 * dt, side="right") - 1, 0, len(t) - 1)
-    return TimeSeries({"time_s": grid, **{n: ts[n][before] if n == "pump" else np.interp(grid, t, ts[n])
+    return TimeSeries({"time_s": grid, **{n: ts[n][before] if n in held else np.interp(grid, t, ts[n])
                                           for n in names[1:]}}), True
 
 

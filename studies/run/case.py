@@ -11,6 +11,7 @@ valid. README "Case files" is the reference of every key.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -23,16 +24,19 @@ from gatetherm.checks import CELSIUS, Range, ranges
 from gatetherm.files import read_text
 from gatetherm.geometry.gmshfile import CAD, SCRIPT, BoxGroup, MeshSpec, Refinement, mesh_geometry
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
+from gatetherm.solvers.effects import Targets
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
 from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
-                                       Relative, Signals, Source, Support)
+                                       Relative, Signals, Source, Support, inputs)
+from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
+from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
-            "supports", "probes", "relative", "means", "signals", "time")
+            "supports", "probes", "relative", "means", "signals", "time", "actuator")
 MATERIAL_KEYS = {"k": "W/(m K)", "rho": "kg/m³", "c": "J/(kg K)", "E": "Pa", "nu": "1", "alpha": "1/K",
                  "thickness": "m"}
 MATERIAL = ranges(Material)
@@ -60,22 +64,111 @@ class TimeSettings:
 
 @dataclass(frozen=True)
 class Case:
-    """A case file, read and checked against its mesh."""
+    """A model ready to run: a problem on its named mesh, what drives it, and how it was made.
 
-    path: Path
+    A case file is read into one (:func:`load_case`); so is the paper's frame
+    (:func:`gatetherm.studies.run.frame_case.gate_frame`). Every command, study and API
+    function runs a Case; nothing downstream asks which of the two it came from."""
+
     name: str
     problem: Problem
     mesh: FrameMesh
     time: TimeSettings | None = None
     """None: steady state (or a prescribed temperature)."""
+    schedule: Schedule = STEADY
+    """What drives a run by default (a case file's ``[time]`` and schedule file; a paper condition)."""
+    origin: object = None
+    """How the case was made (:class:`CaseFile` or the frame generator's origin): ``remake``
+    with some of its keys changed (:meth:`with_overrides`), and its ``parameters`` (the
+    hypotheses a diagnosis may move)."""
+    targets: Targets = Targets()
+    """The names the effects act on (joints, supports, regions; declared effects)."""
+    defaults: dict = field(default_factory=dict)
+    """Inputs that a recorded series may leave out, with the value they then keep."""
+    actuator: object = None
+    """The compensation actuator (``[actuator]``: an ActuatorParams), None: ideal (a correction sent
+    to the control as an offset)."""
+    parameters: object = None
+    """What a generator made the case from (the frame's ModelConfig), for analyses that only such a
+    model has (beam theory); None for a case file."""
     effects: dict = field(default_factory=dict)
-    """Catalogue effects switched on (the scenario path's interface; none from the file)."""
+    """Effects switched on, {key: value} (:mod:`gatetherm.solvers.effects`)."""
     sensors: dict = field(default_factory=dict)
-    """Sensor faults, {channel: {fault: value}} (the scenario path's interface; none from the file)."""
+    """Sensor faults, {channel: {fault: value}}."""
+    path: Path | None = None
+    """The case (or model) file, if any."""
+    source: str = ""
+    """Where the case came from, for metadata (a file path, or the generator and its model file)."""
 
     @property
-    def source(self) -> str:
-        return str(self.path)
+    def dim(self) -> int:
+        return self.mesh.dim
+
+    def with_overrides(self, overrides: dict) -> "Case":
+        """The case made again with ``overrides`` ({dotted key: value} of its file: ``materials.column.k``,
+        ``thermal.free.film``, ``mesh.parameters.h``, ``geometry.l4`` …); effects and sensor faults kept.
+        The mesh is reused when nothing it depends on changed."""
+        if not overrides:
+            return self
+        made = self.origin.remake(overrides, self)
+        return dataclasses.replace(made, effects={**made.effects, **self.effects},
+                                   sensors={**made.sensors, **self.sensors})
+
+    def with_schedule(self, schedule: Schedule) -> "Case":
+        return dataclasses.replace(self, schedule=schedule)
+
+    def inputs(self) -> set[str]:
+        """The schedule columns its values read."""
+        return inputs(self.problem)
+
+    def held(self) -> set[str]:
+        """Inputs that are pump states (they keep their last sample)."""
+        return {n for f in self.problem.fluids for n in f.pump.names()}
+
+
+def nested(overrides: dict) -> dict:
+    """``{"a.b": 1}`` as ``{"a": {"b": 1}}`` (a TOML document to overlay)."""
+    out: dict = {}
+    for key, value in overrides.items():
+        node, parts = out, key.split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise InputError(key, "overrides a value with a table", "check the key")
+        node[parts[-1]] = value
+    return out
+
+
+def overlay(document: dict, changes: dict) -> dict:
+    """``document`` with the tables of ``changes`` merged in (values replaced), as a new dict."""
+    out = dict(document)
+    for k, v in changes.items():
+        out[k] = overlay(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+@dataclass(frozen=True)
+class CaseFile:
+    """A case file as read: its parsed document, to be read again with keys changed."""
+
+    path: Path
+    document: dict = field(repr=False, compare=False)
+    mesh_factor: float = 1.0
+
+    def remake(self, overrides: dict, previous: Case | None = None) -> Case:
+        doc = overlay(self.document, nested(overrides))
+        same_mesh = previous is not None and doc.get("mesh") == self.document.get("mesh")
+        return case_from_document(doc, self.path, self.mesh_factor, previous.mesh if same_mesh else None)
+
+    def parameters(self, case: Case) -> tuple:
+        from gatetherm.studies.run.parameters import case_parameters
+
+        return case_parameters(case)
+
+    def model_file(self, case: Case, header: str = "") -> None:
+        """None: a case file is not rewritten (its comments and layout are the user's); the
+        diagnosis report lists the values to put into it."""
+        return None
 
 
 def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
@@ -283,8 +376,6 @@ def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tupl
                         int(sch.number("restart_intervals", SCHEME["restart_intervals"], 3)))
     schedule, columns = None, ()
     if "schedule" in t.data:
-        from gatetherm.studies.run.timeseries import read_timeseries
-
         schedule = base / t.string("schedule")
         if not schedule.is_file():
             t.fail("schedule", f"no such file '{schedule}'", "give a time-series file (docs/data-format.md)")
@@ -293,21 +384,27 @@ def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tupl
                         schedule), scheme, columns
 
 
-def load_case(path, mesh_factor: float = 1.0) -> Case:
+def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
     """Read and check a case file (paths inside it are relative to its folder); with
-    ``mesh_factor``, a geometry is meshed with its element sizes times that factor."""
+    ``mesh_factor``, a geometry is meshed with its element sizes times that factor;
+    ``overrides`` ({dotted key: value}) change keys of the file as it is read."""
     path = Path(path)
     text = read_text(path, "CASE.toml", "give the path of a .toml case file")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise InputError(str(path), f"not valid TOML ({err})") from None
+    return case_from_document(overlay(data, nested(overrides or {})), path, mesh_factor)
+
+
+def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: FrameMesh | None = None) -> Case:
+    """The case of a parsed case file ``data`` read from ``path`` (``mesh``: its mesh, already made)."""
     top = Table(path, "", data, SECTIONS)
     head = top.sub("case", ("name", "order", "plane"))
     order = head.data.get("order", 1)
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")
-    fm = _mesh(top, path.parent, mesh_factor)
+    fm = _mesh(top, path.parent, mesh_factor) if mesh is None else mesh
     time, scheme, columns = _time(top, path.parent)
     prescribed = "temperature" in data
     elastic = "supports" in data
@@ -341,8 +438,7 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
             if "density" in s.data:
                 sources.append(Source(r, s.value("density", names, unit="W/m³")))
             else:
-                vol = region_volume(fm, r, thickness.get(r, 1.0))
-                sources.append(Source(r, Value.of(f"({s.value('power', names, unit='W')}) / {vol!r}")))
+                sources.append(Source(r, s.value("power", names, unit="W"), 1.0 / region_volume(fm, r, thickness.get(r, 1.0))))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:
@@ -364,7 +460,59 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
                       T0, init.number("reference", CELSIUS, T0),
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
                       signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme, **kw)
-    return Case(path, head.string("name", path.stem), problem, fm, time)
+    if time is None:
+        schedule = STEADY
+    else:
+        drive = (series_drive(read_timeseries(time.schedule, required=("time_s",)), columns,
+                              {n for f in problem.fluids for n in f.pump.names()}, label=str(time.schedule))
+                 if time.schedule else (lambda _: {}))
+        schedule = timed_schedule(time.end, time.step, time.output, drive,
+                                  f"schedule {time.schedule}" if time.schedule else "no schedule")
+    return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
+                case_targets(problem), actuator=_actuator(top), path=path, source=str(path))
+
+
+def _actuator(top: Table):
+    """``[actuator]``: the paper's piezo model with its reach, stiffnesses, preload, dead band,
+    hysteresis and drive set, or ``type = "none"`` (ideal: an offset to the control); None without it."""
+    from gatetherm.studies.control.actuator import ActuatorParams, with_stroke
+
+    if "actuator" not in top.data:
+        return None
+    a = top.sub("actuator", ("type", "stroke", "stack_stiffness", "spring_stiffness", "preload", "dead_band",
+                             "hysteresis", "reset"))
+    if a.string("type", "piezo", ("piezo", "none")) == "none":
+        if len(a.data) > 1:
+            a.fail(next(k for k in a.data if k != "type"), "goes with type = \"piezo\" only", "remove it")
+        return None
+    base, stiff = ActuatorParams(), Range(0.0, lo_open=True, unit="N/m")
+    reset = a.data.get("reset", True)
+    if not isinstance(reset, bool):
+        a.fail("reset", f"expected true/false, got {reset!r}", "true: back to 0 V before each new voltage")
+    h = a.number("hysteresis", Range(0.0, 4.0, unit="× the default"), 1.0)
+    p = dataclasses.replace(
+        base, stack_stiffness_N_per_m=a.number("stack_stiffness", stiff, base.stack_stiffness_N_per_m),
+        spring_stiffness_N_per_m=a.number("spring_stiffness", stiff, base.spring_stiffness_N_per_m),
+        preload_N=a.number("preload", Range(0.0, unit="N"), base.preload_N),
+        dead_band_unloaded_um=a.number("dead_band", Range(0.0, 100.0, unit="um"), base.dead_band_unloaded_um),
+        play_weights=(base.play_weights[0], *(w * h for w in base.play_weights[1:])),
+        strategy="reset" if reset else "direct")
+    if "stroke" not in a.data:
+        return p
+    st = a.data["stroke"]
+    if not (isinstance(st, list) and len(st) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                         for v in st)):
+        a.fail("stroke", f"expected [away, towards] in um, got {st!r}", "e.g. stroke = [-70.0, 10.0]")
+    try:
+        return with_stroke(p, float(st[0]), float(st[1]))
+    except InputError as err:
+        a.fail("stroke", err.problem, err.fix)
+
+
+def case_targets(problem: Problem) -> Targets:
+    """What a case file's effects act on by default: its one support, if it has only one."""
+    rigid = [s.boundary for s in problem.supports if s.stiffness is None]
+    return Targets(defaults={"compliant_base": rigid[0], "base_conduction": rigid[0]} if len(rigid) == 1 else {})
 
 
 def _twice(kw: dict) -> str | None:

@@ -47,7 +47,7 @@ def case_toml(problem: Problem, name: str, mesh_file: str, points: dict[str, str
     if p.faces is not None:
         L += _table("faces", {"film": p.faces.h, "ambient": p.faces.ambient})
     for s in p.sources:
-        L += _table(f"sources.{s.region}", {"density": s.density})
+        L += _table(f"sources.{s.region}", {"density": s.density} if s.per == 1.0 else {"power": s.density})
     for f in p.fluids:
         L += _table(f"fluids.{f.name}", {
             "boundary": f.boundary, "capacity": f.capacity, "conductance": f.conductance, "film_on": f.film_on,

@@ -125,14 +125,14 @@ def check_time(schedule, t: float) -> None:
         raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
 
 
-def export_state(config, dim: int, schedule, t: float, title: str) -> tuple[str, dict]:
-    """Run ``config`` (a model file's Config or a Case) through ``schedule`` and export the state
+def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
+    """Run ``case`` through ``schedule`` and export the state
     at ``t`` (s, a step of the run): (``job.inp`` text, ``gatetherm.json`` content: gatetherm's
     relative displacements in m, the probe sets they compare and the mesh size)."""
     from gatetherm.studies.run.scenario import run_scenario
 
     check_time(schedule, t)
-    run = run_scenario(config, dim, schedule, keep_times=[t])
+    run = run_scenario(case, schedule, keep_times=[t])
     (_, U), = [s for s in run.result.states if abs(s[0] - t) < 1e-6]
     model = run.model
     u = {}

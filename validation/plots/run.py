@@ -52,7 +52,8 @@ def plot_responses(runs: dict, path, title: str) -> None:
     t0 = first["time_s"] / 60.0
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True)
     for ax in (a1, a2):
-        shade(ax, t0, first["pump"] > 0.5)
+        if "pump" in first:
+            shade(ax, t0, first["pump"] > 0.5)
     for k, (name, cols) in enumerate(runs.items()):
         t, ls, tag = cols["time_s"] / 60.0, ("-", "--", ":")[k % 3], f" {name}" if name else ""
         for i, (key, lab) in enumerate((("theta_A_degC", "θ_A"), ("theta_B_degC", "θ_B"), ("theta_C_degC", "θ_C"))):
@@ -168,6 +169,30 @@ def plot_channels(cols: dict, path, title: str) -> None:
     axes[0].set_title(title)
     axes[1].set(xlabel="time [h]")
     save(fig, path, tight=False)
+
+
+def write_pictures(run, out, title: str, picture_s: float | None, solved: dict | None = None) -> list[str]:
+    """The pictures of a run (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) into ``out``,
+    by what the case has: ``channels.png`` (every channel of a transient run), ``response.png``
+    (θ_A, θ_B, θ_C and δ: Figs. 11–13), ``oil_temperatures.png`` (a fluid's supply, volume and wall:
+    Fig. 10) and ``deformed.png`` (the state kept nearest ``picture_s``); returns the names written."""
+    from pathlib import Path
+
+    out, cols, written = Path(out), run.columns, []
+    transient = len(cols["time_s"]) > 1
+    if transient:
+        plot_channels(cols, out / "channels.png", title)
+        written.append("channels.png")
+    if transient and all(k in cols for k in ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")):
+        plot_response(cols, out / "response.png", title)
+        written.append("response.png")
+    if transient and "oil_degC" in cols and "pump" in cols:
+        plot_oil(cols, out / "oil_temperatures.png", title)
+        written.append("oil_temperatures.png")
+    if picture_s is not None and run.model.elastic is not None:
+        draw_deformed(run, picture_s, out / "deformed.png", lambda t: f"{title}, t = {t / 60:.0f} min", solved)
+        written.append("deformed.png")
+    return written
 
 
 def plot_case(run, out, title: str, solved: dict | None = None) -> None:

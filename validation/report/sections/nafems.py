@@ -31,10 +31,10 @@ def run(path: Path) -> tuple[dict, object]:
     """The probes' summary and the case of one benchmark (as ``gatetherm run`` computes them)."""
     from gatetherm.studies.run.case import load_case
     from gatetherm.studies.run.output import probe_summary
-    from gatetherm.studies.run.scenario import case_schedule, run_scenario
+    from gatetherm.studies.run.scenario import run_scenario
 
     case = load_case(path)
-    res = run_scenario(case, case.mesh.dim, case_schedule(case))
+    res = run_scenario(case)
     return probe_summary(case.problem, res.columns), case
 
 

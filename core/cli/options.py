@@ -69,3 +69,12 @@ FIELD_FILES = ("fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf",
 """The field files of a run in its --out (studies.run.output.write_fields)."""
 WORKERS = Range(1, whole=True)
 """Worker processes."""
+
+
+def picture_keep(schedule, every: float, picture_every: float = 300.0) -> list[float]:
+    """The sample times whose states a written run needs: the fields every ``every`` s, the
+    candidates of the deformed picture (every ``picture_every`` s: it shows δ's first peak) and
+    the end."""
+    times = [float(t) for t in schedule.times]
+    on = [t for t in times if any(abs(t / e - round(t / e)) < 1e-9 for e in (every, picture_every))]
+    return sorted(set(on) | {times[-1]})

@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.studies.cli.options import WORKERS, number
+from gatetherm.cli.options import WORKERS, number
 
 PAGE = ("index.html",)
 """What a report run replaces in --out; the sections' folders (the cache) are kept."""

@@ -71,7 +71,7 @@ class _Signals:
 def build_parser():
     import importlib
 
-    from gatetherm.studies.cli.options import Parser
+    from gatetherm.cli.options import Parser
 
     parser = Parser(
         prog="gatetherm",
@@ -81,7 +81,7 @@ def build_parser():
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
-        importlib.import_module(f"gatetherm.studies.cli.{name}").register(sub)
+        importlib.import_module(f"gatetherm.cli.{name}").register(sub)
     return parser
 
 
@@ -98,7 +98,7 @@ def _run(argv: list[str] | None) -> int:
     import logging
 
     from gatetherm import InputError
-    from gatetherm.studies.cli.options import UsageError
+    from gatetherm.cli.options import UsageError
 
     parser = build_parser()
     try:
@@ -115,7 +115,7 @@ def _run(argv: list[str] | None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from gatetherm.studies.cli.process import configure
+    from gatetherm.process import configure
     from gatetherm.studies.sweeps.runner import PointsFailed
 
     try:
