@@ -38,12 +38,19 @@ def memory_bytes() -> float:
         return FALLBACK_MEMORY
 
 
+def check_estimate(elements: float, dim: int, key: str, size: float) -> None:
+    """Raise InputError naming ``key`` (an element size of ``size`` m, or a factor on the
+    sizes) if a mesh of about ``elements`` elements of dimension ``dim`` needs more memory
+    than the machine has; the fix gives the smallest admissible value (elements ∝ size^-dim)."""
+    need, have = elements * BYTES_PER_ELEMENT[dim], memory_bytes()
+    if need > have:
+        raise InputError(key, f"{size:g}{' m' if 'factor' not in key else ''} gives about {elements:.2g} "
+                         f"{'triangles' if dim == 2 else 'tetrahedra'} needing ~{need / 1e9:.3g} GB, more than the "
+                         f"{have / 1e9:.3g} GB of memory of this machine",
+                         f"raise it to at least {size * (need / have) ** (1 / dim):.2g}{' m' if 'factor' not in key else ''}")
+
+
 def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
     """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
-    n = element_estimate(p, m, dim)
-    need, have = n * BYTES_PER_ELEMENT[dim], memory_bytes()
-    if need > have:
-        key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
-        raise InputError(key, f"{s:g} m gives about {n:.2g} {'triangles' if dim == 2 else 'tetrahedra'} needing "
-                         f"~{need / 1e9:.3g} GB, more than the {have / 1e9:.3g} GB of memory of this machine",
-                         f"raise it to at least {s * (need / have) ** (1 / dim):.2g} m")
+    key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
+    check_estimate(element_estimate(p, m, dim), dim, key, s)
