@@ -254,7 +254,9 @@ def _scale_own(gmsh, factor: float, sized: bool) -> None:
 
 
 def _measure(gmsh, d: int, t: int) -> float:
-    """Length, area or volume of an entity (its bounding box's for the built-in kernel)."""
+    """Length, area or volume of an entity (its bounding box's for the built-in kernel); 1 for a point."""
+    if d == 0:
+        return 1.0
     try:
         return float(gmsh.model.occ.getMass(d, t))
     except Exception:  # noqa: BLE001 - not an OpenCASCADE entity
@@ -273,20 +275,20 @@ def estimate(gmsh, spec: MeshSpec, dim: int) -> list[tuple[float, str, float]]:
     box = np.reshape(gmsh.model.getBoundingBox(-1, -1), (2, 3))
     lo, hi, factor = opt("Mesh.MeshSizeMin"), opt("Mesh.MeshSizeMax"), opt("Mesh.MeshSizeFactor")
     clip = lambda h: min(max(h * factor, lo), hi)  # noqa: E731
+    f = gmsh.model.mesh.field
+    thresholds = [t for t in f.list() if f.getType(t) == "Threshold"]
+    far = min((clip(f.getNumber(t, "SizeMax")) for t in thresholds), default=hi)
     base, h_base = 0.0, math.inf
     for _, t in gmsh.model.getEntities(dim):
         pts = [p for p in gmsh.model.getBoundary([(dim, t)], recursive=True) if p[0] == 0]
         lc = [s for s in gmsh.model.mesh.getSizes(pts) if s > 0] if pts and opt("Mesh.MeshSizeFromPoints") else []
-        h = clip(math.exp(np.mean(np.log(lc))) if lc else float(np.linalg.norm(box[1] - box[0])))
+        h = min(clip(math.exp(np.mean(np.log(lc))) if lc else float(np.linalg.norm(box[1] - box[0]))), far)
         base += _measure(gmsh, dim, t) / (_CELL[dim] * h ** dim)
         h_base = min(h_base, h)
     total = sum(_measure(gmsh, dim, t) for _, t in gmsh.model.getEntities(dim))
     key = "--mesh-factor" if spec.factor != 1.0 else "mesh.size" if spec.size else f"{spec.path.name}: element size"
     out = [(base, key, spec.factor if spec.factor != 1.0 else h_base)]
-    f = gmsh.model.mesh.field
-    for tag in f.list():
-        if f.getType(tag) != "Threshold":
-            continue
+    for tag in thresholds:
         src = int(f.getNumber(tag, "InField"))
         smin, smax = clip(f.getNumber(tag, "SizeMin")), clip(f.getNumber(tag, "SizeMax"))
         d0, d1 = f.getNumber(tag, "DistMin"), max(f.getNumber(tag, "DistMax"), f.getNumber(tag, "DistMin"))
@@ -361,7 +363,7 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
                 raise InputError(f"mesh region {name}", f"shares entities with region {owner[e]}",
                                  "give every part of the body to one region only")
             owner[e] = name
-    if not any(gmsh.model.mesh.getElements(dim, e)[0] for e in owner):
+    if not any(len(gmsh.model.mesh.getElements(dim, e)[0]) for e in owner):
         raise InputError(str(spec.path), "gmsh made no elements", "check the geometry and the element size")
     points = {name: ents[0] for name, ents in groups[0].items()}
     if dim == 2:

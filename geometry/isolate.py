@@ -83,6 +83,8 @@ def unpack(payload: bytes) -> tuple[dict, dict[str, np.ndarray]]:
         if dtype not in _DTYPES or not all(isinstance(s, int) and s >= 0 for s in shape):
             raise ValueError(f"bad array {name!r} in the result of gmsh's process")
         size = int(np.prod(shape)) * np.dtype(dtype).itemsize
+        if at + size > len(payload):
+            raise ValueError("truncated result from gmsh's process")
         arrays[name] = np.frombuffer(buf[at:at + size], dtype=dtype).reshape(shape).copy()
         at += size
     if at != len(payload):
@@ -119,7 +121,7 @@ def _child(work, out: int, logfd: int, sock: socket.socket, go: int, verbose: bo
                 if listener is None:
                     mode = b"P"
             except OSError as err:
-                listener, mode = None, b"U" + str(err).encode()[:200]
+                listener, mode = None, b"U" + (err.strerror or str(err)).encode()[:200]
             socket.send_fds(sock, [mode], [listener] if listener is not None else [])
             if listener is not None:
                 os.close(listener)
@@ -160,7 +162,7 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
     listener, data, lines, tried = None, bytearray(), deque(maxlen=20), None
     open_fds = {out_r, log_r, mine.fileno()}
     try:
-        last, partial = time.monotonic(), b""
+        last, partial = -PROGRESS_S, b""
         while out_r in open_fds or log_r in open_fds:
             ready, _, _ = select.select(list(open_fds), [], [], 1.0)
             for fd in ready:
@@ -181,9 +183,8 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
                         open_fds.discard(fd)
                         continue
                     os.kill(pid, signal.SIGKILL)
-                    raise InputError(label, f"{FORBIDDEN} (system call {tried})",
-                                     "remove System, Printf > …, Save, Print, CreateDir, Delete File, OnelabRun … "
-                                     "from it")
+                    raise InputError(label, FORBIDDEN, f"remove the command that did it (system call {tried}): "
+                                     "System, Printf … >, Save, Print, CreateDir, Delete File, OnelabRun …")
                 else:
                     chunk = os.read(fd, 1 << 20)
                     if not chunk:
@@ -195,7 +196,7 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
                         lines.extend(x.decode(errors="replace").strip() for x in full if x.strip())
                         if verbose and full and time.monotonic() - last >= PROGRESS_S:
                             last = time.monotonic()
-                            log.info("gmsh: %s", lines[-1] if lines else "")
+                            log.info("gmsh: %s", lines[-1].removeprefix("Info").lstrip(" :"))
         _, status = os.waitpid(pid, 0)
         pid = 0
     finally:
@@ -214,8 +215,8 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
 def _unreported(mode: bytes, label: str, script, scan) -> None:
     """The sandbox cannot report attempts (``P``: it only refuses them) or is not there (``U``)."""
     if mode[:1] == b"U":
-        log.warning("gmsh runs without its sandbox here (%s): %s was checked by a text scan instead",
-                    mode[1:].decode(errors="replace"), label)
+        log.warning("gmsh runs without its sandbox here (%s)%s", mode[1:].decode(errors="replace"),
+                    f": {label} was checked by a text scan instead" if script is not None else "")
     if script is not None and scan is not None:
         scan(script)
 

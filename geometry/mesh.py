@@ -266,8 +266,11 @@ def load_mesh(path: str | os.PathLike) -> FrameMesh:
     import meshio
 
     path = Path(path)
+    if path.suffix not in (".msh", ".vtu"):
+        raise InputError(str(path), f"unknown mesh format '{path.suffix}'", "give a .msh or .vtu file")
     try:
-        mm = meshio.read(path, file_format="gmsh" if path.suffix == ".msh" else None)
+        # the format's reader itself: meshio.read prints an unreadable file's error and exits
+        mm = (meshio.gmsh if path.suffix == ".msh" else meshio.vtu).read(str(path))
         dim = max((b.dim for b in mm.cells if b.type in _CORNERS), default=0)
         if dim < 2:
             raise InputError(str(path), "holds no triangles or tetrahedra", "mesh a surface (2-D) or a volume (3-D)")

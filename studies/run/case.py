@@ -92,7 +92,7 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
                        "mesh the file again in gmsh, or give the .geo")
         if factor != 1.0:
             m.fail("file", "a mesh file cannot be refined", "give the .geo or CAD file to mesh it finer")
-        return load_mesh(path)
+        return _in_case(top, load_mesh, path)
     if suffix not in (SCRIPT, *CAD):
         m.fail("file", f"unknown mesh or geometry format '{suffix}'", f"use .msh, {SCRIPT} or {', '.join(CAD)}")
     params = m.sub("parameters")
@@ -110,8 +110,16 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
     groups = tuple(_group(m.sub("groups").sub(name, ("dim", "box", "rest", "normal", "tolerance")), name)
                    for name in m.data.get("groups", {}))
     size = factor * m.number("size", METRES, 0.0) or None
-    return mesh_geometry(MeshSpec(path, size, {k: params.number(k) for k in params.data}, tuple(refine), groups,
-                                  tuple(base / f for f in include), base, factor))
+    return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
+                                                 tuple(refine), groups, tuple(base / f for f in include), base, factor))
+
+
+def _in_case(top: Table, read, arg) -> FrameMesh:
+    """``read(arg)``, its errors about case keys (``mesh.…``, ``--mesh-factor``) naming the case file."""
+    try:
+        return read(arg)
+    except InputError as err:
+        raise err.at(str(top.file)) if err.field.startswith(("mesh", "--")) else err from None
 
 
 def _group(g: Table, name: str) -> GroupRule:
