@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.geometry.gmshfile import GroupRule, MeshSpec, mesh_geometry
+from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+from gatetherm.geometry.groups import GroupRule
 from gatetherm.geometry.mesh import FrameMesh, components
 from gatetherm.studies.cli import main
 
@@ -180,8 +181,9 @@ def test_the_element_estimate_against_gmsh(case, low, high):
     2.03 on T1 (a Threshold field of the script), 1.54 on the C-frame (a refinement of the case)."""
     import tomllib
 
-    from gatetherm.geometry import gmshfile
+    from gatetherm.geometry import gmshfile, groups
     from gatetherm.geometry.isolate import gmsh_session
+    from gatetherm.geometry.sizing import model_estimate
     from gatetherm.studies.run.case import load_case
 
     path = Path(__file__).resolve().parents[1] / "validation" / case
@@ -190,9 +192,20 @@ def test_the_element_estimate_against_gmsh(case, low, high):
                     tuple(gmshfile.Refinement(**r) for r in m.get("refine", [])))
     with gmsh_session() as gmsh:
         dim = gmshfile._read(gmsh, spec)
-        gmshfile._regions(gmsh, spec, dim)
+        groups.regions(gmsh, spec.groups, dim)
         if spec.size:
             gmsh.option.setNumber("Mesh.MeshSizeMax", spec.size)
-        gmshfile._refine(gmsh, spec, gmshfile._physical(gmsh), dim)
-        estimate = sum(n for n, _, _ in gmshfile.estimate(gmsh, spec, dim))
+        gmshfile._refine(gmsh, spec, groups.physical(gmsh))
+        estimate = sum(n for n, _, _ in model_estimate(gmsh, dim))
     assert low < estimate / len(load_case(path).mesh.cells) < high
+
+
+def test_the_mesh_factor_scales_the_scripts_own_sizes():
+    """T4 takes its sizes from its points (no size in the case): --mesh-factor 0.5 halves them,
+    about four times the triangles (it changed nothing before)."""
+    from gatetherm.studies.run.case import load_case
+
+    t4 = Path(__file__).resolve().parents[1] / "validation" / "nafems" / "t4.toml"
+    ratio = len(load_case(t4, 0.5).mesh.cells) / len(load_case(t4).mesh.cells)
+    assert ratio == pytest.approx(3.92, abs=0.05)  # achieved 5241 / 1337 = 3.920; band: 4 ± 10 %
+    assert 3.6 < ratio < 4.4

@@ -21,8 +21,8 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, ranges
 from gatetherm.files import read_text
-from gatetherm.geometry.gmshfile import (CAD, NORMAL_TOLERANCE, SCRIPT, GroupRule, MeshSpec, Refinement,
-                                         mesh_geometry)
+from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_geometry
+from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
