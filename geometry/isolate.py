@@ -17,10 +17,12 @@ import contextlib
 import json
 import logging
 import os
+import pickle
 import select
 import signal
 import socket
 import struct
+import sys
 import threading
 import time
 from collections import deque
@@ -40,6 +42,12 @@ _DTYPES = {"<f8", "<i8", "<i4", "|i1", "|b1"}
 _RESULT, _ERROR, _CRASH = b"R", b"E", b"X"
 
 
+THREADS_STARTED = {"here": False}
+"""Whether gmsh has started threads in this process (a 3-D mesh made here, in
+:func:`gmsh_session`): they would be missing in a forked child, which then waits for them
+for ever; gmsh's processes are then started afresh (a new interpreter, ~0.5 s more)."""
+
+
 @contextlib.contextmanager
 def gmsh_session(name: str = "frame", verbosity: int = 0):
     """Initialise gmsh for the duration of the block (without the user's option files),
@@ -47,6 +55,7 @@ def gmsh_session(name: str = "frame", verbosity: int = 0):
     finalise it."""
     import gmsh
 
+    threads = sandbox.threads()
     if gmsh.isInitialized():
         gmsh.finalize()
     gmsh.initialize(readConfigFiles=False, interruptible=False)
@@ -61,6 +70,7 @@ def gmsh_session(name: str = "frame", verbosity: int = 0):
         yield gmsh
     finally:
         gmsh.finalize()
+        THREADS_STARTED["here"] |= sandbox.threads() > threads
 
 
 def _record(kind: bytes, payload: bytes) -> bytes:
@@ -152,10 +162,13 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
     go_r, go_w = os.pipe()
     mine, theirs = socket.socketpair()
     parent = os.getpid()
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child's coverage is not collected
-        mine.close()
-        _child(work, out_w, log_w, theirs, go_r, verbose, parent)
+    if THREADS_STARTED["here"]:
+        pid = _spawn(work, (out_w, log_w, go_r, theirs.fileno()), verbose)
+    else:
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child's coverage is not collected
+            mine.close()
+            _child(work, out_w, log_w, theirs, go_r, verbose, parent)
     for fd in (out_w, log_w, go_r):
         os.close(fd)
     theirs.close()
@@ -210,6 +223,28 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
             os.close(fd)
         mine.close()
     return _result(bytes(data), status, label, lines)
+
+
+def _spawn(work, fds, verbose: bool) -> int:
+    """Start the child as a new interpreter (see :data:`THREADS_STARTED`); its pid."""
+    work_r, work_w = os.pipe()
+    for fd in (*fds, work_r):
+        os.set_inheritable(fd, True)
+    code = "import gatetherm.geometry.isolate as m; m._spawned()"
+    pid = os.posix_spawn(sys.executable, [sys.executable, "-c", code, *map(str, (*fds, work_r, os.getpid(),
+                                                                                int(verbose)))], os.environ)
+    os.close(work_r)
+    with os.fdopen(work_w, "wb") as f:
+        pickle.dump(work, f)
+    return pid
+
+
+def _spawned() -> None:  # pragma: no cover - runs in the child
+    """The entry of a spawned child: its pipes' numbers and the parent's pid in ``sys.argv``."""
+    out, logfd, go, sock, work_r, parent, verbose = map(int, sys.argv[1:])
+    with os.fdopen(work_r, "rb") as f:
+        work = pickle.load(f)  # from the parent, which trusts itself
+    _child(work, out, logfd, socket.socket(fileno=sock), go, bool(verbose), parent)
 
 
 def _unreported(mode: bytes, label: str, script, scan) -> None:

@@ -127,7 +127,8 @@ def _libc():
     return libc
 
 
-def _threads() -> int:
+def threads() -> int:
+    """Threads of this process."""
     with open("/proc/self/status", encoding="ascii") as f:
         return next(int(line.split()[1]) for line in f if line.startswith("Threads:"))
 
@@ -152,7 +153,7 @@ def confine(listen: bool = True) -> int | None:
         fd = libc.syscall(_NR[arch]["seccomp"], _SECCOMP_SET_MODE_FILTER, flags, prog)
         if fd >= 0:
             return int(fd) if flags & _FLAG_NEW_LISTENER else None
-    if _threads() == 1 and libc.prctl(_PR_SET_SECCOMP, _SECCOMP_MODE_FILTER, ctypes.addressof(prog), 0, 0) == 0:
+    if threads() == 1 and libc.prctl(_PR_SET_SECCOMP, _SECCOMP_MODE_FILTER, ctypes.addressof(prog), 0, 0) == 0:
         return None
     raise OSError(ctypes.get_errno(), "the kernel refuses the seccomp filter")
 

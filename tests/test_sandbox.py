@@ -16,6 +16,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from gatetherm import InputError
@@ -234,3 +235,29 @@ def test_the_result_comes_back_through_the_pipe_checked():
         isolate.unpack(isolate.pack({}, {"x": np.array(["s"])})[9:])
     with pytest.raises(ValueError, match="truncated"):
         isolate.unpack(isolate.pack({}, {"x": np.arange(3.0)})[9:-1])
+
+
+def test_after_gmsh_ran_here_its_processes_start_afresh(tmp_path):
+    """A 3-D mesh made in this process leaves gmsh's threads behind: a forked child would wait
+    for them for ever, so the next mesh is made by a new interpreter (in a subprocess here,
+    not to leave the threads in the test session)."""
+    code = ("from gatetherm.geometry.build import _build, build_mesh, gmsh_session\n"
+            "from gatetherm.geometry.frame import FrameParams, MeshParams\n"
+            "from gatetherm.geometry.isolate import THREADS_STARTED\n"
+            "m = MeshParams(size=0.04, size_3d=0.08)\n"
+            "with gmsh_session() as g:\n    _build(FrameParams(), 3, m, g)\n"
+            "print(THREADS_STARTED['here'], len(build_mesh(FrameParams(), 3, m).cells))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split()[0] == "True" and int(out.stdout.split()[1]) > 1000
+
+
+def test_a_spawned_child_makes_the_same_mesh(monkeypatch):
+    from gatetherm.geometry.build import build_mesh
+
+    from conftest import COARSE, FIXED
+
+    forked = build_mesh(FIXED, 2, COARSE)
+    monkeypatch.setitem(isolate.THREADS_STARTED, "here", True)
+    spawned = build_mesh(FIXED, 2, COARSE)
+    assert np.array_equal(forked.points, spawned.points) and np.array_equal(forked.cells, spawned.cells)
