@@ -22,6 +22,7 @@ import errno
 import os
 import platform
 import struct
+import threading
 
 _ARCH = {"x86_64": 0xC000003E, "aarch64": 0xC00000B7}
 """AUDIT_ARCH_* of the supported machines."""
@@ -128,9 +129,12 @@ def _libc():
 
 
 def threads() -> int:
-    """Threads of this process."""
-    with open("/proc/self/status", encoding="ascii") as f:
-        return next(int(line.split()[1]) for line in f if line.startswith("Threads:"))
+    """Threads of this process (those of Python where /proc is missing)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            return next(int(line.split()[1]) for line in f if line.startswith("Threads:"))
+    except OSError:
+        return threading.active_count()
 
 
 def confine(listen: bool = True) -> int | None:

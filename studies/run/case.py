@@ -126,18 +126,14 @@ def _group(g: Table, name: str) -> GroupRule:
     """A [mesh.groups.NAME] rule: box (one or a list), rest, normal (with tolerance)."""
     box = g.data.get("box", [])
     boxes = [box] if box and all(isinstance(b, (int, float)) for b in box) else box
-    six = lambda b: isinstance(b, list) and len(b) == 6 and all(  # noqa: E731
-        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in b)
-    if not (isinstance(boxes, list) and all(map(six, boxes))):
+    if not (isinstance(boxes, list) and all(_numbers(b, (6,)) for b in boxes)):
         g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax] or a list of them, got {box!r}",
                "give six numbers in m per box")
     rest = g.data.get("rest", False)
     if not isinstance(rest, bool):
         g.fail("rest", f"expected true or false, got {rest!r}")
     normal = g.data.get("normal")
-    if normal is not None and not (isinstance(normal, list) and len(normal) in (2, 3) and all(
-            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in normal)
-            and any(normal)):
+    if normal is not None and not (_numbers(normal, (2, 3)) and any(normal)):
         g.fail("normal", f"expected a direction [nx, ny(, nz)], got {normal!r}", "e.g. normal = [0, 0, 1]")
     if not (boxes or rest or normal):
         g.fail("box", "the group selects nothing", "give box, normal or rest = true")
@@ -146,6 +142,12 @@ def _group(g: Table, name: str) -> GroupRule:
     return GroupRule(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(tuple(map(float, b)) for b in boxes),
                      rest, tuple(map(float, normal)) if normal else None,
                      g.number("tolerance", Range(0.0, math.pi, lo_open=True, unit="rad"), NORMAL_TOLERANCE))
+
+
+def _numbers(v, lengths) -> bool:
+    """Whether ``v`` is a list of finite numbers of one of ``lengths``."""
+    return isinstance(v, list) and len(v) in lengths and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
 
 
 def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
@@ -261,8 +263,7 @@ def _probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
                 t.fail("point", f"'{point}' is not a point group of the mesh", f"points: {', '.join(fm.sensors) or 'none'}"
                        "; or give coordinates [x, y(, z)] in m")
             xyz = tuple(float(v) for v in fm.points[fm.sensors[point]])
-        elif isinstance(point, list) and len(point) == fm.dim and all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in point):
+        elif _numbers(point, (fm.dim,)):
             xyz = tuple(float(v) for v in point)
             if finder is None:
                 from gatetherm.solvers.fem import to_skfem
