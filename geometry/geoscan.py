@@ -74,7 +74,8 @@ def scan(path: Path, root: Path, allowed=(), commands: bool = False) -> list[Pat
         toks = tokens(text)
         for i, (tok, line) in enumerate(toks):
             if i and toks[i - 1][0] == ".":  # an option (General.FileName …)
-                if commands and (toks[i - 2][0] == "Solver" or toks[i - 2][0] == "General" and _FILE_OPTION.search(tok)):
+                group = toks[i - 2][0]
+                if commands and (group == "Solver" or group == "General" and _FILE_OPTION.search(tok)):
                     _refuse(f, line, f"{toks[i - 2][0]}.{tok}", "names a program or a file to write")
                 continue
             if tok in READERS:

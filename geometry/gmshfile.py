@@ -135,7 +135,8 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
     try:
         fragment(gmsh, dim)
     except Exception as err:  # noqa: BLE001 - OpenCASCADE's own failure
-        raise InputError(str(spec.path), f"its solids cannot be made conformal ({err})", "check the CAD model") from None
+        raise InputError(str(spec.path), f"its solids cannot be made conformal ({err})",
+                         "check the CAD model") from None
     regions(gmsh, spec.groups, dim)
     interfaces(gmsh, dim)
     if spec.factor != 1.0:

@@ -1,10 +1,11 @@
 """gmsh in a child process: sandboxed, interruptible, its result back through a pipe.
 
-:func:`run_isolated` forks (a fork costs ~0.15 s more than meshing in the process, measured on
-the paper's 2-D frame; a new interpreter ~0.5 s more, so one is started only once gmsh has
-run threads in this process, :data:`THREADS_STARTED`). The child imports and initialises gmsh, installs the seccomp
-sandbox (:mod:`gatetherm.geometry.sandbox`) and only then, once the parent agrees, runs the
-work on the user's file; the result (a JSON header and numpy arrays, :func:`unpack`) comes
+:func:`run_isolated` forks: 0.01 to 0.15 s more than meshing in the process (the paper's 2-D
+frame, medians of 7 interleaved runs on a loaded machine); a new interpreter costs 0.3 s more
+still, so one is started only once gmsh has run threads in this process (:data:`THREADS_STARTED`).
+The child imports and initialises gmsh, installs the seccomp sandbox
+(:mod:`gatetherm.geometry.sandbox`) and only then, once the parent agrees, runs the work on
+the user's file; the result (a JSON header and numpy arrays, :func:`unpack`) comes
 back through a pipe opened before the fork, never through a file. The parent holds the
 sandbox's listener: the first program run or file written ends the child, and the run
 with one line. Where the kernel cannot report denials (or refuses the filter), the parent
@@ -47,7 +48,7 @@ _RESULT, _ERROR, _CRASH = b"R", b"E", b"X"
 THREADS_STARTED = {"here": False}
 """Whether gmsh has started threads in this process (a 3-D mesh made here, in
 :func:`gmsh_session`): they would be missing in a forked child, which then waits for them
-for ever; gmsh's processes are then started afresh (a new interpreter, ~0.5 s more)."""
+for ever; gmsh's processes are then started afresh (a new interpreter, ~0.3 s more)."""
 
 
 @contextlib.contextmanager

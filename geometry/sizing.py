@@ -103,11 +103,12 @@ def check_estimate(elements: float, dim: int, key: str, size: float) -> None:
     sizes) if a mesh of about ``elements`` elements of dimension ``dim`` needs more memory
     than the machine has; the fix gives the smallest admissible value (elements ∝ size^-dim)."""
     need, have = elements * BYTES_PER_ELEMENT[dim], memory_bytes()
+    unit = "" if "factor" in key else " m"
     if need > have:
-        raise InputError(key, f"{size:g}{' m' if 'factor' not in key else ''} gives about {elements:.2g} "
+        raise InputError(key, f"{size:g}{unit} gives about {elements:.2g} "
                          f"{'triangles' if dim == 2 else 'tetrahedra'} needing ~{need / 1e9:.3g} GB, more than the "
                          f"{have / 1e9:.3g} GB of memory of this machine",
-                         f"raise it to at least {size * (need / have) ** (1 / dim):.2g}{' m' if 'factor' not in key else ''}")
+                         f"raise it to at least {size * (need / have) ** (1 / dim):.2g}{unit}")
 
 
 def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:

@@ -152,17 +152,14 @@ def test_case_group_keys_old_and_new_forms(tmp_path, capsys):
     fm = load_case(tmp_path / "case.toml").mesh
     got = {b: _measure(fm.points, f) for b, f in fm.boundaries.items()}
     assert got == pytest.approx({"hot": 6.0, "ends": 6.0, "cooled": 10.0}, rel=1e-12)
-    for body, needle in [("box = [1, 2]", "mesh.groups.hot.box: expected [xmin, ymin, zmin, xmax, ymax, zmax] or a "
-                          "list of them"), ("rest = 1", "mesh.groups.cooled.rest: expected true or false"),
-                         ("normal = [0, 0, 0]", "mesh.groups.hot.normal: expected a direction"),
-                         ("tolerance = 0.1", "mesh.groups.hot.tolerance: goes with normal only")]:
-        key = body.split(" ")[0]
-        text = CASE_GROUPS.replace("rest = true", body) if key == "rest" else \
-            CASE_GROUPS.replace("box = [-1e-6, -1e-6, -1e-6, 1e-6, 2.000001, 3.000001]",
-                                body if key != "tolerance" else "box = [-1e-6, -1e-6, -1e-6, 1e-6, 2.000001, 3.000001]\n"
-                                + body)
-        (tmp_path / "bad.toml").write_text(text)
-        with pytest.raises(InputError, match=needle.replace("[", r"\[").replace("]", r"\]")):
+    hot = "box = [-1e-6, -1e-6, -1e-6, 1e-6, 2.000001, 3.000001]"
+    for old, new, needle in [
+            (hot, "box = [1, 2]", "mesh.groups.hot.box: expected [xmin, ymin, zmin, xmax, ymax, zmax] or a list"),
+            ("rest = true", "rest = 1", "mesh.groups.cooled.rest: expected true or false"),
+            (hot, "normal = [0, 0, 0]", "mesh.groups.hot.normal: expected a direction"),
+            (hot, f"{hot}\ntolerance = 0.1", "mesh.groups.hot.tolerance: goes with normal only")]:
+        (tmp_path / "bad.toml").write_text(CASE_GROUPS.replace(old, new))
+        with pytest.raises(InputError, match=re.escape(needle)):
             load_case(tmp_path / "bad.toml")
 
 

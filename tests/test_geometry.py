@@ -285,7 +285,8 @@ def test_a_stray_patch_is_refused_naming_the_boundary(tmp_path):
         'Curve Loop(1) = {1,2,3,4}; Plane Surface(1) = {1};\n'
         'v[] = Extrude {0,0,1} { Surface{1}; };\n'
         'Point(50) = {2,0,0,0.5}; Point(51) = {3,0,0,0.5}; Point(52) = {3,1,0,0.5};\n'
-        'Line(60) = {50,51}; Line(61) = {51,52}; Line(62) = {52,50}; Curve Loop(60) = {60,61,62}; Plane Surface(60) = {60};\n'
+        'Line(60) = {50,51}; Line(61) = {51,52}; Line(62) = {52,50};\n'
+        'Curve Loop(60) = {60,61,62}; Plane Surface(60) = {60};\n'
         'Physical Volume("body") = {v[1]}; Physical Surface("base") = {1}; Physical Surface("flap") = {60};\n')
     with pytest.raises(InputError, match=r"a\.geo: boundary flap: has facets that are not facets of the mesh's "):
         mesh_geometry(MeshSpec(tmp_path / "a.geo"))

@@ -97,7 +97,8 @@ def test_run_ends_in_one_line_exit_2_naming_the_script(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err, err
     assert err.startswith(f"gatetherm: error: {tmp_path / 'a.geo'}: the geometry script tried to run a program / "
-                          "write a file; gatetherm does not allow it; remove the command that did it (system call clone)")
+                          "write a file; gatetherm does not allow it; remove the command that did it "
+                          "(system call clone)")
     assert not marker.exists() and not (tmp_path / "out").exists()
 
 

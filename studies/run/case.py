@@ -106,7 +106,8 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
         m.fail("include", f"expected a list of file names, got {include!r}", 'e.g. include = ["../common.geo"]')
     for f in include:
         if not (base / f).is_file():
-            m.fail("include", f"no such file '{base / f}'", "name files the geometry script reads, relative to the case")
+            m.fail("include", f"no such file '{base / f}'",
+                   "name files the geometry script reads, relative to the case")
     groups = tuple(_group(m.sub("groups").sub(name, ("dim", "box", "rest", "normal", "tolerance")), name)
                    for name in m.data.get("groups", {}))
     size = factor * m.number("size", METRES, 0.0) or None
