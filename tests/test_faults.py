@@ -104,7 +104,17 @@ def test_ctrl_c_at_any_moment(tmp_path):
     a fast machine reached the output files, still no hidden or partial file and no
     summary.json, which marks a finished run."""
     def mapped(name):
-        return lambda pid: name in Path(f"/proc/{pid}/maps").read_text()
+        """``name`` is loaded in the process or in one of its children (gmsh runs in a child)."""
+        def fired(pid):
+            kids = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+            for p in (pid, *kids):
+                try:
+                    if name in Path(f"/proc/{p}/maps").read_text():
+                        return True
+                except OSError:  # the child has ended meanwhile
+                    pass
+            return False
+        return fired
 
     locked = {}
 

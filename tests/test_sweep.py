@@ -254,8 +254,8 @@ def test_killed_sweep_restarts_to_the_same_table(study_dir):
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     deadline = time.monotonic() + 10
-    while any(map(alive, workers)) and time.monotonic() < deadline:
-        time.sleep(0.01)
+    while (any(map(alive, workers)) or group(proc.pid)) and time.monotonic() < deadline:
+        time.sleep(0.01)  # the workers, and gmsh's processes they started, die with the sweep
     left = group(proc.pid)
     for pid in left:
         os.kill(pid, signal.SIGKILL)

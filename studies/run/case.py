@@ -22,7 +22,8 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, ranges
 from gatetherm.files import read_text
-from gatetherm.geometry.gmshfile import CAD, SCRIPT, BoxGroup, MeshSpec, Refinement, mesh_geometry
+from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_geometry
+from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
 from gatetherm.solvers.effects import Targets
 from gatetherm.solvers.expr import Value
@@ -172,19 +173,19 @@ class CaseFile:
 
 
 def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
-    m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups"))
+    m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups", "include"))
     path = base / m.string("file")
     if not path.is_file():
         m.fail("file", f"no such file '{path}'", "give a .msh, .geo or CAD file beside the case")
     suffix = path.suffix.lower()
     if suffix in (".msh", ".vtu"):
-        for k in ("size", "parameters", "refine", "groups"):
+        for k in ("size", "parameters", "refine", "groups", "include"):
             if k in m.data:
                 m.fail(k, f"applies only to a geometry that gatetherm meshes ({SCRIPT}, {', '.join(CAD)})",
                        "mesh the file again in gmsh, or give the .geo")
         if factor != 1.0:
             m.fail("file", "a mesh file cannot be refined", "give the .geo or CAD file to mesh it finer")
-        return load_mesh(path)
+        return _in_case(top, load_mesh, path)
     if suffix not in (SCRIPT, *CAD):
         m.fail("file", f"unknown mesh or geometry format '{suffix}'", f"use .msh, {SCRIPT} or {', '.join(CAD)}")
     params = m.sub("parameters")
@@ -193,16 +194,54 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
         rt = Table(top.file, f"mesh.refine[{i + 1}]", r, ("near", "size", "distance"))
         refine.append(Refinement(rt.string("near"), factor * rt.number("size", METRES),
                                  rt.number("distance", METRES)))
-    groups = []
-    for name in m.data.get("groups", {}):
-        g = m.sub("groups").sub(name, ("dim", "box"))
-        box = g.data.get("box")
-        if not (isinstance(box, list) and len(box) == 6 and all(isinstance(b, (int, float)) for b in box)):
-            g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax], got {box!r}", "give six numbers in m")
-        groups.append(BoxGroup(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(float(b) for b in box)))
+    include = m.data.get("include", [])
+    if not (isinstance(include, list) and all(isinstance(f, str) for f in include)):
+        m.fail("include", f"expected a list of file names, got {include!r}", 'e.g. include = ["../common.geo"]')
+    for f in include:
+        if not (base / f).is_file():
+            m.fail("include", f"no such file '{base / f}'",
+                   "name files the geometry script reads, relative to the case")
+    groups = tuple(_group(m.sub("groups").sub(name, ("dim", "box", "rest", "normal", "tolerance")), name)
+                   for name in m.data.get("groups", {}))
     size = factor * m.number("size", METRES, 0.0) or None
-    return mesh_geometry(MeshSpec(path, size, {k: params.number(k) for k in params.data}, tuple(refine),
-                                  tuple(groups)))
+    return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
+                                                 tuple(refine), groups, tuple(base / f for f in include), base, factor))
+
+
+def _in_case(top: Table, read, arg) -> FrameMesh:
+    """``read(arg)``, its errors about case keys (``mesh.…``, ``--mesh-factor``) naming the case file."""
+    try:
+        return read(arg)
+    except InputError as err:
+        raise err.at(str(top.file)) if err.field.startswith(("mesh", "--")) else err from None
+
+
+def _group(g: Table, name: str) -> GroupRule:
+    """A [mesh.groups.NAME] rule: box (one or a list), rest, normal (with tolerance)."""
+    box = g.data.get("box", [])
+    boxes = [box] if box and all(isinstance(b, (int, float)) for b in box) else box
+    if not (isinstance(boxes, list) and all(_numbers(b, (6,)) for b in boxes)):
+        g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax] or a list of them, got {box!r}",
+               "give six numbers in m per box")
+    rest = g.data.get("rest", False)
+    if not isinstance(rest, bool):
+        g.fail("rest", f"expected true or false, got {rest!r}")
+    normal = g.data.get("normal")
+    if normal is not None and not (_numbers(normal, (2, 3)) and any(normal)):
+        g.fail("normal", f"expected a direction [nx, ny(, nz)], got {normal!r}", "e.g. normal = [0, 0, 1]")
+    if not (boxes or rest or normal):
+        g.fail("box", "the group selects nothing", "give box, normal or rest = true")
+    if "tolerance" in g.data and normal is None:
+        g.fail("tolerance", "goes with normal only", "remove it or give normal")
+    return GroupRule(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(tuple(map(float, b)) for b in boxes),
+                     rest, tuple(map(float, normal)) if normal else None,
+                     g.number("tolerance", Range(0.0, math.pi, lo_open=True, unit="rad"), NORMAL_TOLERANCE))
+
+
+def _numbers(v, lengths) -> bool:
+    """Whether ``v`` is a list of finite numbers of one of ``lengths``."""
+    return isinstance(v, list) and len(v) in lengths and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
 
 
 def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
@@ -318,8 +357,7 @@ def _probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
                 t.fail("point", f"'{point}' is not a point group of the mesh", f"points: {', '.join(fm.sensors) or 'none'}"
                        "; or give coordinates [x, y(, z)] in m")
             xyz = tuple(float(v) for v in fm.points[fm.sensors[point]])
-        elif isinstance(point, list) and len(point) == fm.dim and all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in point):
+        elif _numbers(point, (fm.dim,)):
             xyz = tuple(float(v) for v in point)
             if finder is None:
                 from gatetherm.solvers.fem import to_skfem
