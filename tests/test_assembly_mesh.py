@@ -16,7 +16,7 @@ from gatetherm import InputError
 from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
 from gatetherm.geometry.groups import GroupRule
 from gatetherm.geometry.mesh import FrameMesh, components
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 
 from test_geometry import _measure
 

@@ -23,7 +23,7 @@ from gatetherm import InputError
 from gatetherm.geometry import isolate, sandbox
 from gatetherm.geometry.geoscan import scan
 from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 
 pytestmark = pytest.mark.skipif(not sandbox.available(), reason="seccomp sandbox: Linux x86_64/aarch64 only")
 
@@ -208,7 +208,7 @@ def _children(pid: int) -> list[int]:
 def test_a_signal_ends_a_run_inside_gmsh_within_2_s(tmp_path, sig, code, said):
     """An endless .geo loop: the run ends with the usual line and code, no output, no child left."""
     case = _endless(tmp_path)
-    proc = subprocess.Popen([sys.executable, "-m", "gatetherm.studies.cli", "run", str(case), "--out",
+    proc = subprocess.Popen([sys.executable, "-m", "gatetherm.cli", "run", str(case), "--out",
                              str(tmp_path / "out")], stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 60
