@@ -51,7 +51,7 @@ def _sweep(args, study, tasks, out) -> list:
 
     (records,), failed = run_studies([(tasks, PointStore(out))], args.workers, args.scheduler,
                                      Progress(f"sweep {study.name}"))
-    columns, rows = table(tasks, records)
+    columns, rows = table(tasks, records, study.columns)
     write_table(out / "table.csv", columns, rows)
     write_text_atomic(out / "study.json", json.dumps(
         {"name": study.name, "dim": study.dim, "config": study.case or study.base.source, "compute": list(study.compute),

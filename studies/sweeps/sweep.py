@@ -315,16 +315,17 @@ def plan(study: Study) -> list[Task]:
     return tasks
 
 
-def table(tasks: list[Task], records: dict[str, dict]) -> tuple[list[str], list[dict]]:
+def table(tasks: list[Task], records: dict[str, dict], results=()) -> tuple[list[str], list[dict]]:
     """Columns and rows (grid order) of the tidy table: parameters, status, note, then the
-    results in the order of :data:`COMPUTE`. Points without a record are "pending" rows."""
+    results in the order of :data:`COMPUTE` (a case study's: ``results``). Points without a record
+    are "pending" rows."""
     rows = []
     for t in tasks:
         rec = records.get(t.key, {"status": "pending", "note": "", "results": {}})
         made = {k: rec.get(k, "") for k in MADE_BY}
         rows.append({**dict(t.params), "status": rec["status"], "note": rec["note"], **rec["results"], **made})
     params = [k for k, _ in tasks[0].params] if tasks else []
-    results = ["nodes"] + [c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]
-                           if not (tasks[0].case and k == "run")]
+    results = ["nodes"] + ([c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]]
+                           if not (tasks and tasks[0].case) else list(results))
     extra = [k for r in rows for k in r if k not in params + results + ["status", "note", *MADE_BY]]
     return params + ["status", "note"] + results + list(dict.fromkeys(extra)) + list(MADE_BY), rows
