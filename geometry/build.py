@@ -132,7 +132,7 @@ def build_mesh(p: FrameParams, dim: int = 2, mesh: MeshParams = MeshParams()) ->
         return _extract(gmsh, dim, region_ents, facet_ents, point_of, p)
 
 
-def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
+def _extract(gmsh, dim, region_ents, facet_ents, point_of, p, line_ents=None) -> FrameMesh:
     tags, xyz, _ = gmsh.model.mesh.getNodes()
     index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
     index[tags.astype(np.int64)] = np.arange(len(tags))
@@ -154,6 +154,7 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
         regions[name] = np.arange(offset, offset + len(cells))
         offset += len(cells)
     boundaries = {name: elements(dim - 1, ents) for name, ents in facet_ents.items()}
+    lines = {name: elements(1, ents) for name, ents in (line_ents or {}).items()}
     sensors = {}
     for name, t in point_of.items():
         ntags, _, _ = gmsh.model.mesh.getNodes(0, t)
@@ -166,5 +167,6 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
         points, cells = points[used], remap[cells]
         boundaries = {k: remap[v] for k, v in boundaries.items()}
         sensors = {k: int(remap[v]) for k, v in sensors.items()}
+        lines = {k: remap[v] for k, v in lines.items()}
     log.info("meshed %d-D frame: %d nodes, %d elements", dim, len(points), len(cells))
-    return FrameMesh(dim, points, cells, regions, boundaries, sensors, {"frame": p} if p is not None else {})
+    return FrameMesh(dim, points, cells, regions, boundaries, sensors, {"frame": p} if p is not None else {}, lines)

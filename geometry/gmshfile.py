@@ -131,7 +131,7 @@ def mesh_geometry(spec: MeshSpec) -> FrameMesh:
             _, xyz, _ = gmsh.model.mesh.getNodes()
             if abs(xyz[2::3]).max(initial=0.0) > 1e-12:
                 raise InputError(str(spec.path), "a 2-D geometry must lie in the x-y plane", "draw it in z = 0")
-        fm = _extract(gmsh, dim, groups[dim], groups[dim - 1], points, None)
+        fm = _extract(gmsh, dim, groups[dim], groups[dim - 1], points, None, groups[1] if dim == 3 else None)
         log.info("meshed %s: %d nodes, %d elements, regions %s", spec.path.name, len(fm.points), len(fm.cells),
                  ", ".join(fm.regions))
         return fm

@@ -33,6 +33,8 @@ class FrameMesh:
     meta: dict = field(default_factory=dict, compare=False)
     """What the mesh was made from, when known: ``{"frame": FrameParams}`` for a mesh built
     by :func:`gatetherm.geometry.build.build_mesh` (not kept in files)."""
+    lines: dict[str, np.ndarray] = field(default_factory=dict)
+    """3-D: named curves as (L, 2) node pairs (a support on a line)."""
 
     def sensor_xyz(self, name: str) -> np.ndarray:
         return self.points[self.sensors[name]]
@@ -52,6 +54,8 @@ def _groups(m: FrameMesh):
         yield name, d - 1, _FACET[d], fac
     for name, node in m.sensors.items():
         yield name, 0, "vertex", np.array([[node]])
+    for name, pairs in m.lines.items():
+        yield name, 1, "line", pairs
 
 
 def to_meshio(m: FrameMesh, point_data: dict | None = None):
@@ -126,7 +130,7 @@ def _named_blocks(mm):
 def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
     """A :class:`FrameMesh` from (name, dimension, connectivity) groups; nodes in no
     element are dropped."""
-    regions, boundaries, sensors, chunks, offset = {}, {}, {}, [], 0
+    regions, boundaries, sensors, lines, chunks, offset = {}, {}, {}, {}, [], 0
     for name, d, conn in groups:
         if d == dim:
             chunks.append(conn)
@@ -137,6 +141,8 @@ def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
             boundaries[name] = np.vstack([boundaries[name], conn]) if name in boundaries else conn
         elif d == 0:
             sensors[name] = int(conn[0, 0])
+        elif d == 1:
+            lines[name] = np.vstack([lines[name], conn]) if name in lines else conn
     if not chunks:
         raise InputError("mesh", f"holds no named {_KIND[dim]} groups", f"add a Physical {_KIND[dim].title()}")
     cells = np.vstack(chunks)
@@ -148,7 +154,8 @@ def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
         raise InputError(f"mesh point {orphans[0]}", "is not a node of the mesh's elements",
                          "put the point inside the meshed body (embed it in gmsh)")
     return FrameMesh(dim, points[used][:, :dim].copy(), remap[cells], regions,
-                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()})
+                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()},
+                     lines={k: remap[v] for k, v in lines.items()})
 
 
 def load_mesh(path: str | os.PathLike) -> FrameMesh:

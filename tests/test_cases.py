@@ -138,7 +138,7 @@ BAD = {
     "no material": ("", "materials.plate: region without a material"),
     "two conditions": ("[thermal.base]\ntemperature = 1.0\nfilm = 5.0\nambient = 0.0\n",
                        "thermal.base.film/temperature: give exactly one condition"),
-    "rigid body": ("[supports.base]\ntype = \"normal\"\n", "supports: the supports leave rigid-body motion free "
+    "rigid body": ("[supports.base]\ntype = \"normal\"\n", "supports: the part made of region plate is free to move "
                    "(translation y)"),  # base is the edge x = 0: it holds u_x, so the rotation too
     "bad expression": ("[thermal.base]\ntemperature = \"__import__('os')\"\n", "thermal.base.temperature: '__import__' "
                        "is not allowed"),
