@@ -27,7 +27,7 @@ class Revolution(Field):
         return cls(2.0 * np.pi * mesh.p[0, mesh.t].mean(axis=0))
 
     def at(self, basis) -> np.ndarray:
-        return 2.0 * np.pi * basis.global_coordinates().value[0]
+        return 2.0 * np.pi * np.asarray(basis.global_coordinates())[0]
 
 
 def _trace(u, r):

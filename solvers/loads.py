@@ -110,5 +110,7 @@ def mechanical_terms(problem, mesh, vb: CellBasis, fields: dict[str, Field], sen
 def unit_responses(elastic, terms: Terms) -> np.ndarray:
     """The displacement (m, DOFs × terms) of every term for a unit value, in one solve with
     the elastic system's factor."""
-    load = terms.F - (elastic.K_fixed @ terms.D[elastic.fixed] if elastic.K_fixed is not None else 0.0)
+    load = terms.F
+    if elastic.K_fixed is not None:
+        load = load - elastic.K_fixed @ terms.D[np.setdiff1d(np.arange(len(terms.D)), elastic.free)]
     return terms.D + elastic.from_load(load)
