@@ -256,3 +256,38 @@ point = [0.5, 0.05]
     last = sorted((out / "fields").glob("fields_*.vtu"))[-1]
     u = meshio.read(last).point_data["u"]
     assert np.abs(u[:, 0]).max() == pytest.approx(1e-6, rel=1e-9)
+
+
+def test_run_warns_when_p1_is_too_coarse_for_bending(tmp_path, caplog):
+    """The cantilever under gravity at P1 with two elements through its depth: ``run`` solves
+    it once more at P2 on the same mesh and names the output in one warning line with the
+    fix; P2 itself is not checked."""
+    case = f"""
+[mesh]
+file = "body.geo"
+[materials.body]
+E = 2.1e11
+nu = 0.3
+rho = 7850.0
+[gravity]
+acceleration = [0, -9.81]
+[supports.left]
+type = "clamped"
+[probes.tip]
+point = [1.0, 0.0125]
+quantities = ["u"]
+"""
+    path = write(tmp_path, case, RECTANGLE, x0=0, L=1.0, H=0.025, h=0.0125)
+    with caplog.at_level("WARNING"):
+        assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-pictures"]) == 0
+    warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert len(warned) == 1 and "uy_tip_um changes from" in warned[0] and "set order = 2 in [case]" in warned[0]
+    assert "\n" not in warned[0]
+    caplog.clear()
+    check = json.loads((tmp_path / "o" / "summary.json").read_text())["order_check"]
+    assert check["output"] == "uy_tip_um" and check["p2_minus_p1_relative"] == pytest.approx(-0.3256, abs=0.003)
+    write(tmp_path, case.replace("[mesh]", "[case]\norder = 2\n[mesh]"))
+    with caplog.at_level("WARNING"):
+        assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-pictures"]) == 0
+    assert not [r for r in caplog.records if r.levelname == "WARNING"]
+    assert "order_check" not in json.loads((tmp_path / "o" / "summary.json").read_text())

@@ -33,6 +33,7 @@ def run(args) -> int:
 
 
 def _run(args, case, out: Path, t0: float) -> int:
+    from gatetherm.studies.run.order_check import TOLERANCE, order_check
     from gatetherm.studies.run.output import probe_summary, write_json, write_run
     from gatetherm.studies.run.scenario import case_schedule, run_scenario
 
@@ -40,6 +41,7 @@ def _run(args, case, out: Path, t0: float) -> int:
     every = case.time.fields if case.time else 1.0
     fields = {float(t) for t in schedule.times if abs(t / every - round(t / every)) < 1e-9} | {float(schedule.times[-1])}
     res = run_scenario(case, case.mesh.dim, schedule, keep_times=sorted(fields), on_step=Progress(case.name))
+    check = order_check(case, res)  # a P1 case on a small mesh: P2 once more, a warning if they differ
     solved = write_run(out, res, {"source": "gatetherm run", "case": str(args.case), "name": case.name}, fields)
     if not args.no_pictures:
         from gatetherm.validation.plots.run import plot_case
@@ -47,9 +49,14 @@ def _run(args, case, out: Path, t0: float) -> int:
         plot_case(res, out, case.name, solved)
     p = case.problem
     summary = {"case": case.name, "file": str(args.case), "dim": p.dim, "order": p.order,
-               "analysis": "prescribed temperature" if not p.heat else ("transient" if case.time else "steady"),
+               "analysis": ("prescribed temperature" if p.thermal else "mechanical") if not p.heat else
+               ("transient" if case.time else "steady"),
                "nodes": len(case.mesh.points), "elements": len(case.mesh.cells),
                "wall_time_s": round(time.perf_counter() - t0, 2), **probe_summary(p, res.columns)}
+    if check:
+        worst = max(check, key=lambda k: abs(check[k]))
+        summary["order_check"] = {"output": worst, "p2_minus_p1_relative": round(check[worst], 6),
+                                  "tolerance": TOLERANCE}
     write_json(out / "summary.json", summary)
     print(f"wrote {out}/timeseries.csv, summary.json and fields/")
     for name, q in summary["probes"].items():
