@@ -95,13 +95,14 @@ point = [0.15, 0.025]
 """
 
 
-def test_composite_wall_with_contact_conductance_against_the_1d_closed_form(tmp_path):
+@pytest.mark.parametrize("order", [1, 2])
+def test_composite_wall_with_contact_conductance_against_the_1d_closed_form(tmp_path, order):
     """Two blocks, 0.1 m each, k = 50 and 15 W/(m K), touching through a contact conductance
     h = 2000 W/(m² K), 100 °C and 0 °C on the outer faces: q = ΔT / (L/k₁ + 1/h + L/k₂), a
     jump q/h at the interface. Temperatures at the blocks' middles and on the left face of
     the interface (the mean over the boundary ``left/right``), to round-off (T is linear)."""
     shutil.copy(DATA / "two_blocks.geo", tmp_path)
-    (tmp_path / "case.toml").write_text(COMPOSITE)
+    (tmp_path / "case.toml").write_text(f"[case]\norder = {order}\n{COMPOSITE}")
     res = solve(tmp_path / "case.toml")
     L, k1, k2, hc = 0.1, 50.0, 15.0, 2000.0
     q = 100.0 / (L / k1 + 1 / hc + L / k2)
@@ -114,6 +115,25 @@ def test_composite_wall_with_contact_conductance_against_the_1d_closed_form(tmp_
     jump = (a - q * L / 2 / k1) - (b + q * L / 2 / k2)  # both sides extrapolated to the interface
     assert abs(jump / (q / hc) - 1) < 0.005
     assert jump / (q / hc) - 1 == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_contact_without_stiffness_is_a_bond(tmp_path):
+    """A bimetal of the two blocks (α 12 and 23 µm/(m K)) warmed uniformly by 10 K, one end
+    clamped: with a contact conductance only, the blocks stay bonded; the end displacement
+    equals the conformal mesh's (no contact) to 10⁻⁶."""
+    shutil.copy(DATA / "two_blocks.geo", tmp_path)
+    mats = "".join(f"[materials.{r}]\nk = 50.0\nE = 1e11\nnu = 0.3\nalpha = {a}\n" for r, a in
+                   (("left", 1.2e-5), ("right", 2.3e-5)))
+    body = (f'[mesh]\nfile = "two_blocks.geo"\n{mats}[initial]\ntemperature = 20.0\nreference = 10.0\n'
+            '[thermal.hot]\ntemperature = 20.0\n[supports.hot]\ntype = "clamped"\n[probes.end]\npoint = [0.2, 0.05]\n'
+            'quantities = ["u"]\n')
+    (tmp_path / "case.toml").write_text(body)
+    bonded = solve(tmp_path / "case.toml")["probes"]["end"]
+    (tmp_path / "case.toml").write_text(body + '[contacts.c]\nbetween = ["left", "right"]\nconductance = 1e3\n')
+    joined = solve(tmp_path / "case.toml")["probes"]["end"]
+    for k in ("ux_um", "uy_um"):
+        assert abs(joined[k] / bonded[k] - 1) < 1e-6  # achieved 2e-10 (ux), 2e-8 (uy)
+    assert abs(bonded["uy_um"]) > 1.0  # it bends
 
 
 def test_elastic_joint_adds_its_compliance(tmp_path):
