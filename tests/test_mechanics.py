@@ -311,3 +311,73 @@ quantities = ["u"]
         assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-pictures"]) == 0
     assert not [r for r in caplog.records if r.levelname == "WARNING"]
     assert "order_check" not in json.loads((tmp_path / "o" / "summary.json").read_text())
+
+
+def test_mechanical_tables_written_back_read_the_same(tmp_path):
+    """``case_toml`` of LE1 (a pressure, symmetry) and of a joined, pulled, moved assembly reads
+    back to the same problem."""
+    from gatetherm.studies.run.casefile import case_toml
+
+    NAFEMS = DATA.parents[1] / "validation" / "nafems"
+    shutil.copy(NAFEMS / "le1.geo", tmp_path)
+    shutil.copy(DATA / "two_blocks.geo", tmp_path)
+    joined = """[mesh]\nfile = "two_blocks.geo"\n[materials.left]\nE = 1e11\nnu = 0.3\nrho = 7800.0
+[materials.right]\nE = 1e11\nnu = 0.3\nrho = 7800.0\n[contacts.c]\nbetween = ["left", "right"]\nstiffness = [1e12, 1e11]
+[supports.hot]\ntype = "clamped"\n[supports.cold]\ntype = "displacement"\nvalue = ["free", "1e-6 * t"]
+[gravity]\nacceleration = [0, -9.81]\n[loads.top]\ntraction = [0, -1e4]\n[loads.mid]\nforce = [10.0, 0]\n"""
+    (tmp_path / "joined.toml").write_text(joined)
+    for src, mesh in ((NAFEMS / "le1.toml", "le1.geo"), (tmp_path / "joined.toml", "two_blocks.geo")):
+        case = load_case(src)
+        (tmp_path / "back.toml").write_text(case_toml(case.problem, case.name, mesh))
+        assert repr(load_case(tmp_path / "back.toml").problem) == repr(case.problem)
+
+
+def test_axisymmetric_thick_cylinder_under_internal_pressure_against_lame(tmp_path):
+    """The same hollow cylinder, 10 MPa in the bore, both ends held axially (plane strain),
+    purely mechanical: Lamé's σ_θθ = p a²/(b² − a²) (1 + b²/r²) and σ_rr = p a²/(b² − a²)
+    (1 − b²/r²), u_r = (1 + ν) p a²/(E (b² − a²)) ((1 − 2ν) r + b²/r) at r = 75 mm (P2)."""
+    geo = RECTANGLE.replace('"left"', '"bore"').replace('"right"', '"outside"')
+    path = write(tmp_path, """
+[case]
+order = 2
+plane = "axisymmetric"
+[mesh]
+file = "body.geo"
+[materials.body]
+E = 2.1e11
+nu = 0.3
+[loads.bore]
+pressure = 10e6
+[supports.bottom]
+type = "normal"
+[supports.top]
+type = "normal"
+[probes.mid]
+point = [0.075, 0.025]
+""", geo, x0=0.05, L=0.05, H=0.05, h=0.005)
+    q = solve(path)["probes"]["mid"]
+    a, b, r, p = 0.05, 0.1, 0.075, 10.0
+    c = p * a ** 2 / (b ** 2 - a ** 2)
+    err = {k: q[f"sigma_{k}_MPa"] / exact - 1 for k, exact in (
+        ("tt", c * (1 + b ** 2 / r ** 2)), ("xx", c * (1 - b ** 2 / r ** 2)), ("yy", 0.3 * 2 * c))}  # σ_zz = ν (σ_rr + σ_θθ)
+    assert max(abs(e) for e in err.values()) < 0.005
+    assert err["xx"] == pytest.approx(-0.00272, abs=2e-4)  # the largest; 1e-4 at h = 2.5 mm
+    u_r = (1 + 0.3) * c * 1e6 / 2.1e11 * ((1 - 2 * 0.3) * r + b ** 2 / r)
+    assert q["ux_um"] * 1e-6 == pytest.approx(u_r, rel=1e-5)
+
+
+@pytest.mark.parametrize("backend", ["superlu", "pardiso"])
+def test_a_zero_pivot_is_bad_input_not_a_traceback(monkeypatch, backend):
+    """A singular stiffness that the checks before it missed: the factorisation's failure is
+    an InputError naming the likely cause."""
+    import scipy.sparse as sp
+
+    from gatetherm import InputError
+    from gatetherm.solvers.elasticity import _factor
+
+    if backend == "pardiso":
+        pytest.importorskip("pymklpardiso")
+    monkeypatch.setenv("GATETHERM_SPD_BACKEND", backend)
+    K = sp.csr_matrix(np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+    with pytest.raises(InputError, match="the elastic system is singular .*a part is not held"):
+        _factor(K, 2, None, None)
