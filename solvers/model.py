@@ -238,7 +238,8 @@ def _prescribed_load(model: Model) -> np.ndarray:
     el, f, p = model.elastic, model.fields, model.problem
     vb = CellBasis(model.mesh, el.basis.elem, intorder=2 * p.order + p.axisymmetric)
     b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim, p.plane)[2]
-    return asm(axisym.thermal_load_at if p.axisymmetric else thermal_load_at, vb, b=Field(b).at(vb), t=f["thickness"].at(vb), T=_prescribed_rise(model)(vb))
+    return asm(axisym.thermal_load_at if p.axisymmetric else thermal_load_at, vb, b=Field(b).at(vb),
+               t=f["thickness"].at(vb), T=_prescribed_rise(model)(vb))
 
 
 def _recovery_for(model: Model, elements) -> Recovery:

@@ -224,9 +224,11 @@ Mesh.MeshSizeMax = 0.02;
 
 @pytest.mark.parametrize("what, case, message", [
     ("gap", '[mesh]\nfile = "body.geo"\n[materials.column]\nk = 1.0\n[materials.sleeve]\nk = 1.0\n'
-     '[thermal.base]\ntemperature = 1.0\n', "mesh: region sleeve touches no other region (the mesh falls into 2 pieces)"),
+     '[thermal.base]\ntemperature = 1.0\n',
+     "mesh: region sleeve touches no other region (the mesh falls into 2 pieces)"),
     ("slide", '[mesh]\nfile = "two_blocks.geo"\n[materials.left]\nE = 1e11\nnu = 0.3\n[materials.right]\nE = 1e11\n'
-     'nu = 0.3\n[contacts.guide]\nbetween = ["left", "right"]\nstiffness = [1e12, 0]\n[supports.hot]\ntype = "clamped"\n'
+     'nu = 0.3\n[contacts.guide]\nbetween = ["left", "right"]\nstiffness = [1e12, 0]\n'
+     '[supports.hot]\ntype = "clamped"\n'
      '[loads.cold]\npressure = 1e5\n', "supports: the part made of region right is free to move (translation y)"),
 ])
 def test_a_part_held_by_nothing_is_refused_by_name(tmp_path, capsys, what, case, message):
@@ -381,3 +383,43 @@ def test_a_zero_pivot_is_bad_input_not_a_traceback(monkeypatch, backend):
     K = sp.csr_matrix(np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
     with pytest.raises(InputError, match="the elastic system is singular .*a part is not held"):
         _factor(K, 2, None, None)
+
+
+THREE = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 0.1, 0.05};
+Rectangle(2) = {0.1, 0, 0, 0.1, 0.05};
+Rectangle(3) = {0, 0.05, 0, 0.2, 0.02};
+BooleanFragments{ Surface{1, 2}; Delete; }{ Surface{3}; Delete; }
+e = 1e-6;
+Physical Surface("left") = {Surface In BoundingBox {-e, -e, -e, 0.1 + e, 0.05 + e, e}};
+Physical Surface("right") = {Surface In BoundingBox {0.1 - e, -e, -e, 0.2 + e, 0.05 + e, e}};
+Physical Surface("cover") = {Surface In BoundingBox {-e, 0.05 - e, -e, 0.2 + e, 0.07 + e, e}};
+Physical Curve("left/right") = {Curve In BoundingBox {0.1 - e, -e, -e, 0.1 + e, 0.05 + e, e}};
+Physical Curve("bottom") = {Curve In BoundingBox {-e, -e, -e, 0.2 + e, e, e}};
+Physical Point("corner") = {Point In BoundingBox {0.1 - e, -e, -e, 0.1 + e, e, e}};
+Mesh.MeshSizeMax = 0.01;
+"""
+
+
+def test_split_interface_cuts_between_two_regions_only():
+    """Cutting ``left/right`` open: the right block gets copies of the interface's nodes, but
+    not of the node where the cover joins both blocks (the cut ends there); the bottom edge
+    follows its cells, the point group stays on the left, and the mesh stays one piece."""
+    import tempfile
+
+    from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+    from gatetherm.geometry.interface import parts, split_interface
+    from gatetherm.solvers.fem import to_skfem
+
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "three.geo").write_text(THREE)
+        fm = mesh_geometry(MeshSpec(Path(tmp) / "three.geo"))
+    cut, pairs = split_interface(fm, "left", "right")
+    nodes = np.unique(fm.boundaries["left/right"])
+    top = nodes[np.argmax(fm.points[nodes, 1])]
+    assert len(pairs) == len(nodes) - 1 and top not in pairs[:, 0]
+    assert np.allclose(cut.points[pairs[:, 1]], fm.points[pairs[:, 0]]) and len(parts(cut)) == 1
+    right = np.unique(cut.cells[cut.regions["right"]])
+    assert not np.isin(pairs[:, 0], right).any() and np.isin(pairs[:, 1], right).all()
+    assert np.isin(pairs[:, 1], cut.boundaries["bottom"]).sum() == 1  # the bottom corner node, on the right's side
+    assert cut.sensors == fm.sensors and to_skfem(cut).nvertices == len(fm.points) + len(pairs)

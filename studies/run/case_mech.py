@@ -94,7 +94,8 @@ def read_contacts(top: Table, fm: FrameMesh, heat: bool, elastic: bool) -> tuple
     for name in ct.data:
         t = ct.sub(name, ("between", "conductance", "stiffness"))
         pair = t.data.get("between")
-        if not (isinstance(pair, list) and len(pair) == 2 and all(p in fm.regions for p in pair) and pair[0] != pair[1]):
+        if not (isinstance(pair, list) and len(pair) == 2 and all(p in fm.regions for p in pair)
+                and pair[0] != pair[1]):
             t.fail("between", f"expected two regions of the mesh, got {pair!r}", f"regions: {', '.join(fm.regions)}")
         boundary = interface_name(*pair)
         if boundary not in fm.boundaries:
@@ -120,7 +121,8 @@ def read_contacts(top: Table, fm: FrameMesh, heat: bool, elastic: bool) -> tuple
             stiff = tuple(float(rng.check(t.key(f"stiffness[{i + 1}]"), v))  # tangential 0: a slide
                           for i, (rng, v) in enumerate(zip((STIFFNESS, Range(0.0, unit="N/m³")), raw)))
         if h is None and stiff is None:
-            t.fail("stiffness", "the contact has neither a conductance nor a stiffness", "give one of them or remove it")
+            t.fail("stiffness", "the contact has neither a conductance nor a stiffness",
+                   "give one of them or remove it")
         out.append(Contact(name, tuple(pair), h, stiff))
     return tuple(out)
 
