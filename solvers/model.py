@@ -136,7 +136,8 @@ class Model:
         """Stress components and von Mises (Pa) at the nodes, projected over the whole mesh
         (``rec``: :func:`field_recovery` of this model, set up once for many states)."""
         rec = rec or field_recovery(self)
-        rhs = rec.thermal_rhs(self.rise(U)) if U is not None else rec.thermal_rhs(np.ones(1))
+        rhs = rec.thermal_rhs(self.rise(U)) if U is not None else \
+            rec.thermal_rhs(np.ones(1)) if self.problem.thermal else {}  # the prescribed rise, or none
         comps = rec.field(u, rhs)
         nodal = {c: v[rec.scalar.nodal_dofs[0]] for c, v in comps.items()}
         return {**nodal, "von_mises": von_mises(nodal)}
@@ -202,10 +203,7 @@ def static_fields(model: Model, env=None) -> dict[str, np.ndarray]:
         u = np.zeros((X.shape[1], 3))
         u[:, :model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
         out["u"] = u
-        rec = field_recovery(model)
-        comps = rec.field(u_dofs, rec.thermal_rhs(np.ones(1)) if model.problem.thermal else {})
-        nodal = {c: v[rec.scalar.nodal_dofs[0]] for c, v in comps.items()}
-        out.update({f"sigma_{k}": v for k, v in nodal.items()}, von_mises=von_mises(nodal))
+        out.update({f"sigma_{k}" if k != "von_mises" else k: v for k, v in model.stress_field(u_dofs).items()})
     return out
 
 
