@@ -26,6 +26,7 @@ Physical Curve("left") = {{Curve In BoundingBox {{{x0} - e, -e, -e, {x0} + e, {H
 Physical Curve("right") = {{Curve In BoundingBox {{{x0} + {L} - e, -e, -e, {x0} + {L} + e, {H} + e, e}}}};
 Physical Curve("bottom") = {{Curve In BoundingBox {{{x0} - e, -e, -e, {x0} + {L} + e, e, e}}}};
 Physical Curve("top") = {{Curve In BoundingBox {{{x0} - e, {H} - e, -e, {x0} + {L} + e, {H} + e, e}}}};
+Physical Point("corner") = {{Point In BoundingBox {{{x0} + {L} - e, -e, -e, {x0} + {L} + e, e, e}}}};
 Mesh.MeshSizeMax = {h};
 """
 
@@ -70,6 +71,33 @@ quantities = ["u"]
     beam = 3 * rho * 9.81 * L ** 4 / (2 * E * h ** 2)
     assert abs(got / beam - 1) < 0.01
     assert got / beam - 1 == pytest.approx(-0.00020, abs=1e-4)
+
+
+def test_cantilever_under_a_point_force_against_beam_theory(tmp_path):
+    """The same cantilever with 100 N on its tip's bottom corner (a point group): the tip
+    deflects P L³ / (3 E I), I = t h³/12, to 1 % at P2."""
+    L, h, t, E, P = 1.0, 0.025, 0.02, 2.1e11, 100.0
+    path = write(tmp_path, f"""
+[case]
+order = 2
+[mesh]
+file = "body.geo"
+[materials.body]
+E = {E}
+nu = 0.3
+thickness = {t}
+[loads.corner]
+force = [0, {-P}]
+[supports.left]
+type = "clamped"
+[probes.tip]
+point = [{L}, {h / 2}]
+quantities = ["u"]
+""", RECTANGLE, x0=0, L=L, H=h, h=h / 2)
+    got = -solve(path)["probes"]["tip"]["uy_um"] * 1e-6
+    beam = P * L ** 3 / (3 * E * t * h ** 3 / 12)
+    assert abs(got / beam - 1) < 0.01
+    assert got / beam - 1 == pytest.approx(-0.00016, abs=1e-4)
 
 
 COMPOSITE = """
