@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -53,10 +54,30 @@ def p2_outputs(case, run) -> dict[str, float]:
     return {k: float(v[-1]) for k, v in cols.items() if k.endswith(("_um", "_MPa"))}
 
 
-def order_check(case, run) -> dict[str, float] | None:
-    """``{column: (P2 − P1) / size}`` (:data:`TOLERANCE`) of a P1 ``run`` of ``case`` (None: not checked: a P2
-    case or a mesh above :data:`MAX_NODES`); logs one warning naming the output that differs
-    most when it exceeds :data:`TOLERANCE`."""
+@dataclass(frozen=True)
+class OrderCheck:
+    """The final outputs of a P1 run and at P2 on the same mesh (data-format columns)."""
+
+    p1: dict[str, float]
+    p2: dict[str, float]
+    relative: dict[str, float]
+    """(P2 − P1) relative to the largest output of the unit (:data:`TOLERANCE`)."""
+
+    @property
+    def worst(self) -> str | None:
+        return max(self.relative, key=lambda k: abs(self.relative[k]), default=None)
+
+    def summary(self) -> dict:
+        """What ``summary.json`` records as ``order_check``."""
+        return {"tolerance": TOLERANCE, "worst": self.worst,
+                "outputs": {k: {"p1": self.p1[k], "p2": self.p2[k], "relative": round(v, 6)}
+                            for k, v in self.relative.items()}}
+
+
+def order_check(case, run) -> OrderCheck | None:
+    """The element-order check of a P1 ``run`` of ``case`` (None: not checked: a P2 case or a
+    mesh above :data:`MAX_NODES`); logs one warning naming the output that differs most when
+    it exceeds :data:`TOLERANCE`."""
     if case.problem.order != 1 or len(case.mesh.points) > MAX_NODES[case.mesh.dim]:
         return None
     p2 = p2_outputs(case, run)
@@ -64,9 +85,10 @@ def order_check(case, run) -> dict[str, float] | None:
     base = {u: case.problem.T_ref if u == "_degC" else 0.0 for u in UNITS}
     size = {u: max((abs(p2[k] - base[u]) for k in p1 if k.endswith(u)), default=0.0) for u in UNITS}
     rel = {k: (p2[k] - v) / max(next(s for u, s in size.items() if k.endswith(u)), 1e-300) for k, v in p1.items()}
-    worst = max(rel, key=lambda k: abs(rel[k]), default=None)
+    check = OrderCheck(p1, {k: p2[k] for k in p1}, rel)
+    worst = check.worst
     if worst is not None and abs(rel[worst]) > TOLERANCE:
         log.warning("%s: %s changes from %.4g to %.4g from P1 to P2 on this mesh (%+.1f %% of the largest output "
                     "of its unit, check tolerance %g %%): set order = 2 in [case] or refine the mesh", case.path, worst,
                     p1[worst], p2[worst], 100 * rel[worst], 100 * TOLERANCE)
-    return rel
+    return check
