@@ -253,7 +253,7 @@ Mesh.MeshSizeMax = 0.02;
 @pytest.mark.parametrize("what, case, message", [
     ("gap", '[mesh]\nfile = "body.geo"\n[materials.column]\nk = 1.0\n[materials.sleeve]\nk = 1.0\n'
      '[thermal.base]\ntemperature = 1.0\n',
-     "mesh: region sleeve touches no other region (the mesh falls into 2 pieces)"),
+     "mesh.file: region sleeve touches no other region (the mesh falls into 2 pieces)"),
     ("slide", '[mesh]\nfile = "two_blocks.geo"\n[materials.left]\nE = 1e11\nnu = 0.3\n[materials.right]\nE = 1e11\n'
      'nu = 0.3\n[contacts.guide]\nbetween = ["left", "right"]\nstiffness = [1e12, 0]\n'
      '[supports.hot]\ntype = "clamped"\n'

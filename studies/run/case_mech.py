@@ -163,7 +163,7 @@ def check_assembly(top: Table, fm: FrameMesh, problem, steady: bool) -> None:
     if len(pieces) > 1:
         alone = set(pieces[1].tolist())
         regions = [r for r, els in fm.regions.items() if fm.cells[els[0], 0] in alone]
-        top.fail("mesh", f"region{'s' * (len(regions) > 1)} {', '.join(regions)} touch{'es' * (len(regions) == 1)} "
+        top.sub("mesh").fail("file", f"region{'s' * (len(regions) > 1)} {', '.join(regions)} touch{'es' * (len(regions) == 1)} "
                  f"no other region (the mesh falls into {len(pieces)} pieces)",
                  "make the solids touch in one conformal mesh (BooleanFragments in gmsh), and join them by a "
                  "[contacts] table where they should not be bonded")
