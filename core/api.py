@@ -65,6 +65,9 @@ class Run:
     scenario: ScenarioRun
     seconds: float
     """Wall time of the run, s (model build included)."""
+    order_check: object = None
+    """A linear-element case: its final outputs at P1 and P2 on the same mesh
+    (:class:`~gatetherm.studies.run.order_check.OrderCheck`), if checked."""
 
     @property
     def time(self) -> np.ndarray:
@@ -115,12 +118,15 @@ class Run:
 
         c, p = self.case, self.case.problem
         out = {"case": c.name, "file": c.source, "dim": p.dim, "order": p.order,
-               "analysis": "prescribed temperature" if not p.heat else ("transient" if c.time else "steady"),
+               "analysis": ("prescribed temperature" if p.thermal else "mechanical") if not p.heat else
+               ("transient" if c.time else "steady"),
                "nodes": len(c.mesh.points), "elements": len(c.mesh.cells), "schedule": self.scenario.schedule.label,
                "effects": self.scenario.effects.describe(), "wall_time_s": round(self.seconds, 2),
                "march_s": round(self.scenario.result.seconds, 2), **probe_summary(p, self.columns)}
         if "delta_um" in self.columns and len(self.time) > 1:
             out.update(delta_figures(self.time, self["delta_um"]))
+        if self.order_check is not None:
+            out["order_check"] = self.order_check.summary()
         return out
 
     def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None) -> dict:
@@ -159,7 +165,7 @@ class Run:
 
 
 def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
-        keep=None, on_step: Callable[[int, int], None] | None = None) -> Run:
+        keep=None, on_step: Callable[[int, int], None] | None = None, check_order: bool = False) -> Run:
     """Run ``case``.
 
     Parameters
@@ -176,6 +182,10 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
         take less than :data:`STATE_BUDGET_BYTES`, else the case's field times and the end).
     on_step : callable, optional
         ``on_step(i, n)`` after each of the ``n`` samples.
+    check_order : bool
+        A linear-element case on a small mesh: solve its final state once more with quadratic
+        elements and warn (one log line naming the output and the fix) where they differ by more
+        than :data:`gatetherm.studies.run.order_check.TOLERANCE`.
 
     Returns
     -------
@@ -189,8 +199,14 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
         every = case.time.fields if case.time else 1.0
         keep = times if len(times) * n * 8 <= STATE_BUDGET_BYTES else \
             [t for t in times if abs(t / every - round(t / every)) < 1e-9] + [times[-1]]
-    scenario = run_scenario(case, schedule, effects, keep_times=sorted(set(map(float, keep))), on_step=on_step)
-    return Run(case, scenario, _time.perf_counter() - t0)
+    scenario = run_scenario(case, schedule, effects, keep_times=sorted(set(map(float, keep)) | {times[-1]}),
+                            on_step=on_step)
+    check = None
+    if check_order:
+        from gatetherm.studies.run.order_check import order_check
+
+        check = order_check(case, scenario)
+    return Run(case, scenario, _time.perf_counter() - t0, check)
 
 
 def reduce(case: Case, states: int = 30):

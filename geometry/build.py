@@ -118,9 +118,10 @@ def _build(p: FrameParams, dim: int, mesh: MeshParams, gmsh) -> tuple[dict, dict
     return to_arrays(fm, notes)
 
 
-def _extract(gmsh, dim, region_ents, facet_ents, point_of) -> tuple[FrameMesh, list[str]]:
-    """The mesh of the current model with the named groups (entity tags), and the notes of
-    point groups snapped to nodes (:func:`~gatetherm.geometry.mesh.snap_points`)."""
+def _extract(gmsh, dim, region_ents, facet_ents, point_of, line_ents=None) -> tuple[FrameMesh, list[str]]:
+    """The mesh of the current model with the named groups (entity tags; ``line_ents``: curves of a
+    3-D model), and the notes of point groups snapped to nodes
+    (:func:`~gatetherm.geometry.mesh.snap_points`)."""
     tags, xyz, _ = gmsh.model.mesh.getNodes()
     index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
     index[tags.astype(np.int64)] = np.arange(len(tags))
@@ -142,6 +143,7 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of) -> tuple[FrameMesh, l
         regions[name] = np.arange(offset, offset + len(cells))
         offset += len(cells)
     boundaries = {name: elements(dim - 1, ents) for name, ents in facet_ents.items()}
+    lines = {name: elements(1, ents) for name, ents in (line_ents or {}).items()}
     sensors = {}
     for name, t in point_of.items():
         ntags, _, _ = gmsh.model.mesh.getNodes(0, t)
@@ -155,4 +157,5 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of) -> tuple[FrameMesh, l
         points, cells = points[used], remap[cells]
         boundaries = {k: remap[v] for k, v in boundaries.items()}
         sensors = {k: int(remap[v]) for k, v in sensors.items()}
-    return FrameMesh(dim, points, cells, regions, boundaries, sensors), notes
+        lines = {k: remap[v] for k, v in lines.items()}
+    return FrameMesh(dim, points, cells, regions, boundaries, sensors, lines=lines), notes

@@ -169,7 +169,7 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
         _, xyz, _ = gmsh.model.mesh.getNodes()
         if abs(xyz[2::3]).max(initial=0.0) > 1e-12:
             raise InputError(str(spec.path), "a 2-D geometry must lie in the x-y plane", "draw it in z = 0")
-    fm, notes = _extract(gmsh, dim, groups[dim], groups[dim - 1], points)
+    fm, notes = _extract(gmsh, dim, groups[dim], groups[dim - 1], points, groups[1] if dim == 3 else None)
     return to_arrays(fm, notes)
 
 

@@ -43,6 +43,8 @@ class FrameMesh:
     meta: dict = field(default_factory=dict, compare=False)
     """What the mesh was made from, when known: ``{"frame": FrameParams}`` for a mesh built
     by :func:`gatetherm.geometry.build.build_mesh` (not kept in files)."""
+    lines: dict[str, np.ndarray] = field(default_factory=dict)
+    """3-D: named curves as (L, 2) node pairs (a support on a line)."""
 
     def sensor_xyz(self, name: str) -> np.ndarray:
         return self.points[self.sensors[name]]
@@ -62,6 +64,8 @@ def _groups(m: FrameMesh):
         yield name, d - 1, _FACET[d], fac
     for name, node in m.sensors.items():
         yield name, 0, "vertex", np.array([[node]])
+    for name, pairs in m.lines.items():
+        yield name, 1, "line", pairs
 
 
 def to_meshio(m: FrameMesh, point_data: dict | None = None):
@@ -136,7 +140,7 @@ def _named_blocks(mm):
 def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
     """A :class:`FrameMesh` from (name, dimension, connectivity) groups; nodes in no
     element are dropped."""
-    regions, boundaries, sensors, chunks, offset = {}, {}, {}, [], 0
+    regions, boundaries, sensors, lines, chunks, offset = {}, {}, {}, {}, [], 0
     for name, d, conn in groups:
         if d == dim:
             chunks.append(conn)
@@ -147,6 +151,8 @@ def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
             boundaries[name] = np.vstack([boundaries[name], conn]) if name in boundaries else conn
         elif d == 0:
             sensors[name] = int(conn[0, 0])
+        elif d == 1:
+            lines[name] = np.vstack([lines[name], conn]) if name in lines else conn
     if not chunks:
         raise InputError("mesh", f"holds no named {_KIND[dim]} groups", f"add a Physical {_KIND[dim].title()}")
     cells = np.vstack(chunks)
@@ -157,7 +163,8 @@ def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
     for note in notes:
         log.warning(note)
     return FrameMesh(dim, points[used][:, :dim].copy(), remap[cells], regions,
-                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()})
+                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()},
+                     lines={k: remap[v] for k, v in lines.items()})
 
 
 def snap_points(points: np.ndarray, cells: np.ndarray, sensors: dict[str, int]) -> tuple[dict[str, int], list[str]]:
@@ -231,12 +238,13 @@ def components(fm: FrameMesh) -> list[set[str]]:
 
 def to_arrays(fm: FrameMesh, notes=()) -> tuple[dict, dict[str, np.ndarray]]:
     """The mesh as a JSON-able header and numeric arrays (for a pipe), with ``notes``."""
-    meta = {"dim": fm.dim, "regions": list(fm.regions), "boundaries": list(fm.boundaries),
+    meta = {"dim": fm.dim, "regions": list(fm.regions), "boundaries": list(fm.boundaries), "lines": list(fm.lines),
             "sensors": {k: int(v) for k, v in fm.sensors.items()}, "notes": list(notes)}
     arrays = {"points": np.asarray(fm.points, dtype=np.float64), "cells": np.asarray(fm.cells, dtype=np.int64)}
     arrays |= {f"region{i}": np.asarray(v, dtype=np.int64) for i, v in enumerate(fm.regions.values())}
     arrays |= {f"boundary{i}": np.asarray(v, dtype=np.int64).reshape(-1, fm.dim)
                for i, v in enumerate(fm.boundaries.values())}
+    arrays |= {f"line{i}": np.asarray(v, dtype=np.int64).reshape(-1, 2) for i, v in enumerate(fm.lines.values())}
     return meta, arrays
 
 
@@ -248,16 +256,18 @@ def from_arrays(meta: dict, arrays: dict[str, np.ndarray]) -> FrameMesh:
     regions = {name: arrays[f"region{i}"] for i, name in enumerate(meta["regions"])}
     boundaries = {name: arrays[f"boundary{i}"] for i, name in enumerate(meta["boundaries"])}
     sensors = {str(k): int(v) for k, v in meta["sensors"].items()}
+    lines = {name: arrays[f"line{i}"] for i, name in enumerate(meta.get("lines", []))}
     ok = dim in (2, 3) and points.ndim == 2 and points.shape[1] == dim and cells.ndim == 2 and \
         cells.shape[1] == dim + 1 and cells.dtype.kind == "i" and points.dtype.kind == "f"
     n, e = len(points), len(cells)
     ok = ok and (cells.size == 0 or 0 <= cells.min() and cells.max() < n) and all(
         v.ndim == 1 and (v.size == 0 or 0 <= v.min() and v.max() < e) for v in regions.values()) and all(
         v.ndim == 2 and v.shape[1] == dim and (v.size == 0 or v.min() >= -1 and v.max() < n)
-        for v in boundaries.values()) and all(0 <= v < n for v in sensors.values())
+        for v in boundaries.values()) and all(0 <= v < n for v in sensors.values()) and all(
+        v.ndim == 2 and v.shape[1] == 2 and (v.size == 0 or 0 <= v.min() and v.max() < n) for v in lines.values())
     if not ok:
         raise ValueError("inconsistent mesh arrays")
-    return FrameMesh(dim, points, cells, regions, boundaries, sensors)
+    return FrameMesh(dim, points, cells, regions, boundaries, sensors, lines=lines)
 
 
 def load_mesh(path: str | os.PathLike) -> FrameMesh:

@@ -30,6 +30,7 @@ from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
+from gatetherm.studies.run import case_mech
 from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
                                        Relative, Signals, Source, Support, inputs)
@@ -37,7 +38,7 @@ from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, time
 from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
-            "supports", "probes", "relative", "means", "signals", "time", "actuator")
+            "supports", "probes", "relative", "means", "signals", "time", "actuator") + case_mech.SECTIONS
 MATERIAL_KEYS = {"k": "W/(m K)", "rho": "kg/m³", "c": "J/(kg K)", "E": "Pa", "nu": "1", "alpha": "1/K",
                  "thickness": "m"}
 MATERIAL = ranges(Material)
@@ -312,12 +313,16 @@ def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
     return tuple(out)
 
 
-def _supports(top: Table, fm: FrameMesh) -> tuple:
-    sup = top.sub("supports", tuple(fm.boundaries))
+def _supports(top: Table, fm: FrameMesh, names) -> tuple:
+    sup = top.sub("supports", case_mech.support_names(fm))
     out = []
     for b in sup.data:
-        t = sup.sub(b, ("type", "components", "stiffness"))
-        kind = t.string("type", choices=("clamped", "normal", "fixed", "foundation"))
+        t = sup.sub(b, ("type", "components", "stiffness", "value"))
+        kind = t.string("type", choices=("clamped", "normal", "fixed", "foundation", "displacement"))
+        case_mech.check_support(t, fm, b, kind)
+        if kind == "displacement":
+            out.append(case_mech.displacement_support(t, fm, b, names))
+            continue
         comps = tuple(range(fm.dim))
         if kind in ("fixed", "foundation") and ("components" in t.data or kind == "fixed"):
             raw = t.data.get("components")
@@ -443,11 +448,16 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")
     fm = _mesh(top, path.parent, mesh_factor) if mesh is None else mesh
+    plane = head.string("plane", "stress", ("stress", "strain", "axisymmetric"))
+    if plane == "axisymmetric":
+        case_mech.check_axisymmetric(top, fm, data)
     time, scheme, columns = _time(top, path.parent)
     prescribed = "temperature" in data
     elastic = "supports" in data
+    mechanical = case_mech.mechanical_only(data)  # no temperature at all
     need = ({"E", "nu", "alpha"} if elastic else set()) | (set() if prescribed else {"k"}) | \
         ({"rho", "c"} if time else set())
+    need = ({"E", "nu"} if mechanical else need) | ({"rho"} if "gravity" in data else set())
     materials, thickness = _materials(top, fm, need)
     names = ("t", *columns)
     init = top.sub("initial", ("temperature", "reference"))
@@ -476,7 +486,9 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             if "density" in s.data:
                 sources.append(Source(r, s.value("density", names, unit="W/m³")))
             else:
-                sources.append(Source(r, s.value("power", names, unit="W"), 1.0 / region_volume(fm, r, thickness.get(r, 1.0))))
+                vol = case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else \
+                    region_volume(fm, r, thickness.get(r, 1.0))
+                sources.append(Source(r, s.value("power", names, unit="W"), 1.0 / vol))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:
@@ -487,17 +499,24 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     twice = _twice(kw)
     if twice:
         top.fail("thermal", f"boundary '{twice}' is given two conditions", "give each boundary one condition")
-    supports = _supports(top, fm) if elastic else ()
-    quantities = ("T",) + (("u", "sigma") if elastic else ())
+    supports = _supports(top, fm, names) if elastic else ()
+    if elastic:
+        kw.update(case_mech.read_loads(top, fm, names))
+    elif "gravity" in data or "loads" in data:
+        top.fail("gravity" if "gravity" in data else "loads", "a mechanical load needs [supports]",
+                 "hold the body with [supports.BOUNDARY] tables")
+    kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
+    quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
     probes = _probes(top, fm, quantities)
     relative = _relative(top, probes, fm.dim) if elastic or "relative" in data else ()
     means = top.sub("means", None)
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)
-    problem = Problem(fm.dim, materials, int(order), thickness,
-                      head.string("plane", "stress", ("stress", "strain")),
+    problem = Problem(fm.dim, materials, int(order), thickness, plane,
                       T0, init.number("reference", CELSIUS, T0),
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
-                      signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme, **kw)
+                      signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme,
+                      thermal=not mechanical, **kw)
+    case_mech.check_assembly(top, fm, problem, time is None)
     if time is None:
         schedule = STEADY
     else:

@@ -37,6 +37,10 @@ def job_inp(model: Model, U: np.ndarray | None, title: str) -> str:
     if any(s.stiffness is not None for s in p.supports):
         raise InputError("supports", "an elastic foundation has no CalculiX counterpart here",
                          "export a model with fixed supports")
+    if model.terms is not None or p.contacts or not p.thermal:
+        raise InputError("loads", "the export writes the thermal load only (no mechanical loads, joints or purely "
+                         "mechanical cases)", "export a case without [gravity], [loads], [contacts] and displacement "
+                         "supports")
     fm, order = model.fmesh, p.order
     cells = fm.cells.copy()
     X = fm.points[cells]

@@ -111,19 +111,25 @@ def _build(case: Case) -> tuple[Model, HeatSolver | None]:
 
 
 def _once(p: Prepared, schedule: Schedule) -> RunResult:
-    """A prescribed-temperature or steady problem: the outputs of its one state at t = 0."""
+    """A steady problem: the outputs of its one state at t = 0; or one without a heat solve
+    (a prescribed temperature, or none): its outputs at every time of the schedule (the
+    loads' values change), states kept at t = 0 and at the end."""
     t0 = time.perf_counter()
     model = p.model
+    times = schedule.times if model.heat is None else schedule.times[:1]
+    envs = {float(t): environment(schedule.drive, float(t)) for t in times}
     if model.heat is None:
-        values, state = model.static(), None
-        keys = tuple(values)
-        Y = np.array([[values[k] for k in keys]])
+        rows = model.static(list(envs.values()))
+        keys = tuple(rows[0])
+        Y, states = np.array([[r[k] for k in keys] for r in rows]), [(float(t), None) for t in {times[0], times[-1]}]
     else:
-        state = p.solver.steady(environment(schedule.drive, 0.0))
-        keys, Y = model.readout.keys, model.read(state)[None, :]
-    cols = {"time_s": np.zeros(1), **{k: np.array([v]) for k, v in schedule.drive(0.0).items()}}
+        states = [(0.0, p.solver.steady(envs[0.0]))]
+        keys, Y = model.readout.keys, model.read(states[0][1], envs[0.0])[None, :]
+    drive = schedule.drive
+    cols = {"time_s": np.asarray(times, float), **{k: np.array([drive(float(t))[k] for t in times])
+                                                   for k in drive(0.0)}}
     cols.update(output_columns(model.problem, keys, Y))
-    return RunResult(cols, [(0.0, state)], time.perf_counter() - t0)
+    return RunResult(cols, sorted(states, key=lambda s: s[0]), time.perf_counter() - t0, envs)
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, march
+from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, environment, march
 from gatetherm.solvers.model import Model
 from gatetherm.solvers.problem import Problem
 from gatetherm.solvers.stress import von_mises
@@ -31,6 +31,9 @@ class RunResult:
     columns: dict[str, np.ndarray]
     states: list[tuple[float, np.ndarray]] = field(default_factory=list)
     seconds: float = 0.0
+    envs: dict[float, dict] = field(default_factory=dict)
+    """The inputs (``t`` and the drive's) at the times of :attr:`states`: the mechanical
+    loads' values there."""
 
 
 def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
@@ -96,24 +99,26 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     ``solver`` of ``model.heat`` carries its factorisations over from earlier runs.
     Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
-    inputs, Y, states = [], [], []
+    inputs, Y, states, envs = [], [], [], {}
     t0 = _time.perf_counter()
     scheme = model.problem.scheme if scheme is None else scheme
     if model.elastic is not None:  # outputs come from adjoint weights: room for the heat factors
         model.elastic.solve.release()
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
+        env = environment(drive, t)
         inputs.append({"time_s": t, **drive(t)})
-        Y.append(model.read(U))
+        Y.append(model.read(U, env))
         if t in keep:
             states.append((t, U.copy()))
+            envs[t] = env
         if on_step:
             on_step(i + 1, len(times))
     cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
     cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
     secs = _time.perf_counter() - t0
     log.info("marched %d steps in %.2f s", len(Y) - 1, secs)
-    return RunResult(cols, states, secs)
+    return RunResult(cols, states, secs, envs)
 
 
 def prominent_peaks(x: np.ndarray, prominence: float) -> list[int]:

@@ -24,7 +24,7 @@ class Table:
                     raise InputError(f"{file}: {where}.{key}", "unknown key", f"known keys: {', '.join(known)}")
 
     def key(self, k: str) -> str:
-        return f"{self.file}: {self.where}.{k}"
+        return f"{self.file}: {self.where}.{k}" if self.where else f"{self.file}: {k}"
 
     def fail(self, k: str, problem: str, fix: str = ""):
         raise InputError(self.key(k), problem, fix)

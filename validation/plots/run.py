@@ -74,7 +74,8 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     """Temperature on the frame deformed by ``scale`` × displacement, the undeformed outline
     in grey (pyvista, off screen), framed by matplotlib with a labelled colour bar.
 
-    ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components).
+    ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components);
+    without ``T`` (a purely mechanical case) the colours show the displacement's magnitude.
     """
     import pyvista as pv
     from matplotlib.cm import ScalarMappable
@@ -83,7 +84,11 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
 
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)  # no X display: VTK falls back quietly
     pv.OFF_SCREEN = True
-    T = np.asarray(grid["T"])
+    thermal = "T" in grid.point_data
+    if not thermal:
+        grid["|u| [µm]"] = 1e6 * np.linalg.norm(np.asarray(grid["u"]), axis=1)
+    name = "T" if thermal else "|u| [µm]"
+    T = np.asarray(grid[name])
     clim = (float(T.min()), float(T.max()) if T.max() > T.min() else float(T.min()) + 1.0)
     flat = grid.bounds[5] - grid.bounds[4] < 1e-12
     outline = grid.extract_surface(algorithm="dataset_surface").extract_feature_edges(feature_angle=30.0, boundary_edges=flat,
@@ -91,7 +96,7 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
                                                            non_manifold_edges=False)
     p = pv.Plotter(off_screen=True, window_size=(1600, 1200))
     p.set_background("white")
-    p.add_mesh(grid.warp_by_vector("u", factor=scale), scalars="T", cmap=CMAP, clim=clim, show_scalar_bar=False)
+    p.add_mesh(grid.warp_by_vector("u", factor=scale), scalars=name, cmap=CMAP, clim=clim, show_scalar_bar=False)
     p.add_mesh(outline, color="#8c8c8c", line_width=2)
     if flat:
         p.view_xy()
@@ -103,7 +108,7 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     ax.imshow(img, interpolation="lanczos")
     ax.set_axis_off()
     bar = fig.colorbar(ScalarMappable(Normalize(*clim), CMAP), ax=ax, fraction=0.04, pad=0.02, shrink=0.85)
-    bar.set_label("temperature T [°C]")
+    bar.set_label("temperature T [°C]" if thermal else "displacement |u| [µm]")
     ax.set_title(f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges", fontsize="medium")
     save(fig, path, tight=True)
 

@@ -76,9 +76,9 @@ SECTIONS: tuple[Section, ...] = (
             also="python -m pytest tests/test_verification_heat.py tests/test_verification_elastic.py -s "
                  "(-m slow adds the 3-D elastic orders)"),
     Section("nafems", "NAFEMS benchmarks through case files", "nafems:compute",
-            subset={"cases": ["t1", "t3", "t4", "le11"]}, inputs=("gatetherm.validation:nafems/*",),
+            subset={"cases": ["t1", "t3", "t4", "le11", "le1", "le10"]}, inputs=("gatetherm.validation:nafems/*",),
             readme=("nafems",),
-            also="gatetherm run validation/nafems/t1.toml --out D (and t3, t4, le11)"),
+            also="gatetherm run validation/nafems/t1.toml --out D (and t3, t4, le11, le1, le10)"),
     Section("paper", "Paper vs gatetherm, 2-D and 3-D (Figs. 10-13 analogues)", "paper:compute",
             subset={"dims": [2, 3], "size_3d": 0.015}, full={"dims": [2, 3], "size_3d": None},
             about="3-D on a coarser mesh (element size 15 mm instead of the model's 9 mm)",
