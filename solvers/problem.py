@@ -195,9 +195,13 @@ class Problem:
         return self.prescribed is None and not self.prescribed_regions
 
 
+def values(problem: Problem) -> list[Value]:
+    """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
+    out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
+    out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    return out + [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
+
+
 def inputs(problem: Problem) -> set[str]:
     """The schedule columns the problem's values read (not time ``t``)."""
-    values = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
-    values += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
-    values += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
-    return set().union(*(v.names() for v in values)) - {"t"}
+    return set().union(*(v.names() for v in values(problem))) - {"t"}

@@ -159,25 +159,32 @@ def run(args: argparse.Namespace) -> int:
     if args.case is not None and args.method != "paper":
         raise InputError("--method", f"{args.method} works on the paper frame's model, not on a case file",
                          "use --method paper with --case")
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out_dir:
+    case = _case(args.case) if args.case is not None else None
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *(case.inputs if case else ()))) as out_dir:
         if args.condition is not None:
             ts, what = _simulated(args, cfg, cache), f"condition {args.condition}"
-        elif args.case is not None:
-            ts, what = _case_series(args.case), str(args.case)
+        elif case is not None:
+            ts, what = _case_series(case), str(args.case)
         return _compensate(args, cfg, ts, what, params, model, cache, out_dir)
 
 
-def _case_series(path):
-    """The time series of a case's run; its signals must map the compensator's channels."""
+def _case(path):
+    """A case to compensate: its signals must map the compensator's channels."""
     from gatetherm.studies.run.case import load_case
-    from gatetherm.studies.run.scenario import case_schedule, run_scenario
 
     case = load_case(path)
     if not case.problem.signals.complete or case.time is None:
         raise InputError(f"{path}: signals", "a compensated case needs [time] and [signals] with theta_A, theta_B, "
                          "theta_C and delta", "map them to the case's probes and relative displacement")
+    return case
+
+
+def _case_series(case):
+    """The time series of a case's run."""
+    from gatetherm.studies.run.scenario import case_schedule, run_scenario
+
     run = run_scenario(case, case.mesh.dim, case_schedule(case))
-    return run.series({"format": FORMAT, "source": "gatetherm compensate", "case": str(path)})
+    return run.series({"format": FORMAT, "source": "gatetherm compensate", "case": str(case.path)})
 
 
 def _simulated(args, cfg, cache):

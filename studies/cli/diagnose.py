@@ -134,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         mesh = cfg.model.mesh if args.mesh_size is None else dataclasses.replace(
             cfg.model.mesh, **{"size" if args.dim == 2 else "size_3d": args.mesh_size})
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out:
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *(cfg.inputs if args.case else ()))) as out:
         diag = diagnose(cfg, ts, args.dim, mesh, settings)
         _write(args, cfg, diag, adopted_config(cfg, diag), out)
     s = diag.summary()

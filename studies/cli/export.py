@@ -45,7 +45,7 @@ def run(args) -> int:
         schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
     check_time(schedule, t)
-    with output_dir(args.out, OUTPUTS, keep=(args.case, args.config)) as out:
+    with output_dir(args.out, OUTPUTS, keep=(args.config, *(cfg.inputs if args.case else ()))) as out:
         inp, info = export_state(cfg, dim, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
         write_text_atomic(out / "job.inp", inp)
         write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")

@@ -27,8 +27,7 @@ def run(args) -> int:
 
     t0 = time.perf_counter()
     case = load_case(args.case)
-    inputs = (args.case, case.time.schedule if case.time else None)
-    with output_dir(args.out, OUTPUTS, keep=inputs) as out:
+    with output_dir(args.out, OUTPUTS, keep=case.inputs) as out:
         return _run(args, case, out, t0)
 
 

@@ -224,7 +224,7 @@ def _case_with(case: Case, params: dict) -> Case:
 
 
 def _scaled(v: Value, factor: float) -> Value:
-    return Value(v.constant * factor) if v.is_constant else Value.of(f"{factor!r} * ({v.text})")
+    return Value(v.constant * factor) if v.is_constant else Value.of(f"{factor!r} * ({v.text})", v.key, v.range)
 
 
 PROPORTIONAL = (frozenset({"parameter:expansion", "sensor:sensor_gain@delta_um"}),)

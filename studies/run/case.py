@@ -29,7 +29,7 @@ from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
 from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
-                                       Relative, Signals, Source, Support)
+                                       Relative, Signals, Source, Support, values)
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
             "supports", "probes", "relative", "means", "signals", "time")
@@ -72,6 +72,8 @@ class Case:
     """Catalogue effects switched on (the scenario path's interface; none from the file)."""
     sensors: dict = field(default_factory=dict)
     """Sensor faults, {channel: {fault: value}} (the scenario path's interface; none from the file)."""
+    inputs: tuple[Path, ...] = ()
+    """The files the case reads (itself, its mesh or geometry, its schedule): a run keeps them."""
 
     @property
     def source(self) -> str:
@@ -143,11 +145,11 @@ def _boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
             t.fail("/".join(kinds) or "film", "give exactly one condition: film (with ambient), temperature or flux",
                    "a boundary without a condition is adiabatic; leave it out")
         if kinds == ["film"]:
-            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C")))
+            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C", rng=CELSIUS)))
         elif "ambient" in t.data:
             t.fail("ambient", "goes with a film only", "remove it or give film")
         elif kinds == ["temperature"]:
-            out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C")))
+            out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C", rng=CELSIUS)))
         else:
             out["fluxes"].append(Flux(b, t.value("flux", names, unit="W/m²")))
     return out
@@ -173,9 +175,9 @@ def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
             rho_c = t.number("rho_c", Range(0.0, lo_open=True, unit="J/(m³ K)"))
             capacity, conductance = rho_c * volume, rho_c * t.number("flow_rate", Range(0.0, unit="m³/s"))
         out.append(Fluid(name, wall, capacity, t.number("film_on", FILM),
-                         t.number("film_off", FILM), conductance, t.value("supply", names, unit="°C"),
+                         t.number("film_off", FILM), conductance, t.value("supply", names, unit="°C", rng=CELSIUS),
                          t.value("pump", names, default=1.0), hose, t.number("hose_loss", Range(0.0, unit="W/K"), 0.0),
-                         t.value("ambient", names, default=20.0 if not hose else None, unit="°C"),
+                         t.value("ambient", names, default=20.0 if not hose else None, unit="°C", rng=CELSIUS),
                          t.string("hose_name", default="")))
     return tuple(out)
 
@@ -269,28 +271,45 @@ def _signals(top: Table, probes, relative) -> Signals:
                    tuple(c), s.name("delta", [r.name for r in relative], "relative displacement", "") or None)
 
 
-def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tuple[str, ...]]:
+def _time(top: Table, base: Path):
+    """The time settings, the scheme and the schedule file's series (None: no schedule)."""
     if "time" not in top.data:
-        return None, TimeScheme(), ()
+        return None, TimeScheme(), None
+    from gatetherm.studies.run.timeseries import check_steps, read_timeseries
+
     t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
     end = t.number("end", SECONDS)
-    output = t.number("output", SECONDS, min(60.0, end))
-    step = t.number("step", SECONDS, output)
+    within = Range(0.0, end, lo_open=True, unit="s")  # an interval longer than the run is refused
+    output = t.number("output", within, min(60.0, end))
+    step = t.number("step", within, output)
     if abs(output / step - round(output / step)) > 1e-9:
         t.fail("output", f"{output:g} s is not a whole multiple of the step {step:g} s", "change output or step")
+    check_steps(end, step, t.key("step"))
     sch = t.sub("scheme", ("theta", "restart", "restart_intervals"))
     scheme = TimeScheme(sch.number("theta", SCHEME["theta"], 0.5), int(sch.number("restart", SCHEME["restart"], 4)),
                         int(sch.number("restart_intervals", SCHEME["restart_intervals"], 3)))
-    schedule, columns = None, ()
+    schedule, ts = None, None
     if "schedule" in t.data:
-        from gatetherm.studies.run.timeseries import read_timeseries
-
         schedule = base / t.string("schedule")
         if not schedule.is_file():
             t.fail("schedule", f"no such file '{schedule}'", "give a time-series file (docs/data-format.md)")
-        columns = tuple(n for n in read_timeseries(schedule, required=("time_s",)).names if n != "time_s")
-    return TimeSettings(end, step, output, t.number("fields", SECONDS, end),
-                        schedule), scheme, columns
+        ts = read_timeseries(schedule, required=("time_s",))
+        span = float(ts.time_s[-1] - ts.time_s[0])
+        if span < end * (1 - 1e-9):
+            t.fail("schedule", f"'{schedule}' spans {span:g} s, less than the run (end = {end:g} s)",
+                   "extend the schedule (its times are seconds) or shorten end")
+    return TimeSettings(end, step, output, t.number("fields", within, end), schedule), scheme, ts
+
+
+def _check_schedule(problem: Problem, ts, end: float) -> None:
+    """Every value that reads the schedule, at the schedule's samples within the run
+    (where its columns are recorded): in the range of its key."""
+    t = np.asarray(ts.time_s - ts.time_s[0], float)
+    env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
+    for v in values(problem):
+        rows = (t <= end) & np.logical_and.reduce([np.isfinite(env[n]) for n in v.names() | {"t"}])
+        if v.names() and rows.any():
+            v({n: env[n][rows] for n in v.names() | {"t"}})
 
 
 def load_case(path, mesh_factor: float = 1.0) -> Case:
@@ -308,7 +327,8 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")
     fm = _mesh(top, path.parent, mesh_factor)
-    time, scheme, columns = _time(top, path.parent)
+    time, scheme, schedule = _time(top, path.parent)
+    columns = tuple(n for n in schedule.names if n != "time_s") if schedule is not None else ()
     prescribed = "temperature" in data
     elastic = "supports" in data
     need = ({"E", "nu", "alpha"} if elastic else set()) | (set() if prescribed else {"k"}) | \
@@ -326,7 +346,7 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
         if ("field" in tt.data) == ("regions" in tt.data):
             tt.fail("field", "give either field (an expression of x, y, z) or a [temperature.regions] table")
         if "field" in tt.data:
-            kw["prescribed"] = tt.value("field", ("x", "y", "z")[:fm.dim], unit="°C")
+            kw["prescribed"] = tt.value("field", ("x", "y", "z")[:fm.dim], unit="°C", rng=CELSIUS)
         else:
             reg = tt.sub("regions", tuple(fm.regions))
             kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
@@ -342,13 +362,13 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
                 sources.append(Source(r, s.value("density", names, unit="W/m³")))
             else:
                 vol = region_volume(fm, r, thickness.get(r, 1.0))
-                sources.append(Source(r, Value.of(f"({s.value('power', names, unit='W')}) / {vol!r}")))
+                sources.append(Source(r, Value.of(f"({s.value('power', names, unit='W')}) / {vol!r}", s.key("power"))))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")
             f = top.sub("faces", ("film", "ambient"))
-            kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C"))
+            kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C", rng=CELSIUS))
         kw["fluids"] = _fluids(top, fm, names, thickness)
     twice = _twice(kw)
     if twice:
@@ -364,7 +384,10 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
                       T0, init.number("reference", CELSIUS, T0),
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
                       signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme, **kw)
-    return Case(path, head.string("name", path.stem), problem, fm, time)
+    if schedule is not None:
+        _check_schedule(problem, schedule, time.end)
+    inputs = (path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else []))
+    return Case(path, head.string("name", path.stem), problem, fm, time, inputs=inputs)
 
 
 def _twice(kw: dict) -> str | None:

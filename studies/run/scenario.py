@@ -243,6 +243,7 @@ def run_scenario(config: Config | Case, dim: int, schedule: Schedule, effects: M
         p = prepare(config, dim, schedule.drive, effects, cache=cache, mesh=mesh)
         result, model = run(p), p.model
     cols = apply_faults(eff.observe(result.columns), config.sensors)
-    if schedule.every > 1:
-        cols = {k: v[::schedule.every] for k, v in cols.items()}
+    if schedule.every > 1:  # every output interval, and the end of the run
+        n = len(next(iter(cols.values())))
+        cols = {k: v[np.unique(np.r_[0:n:schedule.every, n - 1])] for k, v in cols.items()}
     return ScenarioRun(cols, result, model, eff, schedule, time.perf_counter() - t0)

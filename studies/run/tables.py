@@ -53,13 +53,15 @@ class Table:
             self.fail(k, f"'{v}' is not a {what} of the mesh", f"{what}s: {', '.join(valid) or 'none'}")
         return v
 
-    def value(self, k: str, names, default=None, unit: str = "") -> Value:
+    def value(self, k: str, names, default=None, unit: str = "", rng: Range = FINITE) -> Value:
+        """The value at ``k``: a number in ``rng`` or an expression of ``names`` (checked
+        against ``rng`` now if it reads none, else wherever it is evaluated)."""
         if k not in self.data and default is not None:
-            return Value(default)
+            return Value(default, "", self.key(k), rng)
         if k not in self.data:
             self.fail(k, "missing", f"give a number{' in ' + unit if unit else ''} or an expression")
         try:
-            v = Value.of(self.data[k])
+            v = Value.of(self.data[k], self.key(k), rng)
         except ExpressionError as err:
             self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
         unknown = sorted(v.names() - set(names))
