@@ -124,3 +124,39 @@ def check_fields(obj, prefix: str = "", names=None):
         if value is not None and (names is None or name in names):
             rng.check(f"{prefix}{name}", value)
     return obj
+
+
+def check_linear_system(where: str, modes, C, D=None, inputs=None, outputs=None) -> None:
+    """InputError naming ``where`` unless ``ẋ = A x + B u, y = C x (+ D u)`` is a sound
+    linear system in every mode of ``modes`` ({mode: (A, B)}, any number of modes): consistent
+    shapes (and as many ``inputs``/``outputs`` names as B has columns and C rows, where given),
+    finite entries, and every A stable (its eigenvalues' real parts negative)."""
+    fix = "write it again with 'gatetherm reduce'"
+
+    def fail(what: str):
+        raise InputError(where, what, fix)
+
+    if not modes:
+        fail("no mode (no A, B matrices)")
+    arrays = {"C": C, **({"D": D} if D is not None else {})}
+    for mode, (A, B) in modes.items():
+        arrays.update({f"A_{mode}": A, f"B_{mode}": B})
+    for name, M in arrays.items():
+        M = np.asarray(M)
+        if M.ndim != 2 or 0 in M.shape:
+            fail(f"{name} is not a matrix (shape {M.shape})")
+        if not np.issubdtype(M.dtype, np.number) or not np.isfinite(M).all():
+            fail(f"{name} has entries that are not finite numbers")
+    A0, B0 = next(iter(modes.values()))
+    n, m, p = np.shape(A0)[0], np.shape(B0)[1], np.shape(C)[0]
+    want = {**{f"A_{k}": (n, n) for k in modes}, **{f"B_{k}": (n, m) for k in modes}, "C": (p, n), "D": (p, m)}
+    for name, M in arrays.items():
+        if np.shape(M) != want[name]:
+            fail(f"{name} has shape {np.shape(M)}, expected {want[name]} ({n} states, {m} inputs, {p} outputs)")
+    for names, count, what in ((inputs, m, "inputs"), (outputs, p, "outputs")):
+        if names is not None and len(names) != count:
+            fail(f"{len(names)} {what} named for {count} {what} of the matrices")
+    for mode, (A, _) in modes.items():
+        growth = float(np.linalg.eigvals(np.asarray(A, float)).real.max())
+        if not growth < 0:
+            fail(f"A_{mode} is not stable (an eigenvalue with real part {growth:.3g} 1/s >= 0)")

@@ -10,12 +10,14 @@ from __future__ import annotations
 import hashlib
 import logging
 import time
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from gatetherm import InputError, __version__, atomic_path, write_text_atomic
+from gatetherm.checks import CELSIUS, check_linear_system
 from gatetherm.solvers.rom import Reduction, ReducedModel, linear_heat_model, reduce
 from gatetherm.solvers.rom_time import discretise, march_rom
 from gatetherm.studies.run.config import Config
@@ -66,13 +68,23 @@ def write_rom(rom: ReducedModel, path) -> None:
 
 
 def load_rom(path) -> ReducedModel:
-    """Read a ``rom.npz`` written by :func:`write_rom`."""
+    """Read a ``rom.npz`` written by :func:`write_rom`, checked
+    (:func:`~gatetherm.checks.check_linear_system`, T0 a temperature)."""
+    fix = "write one with 'gatetherm reduce'"
+    if not Path(path).is_file():
+        raise InputError(str(path), "no such file", fix)
+    if not zipfile.is_zipfile(path):
+        raise InputError(str(path), "not an .npz archive (truncated, or another kind of file)", fix)
     try:
         with np.load(path, allow_pickle=False) as d:
-            return ReducedModel(*(np.array(d[k], float) for k in ("A_on", "B_on", "A_off", "B_off", "C")),
-                                float(d["T0"]), tuple(map(str, d["inputs"])), tuple(map(str, d["outputs"])))
-    except (KeyError, ValueError, OSError) as err:
-        raise InputError(str(path), f"not a reduced model ({err})", "write one with 'gatetherm reduce'") from None
+            rom = ReducedModel(*(np.array(d[k], float) for k in ("A_on", "B_on", "A_off", "B_off", "C")),
+                               float(d["T0"]), tuple(map(str, d["inputs"])), tuple(map(str, d["outputs"])))
+    except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as err:
+        raise InputError(str(path), f"not a reduced model ({type(err).__name__}: {err})", fix) from None
+    CELSIUS.check(f"{path}: T0", rom.T0, fix)
+    check_linear_system(str(path), {"on": (rom.A_on, rom.B_on), "off": (rom.A_off, rom.B_off)}, rom.C,
+                        inputs=rom.inputs, outputs=rom.outputs)
+    return rom
 
 
 def save_rom(rom: ReducedModel, key: str, directory: Path, name: str = "rom") -> None:
@@ -87,9 +99,12 @@ def cached_rom(config: Config, dim: int, states: int, directory: Path, cache: Sc
     reused while its key (:func:`rom_key`, in ``<name>.key``) matches, else built and kept."""
     path, keyfile = Path(directory) / f"{name}.npz", Path(directory) / f"{name}.key"
     key = rom_key(config, dim, states)
-    if path.exists() and keyfile.exists() and keyfile.read_text().strip() == key:
+    if path.exists() and keyfile.exists() and keyfile.read_text(errors="replace").strip() == key:
         log.info("reusing %s", path)
-        return load_rom(path)
+        try:
+            return load_rom(path)
+        except InputError as err:
+            log.warning("%s; building the reduced model again", err)
     rom = build_rom(config, dim, states, cache).rom
     save_rom(rom, key, directory, name)
     return rom
