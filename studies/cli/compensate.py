@@ -38,7 +38,7 @@ from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.solvers.beam import theory_coefficients
-from gatetherm.studies.cli.options import add_model_options
+from gatetherm.studies.cli.options import add_model_options, refuse_model_options
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import (NEEDED, CompensatorParams, close_loop, compensate,
                                                    external_prediction, summarize)
@@ -159,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
     if args.case is not None and args.method != "paper":
         raise InputError("--method", f"{args.method} works on the paper frame's model, not on a case file",
                          "use --method paper with --case")
+    if args.case is not None:
+        refuse_model_options(args)
     case = _case(args.case) if args.case is not None else None
     with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *(case.inputs if case else ()))) as out_dir:
         if args.condition is not None:

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE
-from gatetherm.studies.cli.options import add_model_options, number
+from gatetherm.studies.cli.options import add_model_options, number, refuse_model_options
 
 log = logging.getLogger(__name__)
 
@@ -101,10 +101,9 @@ def load_model(args):
         if args.mesh_factor is not None:
             raise InputError("--mesh-factor", "goes with --case only", "give --mesh-size for the paper model")
         return load_config(args.config)
-    if args.config is not None:
-        raise InputError("--case/--config", "give one model, a case file or a model file", "drop one of the two")
-    if args.dim != 2 or args.mesh_size is not None:
-        raise InputError("--dim/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
+    refuse_model_options(args)
+    if args.mesh_size is not None:
+        raise InputError("--case/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
     case = load_case(args.case, args.mesh_factor or 1.0)
     if case.time is None:
         raise InputError(f"{args.case}: time", "a diagnosed case needs [time] (a transient run)",

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.studies.cli.options import add_model_options
+from gatetherm.studies.cli.options import add_model_options, refuse_model_options
 
 #: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
 OUTPUTS = ("job.inp", "gatetherm.json")
@@ -36,6 +36,7 @@ def run(args) -> int:
     if args.case:
         from gatetherm.studies.run.case import load_case
 
+        refuse_model_options(args, "CASE.toml")
         cfg = load_case(args.case)
         schedule, dim, what = case_schedule(cfg), cfg.mesh.dim, str(args.case)
     else:
@@ -44,7 +45,7 @@ def run(args) -> int:
         cfg = load_config(args.config)
         schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
-    check_time(schedule, t)
+    t = check_time(schedule, t)
     with output_dir(args.out, OUTPUTS, keep=(args.config, *(cfg.inputs if args.case else ()))) as out:
         inp, info = export_state(cfg, dim, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
         write_text_atomic(out / "job.inp", inp)

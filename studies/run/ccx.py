@@ -119,10 +119,12 @@ def probe_set(name: str) -> str:
     return f"P_{_set(name)}"
 
 
-def check_time(schedule, t: float) -> None:
-    """InputError unless ``t`` (s) is a step of ``schedule``."""
-    if not any(abs(t - s) < 1e-6 for s in schedule.times):
+def check_time(schedule, t: float) -> float:
+    """The step of ``schedule`` at ``t`` (s, within 1e-6 s); InputError if there is none."""
+    near = [float(s) for s in schedule.times if abs(t - s) < 1e-6]
+    if not near:
         raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
+    return near[0]
 
 
 def export_state(config, dim: int, schedule, t: float, title: str) -> tuple[str, dict]:
@@ -131,7 +133,7 @@ def export_state(config, dim: int, schedule, t: float, title: str) -> tuple[str,
     relative displacements in m, the probe sets they compare and the mesh size)."""
     from gatetherm.studies.run.scenario import run_scenario
 
-    check_time(schedule, t)
+    t = check_time(schedule, t)
     run = run_scenario(config, dim, schedule, keep_times=[t])
     (_, U), = [s for s in run.result.states if abs(s[0] - t) < 1e-6]
     model = run.model
