@@ -147,8 +147,10 @@ def check_linear_system(where: str, modes, C, D=None, inputs=None, outputs=None)
             fail(f"{name} is not a matrix (shape {M.shape})")
         if not np.issubdtype(M.dtype, np.number) or not np.isfinite(M).all():
             fail(f"{name} has entries that are not finite numbers")
-    A0, B0 = next(iter(modes.values()))
-    n, m, p = np.shape(A0)[0], np.shape(B0)[1], np.shape(C)[0]
+    def usual(sizes):  # the size most matrices agree on: the others are wrong
+        return max(sizes, key=sizes.count)
+    n = usual([np.shape(A)[0] for A, _ in modes.values()] + [np.shape(C)[1]])
+    m, p = usual([np.shape(B)[1] for _, B in modes.values()]), np.shape(C)[0]
     want = {**{f"A_{k}": (n, n) for k in modes}, **{f"B_{k}": (n, m) for k in modes}, "C": (p, n), "D": (p, m)}
     for name, M in arrays.items():
         if np.shape(M) != want[name]:
@@ -157,6 +159,6 @@ def check_linear_system(where: str, modes, C, D=None, inputs=None, outputs=None)
         if names is not None and len(names) != count:
             fail(f"{len(names)} {what} named for {count} {what} of the matrices")
     for mode, (A, _) in modes.items():
-        growth = float(np.linalg.eigvals(np.asarray(A, float)).real.max())
-        if not growth < 0:
-            fail(f"A_{mode} is not stable (an eigenvalue with real part {growth:.3g} 1/s >= 0)")
+        eig = np.linalg.eigvals(np.asarray(A, float))
+        if not eig.real.max() < -1e-9 * np.abs(eig).max():  # a zero eigenvalue is zero only to round-off
+            fail(f"A_{mode} is not stable (an eigenvalue with real part {eig.real.max():.3g} >= 0)")

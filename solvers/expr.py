@@ -207,7 +207,7 @@ class Value:
 
     def _error(self, env: Mapping[str, object], at, problem: str, must: str = "") -> InputError:
         """The error of an evaluation: the key, the expression, the time or point, the range."""
-        names = sorted(self.names() & set(env), key=lambda n: (n != "t", n))
+        names = sorted((self.names() | {"t"}) & set(env), key=lambda n: (n != "t", n))
         shape = np.broadcast_shapes(*(np.shape(env[n]) for n in names))
         where = [f"{n} = {show(float(np.broadcast_to(np.asarray(env[n], float), shape)[at]))}{' s' * (n == 't')}"
                  for n in names] if at is not None else []

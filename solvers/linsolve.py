@@ -47,7 +47,7 @@ HINTS = {"pardiso": "pip install py-mkl-pardiso (Linux x86_64, Windows)", "cholm
 
 
 class SolverError(RuntimeError):
-    """An iterative solve did not converge."""
+    """An iterative solve did not converge, or a matrix cannot be factorised."""
 
 
 def _say_once(key: str, level: int, msg: str, *args, _said: set = set()) -> None:  # noqa: B006
@@ -114,7 +114,11 @@ def _pardiso(A: sp.spmatrix, order) -> Solve:
     else:
         solver.set_iparm(4, 1)  # the given order
         solver.set_perm(np.asarray(order, dtype=np.int64))
-    solver.factor(U.data.astype(float))
+    try:
+        solver.factor(U.data.astype(float))
+    except RuntimeError as err:
+        raise SolverError(f"the matrix cannot be factorised ({err}): material constants or thicknesses many "
+                          "orders of magnitude apart?") from None
     return solver.solve
 
 

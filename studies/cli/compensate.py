@@ -140,6 +140,8 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.interval_min) and args.interval_min > 0):
         raise InputError("--interval-min", f"must be > 0, got {args.interval_min}", "e.g. --interval-min 5")
     params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
+    if args.case is not None:
+        refuse_model_options(args)
     cfg = load_config(args.config)
 
     cache = ScenarioCache()
@@ -159,8 +161,6 @@ def run(args: argparse.Namespace) -> int:
     if args.case is not None and args.method != "paper":
         raise InputError("--method", f"{args.method} works on the paper frame's model, not on a case file",
                          "use --method paper with --case")
-    if args.case is not None:
-        refuse_model_options(args)
     case = _case(args.case) if args.case is not None else None
     with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *(case.inputs if case else ()))) as out_dir:
         if args.condition is not None:
@@ -220,7 +220,7 @@ def _compensate(args, cfg, ts, what, params, model, cache, out_dir: Path) -> int
             f"every {args.interval_min:g} min"
         head = f"mlr ({label})"
     else:
-        loop, extra, label = _rom_loop(args, ts, cfg, cache, params, actuator)
+        loop, extra, label = _rom_loop(args, ts, what, cfg, cache, params, actuator)
         head = f"rom ({label})"
     summary = {**summarize(loop, params.settle_s), "method": args.method, **extra,
                "data": args.data, "case": args.case,
@@ -249,11 +249,11 @@ def _compensate(args, cfg, ts, what, params, model, cache, out_dir: Path) -> int
     return 0
 
 
-def _rom_loop(args, ts, cfg, cache, params, actuator):
+def _rom_loop(args, ts, what, cfg, cache, params, actuator):
     """The rom method's closed loop, its summary entries and a label."""
     from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
     from gatetherm.studies.control.observer import ObserverParams
-    from gatetherm.studies.run.reduce import cached_rom, load_rom
+    from gatetherm.studies.run.reduce import cached_rom, load_rom, output_of
 
     if not 2 <= args.states <= 200:
         raise InputError("--states", f"{args.states} is outside 2..200", "e.g. --states 30")
@@ -265,6 +265,13 @@ def _rom_loop(args, ts, cfg, cache, params, actuator):
         rom, where = load_rom(args.rom), args.rom
     else:
         rom, where = cached_rom(cfg, args.dim, args.states, Path(args.out), cache), str(Path(args.out) / "rom.npz")
+    missing = [n for n in ("delta_um", *map(output_of, sensors)) if n not in rom.outputs]
+    if missing:
+        raise InputError(f"{where}: outputs", f"no {missing[0]!r}", f"its outputs: {', '.join(rom.outputs)}")
+    lacking = [n for n in rom.inputs if n not in ts and n != "ambient_degC"]
+    if lacking:
+        raise InputError(f"{what}, column {lacking[0]}", f"missing: the reduced model {where} reads it",
+                         "record it, or give a reduced model of the inputs recorded")
     pr, cmds = rom_prediction(ts, rom, params, control, ObserverParams(), sensors, cfg.supply.T_room)
     loop = close_loop(ts, pr, params, actuator)
     extra = {"rom": where, "rom_states": rom.states, "sensors": list(sensors), "threshold_um": cmds.threshold_um,

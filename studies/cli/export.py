@@ -44,6 +44,9 @@ def run(args) -> int:
 
         cfg = load_config(args.config)
         schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
+    if dim != 3:  # before the run
+        raise InputError(f"{args.case}: mesh" if args.case else "--dim", "CalculiX export is for 3-D models",
+                         "give a 3-D mesh" if args.case else "use --dim 3")
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
     t = check_time(schedule, t)
     with output_dir(args.out, OUTPUTS, keep=(args.config, *(cfg.inputs if args.case else ()))) as out:

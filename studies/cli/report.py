@@ -77,10 +77,11 @@ def run(args) -> int:
 def _drift(args) -> int:
     from gatetherm.outdir import output_dir
     from gatetherm.studies.run.timeseries import read_timeseries
-    from gatetherm.validation.report.drift import compute
+    from gatetherm.validation.report.drift import check_record, compute
     from gatetherm.validation.report.page import drift_html
 
     ts = read_timeseries(args.data, required=("time_s",))
+    check_record(ts, args.data)
     with output_dir(args.out, DRIFT, keep=(args.data,)) as out:
         result = compute(ts, out, Path(args.data).name)
         write_text_atomic(out / "index.html", drift_html(result, args.data, f"gatetherm report --data {args.data} "

@@ -30,7 +30,7 @@ from gatetherm.studies.run.case import Case
 from gatetherm.solvers.sensors import apply_faults
 from gatetherm.studies.run.conditions import TableDrive, condition, condition_drive, filled, table_drive
 from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.simulate import RunResult, output_columns, run_model, sample_times
+from gatetherm.studies.run.simulate import RunResult, check_temperatures, output_columns, run_model, sample_times
 from gatetherm.studies.run.timeseries import INPUT_COLUMNS, TimeSeries, check_steps, read_timeseries
 
 log = logging.getLogger(__name__)
@@ -191,6 +191,7 @@ def _once(p: Prepared, schedule: Schedule) -> RunResult:
         Y = np.array([[values[k] for k in keys]])
     else:
         state = p.solver.steady(environment(p.drive, 0.0))
+        check_temperatures(state, 0.0)
         keys, Y = model.readout.keys, model.read(state)[None, :]
     cols = {"time_s": np.zeros(1), **{k: np.array([v]) for k, v in p.drive(0.0).items()}}
     cols.update(output_columns(model.problem, keys, Y))
