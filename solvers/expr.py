@@ -28,7 +28,19 @@ from gatetherm.checks import FINITE, Range, show
 FUNCTIONS = {"sqrt": np.sqrt, "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log,
              "abs": np.abs, "tanh": np.tanh, "atan2": np.arctan2,
              "min": lambda *a: functools.reduce(np.minimum, a), "max": lambda *a: functools.reduce(np.maximum, a)}
-"""Functions an expression may call."""
+"""Functions an expression may call (on arrays: a field)."""
+
+
+def _power(a: float, b: float) -> float:
+    r = a ** b
+    if isinstance(r, complex):
+        raise ValueError("a negative number to a fractional power")
+    return r
+
+
+_SCALAR = {"sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "tan": math.tan, "exp": math.exp, "log": math.log,
+           "abs": abs, "tanh": math.tanh, "atan2": math.atan2, "min": min, "max": max, "**": _power}
+"""The functions for numbers (a value at one time): without numpy, fast, and an error raises."""
 ARITY = {"atan2": (2, 2), "min": (2, None), "max": (2, None)}
 """(fewest, most) arguments of the functions that do not take exactly one (None: no limit)."""
 CONSTANTS = {"pi": math.pi}
@@ -109,26 +121,28 @@ def _depth(tree: ast.AST) -> int:
     return deepest
 
 
-def _eval(node: ast.AST, env: Mapping[str, object]):
+def _eval(node: ast.AST, env: Mapping[str, object], fns, num):
+    """The value of ``node``: numbers are ``num`` (float, or np.float64 for arrays), functions ``fns``."""
     if isinstance(node, ast.Expression):
-        return _eval(node.body, env)
+        return _eval(node.body, env, fns, num)
     if isinstance(node, ast.Constant):
-        return np.float64(node.value)
+        return num(node.value)
     if isinstance(node, ast.Name):
         v = env[node.id] if node.id in env else CONSTANTS[node.id]
-        return np.float64(v) if isinstance(v, (int, float)) else v
+        return v if isinstance(v, np.ndarray) else num(v)
     if isinstance(node, ast.BinOp):
-        return _BINARY[type(node.op)](_eval(node.left, env), _eval(node.right, env))
+        a, b = _eval(node.left, env, fns, num), _eval(node.right, env, fns, num)
+        return fns["**"](a, b) if isinstance(node.op, ast.Pow) and "**" in fns else _BINARY[type(node.op)](a, b)
     if isinstance(node, ast.UnaryOp):
-        v = _eval(node.operand, env)
+        v = _eval(node.operand, env, fns, num)
         return -v if isinstance(node.op, ast.USub) else v
     if isinstance(node, ast.Compare):
-        return 1.0 * _COMPARE[type(node.ops[0])](_eval(node.left, env), _eval(node.comparators[0], env))
-    return FUNCTIONS[node.func.id](*(_eval(a, env) for a in node.args))
+        return 1.0 * _COMPARE[type(node.ops[0])](_eval(node.left, env, fns, num),
+                                                 _eval(node.comparators[0], env, fns, num))
+    return fns[node.func.id](*(_eval(a, env, fns, num) for a in node.args))
 
 
-def _arrays(env: Mapping[str, object]) -> bool:
-    return any(np.ndim(v) for v in env.values())
+_DOMAIN = "an argument outside a function's domain: the root of a negative number, the logarithm of zero or less"
 
 
 def _first(ok: np.ndarray):
@@ -190,15 +204,23 @@ class Value:
         if self.is_constant:
             return self.constant
         env = env or {}
+        arrays = np.ndarray in map(type, env.values())
         try:
-            with np.errstate(all="raise", under="ignore"):
-                v = _eval(self.tree, env)
+            if not arrays:
+                v = _eval(self.tree, env, _SCALAR, float)
+            else:
+                with np.errstate(all="raise", under="ignore"):
+                    v = _eval(self.tree, env, FUNCTIONS, np.float64)
         except KeyError as err:
             raise self._error(env, (), f"reads {err}, which is not given") from None
-        except (FloatingPointError, ZeroDivisionError, OverflowError) as err:
+        except (FloatingPointError, ZeroDivisionError, OverflowError, ValueError) as err:
+            why = str(err) if arrays or "power" in str(err) else {ZeroDivisionError: "division by zero",
+                                                                   OverflowError: "overflow"}.get(type(err), _DOMAIN)
             with np.errstate(all="ignore"):  # where, for arrays (a field)
-                ok = np.isfinite(_eval(self.tree, env)) if _arrays(env) else np.ones(())
-            raise self._error(env, _first(ok), f"cannot be evaluated ({err})") from None
+                ok = np.isfinite(_eval(self.tree, env, FUNCTIONS, np.float64)) if arrays else np.ones(())
+            raise self._error(env, _first(ok), f"cannot be evaluated ({why})") from None
+        if not arrays and self.range.holds(v):  # the usual case, fast
+            return v
         ok = self.range.mask(v)
         if not ok.all():
             at = _first(ok)

@@ -42,18 +42,21 @@ def t3(tmp_path: Path, old: str = "", new: str = "", extra: str = "") -> Path:
 # ---- expressions -------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("text, error, needle", [
-    ("1/0", InputError, f"{KEY}: '1/0' cannot be evaluated (divide by zero encountered in scalar divide)"),
-    ("2**2000", InputError, "'2**2000' cannot be evaluated (overflow encountered in scalar power)"),
-    ("exp(1000)", InputError, "(overflow encountered in exp)"),
+    ("1/0", InputError, f"{KEY}: '1/0' cannot be evaluated (division by zero)"),
+    ("2**2000", InputError, "'2**2000' cannot be evaluated (overflow)"),
+    ("exp(1000)", InputError, "'exp(1000)' cannot be evaluated (overflow)"),
     ("1" * 401, ExpressionError, "a number of 401 digits is beyond the floating-point range"),
     ("atan2(t)", ExpressionError, "atan2() takes 2 arguments, got 1"),
     ("sin(t, t)", ExpressionError, "sin() takes 1 argument, got 2"),
     ("min()", ExpressionError, "min() takes 2 or more arguments, got 0"),
     ("+".join(["1"] * 100_000), ExpressionError, f"the expression has 199999 characters, more than {MAX_LENGTH}"),
     ("-" * 900 + "1", ExpressionError, f"the expression is nested more than {MAX_DEPTH} deep"),
-    ("sqrt(-1)", InputError, "'sqrt(-1)' cannot be evaluated (invalid value encountered in sqrt)"),
-    ("log(0)", InputError, "'log(0)' cannot be evaluated (divide by zero encountered in log)"),
-    ("(-8)**(1/3)", InputError, "(invalid value encountered in scalar power)"),
+    ("sqrt(-1)", InputError, "'sqrt(-1)' cannot be evaluated (an argument outside a function's domain: the root of a negative number"),
+    ("log(0)", InputError, "'log(0)' cannot be evaluated (an argument outside a function's domain"),
+    ("(-8)**(1/3)", InputError, "cannot be evaluated (a negative number to a fractional power)"),
+    ("abs((-8)**0.5)", InputError, "(a negative number to a fractional power)"),
+    ("min(1/0, 3)", InputError, "'min(1/0, 3)' cannot be evaluated (division by zero)"),
+    ("1e300 * 1e300", InputError, "'1e300 * 1e300' is inf, must be a number in"),
     ("2 * 2500", InputError, f"{KEY}: '2 * 2500' is 5000, must be a number in (-273.15, 1000] °C"),
 ])
 def test_a_bad_expression_is_a_clean_error_where_it_is_read(text, error, needle):

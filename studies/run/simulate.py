@@ -94,9 +94,9 @@ def check_temperatures(U: np.ndarray, t: float) -> None:
     """InputError unless every temperature of the state ``U`` (°C) at ``t`` (s) is admissible
     (:data:`~gatetherm.checks.CELSIUS`): a run that leaves the range has met heat inputs out of
     all proportion, or a steady problem without a solution."""
-    lo, hi = float(np.min(U)), float(np.max(U))
-    if not (CELSIUS.admits(lo) and CELSIUS.admits(hi)):
-        raise InputError("temperature", f"the solution reaches {show(hi if CELSIUS.admits(lo) else lo)} °C at "
+    lo, hi = float(U.min()), float(U.max())
+    if not (CELSIUS.holds(lo) and CELSIUS.holds(hi)):
+        raise InputError("temperature", f"the solution reaches {show(hi if CELSIUS.holds(lo) else lo)} °C at "
                          f"t = {t:g} s, must be {CELSIUS}", "check the heat inputs (sources, fluxes: units and size) and, "
                          "for a steady state, that a boundary holds a temperature or a film")
 
