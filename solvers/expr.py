@@ -38,9 +38,6 @@ def _power(a: float, b: float) -> float:
     return r
 
 
-_SCALAR = {"sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "tan": math.tan, "exp": math.exp, "log": math.log,
-           "abs": abs, "tanh": math.tanh, "atan2": math.atan2, "min": min, "max": max, "**": _power}
-"""The functions for numbers (a value at one time): without numpy, fast, and an error raises."""
 ARITY = {"atan2": (2, 2), "min": (2, None), "max": (2, None)}
 """(fewest, most) arguments of the functions that do not take exactly one (None: no limit)."""
 CONSTANTS = {"pi": math.pi}
@@ -51,6 +48,13 @@ MAX_DEPTH = 50
 _BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
            ast.Pow: operator.pow}
 _COMPARE = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt, ast.GtE: operator.ge}
+_NUMBERS = ({"sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "tan": math.tan, "exp": math.exp, "log": math.log,
+             "abs": abs, "tanh": math.tanh, "atan2": math.atan2, "min": min, "max": max},
+            {**_BINARY, ast.Pow: _power}, float)
+"""(functions, operators, number type) for a value at one time: Python floats, without numpy
+(fast, and every error raises)."""
+_ARRAYS = (FUNCTIONS, _BINARY, np.float64)
+"""The same for arrays (a field): numpy, whose errors raise under ``np.errstate(all="raise")``."""
 
 
 class ExpressionError(ValueError):
@@ -121,25 +125,23 @@ def _depth(tree: ast.AST) -> int:
     return deepest
 
 
-def _eval(node: ast.AST, env: Mapping[str, object], fns, num):
-    """The value of ``node``: numbers are ``num`` (float, or np.float64 for arrays), functions ``fns``."""
+def _eval(node: ast.AST, env: Mapping[str, object], how):
+    """The value of ``node`` for ``env``, computed ``how`` (:data:`_NUMBERS` or :data:`_ARRAYS`)."""
     if isinstance(node, ast.Expression):
-        return _eval(node.body, env, fns, num)
+        return _eval(node.body, env, how)
     if isinstance(node, ast.Constant):
-        return num(node.value)
+        return how[2](node.value)
     if isinstance(node, ast.Name):
         v = env[node.id] if node.id in env else CONSTANTS[node.id]
-        return v if isinstance(v, np.ndarray) else num(v)
+        return v if isinstance(v, np.ndarray) else how[2](v)
     if isinstance(node, ast.BinOp):
-        a, b = _eval(node.left, env, fns, num), _eval(node.right, env, fns, num)
-        return fns["**"](a, b) if isinstance(node.op, ast.Pow) and "**" in fns else _BINARY[type(node.op)](a, b)
+        return how[1][type(node.op)](_eval(node.left, env, how), _eval(node.right, env, how))
     if isinstance(node, ast.UnaryOp):
-        v = _eval(node.operand, env, fns, num)
+        v = _eval(node.operand, env, how)
         return -v if isinstance(node.op, ast.USub) else v
     if isinstance(node, ast.Compare):
-        return 1.0 * _COMPARE[type(node.ops[0])](_eval(node.left, env, fns, num),
-                                                 _eval(node.comparators[0], env, fns, num))
-    return fns[node.func.id](*(_eval(a, env, fns, num) for a in node.args))
+        return 1.0 * _COMPARE[type(node.ops[0])](_eval(node.left, env, how), _eval(node.comparators[0], env, how))
+    return how[0][node.func.id](*(_eval(a, env, how) for a in node.args))
 
 
 _DOMAIN = "an argument outside a function's domain: the root of a negative number, the logarithm of zero or less"
@@ -207,17 +209,17 @@ class Value:
         arrays = np.ndarray in map(type, env.values())
         try:
             if not arrays:
-                v = _eval(self.tree, env, _SCALAR, float)
+                v = _eval(self.tree, env, _NUMBERS)
             else:
                 with np.errstate(all="raise", under="ignore"):
-                    v = _eval(self.tree, env, FUNCTIONS, np.float64)
+                    v = _eval(self.tree, env, _ARRAYS)
         except KeyError as err:
             raise self._error(env, (), f"reads {err}, which is not given") from None
         except (FloatingPointError, ZeroDivisionError, OverflowError, ValueError) as err:
             why = str(err) if arrays or "power" in str(err) else {ZeroDivisionError: "division by zero",
                                                                    OverflowError: "overflow"}.get(type(err), _DOMAIN)
             with np.errstate(all="ignore"):  # where, for arrays (a field)
-                ok = np.isfinite(_eval(self.tree, env, FUNCTIONS, np.float64)) if arrays else np.ones(())
+                ok = np.isfinite(_eval(self.tree, env, _ARRAYS)) if arrays else np.ones(())
             raise self._error(env, _first(ok), f"cannot be evaluated ({why})") from None
         if not arrays and self.range.holds(v):  # the usual case, fast
             return v

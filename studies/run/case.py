@@ -149,11 +149,11 @@ def _boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
             t.fail("/".join(kinds) or "film", "give exactly one condition: film (with ambient), temperature or flux",
                    "a boundary without a condition is adiabatic; leave it out")
         if kinds == ["film"]:
-            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C", rng=CELSIUS)))
+            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C")))
         elif "ambient" in t.data:
             t.fail("ambient", "goes with a film only", "remove it or give film")
         elif kinds == ["temperature"]:
-            out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C", rng=CELSIUS)))
+            out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C")))
         else:
             out["fluxes"].append(Flux(b, t.value("flux", names, unit="W/m²")))
     return out
@@ -179,9 +179,9 @@ def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
             rho_c = t.number("rho_c", Range(0.0, lo_open=True, unit="J/(m³ K)"))
             capacity, conductance = rho_c * volume, rho_c * t.number("flow_rate", Range(0.0, unit="m³/s"))
         out.append(Fluid(name, wall, capacity, t.number("film_on", FILM),
-                         t.number("film_off", FILM), conductance, t.value("supply", names, unit="°C", rng=CELSIUS),
+                         t.number("film_off", FILM), conductance, t.value("supply", names, unit="°C"),
                          t.value("pump", names, default=1.0), hose, t.number("hose_loss", Range(0.0, unit="W/K"), 0.0),
-                         t.value("ambient", names, default=20.0 if not hose else None, unit="°C", rng=CELSIUS),
+                         t.value("ambient", names, default=20.0 if not hose else None, unit="°C"),
                          t.string("hose_name", default="")))
     return tuple(out)
 
@@ -311,9 +311,10 @@ def _check_schedule(problem: Problem, ts, end: float) -> None:
     t = np.asarray(ts.time_s - ts.time_s[0], float)
     env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
     for v in values(problem):
-        rows = (t <= end) & np.logical_and.reduce([np.isfinite(env[n]) for n in v.names() | {"t"}])
-        if v.names() and rows.any():
-            v({n: env[n][rows] for n in v.names() | {"t"}})
+        names = v.names() | {"t"}
+        rows = (t <= end) & np.logical_and.reduce([np.isfinite(env[n]) for n in names])
+        if not v.is_constant and rows.any():
+            v({n: env[n][rows] for n in names})
 
 
 def load_case(path, mesh_factor: float = 1.0) -> Case:
@@ -350,7 +351,7 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
         if ("field" in tt.data) == ("regions" in tt.data):
             tt.fail("field", "give either field (an expression of x, y, z) or a [temperature.regions] table")
         if "field" in tt.data:
-            kw["prescribed"] = tt.value("field", ("x", "y", "z")[:fm.dim], unit="°C", rng=CELSIUS)
+            kw["prescribed"] = tt.value("field", ("x", "y", "z")[:fm.dim], unit="°C")
         else:
             reg = tt.sub("regions", tuple(fm.regions))
             kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
@@ -372,7 +373,7 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")
             f = top.sub("faces", ("film", "ambient"))
-            kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C", rng=CELSIUS))
+            kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C"))
         kw["fluids"] = _fluids(top, fm, names, thickness)
     twice = _twice(kw)
     if twice:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.checks import FINITE, Range
+from gatetherm.checks import CELSIUS, FINITE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
 
 
@@ -53,9 +53,11 @@ class Table:
             self.fail(k, f"'{v}' is not a {what} of the mesh", f"{what}s: {', '.join(valid) or 'none'}")
         return v
 
-    def value(self, k: str, names, default=None, unit: str = "", rng: Range = FINITE) -> Value:
-        """The value at ``k``: a number in ``rng`` or an expression of ``names`` (checked
-        against ``rng`` now if it reads none, else wherever it is evaluated)."""
+    def value(self, k: str, names, default=None, unit: str = "") -> Value:
+        """The value at ``k``: a number or an expression of ``names``, in the range of its
+        ``unit`` (°C: a temperature, else finite), checked now if it reads no input, else
+        wherever it is evaluated."""
+        rng = CELSIUS if unit == "°C" else FINITE
         if k not in self.data and default is not None:
             return Value(default, "", self.key(k), rng)
         if k not in self.data:
