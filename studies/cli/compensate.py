@@ -265,7 +265,7 @@ def _rom_loop(args, ts, what, cfg, cache, params, actuator):
         rom, where = load_rom(args.rom), args.rom
     else:
         rom, where = cached_rom(cfg, args.dim, args.states, Path(args.out), cache), str(Path(args.out) / "rom.npz")
-    missing = [n for n in ("delta_um", *map(output_of, sensors)) if n not in rom.outputs]
+    missing = [n for n in ("delta_um", *(output_of(s) for s in sensors if s in ts)) if n not in rom.outputs]
     if missing:
         raise InputError(f"{where}: outputs", f"no {missing[0]!r}", f"its outputs: {', '.join(rom.outputs)}")
     lacking = [n for n in rom.inputs if n not in ts and n != "ambient_degC"]
