@@ -127,6 +127,14 @@ def test_case_values_have_the_ranges_of_model_files(tmp_path, old, new, extra, s
     assert str(got.value).startswith(f"{case}: ") and needle.format(d=tmp_path) in str(got.value), got.value
 
 
+def test_a_schedule_column_without_values_names_the_file(tmp_path):
+    case = t3(tmp_path, HOT, 'temperature = "T"', 'schedule = "s.csv"\n')
+    (tmp_path / "s.csv").write_text(SCHEDULE + "0,\n40,\n")
+    with pytest.raises(InputError, match=f"^{tmp_path / 's.csv'}, column T: has no values; fill it "
+                                         f"\\({case}: thermal.hot_end.temperature reads it\\)"):
+        load_case(case)
+
+
 def test_the_final_state_is_the_end_of_the_run(tmp_path):
     """T3 with output every 5 s: the time series ends with t = 32 s (not 30 s) at the target."""
     case = load_case(t3(tmp_path, "output = 1.0", "output = 5.0"))

@@ -305,14 +305,17 @@ def _time(top: Table, base: Path):
     return TimeSettings(end, step, output, t.number("fields", within, end), schedule), scheme, ts
 
 
-def _check_schedule(problem: Problem, ts, end: float) -> None:
+def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
     """Every value that reads the schedule, at the schedule's samples within the run
-    (where its columns are recorded): in the range of its key."""
+    (where its columns are recorded): in the range of its key; every column it reads recorded."""
     t = np.asarray(ts.time_s - ts.time_s[0], float)
     env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
     for v in values(problem):
         names = v.names() | {"t"}
-        rows = (t <= end) & np.logical_and.reduce([np.isfinite(env[n]) for n in names])
+        empty = next((n for n in sorted(names) if not np.isfinite(env[n]).any()), None)
+        if empty:
+            raise InputError(f"{time.schedule}, column {empty}", "has no values", f"fill it ({v.key} reads it)")
+        rows = (t <= time.end) & np.logical_and.reduce([np.isfinite(env[n]) for n in names])
         if not v.is_constant and rows.any():
             v({n: env[n][rows] for n in names})
 
@@ -390,7 +393,7 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
                       signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme, **kw)
     if schedule is not None:
-        _check_schedule(problem, schedule, time.end)
+        _check_schedule(problem, schedule, time)
     inputs = (path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else []))
     return Case(path, head.string("name", path.stem), problem, fm, time, inputs=inputs)
 
