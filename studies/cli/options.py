@@ -21,7 +21,8 @@ def add_model_options(p: argparse.ArgumentParser, dims=(2, 3), dim_help: str = "
 
 def refuse_model_options(args, case: str = "--case") -> None:
     """InputError if ``--dim`` or ``--config`` was given with a case file (which gives its own model and mesh)."""
-    given = [o for o, v in (("--dim", args.dim), ("--config", args.config)) if v is not None and type(v) is not _Default]
+    given = [o for o, v in (("--dim", args.dim), ("--config", args.config))
+             if v is not None and type(v) is not _Default]
     if given:
         raise InputError(f"{case}/{given[0]}", "a case file gives its own model and mesh", f"drop {given[0]}")
 

@@ -64,7 +64,8 @@ def run(args) -> int:
         write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code_digest()))
     print(f"wrote {out}/index.html in {time.perf_counter() - t0:.0f} s")
     if text is not None:
-        text = read_text(args.readme, "--readme", "give the project's README.md")  # as it is now: it may have been edited meanwhile
+        # as it is now: it may have been edited meanwhile
+        text = read_text(args.readme, "--readme", "give the project's README.md")
         tables, partial = rd.full_tables(results)
         new, done = rd.rewrite(text, tables)
         write_text_atomic(args.readme, new)

@@ -97,8 +97,8 @@ def check_temperatures(U: np.ndarray, t: float) -> None:
     lo, hi = float(U.min()), float(U.max())
     if not (CELSIUS.holds(lo) and CELSIUS.holds(hi)):
         raise InputError("temperature", f"the solution reaches {show(hi if CELSIUS.holds(lo) else lo)} °C at "
-                         f"t = {t:g} s, must be {CELSIUS}", "check the heat inputs (sources, fluxes: units and size) and, "
-                         "for a steady state, that a boundary holds a temperature or a film")
+                         f"t = {t:g} s, must be {CELSIUS}", "check the heat inputs (sources, fluxes: units and "
+                         "size) and, for a steady state, that a boundary holds a temperature or a film")
 
 
 def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
