@@ -47,7 +47,11 @@ HINTS = {"pardiso": "pip install py-mkl-pardiso (Linux x86_64, Windows)", "cholm
 
 
 class SolverError(RuntimeError):
-    """An iterative solve did not converge."""
+    """An iterative solve did not converge, or a matrix cannot be factorised."""
+
+
+class NoBackend(SolverError):
+    """No sparse Cholesky backend of those asked for is installed."""
 
 
 def _say_once(key: str, level: int, msg: str, *args, _said: set = set()) -> None:  # noqa: B006
@@ -114,7 +118,11 @@ def _pardiso(A: sp.spmatrix, order) -> Solve:
     else:
         solver.set_iparm(4, 1)  # the given order
         solver.set_perm(np.asarray(order, dtype=np.int64))
-    solver.factor(U.data.astype(float))
+    try:
+        solver.factor(U.data.astype(float))
+    except RuntimeError as err:
+        raise SolverError(f"the matrix cannot be factorised ({err}): material constants or thicknesses many "
+                          "orders of magnitude apart?") from None
     return solver.solve
 
 
@@ -168,7 +176,7 @@ def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACK
             continue
         _say_once(f"use {name}", logging.INFO, "sparse Cholesky backend: %s", name)
         return solve, name
-    raise SolverError(f"no sparse Cholesky backend of {', '.join(names)} is installed")
+    raise NoBackend(f"no sparse Cholesky backend of {', '.join(names)} is installed")
 
 
 class Bordered:
@@ -238,7 +246,7 @@ def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None, rt
     if os.environ.get(BACKEND_ENV) != "amg" or near_null is None:
         try:
             return spd_factor(A, order, ("pardiso", "cholmod") + (("superlu",) if small else ()))[0]
-        except SolverError:
+        except NoBackend:
             _say_once("amg", logging.INFO, "no Cholesky backend: elasticity by AMG-CG; %s", HINTS["pardiso"])
     import pyamg
 

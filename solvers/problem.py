@@ -250,11 +250,15 @@ class Problem:
         return self.dim == 2 and self.plane == "axisymmetric"
 
 
+def values(problem: Problem) -> list[Value]:
+    """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
+    out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
+    out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
+    out += [*problem.gravity, *(v for x in (*problem.loads, *problem.supports) for v in x.values)]
+    return out + [v for pl in problem.point_loads for v in pl.force]
+
+
 def inputs(problem: Problem) -> set[str]:
     """The schedule columns the problem's values read (not time ``t``)."""
-    values = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
-    values += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
-    values += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
-    values += [*problem.gravity, *(v for x in (*problem.loads, *problem.supports) for v in x.values)]
-    values += [v for pl in problem.point_loads for v in pl.force]
-    return set().union(*(v.names() for v in values)) - {"t"}
+    return set().union(*(v.names() for v in values(problem))) - {"t"}

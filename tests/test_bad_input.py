@@ -384,12 +384,17 @@ def test_a_rerun_replaces_the_whole_output_set(tmp_path, capsys):
     assert files(tmp_path / "o") == sorted(files(tmp_path / "fresh") + ["my_notes.txt"])
 
 
-def test_a_rerun_keeps_its_input_files(tmp_path):
-    """diagnose --config DIR/model.toml --out DIR: the model file read is not removed as a
-    file of the previous run (it is replaced only if the run writes a new one)."""
+def test_a_run_never_overwrites_its_input_files(tmp_path):
+    """diagnose --config DIR/model.toml --out DIR would write a new DIR/model.toml over the
+    model file it read: refused in one line before anything is removed. An input that is
+    not among the files the command writes is kept while the previous run's files go."""
     _write(tmp_path / "model.toml", "[geometry]\n")
     _write(tmp_path / "report.md", "old")
-    with output_dir(tmp_path, ("model.toml", "report.md"), keep=(str(tmp_path / "model.toml"), None)):
+    with pytest.raises(InputError, match=f"would overwrite its input '{tmp_path / 'model.toml'}'"):
+        with output_dir(tmp_path, ("model.toml", "report.md"), keep=(str(tmp_path / "model.toml"), None)):
+            pass
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml", "report.md"]
+    with output_dir(tmp_path, ("report.md",), keep=(str(tmp_path / "model.toml"),)):
         pass
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml"]
 

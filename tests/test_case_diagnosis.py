@@ -91,7 +91,7 @@ def test_bad_case_diagnosis_is_one_line_and_exit_2(case, tmp_path, capsys):
     data = _measured(case, {}, tmp_path / "m.csv")
     base = ["diagnose", "--case", CASE, "--data", data, "--out", tmp_path / "d"]
     refused(capsys, 2, base + ["--config", CASE], "--case/--config")
-    refused(capsys, 2, base + ["--dim", "3"], "a case file gives its own mesh")
+    refused(capsys, 2, base + ["--dim", "2"], "--case/--dim", "a case file gives its own model and mesh")
     refused(capsys, 2, ["diagnose", "--data", data, "--out", tmp_path / "d", "--mesh-factor", "0.5"],
             "--mesh-factor", "with --case only")
     refused(capsys, 2, base + ["--effects", "joint_resistance"], "--effects",

@@ -94,7 +94,7 @@ def test_paper_method_stays_the_default_and_bad_rom_input(reduced, tmp_path, cap
     capsys.readouterr()
     assert cli.main(["compensate", "--condition", "2", "--method", "rom", "--rom", str(tmp_path / "none.npz"),
                      "--out", str(tmp_path)]) == 2
-    assert "not a reduced model" in capsys.readouterr().err
+    assert "none.npz: no such file" in capsys.readouterr().err
     assert cli.main(["compensate", "--condition", "2", "--method", "rom", "--rom", str(reduced / "rom.npz"),
                      "--sensors", "theta_A_degC,T_C1_degC,T_nowhere_degC", "--out", str(tmp_path)]) == 2
     assert "T_nowhere_degC" in capsys.readouterr().err

@@ -1,11 +1,12 @@
 """The ``gatetherm`` console command: argument parsing and error reporting only.
 
 Exit codes: 0 done; 1 an I/O failure (a full disk, an output directory that cannot be
-written or that another run is writing into) or failed sweep points; 2 bad input; 130
-Ctrl-C; 143 SIGTERM. Each failure is one line on stderr, never a traceback; argument
-errors too (the usage is printed by ``--help``). Only ``os``, ``signal``, ``sys`` and
-``threading`` are imported before :func:`main` runs, so that a Ctrl-C while the command
-modules are imported ends in that one line as well.
+written or that another run is writing into) or failed sweep points; 2 bad input (also
+equations made from it that no solver can solve); 130 Ctrl-C; 143 SIGTERM. Each failure is
+one line on stderr, never a traceback; argument errors too (the usage is printed by
+``--help``). Only ``os``, ``signal``, ``sys`` and ``threading`` are imported before
+:func:`main` runs, so that a Ctrl-C while the command modules are imported ends in that one
+line as well.
 """
 from __future__ import annotations
 
@@ -118,6 +119,8 @@ def _run(argv: list[str] | None) -> int:
     from gatetherm.process import configure
     from gatetherm.studies.sweeps.runner import PointsFailed
 
+    logging.captureWarnings(True)  # the numerical libraries' warnings: in the log, shown with -v
+    logging.getLogger("py.warnings").setLevel(logging.INFO if args.verbose else logging.ERROR)
     try:
         configure()
         return int(args.func(args) or 0)
@@ -125,8 +128,15 @@ def _run(argv: list[str] | None) -> int:
         return _say(f"error: {err}", 2)
     except PointsFailed as err:
         return _say(f"error: {err}", 1)
+    except RuntimeError as err:  # the equations of the input cannot be solved (a solver ran: it is imported)
+        linsolve = sys.modules.get("gatetherm.solvers.linsolve")
+        if linsolve is None or not isinstance(err, linsolve.SolverError):
+            raise
+        return _say(f"error: {err}", 2)
     except OSError as err:
         return _say(f"error: {_os_message(err)}", 1)
+    finally:
+        logging.captureWarnings(False)
 
 
 def main(argv: list[str] | None = None) -> int:

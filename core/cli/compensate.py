@@ -41,7 +41,7 @@ import math
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.cli.options import add_model_options
+from gatetherm.cli.options import add_model_options, refuse_model_options
 
 log = logging.getLogger(__name__)
 
@@ -120,8 +120,8 @@ def run(args: argparse.Namespace) -> int:
     if args.case is not None and args.condition is not None:
         raise InputError("--case/--condition", "the paper's conditions drive the frame's oil supply",
                          "compensate a case's own run (--case alone) or a recorded file (--data)")
-    if args.case is not None and (args.config is not None or args.dim != 2):
-        raise InputError("--case/--config/--dim", "a case file is its own model", "drop --config and --dim")
+    if args.case is not None:
+        refuse_model_options(args)
     if args.condition is not None:
         gt.condition(args.condition)  # a bad number fails before the model is built
         case = gt.gate_frame(args.dim, args.config)
@@ -133,7 +133,7 @@ def run(args: argparse.Namespace) -> int:
         if clash and "compensation" not in ts.metadata:
             raise InputError(f"{args.data}, column {clash[0]}", "compensate writes a column of this name "
                              "and the file is not from an earlier compensate", "rename the column so that it is kept")
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out_dir:
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *case.files)) as out_dir:
         if args.data is None:
             if not case.problem.signals.complete or case.time is None:
                 raise InputError(f"{case.source}: signals", "a compensated case needs [time] and [signals] with "
@@ -161,7 +161,8 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     replaced = [name for name in WRITTEN if name in ts]
     if replaced:
         log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
-    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=out_dir)
+    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=out_dir,
+                      source=what, rom_source=args.rom)
     summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
                "config": case.source, "dim": case.dim}
     text = json.dumps(summary, indent=2, allow_nan=False) + "\n"

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE
-from gatetherm.cli.options import add_model_options, number
+from gatetherm.cli.options import add_model_options, number, refuse_model_options
 
 log = logging.getLogger(__name__)
 
@@ -103,10 +103,9 @@ def load_model(args):
         if args.mesh_size is not None:
             case = case.with_overrides({"mesh.size" if args.dim == 2 else "mesh.size_3d": args.mesh_size})
         return case
-    if args.config is not None:
-        raise InputError("--case/--config", "give one model, a case file or a model file", "drop one of the two")
-    if args.dim != 2 or args.mesh_size is not None:
-        raise InputError("--dim/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
+    refuse_model_options(args)
+    if args.mesh_size is not None:
+        raise InputError("--case/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
     case = gt.load_case(args.case, args.mesh_factor or 1.0)
     if case.time is None:
         raise InputError(f"{args.case}: time", "a diagnosed case needs [time] (a transient run)",
@@ -131,7 +130,7 @@ def run(args: argparse.Namespace) -> int:
     case = load_model(args)
     ts = read_timeseries(args.data, required=("time_s",))
     measured_schedule(case, ts, str(args.data))  # every input the case reads is in the file
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out:
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *case.files)) as out:
         diag = diagnose(case, ts, settings)
         _write(args, case, diag, adopted_case(case, diag), out)
     s = diag.summary()

@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.cli.options import add_model_options
+from gatetherm.cli.options import add_model_options, refuse_model_options
 
 #: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
 OUTPUTS = ("job.inp", "gatetherm.json")
@@ -33,15 +33,18 @@ def run(args) -> int:
 
     if (args.case is None) == (args.condition is None):
         raise InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
-    if args.case and (args.config is not None or args.dim != 2):
-        raise InputError("--config/--dim", "a case file is its own model", "drop --config and --dim")
+    if args.case:
+        refuse_model_options(args, "CASE.toml")
     gt.condition(args.condition or 1)
     case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config, args.condition)
     what = str(args.case) if args.case else f"condition {args.condition}"
+    if case.dim != 3:  # before the run
+        raise InputError(f"{args.case}: mesh" if args.case else "--dim", "CalculiX export is for 3-D models",
+                         "give a 3-D mesh" if args.case else "use --dim 3")
     schedule = case.schedule
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
-    check_time(schedule, t)
-    with output_dir(args.out, OUTPUTS, keep=(args.case, args.config)) as out:
+    t = check_time(schedule, t)
+    with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files)) as out:
         inp, info = export_state(case, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
         write_text_atomic(out / "job.inp", inp)
         write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")

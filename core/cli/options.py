@@ -5,13 +5,26 @@ import argparse
 import os
 import sys
 
+from gatetherm import InputError
 from gatetherm.checks import Range
+
+
+class _Default(int):
+    """An option's default value, told apart from the same value given on the command line."""
 
 
 def add_model_options(p: argparse.ArgumentParser, dims=(2, 3), dim_help: str = "2-D section or 3-D solid (default 2)") -> None:
     """``--dim`` and ``--config``, shared by the commands that build a model."""
-    p.add_argument("--dim", type=int, choices=dims, default=2, help=dim_help)
+    p.add_argument("--dim", type=int, choices=dims, default=_Default(2), help=dim_help)
     p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
+
+
+def refuse_model_options(args, case: str = "--case") -> None:
+    """InputError if ``--dim`` or ``--config`` was given with a case file (which gives its own model and mesh)."""
+    given = [o for o, v in (("--dim", args.dim), ("--config", args.config))
+             if v is not None and type(v) is not _Default]
+    if given:
+        raise InputError(f"{case}/{given[0]}", "a case file gives its own model and mesh", f"drop {given[0]}")
 
 
 def add_parallel_options(p: argparse.ArgumentParser) -> None:

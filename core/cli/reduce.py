@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 
 from gatetherm import InputError
-from gatetherm.cli.options import add_model_options
+from gatetherm.cli.options import add_model_options, refuse_model_options
 
 MAX_STATES = 200
 #: What a run writes into --out; a rerun replaces all of it.
@@ -39,11 +39,11 @@ def run(args) -> int:
 
     if not 2 <= args.states <= MAX_STATES:
         raise InputError("--states", f"{args.states} is outside 2..{MAX_STATES}", "e.g. --states 30")
-    if args.case is not None and (args.config is not None or args.dim != 2):
-        raise InputError("--case/--config/--dim", "a case file is its own model", "drop --config and --dim")
+    if args.case is not None:
+        refuse_model_options(args)
     case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config)
     schedules = [] if args.no_check else [*gt.check_schedules(case), *(gt.schedule_file(f, case) for f in args.check)]
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.case, *args.check)) as out:
+    with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files, *args.check)) as out:
         t0 = time.perf_counter()
         red = gt.reduce(case, args.states)
         seconds = time.perf_counter() - t0

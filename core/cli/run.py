@@ -25,7 +25,7 @@ def run(args) -> int:
 
     case = gt.load_case(args.case)
     every = case.time.fields if case.time else 1.0
-    with output_dir(args.out, OUTPUTS, keep=(args.case, case.time.schedule if case.time else None)) as out:
+    with output_dir(args.out, OUTPUTS, keep=case.files) as out:
         res = gt.run(case, keep=picture_keep(case.schedule, every), on_step=Progress(case.name), check_order=True)
         summary = res.write(out, pictures=not args.no_pictures)
     print(f"wrote {out}/timeseries.csv, summary.json and fields/")

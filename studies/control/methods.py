@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gatetherm import InputError
+from gatetherm.solvers.expr import Value
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import (NEEDED, ClosedLoop, CompensatorParams, close_loop, compensate as
                                                    paper_loop, external_prediction, summarize)
@@ -96,7 +97,8 @@ def coefficients(case: Case | None, ts: TimeSeries, s: Settings, cache: Scenario
 
 def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Settings(),
                actuator: ActuatorParams | None = None, *, rom=None, rom_dir: Path | None = None,
-               cache: ScenarioCache | None = None) -> Compensation:
+               cache: ScenarioCache | None = None, source: str = "--data", rom_source: str | None = None
+               ) -> Compensation:
     """Compensate the series ``ts`` (δ the uncompensated thermal displacement).
 
     Parameters
@@ -110,7 +112,10 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
     actuator : ActuatorParams, optional
         None: ideal (the command is applied exactly).
     rom : ReducedModel, optional
-        ``rom``: this reduced model instead of one built from ``case`` (kept in ``rom_dir``).
+        ``rom``: this reduced model (read from ``rom_source``) instead of one built from ``case``
+        (kept in ``rom_dir``).
+    source : str
+        What the series is, for messages (a file name).
 
     Returns
     -------
@@ -138,7 +143,7 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
             + every
         head = f"mlr ({label})"
     else:
-        loop, extra, label = _rom_loop(ts, case, s, actuator, rom, rom_dir, cache)
+        loop, extra, label = _rom_loop(ts, case, s, actuator, rom, rom_dir, cache, source, rom_source)
         head = f"rom ({label})"
     summary = {**summarize(loop, params.settle_s), "method": s.method, **extra,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
@@ -146,7 +151,7 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
     return Compensation(loop, summary, label, head, extra)
 
 
-def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache):
+def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache, source: str, where: str | None):
     """The rom method's closed loop, its summary entries and a label."""
     from gatetherm.studies.run.reduce import build_rom, cached_rom
 
@@ -155,7 +160,6 @@ def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache):
     if not s.sensors:
         raise InputError("--sensors", "no column named", "e.g. --sensors theta_A_degC,theta_B_degC")
     control = dataclasses.replace(s.control, interval_s=s.params.update_interval_s)
-    where = None
     if rom is None:
         if case is None:
             raise InputError("--method rom", "needs a reduced model", "give --rom FILE or a model (--case)")
@@ -163,6 +167,11 @@ def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache):
             rom, where = cached_rom(case, s.states, rom_dir, cache), str(Path(rom_dir) / "rom.npz")
         else:
             rom = build_rom(case, s.states, cache).rom
+    read = set().union(*(Value.of(u.text).names() for u in rom.inputs), *(Value.of(p).names() for p in rom.pumps))
+    lacking = sorted(read - {"t"} - set(ts.names) - set(rom.defaults))
+    if lacking:
+        raise InputError(f"{source}, column {lacking[0]}", f"missing: the reduced model {where or ''} reads it",
+                         "record it, or give a reduced model of the inputs recorded")
     pr, cmds = rom_prediction(ts, rom, s.params, control, s.observer, s.sensors)
     loop = close_loop(ts, pr, s.params, actuator)
     extra = {"rom": where, "rom_states": rom.states, "sensors": list(s.sensors), "threshold_um": cmds.threshold_um,

@@ -33,7 +33,7 @@ from gatetherm.solvers.material import Material
 from gatetherm.studies.run import case_mech
 from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
-                                       Relative, Signals, Source, Support, inputs)
+                                       Relative, Signals, Source, Support, inputs, values)
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
 from gatetherm.studies.run.timeseries import read_timeseries
 
@@ -45,6 +45,10 @@ MATERIAL = ranges(Material)
 """Admissible values of the material keys (those of the model file's [material])."""
 SCHEME = ranges(TimeScheme)
 METRES, SECONDS = Range(0.0, lo_open=True, unit="m"), Range(0.0, lo_open=True, unit="s")
+THICKNESS = Range(1e-6, 1e3, unit="m")
+"""Thickness of a 2-D section, from a micrometre to a kilometre: far beyond, the solid's
+matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
+C-frame example, whose other regions are 0.25–0.6 m thick)."""
 FILM = Range(0.0, unit="W/(m² K)")
 
 
@@ -99,6 +103,8 @@ class Case:
     """Sensor faults, {channel: {fault: value}}."""
     path: Path | None = None
     """The case (or model) file, if any."""
+    files: tuple[Path, ...] = ()
+    """The files the case reads (itself, its mesh or geometry, its schedule): a run never overwrites them."""
     source: str = ""
     """Where the case came from, for metadata (a file path, or the generator and its model file)."""
 
@@ -262,7 +268,7 @@ def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
         if "thickness" in t.data:
             if fm.dim == 3:
                 t.fail("thickness", "applies to 2-D sections only", "remove it")
-            thickness[region] = t.number("thickness", METRES)
+            thickness[region] = t.number("thickness", THICKNESS)
     return materials, thickness
 
 
@@ -405,26 +411,49 @@ def _signals(top: Table, probes, relative) -> Signals:
                    tuple(c), s.name("delta", [r.name for r in relative], "relative displacement", "") or None)
 
 
-def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tuple[str, ...]]:
+def _time(top: Table, base: Path):
+    """The time settings, the scheme and the schedule file's series (None: no schedule)."""
     if "time" not in top.data:
-        return None, TimeScheme(), ()
+        return None, TimeScheme(), None
+    from gatetherm.studies.run.timeseries import check_steps, read_timeseries
+
     t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
     end = t.number("end", SECONDS)
-    output = t.number("output", SECONDS, min(60.0, end))
-    step = t.number("step", SECONDS, output)
+    within = Range(0.0, end, lo_open=True, unit="s")  # an interval longer than the run is refused
+    output = t.number("output", within, min(60.0, end))
+    step = t.number("step", within, output)
+    check_steps(end, step, t.key("step"))
     if abs(output / step - round(output / step)) > 1e-9:
         t.fail("output", f"{output:g} s is not a whole multiple of the step {step:g} s", "change output or step")
     sch = t.sub("scheme", ("theta", "restart", "restart_intervals"))
     scheme = TimeScheme(sch.number("theta", SCHEME["theta"], 0.5), int(sch.number("restart", SCHEME["restart"], 4)),
                         int(sch.number("restart_intervals", SCHEME["restart_intervals"], 3)))
-    schedule, columns = None, ()
+    schedule, ts = None, None
     if "schedule" in t.data:
         schedule = base / t.string("schedule")
         if not schedule.is_file():
             t.fail("schedule", f"no such file '{schedule}'", "give a time-series file (docs/data-format.md)")
-        columns = tuple(n for n in read_timeseries(schedule, required=("time_s",)).names if n != "time_s")
-    return TimeSettings(end, step, output, t.number("fields", SECONDS, end),
-                        schedule), scheme, columns
+        ts = read_timeseries(schedule, required=("time_s",))
+        span = float(ts.time_s[-1] - ts.time_s[0])
+        if span < end * (1 - 1e-9):
+            t.fail("schedule", f"'{schedule}' spans {span:g} s, less than the run (end = {end:g} s)",
+                   "extend the schedule (its times are seconds) or shorten end")
+    return TimeSettings(end, step, output, t.number("fields", within, end), schedule), scheme, ts
+
+
+def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
+    """Every value that reads the schedule, at the schedule's samples within the run
+    (where its columns are recorded): in the range of its key; every column it reads recorded."""
+    t = np.asarray(ts.time_s - ts.time_s[0], float)
+    env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
+    for v in values(problem):
+        names = v.names() | {"t"}
+        empty = next((n for n in sorted(names) if not np.isfinite(env[n]).any()), None)
+        if empty:
+            raise InputError(f"{time.schedule}, column {empty}", "has no values", f"fill it ({v.key} reads it)")
+        rows = (t <= time.end) & np.logical_and.reduce([np.isfinite(env[n]) for n in names])
+        if not v.is_constant and rows.any():
+            v({n: env[n][rows] for n in names})
 
 
 def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
@@ -451,7 +480,8 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     plane = head.string("plane", "stress", ("stress", "strain", "axisymmetric"))
     if plane == "axisymmetric":
         case_mech.check_axisymmetric(top, fm, data)
-    time, scheme, columns = _time(top, path.parent)
+    time, scheme, schedule_ts = _time(top, path.parent)
+    columns = tuple(n for n in schedule_ts.names if n != "time_s") if schedule_ts is not None else ()
     prescribed = "temperature" in data
     elastic = "supports" in data
     mechanical = case_mech.mechanical_only(data)  # no temperature at all
@@ -517,16 +547,18 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                       signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme,
                       thermal=not mechanical, **kw)
     case_mech.check_assembly(top, fm, problem, time is None)
+    if schedule_ts is not None:
+        _check_schedule(problem, schedule_ts, time)
     if time is None:
         schedule = STEADY
     else:
-        drive = (series_drive(read_timeseries(time.schedule, required=("time_s",)), columns,
-                              {n for f in problem.fluids for n in f.pump.names()}, label=str(time.schedule))
-                 if time.schedule else (lambda _: {}))
+        drive = (series_drive(schedule_ts, columns, {n for f in problem.fluids for n in f.pump.names()},
+                              label=str(time.schedule)) if schedule_ts is not None else (lambda _: {}))
         schedule = timed_schedule(time.end, time.step, time.output, drive,
                                   f"schedule {time.schedule}" if time.schedule else "no schedule")
     return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
-                case_targets(problem), actuator=_actuator(top), path=path, source=str(path))
+                case_targets(problem), actuator=_actuator(top), path=path, source=str(path),
+                files=(path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else [])))
 
 
 def _actuator(top: Table):

@@ -123,10 +123,12 @@ def probe_set(name: str) -> str:
     return f"P_{_set(name)}"
 
 
-def check_time(schedule, t: float) -> None:
-    """InputError unless ``t`` (s) is a step of ``schedule``."""
-    if not any(abs(t - s) < 1e-6 for s in schedule.times):
+def check_time(schedule, t: float) -> float:
+    """The step of ``schedule`` at ``t`` (s, within 1e-6 s); InputError if there is none."""
+    near = [float(s) for s in schedule.times if abs(t - s) < 1e-6]
+    if not near:
         raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
+    return near[0]
 
 
 def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
@@ -135,7 +137,7 @@ def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
     relative displacements in m, the probe sets they compare and the mesh size)."""
     from gatetherm.studies.run.scenario import run_scenario
 
-    check_time(schedule, t)
+    t = check_time(schedule, t)
     run = run_scenario(case, schedule, keep_times=[t])
     (_, U), = [s for s in run.result.states if abs(s[0] - t) < 1e-6]
     model = run.model

@@ -19,12 +19,14 @@ import dataclasses
 import hashlib
 import logging
 import time
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from gatetherm import InputError, __version__, atomic_path, write_text_atomic
+from gatetherm.checks import CELSIUS, check_linear_system
 from gatetherm.solvers.effects import room
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.rom import Input, Reduction, ReducedModel, linear_heat_model, mode_name, reduce
@@ -75,20 +77,34 @@ def write_rom(rom: ReducedModel, path) -> None:
 
 
 def load_rom(path) -> ReducedModel:
-    """Read a ``rom.npz`` written by :func:`write_rom`; InputError naming the file if it is not one."""
+    """Read a ``rom.npz`` written by :func:`write_rom`, checked (:func:`~gatetherm.checks.check_linear_system`,
+    T0 a temperature); InputError naming the file if it is not one."""
+    fix = "write one with 'gatetherm reduce'"
+    if not Path(path).is_file():
+        raise InputError(str(path), "no such file", fix)
+    if not zipfile.is_zipfile(path):
+        raise InputError(str(path), "not an .npz archive (truncated, or another kind of file)", fix)
     try:
         with np.load(path, allow_pickle=False) as d:
             modes = tuple(map(str, d["modes"]))
             A = {m: np.array(d[f"A{_suffix(m)}"], float) for m in modes}
             B = {m: np.array(d[f"B{_suffix(m)}"], float) for m in modes}
-            inputs = tuple(Input(str(t), float(o)) for t, o in zip(d["inputs"], d["offsets"]))
-            defaults = dict(zip(map(str, d["default_inputs"]), map(float, d["default_values"])))
+            inputs = tuple(Input(str(t), float(o)) for t, o in zip(d["inputs"], d["offsets"], strict=True))
+            defaults = dict(zip(map(str, d["default_inputs"]), map(float, d["default_values"]), strict=True))
             room = int(d["room"])
-            return ReducedModel(A, B, np.array(d["C"], float), np.array(d["D"], float), np.array(d["y0"], float),
-                                inputs, tuple(map(str, d["outputs"])), tuple(map(str, d["pumps"])), float(d["T0"]),
-                                defaults, None if room < 0 else room)
-    except (KeyError, ValueError, OSError, EOFError) as err:
-        raise InputError(str(path), f"not a reduced model ({err})", "write one with 'gatetherm reduce'") from None
+            rom = ReducedModel(A, B, np.array(d["C"], float), np.array(d["D"], float), np.array(d["y0"], float),
+                               inputs, tuple(map(str, d["outputs"])), tuple(map(str, d["pumps"])), float(d["T0"]),
+                               defaults, None if room < 0 else room)
+    except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as err:
+        raise InputError(str(path), f"not a reduced model ({type(err).__name__}: {err})", fix) from None
+    CELSIUS.check(f"{path}: T0", rom.T0, fix)
+    check_linear_system(str(path), {m: (rom.A[m], rom.B[m]) for m in rom.modes}, rom.C, rom.D,
+                        inputs=rom.inputs, outputs=rom.outputs)
+    if len(rom.y0) != len(rom.outputs) or not np.isfinite(rom.y0).all():
+        raise InputError(str(path), "y0 is not one finite number per output", fix)
+    if rom.room is not None and not 0 <= rom.room < len(rom.inputs):
+        raise InputError(str(path), f"room {rom.room} is not an input", fix)
+    return rom
 
 
 def save_rom(rom: ReducedModel, key: str, directory: Path, name: str = "rom") -> None:
@@ -103,13 +119,13 @@ def cached_rom(case: Case, states: int, directory: Path, cache: ScenarioCache | 
     (:func:`rom_key`, in ``<name>.key``) matches, else built and kept."""
     path, keyfile = Path(directory) / f"{name}.npz", Path(directory) / f"{name}.key"
     key = rom_key(case, states)
-    if path.exists() and keyfile.exists() and keyfile.read_text().strip() == key:
+    if path.exists() and keyfile.exists() and keyfile.read_text(errors="replace").strip() == key:
         try:
             rom = load_rom(path)
             log.info("reusing %s", path)
             return rom
         except InputError as err:
-            log.warning("%s; building it again", err)
+            log.warning("%s; building the reduced model again", err)
     rom = build_rom(case, states, cache).rom
     save_rom(rom, key, directory, name)
     return rom

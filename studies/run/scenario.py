@@ -26,7 +26,7 @@ from gatetherm.solvers.sensors import apply_faults
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.schedules import (STEADY, Schedule, condition_schedule, file_schedule,  # noqa: F401
                                              series_schedule)
-from gatetherm.studies.run.simulate import RunResult, output_columns, run_model
+from gatetherm.studies.run.simulate import RunResult, check_temperatures, output_columns, run_model
 from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
@@ -124,6 +124,7 @@ def _once(p: Prepared, schedule: Schedule) -> RunResult:
         Y, states = np.array([[r[k] for k in keys] for r in rows]), [(float(t), None) for t in {times[0], times[-1]}]
     else:
         states = [(0.0, p.solver.steady(envs[0.0]))]
+        check_temperatures(states[0][1], 0.0)
         keys, Y = model.readout.keys, model.read(states[0][1], envs[0.0])[None, :]
     drive = schedule.drive
     cols = {"time_s": np.asarray(times, float), **{k: np.array([drive(float(t))[k] for t in times])
@@ -178,8 +179,9 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
         model, solver = _build(target) if cache is None else cache.model(target)
         result = run(Prepared(model, solver, eff))
     cols = apply_faults(eff.observe(result.columns, target.problem), case.sensors)
-    if schedule.every > 1:
-        cols = {k: v[::schedule.every] for k, v in cols.items()}
+    if schedule.every > 1:  # every output interval, and the end of the run
+        n = len(next(iter(cols.values())))
+        cols = {k: v[np.unique(np.r_[0:n:schedule.every, n - 1])] for k, v in cols.items()}
     return ScenarioRun(cols, result, model, eff, schedule, time.perf_counter() - t0)
 
 

@@ -13,6 +13,8 @@ from typing import Callable
 
 import numpy as np
 
+from gatetherm import InputError
+from gatetherm.checks import CELSIUS, show
 from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, environment, march
 from gatetherm.solvers.model import Model
 from gatetherm.solvers.problem import Problem
@@ -91,6 +93,17 @@ def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarra
     return out
 
 
+def check_temperatures(U: np.ndarray, t: float) -> None:
+    """InputError unless every temperature of the state ``U`` (°C) at ``t`` (s) is admissible
+    (:data:`~gatetherm.checks.CELSIUS`): a run that leaves the range has met heat inputs out of
+    all proportion, or a steady problem without a solution."""
+    lo, hi = float(U.min()), float(U.max())
+    if not (CELSIUS.holds(lo) and CELSIUS.holds(hi)):
+        raise InputError("temperature", f"the solution reaches {show(hi if CELSIUS.holds(lo) else lo)} °C at "
+                         f"t = {t:g} s, must be {CELSIUS}", "check the heat inputs (sources, fluxes: units and "
+                         "size) and, for a steady state, that a boundary holds a temperature or a film")
+
+
 def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
               U0: np.ndarray | None = None, solver: HeatSolver | None = None) -> RunResult:
@@ -107,6 +120,7 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
         env = environment(drive, t)
+        check_temperatures(U, t)
         inputs.append({"time_s": t, **drive(t)})
         Y.append(model.read(U, env))
         if t in keep:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.checks import FINITE, Range
+from gatetherm.checks import CELSIUS, FINITE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
 
 
@@ -54,12 +54,16 @@ class Table:
         return v
 
     def value(self, k: str, names, default=None, unit: str = "") -> Value:
+        """The value at ``k``: a number or an expression of ``names``, in the range of its
+        ``unit`` (°C: a temperature, else finite), checked now if it reads no input, else
+        wherever it is evaluated."""
+        rng = CELSIUS if unit == "°C" else FINITE
         if k not in self.data and default is not None:
-            return Value(default)
+            return Value(default, "", self.key(k), rng)
         if k not in self.data:
             self.fail(k, "missing", f"give a number{' in ' + unit if unit else ''} or an expression")
         try:
-            v = Value.of(self.data[k])
+            v = Value.of(self.data[k], self.key(k), rng)
         except ExpressionError as err:
             self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
         unknown = sorted(v.names() - set(names))
