@@ -327,7 +327,7 @@ def room(problem: Problem) -> Value:
 def _drifting(p: Problem, rate_k_per_h: float) -> Problem:
     """Every film's, the faces' and the hoses' ambient drifting by ``rate`` from its value."""
     def drift(v: Value) -> Value:
-        return Value.of(f"({v.text or repr(v.constant)}) + {rate_k_per_h / 3600.0!r} * t")
+        return Value.of(f"({v.text or repr(v.constant)}) + {rate_k_per_h / 3600.0!r} * t", v.key, v.range)
 
     return dataclasses.replace(
         p, films=tuple(dataclasses.replace(f, ambient=drift(f.ambient)) for f in p.films),
