@@ -107,6 +107,10 @@ def register(subparsers) -> None:
     p.add_argument("--max-updates", type=int, default=60, metavar="N", help="rom: update budget (default 60)")
     p.add_argument("--sensors", default=",".join(THERMOCOUPLES), metavar="COL,...",
                    help="rom: temperature columns the observer reads (default the paper's three)")
+    p.add_argument("--model", metavar="MODEL.json", help="replay a model from 'gatetherm errormodel fit' instead of "
+                   "--method (the --data file needs only time_s, the model's columns and --target)")
+    p.add_argument("--target", metavar="COL", help="--model: the compensated channel (default: the model's only one)")
+    p.add_argument("--correction", action="store_true", help="--model of the paper's form: on-line R_i, R_C (eqs 30-38)")
     p.set_defaults(func=run)
 
 
@@ -148,8 +152,9 @@ def run(args: argparse.Namespace) -> int:
         return prepare(cfg, args.dim, condition_schedule(args.condition or 1, cfg).drive, cache=cache).model
 
     if args.data is not None:
-        ts, what = read_timeseries(args.data), str(args.data)
-        validate_complete(ts, NEEDED, source=args.data)
+        ts, what = read_timeseries(args.data, **({"required": ("time_s",)} if args.model else {})), str(args.data)
+        if args.model is None:
+            validate_complete(ts, NEEDED, source=args.data)
         clash = [name for name in WRITTEN[1:] if name in ts]
         if clash and "compensation" not in ts.metadata:
             raise InputError(f"{args.data}, column {clash[0]}", "compensate writes a column of this name "
@@ -193,7 +198,19 @@ def _compensate(args, cfg, ts, what, params, model, cache, out_dir: Path) -> int
     replaced = [name for name in WRITTEN if name in ts]
     if replaced:
         log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
-    if args.method == "paper":
+    if args.model is not None:  # a fitted error model (studies/errormodel/replay.py)
+        from gatetherm.studies.errormodel.model import load_model
+        from gatetherm.studies.errormodel.replay import replay
+
+        em = load_model(args.model)
+        target = args.target or (em.names[0] if len(em.names) == 1 else None)
+        if target is None:
+            raise InputError("--target", f"the model has {len(em.names)} targets", f"name one of {', '.join(em.names)}")
+        loop = replay(em, ts, target, params, actuator, args.correction)
+        extra = {"method": "errormodel", "model": args.model, "target": target, "correction": args.correction}
+        label = head = f"error model {args.model}, {target} ({em.target(target).form} form" \
+            f"{', on-line R' if args.correction else ''}), update every {args.interval_min:g} min"
+    elif args.method == "paper":
         ki, kc, source = coefficients(args, ts, cfg, model)
         loop = compensate(ts, ki, kc, params, actuator)
         extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source}

@@ -1,0 +1,131 @@
+"""``gatetherm errormodel fit|predict``: thermal-error models from a machine's measurements
+(docs/errormodel.md; the library is gatetherm.studies.errormodel).
+
+``fit`` writes ``DIR/model.json`` and prints per target the form, sensors, time constants and
+held-out error; ``predict`` writes ``DIR/prediction.csv`` (``time_s``, ``<target>_pred``, and
+``<target>`` where the file has it), ``DIR/summary.json`` (MAE and RMS per measured target, the
+filled gaps) and ``DIR/prediction.png``.
+"""
+from __future__ import annotations
+
+import json
+import logging
+
+import numpy as np
+
+from gatetherm import InputError, write_text_atomic
+from gatetherm.studies.errormodel.fit import FIT_FORMS, FitParams, fit_error_model, fraction_span
+from gatetherm.studies.errormodel.model import check_columns, input_gaps, load_model, predict, save_model
+from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
+
+log = logging.getLogger(__name__)
+
+FIT_OUTPUTS = ("model.json",)
+PREDICT_OUTPUTS = ("prediction.csv", "summary.json", "prediction.png")
+
+
+def _names(text: str | None, option: str) -> tuple[str, ...] | None:
+    if text is None:
+        return None
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if not names:
+        raise InputError(option, "no column named", f"e.g. {option} ch1_um,ch2_um")
+    return names
+
+
+def _span(text: str) -> tuple[float, float]:
+    try:
+        lo, hi = (float(v) for v in text.split(":"))
+    except ValueError:
+        raise InputError("--fit-span", f"{text!r} is not START:END", "fractions of the run, e.g. 0:0.6") from None
+    return lo, hi
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("errormodel", help="fit thermal-error models to measured displacements, or apply one",
+                              description="Fit per target a thermal-error model (temperature sensors chosen by "
+                              "held-out error, operating inputs through first-order lags) or apply a fitted one.")
+    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
+    f = sub.add_parser("fit", help="fit models and write DIR/model.json")
+    f.add_argument("--data", required=True, metavar="FILE.csv", help="time-series file (docs/data-format.md)")
+    f.add_argument("--targets", required=True, metavar="COL,...", help="displacement columns to model (um)")
+    f.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    f.add_argument("--candidates", metavar="COL,...", help="temperature columns to choose from (default: every *_degC)")
+    f.add_argument("--inputs", default="", metavar="COL,...", help="operating inputs for lag terms, e.g. spindle_rpm")
+    f.add_argument("--max-sensors", type=int, default=4, metavar="N", help="sensors per target (default 4)")
+    f.add_argument("--max-inputs", type=int, default=2, metavar="N", help="input lag terms per target (default 2)")
+    f.add_argument("--form", choices=FIT_FORMS, default="auto", help="model form (default auto: static or dynamic "
+                   "by held-out error; paper: K_i (theta_a - theta_b) - K_C theta_c)")
+    f.add_argument("--differences", action="store_true", help="also offer sensor differences theta_a - theta_b")
+    f.add_argument("--fit-span", default="0:1", metavar="START:END",
+                   help="fitting span as fractions of the run's duration (default 0:1, all)")
+    f.set_defaults(func=run_fit)
+    q = sub.add_parser("predict", help="apply DIR/model.json to a data file")
+    q.add_argument("model", metavar="MODEL.json", help="from 'gatetherm errormodel fit'")
+    q.add_argument("--data", required=True, metavar="FILE.csv", help="time-series file with the columns the model reads")
+    q.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    q.set_defaults(func=run_predict)
+
+
+def run_fit(args) -> int:
+    from gatetherm.outdir import output_dir
+
+    targets = _names(args.targets, "--targets")
+    candidates, inputs = _names(args.candidates, "--candidates"), _names(args.inputs, "--inputs") or ()
+    ts = read_timeseries(args.data, required=("time_s", *targets, *(candidates or ()), *inputs))
+    params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
+                       differences=args.differences)
+    span = fraction_span(ts.time_s, *_span(args.fit_span))
+    with output_dir(args.out, FIT_OUTPUTS, keep=(args.data,)) as out:
+        model = fit_error_model(ts, targets, candidates, inputs, params, span, source=str(args.data))
+        save_model(out / "model.json", model)
+    print(f"wrote {out}/model.json (fitted on {span[0]:g} .. {span[1]:g} s, {model.fit_span['samples']} samples)")
+    for m in model.targets:
+        taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
+        print(f"{m.target}: {m.form}; sensors {', '.join(m.sensors)}; time constants {taus}; "
+              f"held-out MAE {m.held_out_mae_um:.3g} um, fit RMS {m.residual['rms_um']:.3g} um")
+        by_sensors = {}
+        for s in m.selection:
+            if s["form"] == m.form:
+                by_sensors[s["sensors"]] = min(s["cv_mae_um"], by_sensors.get(s["sensors"], np.inf))
+        print("  held-out MAE by sensors: " + ", ".join(f"{k}: {v:.3g} um" for k, v in sorted(by_sensors.items())))
+    return 0
+
+
+def run_predict(args) -> int:
+    from gatetherm.outdir import output_dir
+    from gatetherm.validation.plots import save
+    from gatetherm.validation.plots.errormodel import prediction_figure
+
+    model = load_model(args.model)
+    ts = read_timeseries(args.data, required=("time_s",))
+    check_columns(model, ts, str(args.data))
+    gaps = input_gaps(model, ts)
+    pred = predict(model, ts)
+    cols, summary = {"time_s": ts.time_s}, {"model": str(args.model), "data": str(args.data), "targets": {}}
+    for name, p in pred.items():
+        cols[f"{name}_pred"] = p
+        entry = {"predicted_samples": int(np.isfinite(p).sum())}
+        if name in ts:
+            cols[name] = ts[name]
+            r = ts[name] - p
+            ok = np.isfinite(r)
+            entry.update(mae_um=float(np.mean(np.abs(r[ok]))) if ok.any() else None,
+                         rms_um=float(np.sqrt(np.mean(r[ok] ** 2))) if ok.any() else None, compared_samples=int(ok.sum()))
+        summary["targets"][name] = entry
+    summary["gaps"] = {k: {"filled": g.filled, "longest_s": g.longest_s, "not_predicted": g.beyond}
+                       for k, g in gaps.items()}
+    with output_dir(args.out, PREDICT_OUTPUTS, keep=(args.data, args.model)) as out:
+        write_timeseries(out / "prediction.csv", TimeSeries(cols, {"source": f"gatetherm errormodel predict {args.model}"}))
+        span = (model.fit_span.get("start_s"), model.fit_span.get("end_s"))
+        save(prediction_figure(ts.time_s, pred, {n: ts[n] for n in pred if n in ts},
+                               span if None not in span else None), out / "prediction.png")
+        write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    print(f"wrote {out}/prediction.csv, prediction.png, summary.json")
+    for name, g in gaps.items():
+        print(f"{name}: {g.filled} missing samples filled (longest gap {g.longest_s:.0f} s), "
+              f"{g.beyond} in gaps over {model.max_gap_s:.0f} s not predicted")
+    for name, e in summary["targets"].items():
+        if e.get("mae_um") is not None:
+            print(f"{name}: MAE {e['mae_um']:.3g} um, RMS {e['rms_um']:.3g} um over {e['compared_samples']} samples")
+    return 0
