@@ -161,6 +161,11 @@ def run(args: argparse.Namespace) -> int:
                              "and the file is not from an earlier compensate", "rename the column so that it is kept")
     elif args.condition is not None:
         condition(args.condition)  # a bad number fails before the model is built
+    if args.model is not None:  # a bad model file or --target fails before --out is touched
+        from gatetherm.studies.errormodel.model import load_model
+        from gatetherm.studies.errormodel.replay import loop_target
+
+        loop_target(load_model(args.model), args.target)
     if args.case is not None and args.method != "paper":
         raise InputError("--method", f"{args.method} works on the paper frame's model, not on a case file",
                          "use --method paper with --case")
@@ -200,12 +205,10 @@ def _compensate(args, cfg, ts, what, params, model, cache, out_dir: Path) -> int
         log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
     if args.model is not None:  # a fitted error model (studies/errormodel/replay.py)
         from gatetherm.studies.errormodel.model import load_model
-        from gatetherm.studies.errormodel.replay import replay
+        from gatetherm.studies.errormodel.replay import loop_target, replay
 
         em = load_model(args.model)
-        target = args.target or (em.names[0] if len(em.names) == 1 else None)
-        if target is None:
-            raise InputError("--target", f"the model has {len(em.names)} targets", f"name one of {', '.join(em.names)}")
+        target = loop_target(em, args.target)
         loop = replay(em, ts, target, params, actuator, args.correction)
         extra = {"method": "errormodel", "model": args.model, "target": target, "correction": args.correction}
         label = head = f"error model {args.model}, {target} ({em.target(target).form} form" \

@@ -24,12 +24,12 @@ FIT_OUTPUTS = ("model.json",)
 PREDICT_OUTPUTS = ("prediction.csv", "summary.json", "prediction.png")
 
 
-def _names(text: str | None, option: str) -> tuple[str, ...] | None:
+def _names(text: str | None, option: str, example: str) -> tuple[str, ...] | None:
     if text is None:
         return None
     names = tuple(n.strip() for n in text.split(",") if n.strip())
     if not names:
-        raise InputError(option, "no column named", f"e.g. {option} ch1_um,ch2_um")
+        raise InputError(option, "no column named", f"e.g. {option} {example}")
     return names
 
 
@@ -51,7 +51,7 @@ def register(subparsers) -> None:
     f.add_argument("--targets", required=True, metavar="COL,...", help="displacement columns to model (um)")
     f.add_argument("--out", required=True, metavar="DIR", help="output directory")
     f.add_argument("--candidates", metavar="COL,...", help="temperature columns to choose from (default: every *_degC)")
-    f.add_argument("--inputs", default="", metavar="COL,...", help="operating inputs for lag terms, e.g. spindle_rpm")
+    f.add_argument("--inputs", metavar="COL,...", help="operating inputs for lag terms, e.g. spindle_rpm")
     f.add_argument("--max-sensors", type=int, default=4, metavar="N", help="sensors per target (default 4)")
     f.add_argument("--max-inputs", type=int, default=2, metavar="N", help="input lag terms per target (default 2)")
     f.add_argument("--form", choices=FIT_FORMS, default="auto", help="model form (default auto: static or dynamic "
@@ -70,8 +70,9 @@ def register(subparsers) -> None:
 def run_fit(args) -> int:
     from gatetherm.outdir import output_dir
 
-    targets = _names(args.targets, "--targets")
-    candidates, inputs = _names(args.candidates, "--candidates"), _names(args.inputs, "--inputs") or ()
+    targets = _names(args.targets, "--targets", "ch1_um,ch2_um")
+    candidates = _names(args.candidates, "--candidates", "t1_degC,t2_degC")
+    inputs = _names(args.inputs, "--inputs", "spindle_rpm") or ()
     ts = read_timeseries(args.data, required=("time_s", *targets, *(candidates or ()), *inputs))
     params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                        differences=args.differences)
@@ -88,7 +89,7 @@ def run_fit(args) -> int:
         for s in m.selection:
             if s["form"] == m.form:
                 by_sensors[s["sensors"]] = min(s["cv_mae_um"], by_sensors.get(s["sensors"], np.inf))
-        print("  held-out MAE by sensors: " + ", ".join(f"{k}: {v:.3g} um" for k, v in sorted(by_sensors.items())))
+        print("  forward path, held-out MAE by sensors: " + ", ".join(f"{k}: {v:.3g} um" for k, v in sorted(by_sensors.items())))
     return 0
 
 

@@ -1,14 +1,16 @@
 """Fitting thermal-error models to measured displacements (:func:`fit_error_model`).
 
-Per target, inside the fitting span and by the held-out error of :mod:`.select`:
+Per target, inside the fitting span and by the held-out error of :mod:`.select` (forward selection
+to the budget, then the smallest model on the path within ``min_gain`` of the best):
 
 * ``static``: ``delta = c0 + sum_k K_k theta_k`` over at most ``max_sensors`` temperature rises
-  (and, with ``differences``, differences ``theta_a - theta_b``), chosen by forward selection;
+  (and, with ``differences``, differences ``theta_a - theta_b``);
 * ``dynamic``: the same candidates plus each operating input as ``lag_tau[(|u|/u_max)^p]`` for
   ``p`` in ``exponents`` and ``tau`` on the grid ``input_taus_s`` (at most ``max_inputs`` such
-  terms), and, with ``sensor_taus_s``, lagged rises ``lag_tau[theta_k]``; after the selection the
-  time constants are refined continuously (least squares on the fitting span, each within a factor
-  sqrt(2) of its grid value, two lags of one signal kept a factor sqrt(2) apart) and kept if the held-out error does not grow;
+  terms), and, with ``sensor_taus_s``, lagged rises ``lag_tau[theta_k]``;
+* then (``refine``) the time constants are refined continuously (least squares on the fitting
+  span, within the grid's range) and each term is dropped whose removal raises the held-out error
+  by less than ``min_gain`` (two grid lags bracketing one time constant become one lag);
 * ``paper``: ``delta = K_i (theta_a - theta_b) - K_C theta_c`` (eq 21, no intercept), every
   triple a, b, c of the candidates tried.
 
@@ -59,7 +61,7 @@ class FitParams:
     form: str = "auto"
     """``auto``, ``static``, ``dynamic`` or ``paper`` (module docstring)."""
     refine: bool = True
-    """Refine the selected time constants continuously."""
+    """Refine the selected time constants continuously and drop terms that do not earn ``min_gain``."""
     max_gap_s: float = 300.0
     """Longest gap in a used column that is bridged by linear interpolation, s; rows in longer gaps
     are left out of the fit and not predicted."""
@@ -206,16 +208,16 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, candidates, params
         if form == "dynamic" and not has_dynamic:
             continue
         terms, cands = _candidates(base, params, form == "dynamic")
-        path = select.forward(cv, cands, intercept, params.max_sensors, params.max_inputs, params.min_gain)
-        fits[form] = (path[-1].cv_mae, [terms[k] for k in path[-1].chosen])
+        path = select.forward(cv, cands, intercept, params.max_sensors, params.max_inputs)
+        pick = select.choose(path, params.min_gain)
+        fits[form] = _refine([terms[k] for k in pick.chosen], pick.cv_mae, t, cols, reference, y_all, rows, params) \
+            if params.refine else ([terms[k] for k in pick.chosen], pick.cv_mae)
         selection += [{"form": form, "terms": [terms[k].label for k in s.chosen], "sensors": s.sensors,
                        "cv_mae_um": s.cv_mae} for s in path]
     form = "dynamic" if "dynamic" in fits and ("static" not in fits or
-                                               fits["dynamic"][0] < fits["static"][0] * (1 - params.min_gain)) \
+                                               fits["dynamic"][1] < fits["static"][1] * (1 - params.min_gain)) \
         else "static"
-    cv_mae, terms = fits[form]
-    if form == "dynamic" and params.refine:
-        terms, cv_mae = _refine(terms, cv_mae, t, cols, reference, y_all, rows, params)
+    terms, cv_mae = fits[form]
     X = np.column_stack([np.ones(t.size)] + [evaluate(term, t, cols, reference) for term in terms])
     c = np.linalg.lstsq(X[rows], y_all[rows], rcond=None)[0]
     return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
@@ -227,41 +229,59 @@ def _residual(r: np.ndarray) -> dict:
             "max_abs_um": float(np.max(np.abs(r))), "samples": int(r.size)}
 
 
-def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):
-    """Terms with the lag time constants refined by least squares on the span; kept if their
-    held-out error is not larger than the grid's (``cv_mae``)."""
+def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
+    """The terms with their lag time constants refined by least squares on the span (each within the
+    grid's range widened by sqrt(2)) and their held-out error; inf if two lags of one signal end up
+    within a factor sqrt(2) of each other (one of them is redundant)."""
     lagged = [j for j, term in enumerate(terms) if term.tau_s is not None]
-    if not lagged:
-        return terms, cv_mae
     fixed = [evaluate(term, t, cols, reference)[rows] for term in terms]
-    # between the neighbouring grid points (the grid doubles), so that two lags of one signal stay apart
-    bounds = [(np.log(terms[j].tau_s / SQRT2), np.log(terms[j].tau_s * SQRT2)) for j in lagged]
+    y = y_all[rows]
 
     def design(log_tau):
         cs = list(fixed)
         for j, lt in zip(lagged, log_tau):
             cs[j] = evaluate(dataclasses.replace(terms[j], tau_s=float(np.exp(lt))), t, cols, reference)[rows]
-        return np.column_stack([np.ones(rows.sum())] + cs)
+        return np.column_stack([np.ones(y.size)] + cs)
 
     def sse(log_tau):
         X = design(log_tau)
-        r = X @ np.linalg.lstsq(X, y_all[rows], rcond=None)[0] - y_all[rows]
+        r = X @ np.linalg.lstsq(X, y, rcond=None)[0] - y
         return float(r @ r)
 
-    x0 = np.log([terms[j].tau_s for j in lagged])
-    res = minimize(sse, x0, method="L-BFGS-B", bounds=bounds)
-    X = design(res.x)
-    refined_cv = select.CrossValidation(X, y_all[rows], params.folds).error(np.eye(X.shape[1]))
-    taus = {j: float(np.exp(lt)) for j, lt in zip(lagged, res.x)}
-    close = [(i, j) for i in lagged for j in lagged if i < j and terms[i].columns == terms[j].columns
-             and terms[i].exponent == terms[j].exponent and max(taus[i], taus[j]) < SQRT2 * min(taus[i], taus[j])]
-    if close or not refined_cv <= cv_mae:
-        log.info("refined time constants raise the held-out error (%.4g > %.4g): grid values kept", refined_cv, cv_mae)
-        return terms, cv_mae
     out = list(terms)
-    for j in lagged:
-        out[j] = dataclasses.replace(terms[j], tau_s=taus[j])
-    return out, refined_cv
+    if lagged:
+        grid = {j: params.input_taus_s if terms[j].kind == "input" else params.sensor_taus_s for j in lagged}
+        bounds = [(np.log(min(grid[j]) / SQRT2), np.log(max(grid[j]) * SQRT2)) for j in lagged]
+        res = minimize(sse, np.log([terms[j].tau_s for j in lagged]), method="L-BFGS-B", bounds=bounds)
+        for j, lt in zip(lagged, res.x):
+            out[j] = dataclasses.replace(terms[j], tau_s=float(np.exp(lt)))
+        if any(a.columns == b.columns and a.kind == b.kind and a.exponent == b.exponent
+               and max(a.tau_s, b.tau_s) < SQRT2 * min(a.tau_s, b.tau_s)
+               for i, a in enumerate(out) for b in out[i + 1:] if a.tau_s and b.tau_s):
+            return out, np.inf
+    X = np.column_stack([np.ones(y.size)] + [evaluate(term, t, cols, reference)[rows] for term in out])
+    return out, select.CrossValidation(X, y, params.folds).error(np.eye(X.shape[1]))
+
+
+def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):
+    """Refine the selected terms' time constants (:func:`_tuned`), then drop, one at a time, any
+    term whose removal (time constants refined again) raises the held-out error by less than
+    ``min_gain``: two grid lags that bracket one true time constant become one. Returns the terms
+    and their held-out error; the grid's (``terms``, ``cv_mae``) if refining does not lower it."""
+    best, best_cv = terms, cv_mae
+    tuned, tuned_cv = _tuned(terms, t, cols, reference, y_all, rows, params)
+    if tuned_cv <= best_cv:
+        best, best_cv = tuned, tuned_cv
+    dropped = True
+    while dropped and len(best) > 1:
+        dropped = False
+        for j in reversed(range(len(best))):
+            fewer, fewer_cv = _tuned(best[:j] + best[j + 1:], t, cols, reference, y_all, rows, params)
+            if fewer_cv < best_cv * (1 + params.min_gain):
+                log.info("%s dropped: held-out error %.4g without it, %.4g with", best[j].label, fewer_cv, best_cv)
+                best, best_cv, dropped = fewer, min(fewer_cv, best_cv), True
+                break
+    return best, best_cv
 
 
 def _paper(cv, name, base, B, y_all, rows) -> TargetModel:

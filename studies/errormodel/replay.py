@@ -21,6 +21,16 @@ from gatetherm.studies.run.timeseries import TimeSeries
 LOOP_COLUMNS = ("time_s", "delta_um")
 
 
+def loop_target(model: ErrorModel, target: str | None) -> str:
+    """``target``, or the model's only target if None; InputError if it has none of that name or several."""
+    if target is None:
+        if len(model.names) != 1:
+            raise InputError("--target", f"the model has {len(model.names)} targets",
+                             f"name one of {', '.join(model.names)}")
+        return model.names[0]
+    return model.target(target).target
+
+
 def replay(model: ErrorModel, ts: TimeSeries, target: str, params: CompensatorParams,
            actuator: piezo.ActuatorParams | None = None, correction: bool = False) -> ClosedLoop:
     """Compensate the measured ``target`` of ``ts`` with the model's prediction.

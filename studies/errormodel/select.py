@@ -12,9 +12,11 @@ lagged rises, lagged inputs, a column of ones): a sensor is a unit vector, a dif
 ``theta_a - theta_b`` the vector ``e_a - e_b``. Per block the Gram matrices of the base columns are
 formed once; any model's are ``W^T G W``, so a cross-validated error costs a few small solves.
 
-* :func:`forward`: greedy forward selection. Each step adds the candidate that lowers the held-out
-  error most, within the budget of sensors and input terms, and stops when none lowers it by at
-  least ``min_gain`` (relative): fewer parameters unless more predict measurably better.
+* :func:`forward`: greedy forward selection. Each step adds the candidate with the lowest held-out
+  error, within the budget of sensors and input terms, until the budget is spent (a step may
+  raise the error: a greedy path can need a detour); :func:`choose` then takes the smallest model
+  on the path whose error is within ``min_gain`` (relative) of the path's lowest: fewer
+  parameters unless more predict measurably better.
 * :func:`exhaustive`: every model of a fixed shape (the paper's ``K_i (theta_a - theta_b) -
   K_C theta_c``: all pairs a, b and third sensors c).
 """
@@ -80,12 +82,11 @@ class Step:
 
 
 def forward(cv: CrossValidation, candidates: list[Candidate], fixed: np.ndarray, max_sensors: int,
-            max_inputs: int, min_gain: float) -> list[Step]:
+            max_inputs: int) -> list[Step]:
     """Greedy forward selection (module docstring). ``fixed`` (p x m, m may be 0) are the columns
     always in the model (the intercept). Returns the path, the first step being ``fixed`` alone."""
     chosen: list[Candidate] = []
-    best = cv.error(fixed) if fixed.shape[1] else np.inf
-    path = [Step((), best, 0)]
+    path = [Step((), cv.error(fixed) if fixed.shape[1] else np.inf, 0)]
     while True:
         used = frozenset().union(*(c.sensors for c in chosen))
         inputs = sum(c.is_input for c in chosen)
@@ -93,14 +94,16 @@ def forward(cv: CrossValidation, candidates: list[Candidate], fixed: np.ndarray,
                 and (not c.is_input or inputs < max_inputs)]
         scored = [(cv.error(np.column_stack([fixed] + [d.w for d in chosen] + [c.w])), k) for k, c in enumerate(pool)]
         if not scored:
-            break
+            return path
         err, k = min(scored)
-        if not err < best * (1.0 - min_gain):
-            break
         chosen.append(pool[k])
-        best = err
         path.append(Step(tuple(c.index for c in chosen), err, len(used | pool[k].sensors)))
-    return path
+
+
+def choose(path: list[Step], min_gain: float) -> Step:
+    """The first step whose held-out error is within ``min_gain`` (relative) of the path's lowest."""
+    best = min(s.cv_mae for s in path)
+    return next(s for s in path if s.cv_mae <= best * (1.0 + min_gain))
 
 
 def exhaustive(cv: CrossValidation, models) -> list[tuple[float, tuple]]:
