@@ -62,6 +62,9 @@ class FitParams:
     """``auto``, ``static``, ``dynamic`` or ``paper`` (module docstring)."""
     refine: bool = True
     """Refine the selected time constants continuously and drop terms that do not earn ``min_gain``."""
+    resolution_K: float = 0.01
+    """Temperature resolution, K: a rise or difference that spans less than 10 x this in the fitting
+    span is not offered (it carries no information, and its coefficient would amplify noise)."""
     max_gap_s: float = 300.0
     """Longest gap in a used column that is bridged by linear interpolation, s; rows in longer gaps
     are left out of the fit and not predicted."""
@@ -171,11 +174,17 @@ def _base_terms(candidates, inputs, cols, in_span, params: FitParams) -> list[Te
     return base
 
 
-def _candidates(base: list[Term], params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:
-    """Terms offered to the forward selection and their combination vectors (column 0 = ones)."""
+def _informative(B: np.ndarray, w: np.ndarray, params: FitParams) -> bool:
+    """True if the combination ``w`` of the base columns spans at least 10 resolutions."""
+    return bool(np.ptp(B @ w) >= 10 * params.resolution_K)
+
+
+def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:
+    """Terms offered to the forward selection and their combination vectors (column 0 = ones);
+    ``B`` are the base columns on the fitting rows."""
     terms, cands, p = [], [], len(base) + 1
     for j, b in enumerate(base):
-        if dynamic or b.tau_s is None:
+        if (dynamic or b.tau_s is None) and (b.kind == "input" or _informative(B, np.eye(p)[j + 1], params)):
             w = np.zeros(p)
             w[j + 1] = 1.0
             terms.append(b)
@@ -186,6 +195,8 @@ def _candidates(base: list[Term], params: FitParams, dynamic: bool) -> tuple[lis
         for i, k in [(i, k) for n, i in enumerate(plain) for k in plain[n + 1:]]:
             w = np.zeros(p)
             w[i + 1], w[k + 1] = 1.0, -1.0
+            if not _informative(B, w, params):
+                continue
             terms.append(Term("difference", base[i].column, other=base[k].column))
             cands.append(select.Candidate(len(cands), w, frozenset((base[i].column, base[k].column)), False))
     return terms, cands
@@ -199,7 +210,7 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, candidates, params
                          f"give at least {4 * max(params.folds)}")
     cv = select.CrossValidation(B[rows], y_all[rows], params.folds)
     if params.form == "paper":
-        return _paper(cv, name, base, B, y_all, rows)
+        return _paper(cv, name, base, B, y_all, rows, params)
     forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
     has_dynamic = any(b.tau_s is not None for b in base)
     fits, selection = {}, []
@@ -207,7 +218,7 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, candidates, params
     for form in forms:
         if form == "dynamic" and not has_dynamic:
             continue
-        terms, cands = _candidates(base, params, form == "dynamic")
+        terms, cands = _candidates(base, B[rows], params, form == "dynamic")
         path = select.forward(cv, cands, intercept, params.max_sensors, params.max_inputs)
         pick = select.choose(path, params.min_gain)
         fits[form] = _refine([terms[k] for k in pick.chosen], pick.cv_mae, t, cols, reference, y_all, rows, params) \
@@ -284,7 +295,7 @@ def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):
     return best, best_cv
 
 
-def _paper(cv, name, base, B, y_all, rows) -> TargetModel:
+def _paper(cv, name, base, B, y_all, rows, params: FitParams) -> TargetModel:
     """The paper's form, every triple of plain sensors (a < b, c neither) by held-out error."""
     plain = [j for j, b in enumerate(base) if b.kind == "sensor" and b.tau_s is None]
     p = len(base) + 1
@@ -294,7 +305,8 @@ def _paper(cv, name, base, B, y_all, rows) -> TargetModel:
         w[a + 1, 0], w[b + 1, 0], w[c + 1, 1] = 1.0, -1.0, 1.0
         return w
 
-    triples = [(a, b, c) for n, a in enumerate(plain) for b in plain[n + 1:] for c in plain if c not in (a, b)]
+    pairs = [(a, b) for n, a in enumerate(plain) for b in plain[n + 1:] if _informative(B[rows], W(a, b, a)[:, 0], params)]
+    triples = [(a, b, c) for a, b in pairs for c in plain if c not in (a, b)]
     if not triples:
         raise InputError("candidates", "the paper's form needs at least 3 temperature columns", "name 3 or more")
     ranked = select.exhaustive(cv, ((abc, W(*abc)) for abc in triples))
