@@ -29,7 +29,8 @@ from scipy.optimize import minimize
 
 from gatetherm import InputError
 from gatetherm.studies.errormodel import select
-from gatetherm.studies.errormodel.model import ErrorModel, TargetModel
+from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, residual_stats
+from gatetherm.studies.errormodel.paper import fit_paper_form
 from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps
 
 log = logging.getLogger(__name__)
@@ -174,17 +175,12 @@ def _base_terms(candidates, inputs, cols, in_span, params: FitParams) -> list[Te
     return base
 
 
-def _informative(B: np.ndarray, w: np.ndarray, params: FitParams) -> bool:
-    """True if the combination ``w`` of the base columns spans at least 10 resolutions."""
-    return bool(np.ptp(B @ w) >= 10 * params.resolution_K)
-
-
 def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:
     """Terms offered to the forward selection and their combination vectors (column 0 = ones);
     ``B`` are the base columns on the fitting rows."""
     terms, cands, p = [], [], len(base) + 1
     for j, b in enumerate(base):
-        if (dynamic or b.tau_s is None) and (b.kind == "input" or _informative(B, np.eye(p)[j + 1], params)):
+        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B @ np.eye(p)[j + 1], params.resolution_K)):
             w = np.zeros(p)
             w[j + 1] = 1.0
             terms.append(b)
@@ -195,7 +191,7 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
         for i, k in [(i, k) for n, i in enumerate(plain) for k in plain[n + 1:]]:
             w = np.zeros(p)
             w[i + 1], w[k + 1] = 1.0, -1.0
-            if not _informative(B, w, params):
+            if not select.informative(B @ w, params.resolution_K):
                 continue
             terms.append(Term("difference", base[i].column, other=base[k].column))
             cands.append(select.Candidate(len(cands), w, frozenset((base[i].column, base[k].column)), False))
@@ -210,7 +206,7 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, candidates, params
                          f"give at least {4 * max(params.folds)}")
     cv = select.CrossValidation(B[rows], y_all[rows], params.folds)
     if params.form == "paper":
-        return _paper(cv, name, base, B, y_all, rows, params)
+        return fit_paper_form(cv, name, base, B, y_all, rows, params.resolution_K)
     forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
     has_dynamic = any(b.tau_s is not None for b in base)
     fits, selection = {}, []
@@ -232,12 +228,7 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, candidates, params
     X = np.column_stack([np.ones(t.size)] + [evaluate(term, t, cols, reference) for term in terms])
     c = np.linalg.lstsq(X[rows], y_all[rows], rcond=None)[0]
     return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
-                       _residual(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection))
-
-
-def _residual(r: np.ndarray) -> dict:
-    return {"mae_um": float(np.mean(np.abs(r))), "rms_um": float(np.sqrt(np.mean(r**2))),
-            "max_abs_um": float(np.max(np.abs(r))), "samples": int(r.size)}
+                       residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection))
 
 
 def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
@@ -293,32 +284,3 @@ def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):
                 best, best_cv, dropped = fewer, min(fewer_cv, best_cv), True
                 break
     return best, best_cv
-
-
-def _paper(cv, name, base, B, y_all, rows, params: FitParams) -> TargetModel:
-    """The paper's form, every triple of plain sensors (a < b, c neither) by held-out error."""
-    plain = [j for j, b in enumerate(base) if b.kind == "sensor" and b.tau_s is None]
-    p = len(base) + 1
-
-    def W(a, b, c):
-        w = np.zeros((p, 2))
-        w[a + 1, 0], w[b + 1, 0], w[c + 1, 1] = 1.0, -1.0, 1.0
-        return w
-
-    pairs = [(a, b) for n, a in enumerate(plain) for b in plain[n + 1:] if _informative(B[rows], W(a, b, a)[:, 0], params)]
-    triples = [(a, b, c) for a, b in pairs for c in plain if c not in (a, b)]
-    if not triples:
-        raise InputError("candidates", "the paper's form needs at least 3 temperature columns", "name 3 or more")
-    ranked = select.exhaustive(cv, ((abc, W(*abc)) for abc in triples))
-    cv_mae, (a, b, c) = ranked[0]
-    X = B[:, [a + 1, b + 1, c + 1]]
-    X = np.column_stack([X[:, 0] - X[:, 1], X[:, 2]])
-    k = np.linalg.lstsq(X[rows], y_all[rows], rcond=None)[0]
-    if k[0] < 0:  # orient the difference so that K_i > 0
-        a, b, k[0] = b, a, -k[0]
-        X[:, 0] *= -1
-    terms = (Term("difference", base[a].column, other=base[b].column), Term("sensor", base[c].column))
-    selection = tuple({"form": "paper", "terms": [f"{base[i].column}-{base[j].column}", base[m].column],
-                       "sensors": 3, "cv_mae_um": e} for e, (i, j, m) in ranked[:10])
-    return TargetModel(name, "paper", terms, (float(k[0]), float(k[1])), 0.0, _residual(X[rows] @ k - y_all[rows]),
-                       float(cv_mae), selection)

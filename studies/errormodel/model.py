@@ -100,6 +100,12 @@ class ErrorModel:
         return tuple(m.target for m in self.targets)
 
 
+def residual_stats(r: np.ndarray) -> dict:
+    """MAE, RMS and largest absolute value (um) and count of residuals ``r`` (um)."""
+    return {"mae_um": float(np.mean(np.abs(r))), "rms_um": float(np.sqrt(np.mean(r**2))),
+            "max_abs_um": float(np.max(np.abs(r))), "samples": int(r.size)}
+
+
 def check_columns(model: ErrorModel, columns, where: str = "data") -> None:
     """Raise InputError if ``columns`` (a mapping or TimeSeries) lacks ``time_s`` or a column the model reads."""
     for name in ("time_s", *model.columns):

@@ -109,3 +109,8 @@ def choose(path: list[Step], min_gain: float) -> Step:
 def exhaustive(cv: CrossValidation, models) -> list[tuple[float, tuple]]:
     """Held-out error of every ``(key, W)`` in ``models``, best first: ``[(cv_mae, key), ...]``."""
     return sorted((cv.error(W), key) for key, W in models)
+
+
+def informative(values: np.ndarray, resolution: float) -> bool:
+    """True if ``values`` span at least 10 ``resolution`` (a signal below that carries no information)."""
+    return bool(np.ptp(values) >= 10 * resolution)
