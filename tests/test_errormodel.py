@@ -162,6 +162,24 @@ def test_replay_keeps_only_the_forecast_error():
     assert np.max(np.abs(loop.delta_comp_um[at])) / swing == pytest.approx(0.0152, abs=0.003)
 
 
+def test_replay_with_the_papers_correction():
+    """A paper-form model replayed with the on-line R of eqs 30-38: for exact data R_i stays 1 and
+    the loop keeps the same forecast error as without the correction."""
+    ts = synthetic(noise_um=0.0)
+    th = {s: ts[s] - ts[s][0] for s in SENSORS}
+    ts = ts.with_columns(d_um=2.0 * (th["s4_degC"] - th["s2_degC"]) - 0.7 * th["s6_degC"])
+    model = fit_error_model(ts, ["d_um"], SENSORS, params=FitParams(form="paper"))
+    with_r = replay(model, ts, "d_um", CompensatorParams(), correction=True)
+    plain = replay(model, ts, "d_um", CompensatorParams())
+    late = with_r.t_s > 600
+    assert np.nanmax(np.abs(with_r.prediction.R_i[2:] - 1.0)) < 1e-6
+    assert np.max(np.abs(with_r.delta_comp_um[late])) == pytest.approx(np.max(np.abs(plain.delta_comp_um[late])),
+                                                                      rel=1e-6)
+    static = fit_error_model(ts, ["d_um"], SENSORS, params=FitParams(form="static"))
+    with pytest.raises(InputError, match="paper's form"):
+        replay(static, ts, "d_um", CompensatorParams(), correction=True)
+
+
 def cli(*argv) -> int:
     return main([str(a) for a in argv])
 
