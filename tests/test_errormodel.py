@@ -195,15 +195,24 @@ def test_cli_fit_predict_compensate(tmp_path, capsys):
         "--fit-span", "0:0.75", "--out", tmp_path / "fit") == 0
     out = capsys.readouterr().out
     assert "d_um: dynamic; sensors s1_degC, s3_degC" in out and "forward path, held-out MAE by sensors" in out
-    assert cli("errormodel", "predict", tmp_path / "fit" / "model.json", "--data", data, "--out", tmp_path / "pred") == 0
+    model = tmp_path / "fit" / "model.json"
+    assert cli("errormodel", "predict", model, "--data", data, "--out", tmp_path / "pred") == 0
     summary = json.loads((tmp_path / "pred" / "summary.json").read_text())
     assert summary["targets"]["d_um"]["mae_um"] == pytest.approx(0.04, abs=0.01)
     assert (tmp_path / "pred" / "prediction.png").stat().st_size > 0
     head = [ln for ln in (tmp_path / "pred" / "prediction.csv").read_text().splitlines() if not ln.startswith("#")][0]
     assert head == "time_s,d_um_pred,d_um"
-    assert cli("compensate", "--model", tmp_path / "fit" / "model.json", "--data", data, "--no-actuator",
+    assert cli("compensate", "--model", model, "--data", data, "--no-actuator",
                "--out", tmp_path / "comp") == 0
     assert json.loads((tmp_path / "comp" / "summary.json").read_text())["method"] == "errormodel"
+    ts = synthetic()
+    s1 = np.array(ts["s1_degC"])
+    s1[100:103] = np.nan
+    gappy = _write(tmp_path, ts.with_columns(s1_degC=s1), "gappy.csv")
+    assert cli("errormodel", "predict", model, "--data", gappy, "--out", tmp_path / "pred") == 0
+    assert "s1_degC: 3 missing samples filled (longest gap 240 s), 0 in gaps over 300 s" in capsys.readouterr().out
+    summary = json.loads((tmp_path / "pred" / "summary.json").read_text())
+    assert summary["gaps"] == {"s1_degC": {"filled": 3, "longest_s": 240.0, "unpredicted": 0}}
 
 
 BAD_FILES = {

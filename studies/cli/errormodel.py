@@ -8,6 +8,7 @@ filled gaps) and ``DIR/prediction.png``.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 
@@ -15,7 +16,7 @@ import numpy as np
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.studies.errormodel.fit import FIT_FORMS, FitParams, fit_error_model, fraction_span
-from gatetherm.studies.errormodel.model import check_columns, input_gaps, load_model, predict, save_model
+from gatetherm.studies.errormodel.model import check_columns, input_gaps, load_model, predict, save_model, score
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
 
 log = logging.getLogger(__name__)
@@ -62,7 +63,8 @@ def register(subparsers) -> None:
     f.set_defaults(func=run_fit)
     q = sub.add_parser("predict", help="apply DIR/model.json to a data file")
     q.add_argument("model", metavar="MODEL.json", help="from 'gatetherm errormodel fit'")
-    q.add_argument("--data", required=True, metavar="FILE.csv", help="time-series file with the columns the model reads")
+    q.add_argument("--data", required=True, metavar="FILE.csv",
+                   help="time-series file with the columns the model reads")
     q.add_argument("--out", required=True, metavar="DIR", help="output directory")
     q.set_defaults(func=run_predict)
 
@@ -89,7 +91,8 @@ def run_fit(args) -> int:
         for s in m.selection:
             if s["form"] == m.form:
                 by_sensors[s["sensors"]] = min(s["cv_mae_um"], by_sensors.get(s["sensors"], np.inf))
-        print("  forward path, held-out MAE by sensors: " + ", ".join(f"{k}: {v:.3g} um" for k, v in sorted(by_sensors.items())))
+        curve = ", ".join(f"{k}: {v:.3g} um" for k, v in sorted(by_sensors.items()))
+        print(f"  forward path, held-out MAE by sensors: {curve}")
     return 0
 
 
@@ -103,21 +106,16 @@ def run_predict(args) -> int:
     check_columns(model, ts, str(args.data))
     gaps = input_gaps(model, ts)
     pred = predict(model, ts)
-    cols, summary = {"time_s": ts.time_s}, {"model": str(args.model), "data": str(args.data), "targets": {}}
+    cols = {"time_s": ts.time_s}
     for name, p in pred.items():
         cols[f"{name}_pred"] = p
-        entry = {"predicted_samples": int(np.isfinite(p).sum())}
         if name in ts:
             cols[name] = ts[name]
-            r = ts[name] - p
-            ok = np.isfinite(r)
-            entry.update(mae_um=float(np.mean(np.abs(r[ok]))) if ok.any() else None,
-                         rms_um=float(np.sqrt(np.mean(r[ok] ** 2))) if ok.any() else None, compared_samples=int(ok.sum()))
-        summary["targets"][name] = entry
-    summary["gaps"] = {k: {"filled": g.filled, "longest_s": g.longest_s, "not_predicted": g.beyond}
-                       for k, g in gaps.items()}
+    summary = {"model": str(args.model), "data": str(args.data), "targets": score(pred, ts)}
+    summary["gaps"] = {k: dataclasses.asdict(g) for k, g in gaps.items()}
     with output_dir(args.out, PREDICT_OUTPUTS, keep=(args.data, args.model)) as out:
-        write_timeseries(out / "prediction.csv", TimeSeries(cols, {"source": f"gatetherm errormodel predict {args.model}"}))
+        source = {"source": f"gatetherm errormodel predict {args.model}"}
+        write_timeseries(out / "prediction.csv", TimeSeries(cols, source))
         span = (model.fit_span.get("start_s"), model.fit_span.get("end_s"))
         save(prediction_figure(ts.time_s, pred, {n: ts[n] for n in pred if n in ts},
                                span if None not in span else None), out / "prediction.png")
@@ -125,8 +123,8 @@ def run_predict(args) -> int:
     print(f"wrote {out}/prediction.csv, prediction.png, summary.json")
     for name, g in gaps.items():
         print(f"{name}: {g.filled} missing samples filled (longest gap {g.longest_s:.0f} s), "
-              f"{g.beyond} in gaps over {model.max_gap_s:.0f} s not predicted")
+              f"{g.unpredicted} in gaps over {model.max_gap_s:.0f} s not predicted")
     for name, e in summary["targets"].items():
-        if e.get("mae_um") is not None:
-            print(f"{name}: MAE {e['mae_um']:.3g} um, RMS {e['rms_um']:.3g} um over {e['compared_samples']} samples")
+        if "mae_um" in e:
+            print(f"{name}: MAE {e['mae_um']:.3g} um, RMS {e['rms_um']:.3g} um over {e['samples']} samples")
     return 0

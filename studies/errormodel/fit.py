@@ -180,7 +180,7 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
     ``B`` are the base columns on the fitting rows."""
     terms, cands, p = [], [], len(base) + 1
     for j, b in enumerate(base):
-        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B @ np.eye(p)[j + 1], params.resolution_K)):
+        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B[:, j + 1], params.resolution_K)):
             w = np.zeros(p)
             w[j + 1] = 1.0
             terms.append(b)

@@ -161,6 +161,20 @@ def predict(model: ErrorModel, columns) -> dict[str, np.ndarray]:
     return out
 
 
+def score(predicted: dict[str, np.ndarray], columns) -> dict[str, dict]:
+    """Per predicted target: ``predicted_samples``, and where ``columns`` has the target measured,
+    :func:`residual_stats` of measured - predicted over the samples where both exist (um)."""
+    out = {}
+    for name, p in predicted.items():
+        entry = {"predicted_samples": int(np.isfinite(p).sum())}
+        if name in columns:
+            r = np.asarray(columns[name], float) - p
+            r = r[np.isfinite(r)]
+            entry.update(residual_stats(r) if r.size else {"samples": 0})
+        out[name] = entry
+    return out
+
+
 def to_dict(model: ErrorModel) -> dict:
     """The JSON-ready content of ``model.json``."""
     def term(t: Term, b: float) -> dict:
@@ -180,7 +194,8 @@ def to_dict(model: ErrorModel) -> dict:
 def from_dict(data: dict, where: str = "model") -> ErrorModel:
     """Inverse of :func:`to_dict`; InputError naming the entry on a bad file."""
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise InputError(f"{where}: format", f"not a {FORMAT} file", "give a model.json from 'gatetherm errormodel fit'")
+        raise InputError(f"{where}: format", f"not a {FORMAT} file",
+                         "give a model.json from 'gatetherm errormodel fit'")
     try:
         targets = []
         for name, d in data["targets"].items():

@@ -116,7 +116,7 @@ class GapReport:
     """Samples that were missing (empty or non-finite) and were filled."""
     longest_s: float
     """Longest run of missing samples, s (from the last good sample to the next)."""
-    beyond: int
+    unpredicted: int
     """Filled samples in runs longer than the allowed gap: their predictions are not kept."""
 
 
