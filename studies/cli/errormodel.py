@@ -87,6 +87,10 @@ def run_fit(args) -> int:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
         print(f"{m.target}: {m.form}; sensors {', '.join(m.sensors)}; time constants {taus}; "
               f"held-out MAE {m.held_out_mae_um:.3g} um, fit RMS {m.residual['rms_um']:.3g} um")
+        if m.form == "paper":
+            best = "; ".join(f"{' and '.join(s['terms'])}: {s['cv_mae_um']:.3g} um" for s in m.selection[:3])
+            print(f"  best triples, held-out MAE: {best}")
+            continue
         by_sensors = {}
         for s in m.selection:
             if s["form"] == m.form:
