@@ -57,7 +57,7 @@ class FitParams:
     """Also offer every difference theta_a - theta_b as one regressor (two sensors, one coefficient)."""
     folds: tuple[int, ...] = (4, 5, 6, 7, 8)
     """Block counts of the blocked cross-validation; its error is averaged over them."""
-    min_gain: float = 0.01
+    min_gain: float = 0.03
     """Relative drop of the held-out error a further term must bring, dimensionless."""
     form: str = "auto"
     """``auto``, ``static``, ``dynamic`` or ``paper`` (module docstring)."""
@@ -82,7 +82,7 @@ class FitParams:
         if bad:
             raise InputError("exponents, time constants, max_gap_s", f"{bad[0]} is not > 0", "use positive values")
         if not 0 <= self.min_gain < 1:
-            raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.01")
+            raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
 
 
 def fraction_span(t_s: np.ndarray, lo: float, hi: float) -> tuple[float, float]:
