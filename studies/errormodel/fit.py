@@ -148,7 +148,7 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
     reference = {c: float(cols[c][np.flatnonzero(in_span & np.isfinite(series[c]))[0]]) for c in candidates}
     base = _base_terms(candidates, inputs, cols, in_span, params)
     B = np.column_stack([np.ones(t.size)] + [evaluate(b, t, cols, reference) for b in base])
-    models = [_fit_target(series[y], y, t, base, B, in_span & ~long, cols, reference, candidates, params)
+    models = [_fit_target(series[y], y, t, base, B, in_span & ~long, cols, reference, params)
               for y in targets]
     used = {s for m in models for s in m.sensors}
     return ErrorModel(tuple(models), {c: reference[c] for c in candidates if c in used},
@@ -198,7 +198,7 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
     return terms, cands
 
 
-def _fit_target(y_all, name, t, base, B, ok, cols, reference, candidates, params: FitParams) -> TargetModel:
+def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams) -> TargetModel:
     y_all = np.asarray(y_all, float)
     rows = ok & np.isfinite(y_all)
     if rows.sum() < 4 * max(params.folds):
