@@ -97,6 +97,16 @@ def test_paper_form_finds_its_three_sensors():
     assert m.intercept_um == 0.0 and m.held_out_mae_um < 1e-9
 
 
+def test_a_difference_is_one_term_for_two_sensors():
+    ts = synthetic(noise_um=0.0)
+    d = 2.0 * ((ts["s4_degC"] - ts["s4_degC"][0]) - (ts["s2_degC"] - ts["s2_degC"][0]))
+    m = fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS,
+                        params=FitParams(form="static", differences=True)).target("d_um")
+    (term,) = m.terms
+    assert (term.kind, {term.column, term.other}) == ("difference", {"s2_degC", "s4_degC"})
+    assert abs(m.coefficients[0]) == pytest.approx(2.0, abs=1e-9) and m.sensors == (term.column, term.other)
+
+
 def test_fit_is_deterministic_and_model_json_round_trips(tmp_path):
     ts = synthetic()
     a = fit_error_model(ts, ["d_um"], SENSORS, ["spindle_rpm"])
