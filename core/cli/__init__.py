@@ -17,7 +17,7 @@ import threading
 
 #: Sub-command modules of this package, in ``--help`` order.
 COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
-                   "export", "report")
+                   "errormodel", "export", "report")
 
 
 class Terminated(BaseException):

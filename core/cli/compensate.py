@@ -81,7 +81,7 @@ def register(subparsers) -> None:
                    help="actuator update interval in minutes (default 5, as in the paper)")
     p.add_argument("--no-actuator", action="store_true",
                    help="ideal actuator: the stroke equals the command")
-    p.add_argument("--method", choices=METHODS, default="paper",
+    p.add_argument("--method", choices=METHODS[:3], default="paper",
                    help="paper (default): the paper's procedure; mlr: regression baseline; rom: Kalman filter "
                    "and predictive control on the reduced model")
     p.add_argument("--rom", metavar="ROM.npz", help="rom: reduced model from 'gatetherm reduce' (default: build "
@@ -92,6 +92,10 @@ def register(subparsers) -> None:
     p.add_argument("--max-updates", type=int, default=60, metavar="N", help="rom: update budget (default 60)")
     p.add_argument("--sensors", default=",".join(THERMOCOUPLES), metavar="COL,...",
                    help="rom: temperature columns the observer reads (default the paper's three)")
+    p.add_argument("--model", metavar="MODEL.json", help="replay a model from 'gatetherm errormodel fit' instead of "
+                   "--method (the --data file needs only time_s, the model's columns and --target)")
+    p.add_argument("--target", metavar="COL", help="--model: the compensated channel (default: the model's only one)")
+    p.add_argument("--correction", action="store_true", help="--model of the paper's form: on-line R_i, R_C (eqs 30-38)")
     p.set_defaults(func=run)
 
 
@@ -105,7 +109,15 @@ def _settings(args):
     params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
     control = PredictiveParams(mode=args.updates, max_updates=args.max_updates, interval_s=params.update_interval_s)
     sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
-    return Settings(args.method, params, args.Ki, args.Kc, args.k_source, args.states, control, sensors=sensors)
+    model = None
+    if args.model is not None:  # a bad model file or --target fails before --out is touched
+        from gatetherm.studies.errormodel.model import load_model
+        from gatetherm.studies.errormodel.replay import loop_target
+
+        model = load_model(args.model)
+        loop_target(model, args.target)
+    return Settings("errormodel" if model else args.method, params, args.Ki, args.Kc, args.k_source, args.states,
+                    control, sensors=sensors, model=model, target=args.target, correction=args.correction)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -114,6 +126,8 @@ def run(args: argparse.Namespace) -> int:
     from gatetherm.studies.run.timeseries import FORMAT, read_timeseries
 
     settings = _settings(args)
+    if args.model is not None and args.data is None:
+        raise InputError("--model", "replays a fitted model on recorded data", "give --data FILE.csv")
     if args.data is None and args.condition is None and args.case is None:
         raise InputError("--data/--condition/--case", "give what to compensate",
                          "a time-series file, one of the paper's conditions, or a case file (its own run)")
@@ -164,13 +178,13 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=out_dir,
                       source=what, rom_source=args.rom)
     summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
-               "config": case.source, "dim": case.dim}
+               "config": case.source, "dim": case.dim, **({"model": args.model} if args.model else {})}
     text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
     loop = comp.loop
     out = ts.with_columns(u_piezo_um=loop.stroke_um, delta_pred_um=loop.delta_pred_um,
                           delta_comp_um=loop.delta_comp_um)
     out = dataclasses.replace(out, metadata={
-        **out.metadata, "compensation": f"{'' if args.method == 'paper' else args.method + ': '}{comp.label}, "
+        **out.metadata, "compensation": f"{'' if settings.method == 'paper' else settings.method + ': '}{comp.label}, "
         f"{'actuator model' if actuator else 'ideal actuator'}"})
 
     from gatetherm.validation.plots.compensation import plot_compensation, plot_piezo_loops  # outer layer

@@ -5,7 +5,9 @@
   (``fe``, ditto) or fitted on the run itself (``fit``);
 * ``mlr``: a static regression of δ on θ_A, θ_B, θ_C fitted on the case's own schedule, forecasting
   one sample ahead from the extrapolated temperatures (the paper's latency);
-* ``rom``: a Kalman filter on the case's reduced model and predictive control (:mod:`.predictive`).
+* ``rom``: a Kalman filter on the case's reduced model and predictive control (:mod:`.predictive`);
+* ``errormodel``: a thermal-error model fitted on measured data (``gatetherm errormodel fit``,
+  :mod:`gatetherm.studies.errormodel`), replayed on one of its targets.
 
 The actuator is the case's (``[actuator]``; the paper frame's piezo), or ideal (None): the
 correction sent to the machine's control as an offset.
@@ -32,7 +34,7 @@ from gatetherm.studies.run.timeseries import TimeSeries, validate_complete
 
 log = logging.getLogger(__name__)
 
-METHODS = ("paper", "mlr", "rom")
+METHODS = ("paper", "mlr", "rom", "errormodel")
 K_SOURCES = ("theory", "fe", "fit")
 
 
@@ -54,6 +56,12 @@ class Settings:
     observer: ObserverParams = ObserverParams()
     sensors: tuple[str, ...] = THERMOCOUPLES
     """rom: temperature columns the observer reads."""
+    model: object = None
+    """errormodel: the fitted :class:`~gatetherm.studies.errormodel.model.ErrorModel`."""
+    target: str | None = None
+    """errormodel: the compensated channel (default: the model's only one)."""
+    correction: bool = False
+    """errormodel of the paper's form: the on-line R_i, R_C of eqs 30–38."""
 
 
 @dataclass(frozen=True)
@@ -124,8 +132,21 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
     s, params = settings, settings.params
     if s.method not in METHODS:
         raise InputError("--method", f"unknown method {s.method!r}", f"choose from {', '.join(METHODS)}")
-    validate_complete(ts, NEEDED)
     every = f"update every {params.update_interval_s / 60:g} min"
+    if s.method == "errormodel":
+        from gatetherm.studies.errormodel.replay import loop_target, replay
+
+        if s.model is None:
+            raise InputError("--model", "the errormodel method needs a fitted model", "give --model MODEL.json")
+        target = loop_target(s.model, s.target)
+        loop = replay(s.model, ts, target, params, actuator, s.correction)
+        extra = {"target": target, "correction": s.correction}
+        label = head = f"error model, {target} ({s.model.target(target).form} form" \
+            f"{', on-line R' if s.correction else ''}), {every}"
+        return Compensation(loop, {**summarize(loop, params.settle_s), "method": s.method, **extra,
+                                   "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
+                                   "actuator": dataclasses.asdict(actuator) if actuator else None}, label, head, extra)
+    validate_complete(ts, NEEDED)
     if s.method == "paper":
         ki, kc, source = coefficients(case, ts, s, cache)
         loop = paper_loop(ts, ki, kc, params, actuator)
