@@ -11,7 +11,7 @@ import pytest
 import gatetherm as gt
 from gatetherm.studies.run.reduce import write_rom
 from gatetherm.studies.run.timeseries import FORMAT, OUTPUT_COLUMNS, TimeSeries, write_timeseries
-from gatetherm.validation.hidden_effects import recorded
+from gatetherm.validation.truth import recorded
 from test_rom_cli import integrate
 
 CASE = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame" / "case.toml"

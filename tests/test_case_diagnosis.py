@@ -18,7 +18,7 @@ from gatetherm.studies.run.case import load_case
 from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, write_timeseries
 from gatetherm.validation.case_diagnosis import SCENARIOS, hidden, write_case_diagnosis
-from gatetherm.validation.hidden_effects import recorded
+from gatetherm.validation.truth import recorded
 from test_bad_input import refused
 
 CASE = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame" / "case.toml"

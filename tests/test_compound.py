@@ -25,7 +25,7 @@ from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.run.scenario import measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
 from gatetherm.validation.compound_study import draw_value, kinds_markdown, pairs, pieces_by_key, visible
-from gatetherm.validation.hidden_effects import measured, truth_with
+from gatetherm.validation.truth import measured, truth_with
 
 FAST = dict(mesh_factor=1.0, step_s=120.0)
 SHORTLIST = Settings(effects=("joint_resistance", "stand_drift", "piezo_heat", "base_conduction"),
@@ -200,11 +200,11 @@ def test_visibility_of_the_weakest_drawn_strengths(coarse):
 
 def test_the_by_kinds_table_counts_each_group_and_all():
     """compound.md's table by kinds (the README's): one wrong pair of two sensor pieces."""
-    def row(kinds, ok):
+    def row(kinds, ok, strict=False):
         return {"kinds": kinds, "verdict": "explained", "both_named": ok, "both_named_or_equivalent": True,
-                "wrong_piece": not ok, "wrong_effect": False}
+                "wrong_piece": not ok, "missed": [], "wrong_effect": False, "wrong_piece_strict": not ok or strict}
 
-    lines = kinds_markdown([row("effect+effect", True), row("sensor+sensor", False)]).splitlines()
-    assert lines[2] == "| effect + effect | 1 | 1 | 1 | 1 | 0 | 0 |"
-    assert lines[7] == "| sensor + sensor | 1 | 1 | 0 | 1 | 1 | 0 |"
-    assert lines[8] == "| all | 2 | 2 | 1 (50.0 %) | 2 | 1 (50.0 %) | 0 |"
+    lines = kinds_markdown([row("effect+effect", True, strict=True), row("sensor+sensor", False)]).splitlines()
+    assert lines[2] == "| effect + effect | 1 | 1 | 1 | 1 | 0 | 0 | 0 | 1 |"  # a group member named: right
+    assert lines[7] == "| sensor + sensor | 1 | 1 | 0 | 1 | 1 | 0 | 0 | 1 |"
+    assert lines[8] == "| all | 2 | 2 | 1 (50.0 %) | 2 | 1 (50.0 %) | 0 | 0 | 2 (100.0 %) |"

@@ -30,7 +30,7 @@ from gatetherm.studies.diagnosis.replay import Replayer, compared_channels, resi
 from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.run.scenario import condition_schedule, measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
-from gatetherm.validation.hidden_effects import Case, measured, truth
+from gatetherm.validation.truth import Case, measured, truth
 
 COARSE = MeshParams(size=0.02)
 HOUR = 3600.0
@@ -140,12 +140,21 @@ def test_list_effects_json(capsys):
     assert main(["diagnose", "--list-effects", "--json"]) == 0
     listed = json.loads(capsys.readouterr().out)
     assert {"kind", "name", "params"} <= set(listed[0]) and {d["kind"] for d in listed} == {"effect", "parameter",
-                                                                                             "sensor"}
+                                                                                             "geometry", "sensor"}
+    geometry = {d["name"]: d["params"] for d in listed if d["kind"] == "geometry"}
+    assert list(geometry) == ["geometry.l4", "geometry.l_C", "geometry.A_C", "geometry.h", "geometry.tank_wall"]
+    assert geometry["geometry.l_C"]["l_C"] == {"unit": "m", "range": [pytest.approx(0.32), pytest.approx(0.5)]}
     k = next(d for d in listed if d["name"] == "conductivity")
     assert k["params"]["k"]["unit"] == "W/(m K)" and k["params"]["k"]["range"][0] < 48 < k["params"]["k"]["range"][1]
     offsets = [d for d in listed if d["name"] == "sensor_offset"]
     assert {d["channel"] for d in offsets} == {"theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um"}
     assert main(["diagnose", "--data", "x.csv"]) == 2
+    assert main(["diagnose", "--list-effects", "--json", "--uncertain", "geometry.column_height"]) == 0
+    more = [d for d in json.loads(capsys.readouterr().out) if d["kind"] == "geometry"]
+    assert more[-1]["name"] == "geometry.column_height" and more[-1]["params"]["column_height"]["range"][1] == \
+        pytest.approx(0.7 * 1.25)
+    assert main(["diagnose", "--list-effects", "--uncertain", "geometry.l1"]) == 2  # beam theory only: no mesh
+    assert "'geometry.l1' is not a dimension of the frame" in capsys.readouterr().err
 
 
 def test_diagnose_in_3d(tmp_path):

@@ -40,6 +40,8 @@ from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, ru
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 from gatetherm.studies.sweeps.pool import run_pool
 from gatetherm.validation import hidden_effects as single, paper_model
+from gatetherm.validation.scoring import score
+from gatetherm.validation.truth import measured, truth_with
 
 log = logging.getLogger(__name__)
 
@@ -136,16 +138,16 @@ def run_pair(pair: Pair, config: Config) -> dict:
     case = frame_case(config, 2)
     known = pieces_by_key(config, case)
     values = {known[k]: v for k, v in pair.pieces}
-    ts = single.measured(single.truth_with(config, pair.condition, values), pair.seed, pair.condition)
+    ts = measured(truth_with(config, pair.condition, values), pair.seed, pair.condition)
     row = single.diagnosis_row(diagnose(case, ts, single.SETTINGS))
     hidden = [k for k, _ in pair.pieces]
     named = set(row["pieces"])
-    either = named | set(row["alternatives"])
-    effects = {k for k in named if k.startswith("effect:")}
+    sc = score(row["pieces"], row["groups"], hidden)
     return {"hidden": hidden, "strengths": [v for _, v in pair.pieces], "condition": pair.condition, "seed": pair.seed,
-            "kinds": "+".join(k.split(":")[0] for k in hidden), **row,
-            "both_named": set(hidden) <= named, "both_named_or_equivalent": set(hidden) <= either,
-            "wrong_piece": bool(named - set(hidden)), "wrong_effect": bool(effects - set(hidden))}
+            "kinds": "+".join(k.split(":")[0] for k in hidden), **row, **sc,
+            "both_named": set(hidden) <= named, "both_named_or_equivalent": not sc["missed"],
+            "wrong_piece": bool(sc["wrong_names"]), "wrong_piece_strict": bool(named - set(hidden)),
+            "wrong_effect": any(k.startswith("effect:") for k in sc["wrong_names"])}
 
 
 def _pair_worker(args):
@@ -161,6 +163,8 @@ def acceptance(rows: list[dict]) -> dict:
            "both_named_or_equivalent": sum(r["both_named_or_equivalent"] for r in rows),
            "wrong_piece": sum(r["wrong_piece"] for r in rows),
            "wrong_piece_pct": 100.0 * sum(r["wrong_piece"] for r in rows) / max(n, 1),
+           "wrong_piece_strict": sum(r["wrong_piece_strict"] for r in rows),
+           "missed": sum(bool(r["missed"]) for r in rows),
            "wrong_effect": sum(r["wrong_effect"] for r in rows),
            "verdicts": {v: sum(r["verdict"] == v for r in rows) for v in sorted({r["verdict"] for r in rows})}}
     for kinds in sorted({r["kinds"] for r in rows}):
@@ -174,7 +178,7 @@ def acceptance(rows: list[dict]) -> dict:
 
 
 COLUMNS = ("hidden", "strengths", "condition", "seed", "verdict", "pieces", "alternatives", "both_named", "wrong_piece",
-           "best_rejected", "rms_before_um", "rms_after_um", "runs", "seconds")
+           "wrong_names", "missed", "stand_ins", "best_rejected", "rms_before_um", "rms_after_um", "runs", "seconds")
 
 
 def _fmt(v) -> str:
@@ -185,17 +189,19 @@ def _fmt(v) -> str:
 
 def kinds_markdown(rows: list[dict]) -> str:
     """The pairs by the kinds of their hidden pieces (README, "Compound diagnosis")."""
-    L = ["| hidden kinds | cases | verdict `explained` | both pieces named | both named, or a stated equivalent "
-         "| a wrong piece named | a wrong catalogue effect |", "|---|---|---|---|---|---|---|"]
+    L = ["| hidden kinds | cases | verdict `explained` | both pieces named | both named, or in a named piece's group "
+         "| a wrong piece named (groups as right) | a piece missed | a wrong catalogue effect "
+         "| a piece other than the hidden (groups as wrong) |", "|---|---|---|---|---|---|---|---|---|"]
     groups = [(" + ".join(k), [r for r in rows if r["kinds"] == "+".join(k)]) for k in KIND_PAIRS]
     for name, mine in groups + [("all", rows)]:
         n = len(mine)
         counts = [sum(r["verdict"] == "explained" for r in mine)] + [
-            sum(r[k] for r in mine) for k in ("both_named", "both_named_or_equivalent", "wrong_piece", "wrong_effect")]
+            sum(bool(r[k]) for r in mine) for k in ("both_named", "both_named_or_equivalent", "wrong_piece", "missed",
+                                                     "wrong_effect", "wrong_piece_strict")]
         cells = [str(c) for c in counts]
         if name == "all":
-            cells[1] += f" ({100 * counts[1] / max(n, 1):.1f} %)"
-            cells[3] += f" ({100 * counts[3] / max(n, 1):.1f} %)"
+            for i in (1, 3, 6):
+                cells[i] += f" ({100 * counts[i] / max(n, 1):.1f} %)"
         L.append(f"| {name} | {n} | " + " | ".join(cells) + " |")
     return "\n".join(L)
 

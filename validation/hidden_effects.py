@@ -3,17 +3,21 @@
     gatetherm validate hidden-effects --out DIR [--workers 2] [--mesh-size M]
                                       [--conditions 1,2,3] [--effects NAME,...]
 
-"Measured" runs are made by simulating a paper condition with one catalogue
-effect switched on at a seeded random strength (one draw in the lower and one
+"Measured" runs (:mod:`validation.truth`) are made by simulating a paper condition with one
+catalogue effect switched on at a seeded random strength (one draw in the lower and one
 in the upper third of its plausible range, log scale for positive
 parameters), on a finer mesh than the diagnosis uses (no inverse crime), then
 adding Gaussian sensor noise at the paper's resolution (0.1 µm, 0.05 K) and
 rounding to it. Each run is diagnosed blind from the baseline model. Also:
-noise-only runs, and runs with an effect outside the catalogue (a heat leak
-at the tie bar, thermocouples A/B mounted 40 mm higher or lower than the model
-assumes, a drop of the tank oil flow at 2.5 h), and runs made with a wrong
-existing parameter (tank-wall film with the pump on ×1.5, film to air ×0.6),
-for which the parameter piece (``oil_film_on``, ``air_film``) is expected.
+noise-only runs; runs with a cause outside every hypothesis (a heat leak at the tie
+bar, thermocouples A/B mounted 40 mm higher or lower than the model assumes, a drop of
+the tank oil flow at 2.5 h, an unrecorded swing of the room, the 3-D frame's run, the
+column 8 % taller: a dimension the diagnosis does not try); runs made with a wrong
+existing parameter (tank-wall film with the pump on ×1.5, film to air ×0.6), for which
+the parameter piece (``oil_film_on``, ``air_film``) is expected; and runs with one of the
+dimensions the diagnosis tries off by 5–10 % (tie-bar height, length and section, column
+width, tank wall), for which that geometry piece is expected within 20 % of the change.
+Every row counts wrong names and misses separately (:mod:`validation.scoring`).
 
 Writes ``DIR/hidden_effects.md`` and ``DIR/hidden_effects.csv`` (one row per
 case: effect, strength, condition, verdict, pieces named, best rejected, margin,
@@ -35,50 +39,20 @@ from gatetherm import write_text_atomic
 from gatetherm.solvers.effects import resolve
 from gatetherm.solvers.frame import EFFECTS, TARGETS
 from gatetherm.studies.run.config import Config, load_config
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.studies.run.frame_case import FRAME_GEOMETRY, frame_case
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
-from gatetherm.studies.diagnosis.replay import DELTA, resolution
-from gatetherm.studies.diagnosis.hypotheses import configure
-from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
-from gatetherm.studies.run.simulate import sample_times
-from gatetherm.studies.run.timeseries import FORMAT, OUTPUT_COLUMNS, TimeSeries
+from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.sweeps.pool import run_pool
 from gatetherm.validation import paper_model
+from gatetherm.validation.scoring import row_groups, score
+from gatetherm.validation.truth import (GEOMETRY_OFF, MISMATCH, MISMATCH_PIECE, NOISE_RMS_UM, OUTSIDE, Case, measured,
+                                        truth)
 
 log = logging.getLogger(__name__)
 
-#: The channels a rig of the paper records (no room temperature).
-MEASURED = ("time_s", "oil_degC", "pump", "theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
-NOISE_RMS_UM = 0.1 * np.sqrt(1 + 1 / 12)
-"""RMS of the added δ noise: Gaussian at the resolution, then rounded to it, µm."""
-TRUTH_MESH_FACTOR = 0.75
-"""Element size of the "measured" runs relative to the diagnosis mesh."""
 SETTINGS = Settings(p2_check=False)
 """The diagnosis of the study (the frame's own discretisation is below the resolution at its mesh:
 README, Verification; the P2 run would only cost time)."""
-
-#: Effects outside the catalogue: name -> (parameter, unit, strengths tried).
-OUTSIDE = {
-    "tie_heat_leak": ("power", "W", (1.0, 2.0)),
-    "sensor_height": ("offset", "m", (0.04, -0.04)),
-    "flow_drop": ("fraction", "1", (0.3, 0.5)),
-}
-FLOW_DROP_AT_S = 2.5 * 3600.0
-"""When the oil flow drops in the ``flow_drop`` case, s."""
-#: Parameter mismatches (no missing effect; the parameter piece is expected):
-#: "mismatch:<ThermalParams field>" -> factors on the model's value.
-MISMATCH = {"mismatch:h_oil_on": (1.5,), "mismatch:h_air": (0.6,)}
-#: The parameter piece that names each mismatch.
-MISMATCH_PIECE = {"mismatch:h_oil_on": "oil_film_on", "mismatch:h_air": "air_film"}
-
-
-@dataclass(frozen=True)
-class Case:
-    effect: str
-    """Catalogue name, an :data:`OUTSIDE` name, or "none" (noise only)."""
-    strength: float
-    condition: int
-    seed: int
 
 
 def draw_strengths(name: str, rng: np.random.Generator) -> tuple[float, float]:
@@ -94,79 +68,6 @@ def draw_strengths(name: str, rng: np.random.Generator) -> tuple[float, float]:
     return tuple(float(m * rng.choice((-1.0, 1.0))) for m in mags)
 
 
-def truth_setup(config: Config, condition: int, mesh_factor: float = TRUTH_MESH_FACTOR,
-                duration: float | None = None, step_s: float = 60.0) -> tuple[Config, Schedule]:
-    """``config`` on the truth mesh (``mesh_factor`` × the model's element size) and the
-    condition's schedule, over its duration unless ``duration`` (s) is given."""
-    mesh = dataclasses.replace(config.model.mesh, size=config.model.mesh.size * mesh_factor)
-    sched = condition_schedule(condition, config.supply, step_s)
-    if duration:
-        sched = dataclasses.replace(sched, times=sample_times(duration, step_s))
-    return dataclasses.replace(config, model=dataclasses.replace(config.model, mesh=mesh)), sched
-
-
-def truth_with(config: Config, condition: int, values: dict, dim: int = 2, **setup) -> dict[str, np.ndarray]:
-    """The noise-free columns with the hypotheses ``values`` ({Piece: value}: effects,
-    parameters, sensor faults) in the model, on the truth mesh (:func:`truth_setup`)."""
-    cfg, sched = truth_setup(config, condition, **setup)
-    return run_scenario(configure(frame_case(cfg, dim), values), sched).columns
-
-
-def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_MESH_FACTOR,
-          duration: float | None = None) -> dict[str, np.ndarray]:
-    """The noise-free columns of a case on the truth mesh (:func:`truth_setup`)."""
-    full, sched = truth_setup(config, case.condition, mesh_factor, duration)
-    cfg = full.model
-
-    def run(model_cfg, schedule=sched, mesh=None, **kw):
-        return run_scenario(frame_case(dataclasses.replace(config, model=model_cfg), dim, mesh=mesh), schedule, **kw)
-
-    if case.effect in EFFECTS:
-        return run(cfg, effects={case.effect: case.strength}).columns
-    if case.effect == "tie_heat_leak":
-        from gatetherm.geometry.frame import part_boxes
-
-        x0, x1, y0, y1, z0, z1 = part_boxes(cfg.frame, dim)["tie_bar"]
-        cfg = dataclasses.replace(cfg, source={"tie_bar": -case.strength / ((x1 - x0) * (y1 - y0) * (z1 - z0))})
-    elif case.effect == "sensor_height":
-        cfg = dataclasses.replace(cfg, frame=cfg.frame.replace(sensor_height=cfg.frame.sensor_height + case.strength))
-    elif case.effect in MISMATCH:
-        field = case.effect.split(":")[1]
-        cfg = dataclasses.replace(cfg, thermal=dataclasses.replace(
-            cfg.thermal, **{field: getattr(cfg.thermal, field) * case.strength}))
-    elif case.effect == "flow_drop":
-        times = sched.times
-        k = int(np.searchsorted(times, FLOW_DROP_AT_S))
-        first = run(cfg, dataclasses.replace(sched, times=times[:k + 1]), keep_times=[times[k]])
-        low = dataclasses.replace(cfg.thermal, flow_rate=cfg.thermal.flow_rate * case.strength)
-        rest = run(dataclasses.replace(cfg, thermal=low), dataclasses.replace(sched, times=times[k:]),
-                   mesh=first.model.fmesh, U0=first.result.states[0][1]).columns
-        return {c: np.concatenate([first.columns[c][:k], rest[c]]) for c in rest}
-    elif case.effect != "none":
-        raise ValueError(f"unknown case effect {case.effect!r}")
-    return run(cfg).columns
-
-
-def measured(cols: dict[str, np.ndarray], seed: int, condition: int) -> TimeSeries:
-    """The rig's channels of ``cols`` with sensor noise at the resolution, rounded to it."""
-    return recorded(cols, MEASURED, OUTPUT_COLUMNS, seed,
-                    {"source": "hidden-effect study", "condition": str(condition)})
-
-
-def recorded(cols: dict[str, np.ndarray], keep, sensors, seed: int, metadata: dict) -> TimeSeries:
-    """The columns ``keep`` of ``cols``, the ``sensors`` among them with Gaussian noise at
-    their resolution, rounded to it."""
-    rng = np.random.default_rng(seed)
-    out = {}
-    for c in keep:
-        v = np.asarray(cols[c], dtype=float)
-        if c in sensors:
-            r = resolution(c)
-            v = np.round(np.round((v + rng.normal(0.0, r, len(v))) / r) * r, 6)
-        out[c] = v
-    return TimeSeries(out, {"format": FORMAT, **metadata})
-
-
 def diagnosis_row(d) -> dict:
     """The study columns of a diagnosis: verdict, pieces, held-out RMS before/after."""
     s = d.summary()
@@ -175,11 +76,21 @@ def diagnosis_row(d) -> dict:
         return float(np.sqrt(np.mean([v ** 2 / resolution(c) ** 2 for c, v in rms.items()]))) if rms else None
 
     return {"verdict": d.verdict, "pieces": [r.piece.key for r in d.pieces],
-            "alternatives": [q.key for r in d.pieces for q in r.alternatives],
+            "alternatives": [q.key for r in d.pieces for q in r.alternatives], "groups": row_groups(d),
+            "stand_ins": [p.key for p, _, _ in d.stand_ins],
             "named": ",".join(d.named_effects) or None, "best_rejected": s["best_rejected"], "margin": d.margin,
             "rms_before_um": s["rms_before_um"], "rms_after_um": s["rms_after_um"],
             "rms_w_before": weighted(s["rms_before"]), "rms_w_after": weighted(s["rms_after"]),
             "fitted": s["fitted"], "runs": d.runs, "seconds": round(d.seconds, 1), "reason": d.reason}
+
+
+def hidden_keys(case: Case) -> list[str]:
+    """The keys of the hypotheses that name what ``case`` hides (none: noise only, or outside them all)."""
+    if case.effect in EFFECTS:
+        return [f"effect:{case.effect}"]
+    if case.effect in MISMATCH:
+        return [f"parameter:{MISMATCH_PIECE[case.effect]}"]
+    return [f"geometry:{case.effect}"] if case.effect in FRAME_GEOMETRY else []
 
 
 def run_case(case: Case, config: Config | None = None, settings: Settings = SETTINGS) -> dict:
@@ -187,13 +98,26 @@ def run_case(case: Case, config: Config | None = None, settings: Settings = SETT
     config = config or load_config()
     ts = measured(truth(config, case), case.seed, case.condition)
     d = diagnose(frame_case(config, 2), ts, settings)
-    return {"effect": case.effect, "strength": case.strength, "condition": case.condition, "seed": case.seed,
-            **diagnosis_row(d)}
+    row = {"effect": case.effect, "strength": case.strength, "condition": case.condition, "seed": case.seed,
+           **diagnosis_row(d)}
+    row.update(score(row["pieces"], row["groups"], hidden_keys(case)))
+    if case.effect in FRAME_GEOMETRY:  # the fitted dimension within 20 % of the hidden change
+        model = getattr(config.model.frame, case.effect.removeprefix("geometry."))
+        fitted = {r.piece.name: r.value for r in d.pieces}.get(case.effect)
+        row["within_20pct"] = fitted is not None and \
+            abs(fitted - model * case.strength) <= 0.2 * abs(model * case.strength - model)
+    return row
+
+
+FIRST_OUTSIDE = ("tie_heat_leak", "sensor_height", "flow_drop")
+"""The causes outside the hypotheses of the first studies (drawn where they were, so that every earlier
+case keeps its strength and noise)."""
 
 
 def cases(seed: int = 6, conditions=(1, 2, 3), effects=EFFECTS, noise_seeds: int = 2) -> list[Case]:
-    """The study: every effect at two strengths on every condition, noise-only runs
-    and the out-of-catalogue effects."""
+    """The study: every effect at two strengths on every condition, noise-only runs,
+    the causes outside the hypotheses, the parameter mismatches, and every dimension the
+    diagnosis tries off by a drawn 5–10 % (from ``seed + 1``) on every condition."""
     rng = np.random.default_rng(seed)
     out = []
     for name in effects:
@@ -201,11 +125,18 @@ def cases(seed: int = 6, conditions=(1, 2, 3), effects=EFFECTS, noise_seeds: int
             out += [Case(name, s, c, int(rng.integers(1 << 31))) for s in draw_strengths(name, rng)]
     for c in conditions:
         out += [Case("none", 0.0, c, int(rng.integers(1 << 31))) for _ in range(noise_seeds)]
-        for name, (_, _, strengths) in OUTSIDE.items():
-            out += [Case(name, s, c, int(rng.integers(1 << 31))) for s in strengths]
+        for name in FIRST_OUTSIDE:
+            out += [Case(name, s, c, int(rng.integers(1 << 31))) for s in OUTSIDE[name][2]]
     for c in conditions:
         for name, factors in MISMATCH.items():
             out += [Case(name, f, c, int(rng.integers(1 << 31))) for f in factors]
+    later = np.random.default_rng(seed + 1)
+    for c in conditions:
+        for name in (n for n in OUTSIDE if n not in FIRST_OUTSIDE):
+            out += [Case(name, s, c, int(later.integers(1 << 31))) for s in OUTSIDE[name][2]]
+        for key in FRAME_GEOMETRY:
+            off = later.uniform(*GEOMETRY_OFF) * later.choice((-1.0, 1.0))
+            out.append(Case(key, float(1.0 + off), c, int(later.integers(1 << 31))))
     return out
 
 
@@ -231,11 +162,17 @@ def acceptance(rows: list[dict]) -> dict:
     noise = [r for r in rows if r["effect"] == "none"]
     outside = [r for r in rows if r["effect"] in OUTSIDE]
     mismatch = [r for r in rows if r["effect"] in MISMATCH]
+    geometry = [r for r in rows if r["effect"] in FRAME_GEOMETRY]
+
+    def kinds(r) -> set[str]:
+        return {k.split(":")[0] for k in r["pieces"]}
     return {
         "catalogue_cases": len(cat), "named_correctly": len(hit),
         "named_fraction": len(hit) / max(len(cat), 1),
         "exactly_the_effect": sum(r["pieces"] == [f"effect:{r['effect']}"] for r in cat),
         "wrong_names": sum(any(n != r["effect"] for n in named(r)) for r in cat),
+        "catalogue_wrong_name": sum(bool(r["wrong_names"]) for r in cat),
+        "catalogue_missed": sum(bool(r["missed"]) for r in cat),
         "delta_rms_fall_min": min(falls, default=float("nan")),
         "delta_rms_fall_median": float(np.median(falls)) if falls else float("nan"),
         "delta_rms_fall_ge_70pct": sum(f >= 0.7 for f in falls), "delta_cases": len(falls),
@@ -244,18 +181,27 @@ def acceptance(rows: list[dict]) -> dict:
         "noise_only": len(noise), "noise_only_named": sum(bool(r["pieces"]) for r in noise),
         "noise_only_verdicts": sorted({r["verdict"] for r in noise}),
         "outside": len(outside), "outside_effect_named": sum(bool(named(r)) for r in outside),
+        "outside_effect_or_sensor_named": sum(bool(kinds(r) & {"effect", "sensor"}) for r in outside),
+        "outside_wrong_name": sum(bool(r["wrong_names"]) for r in outside),
+        "outside_explained": sum(r["verdict"] == "explained" for r in outside),
         "outside_verdicts": sorted({f"{r['effect']}:{r['verdict']}:{'+'.join(r['pieces']) or '-'}" for r in outside}),
         "mismatch": len(mismatch),
         "mismatch_recognised": sum(r["pieces"] == [f"parameter:{MISMATCH_PIECE[r['effect']]}"] for r in mismatch),
         "mismatch_verdicts": sorted({f"{r['effect']}:{r['verdict']}:{'+'.join(r['pieces']) or '-'}"
                                      for r in mismatch}),
+        "mismatch_wrong_name": sum(bool(r["wrong_names"]) for r in mismatch),
+        "mismatch_missed": sum(bool(r["missed"]) for r in mismatch),
+        "geometry": len(geometry), "geometry_within_20pct": sum(r["within_20pct"] for r in geometry),
+        "geometry_wrong_name": sum(bool(r["wrong_names"]) for r in geometry),
+        "geometry_missed": sum(bool(r["missed"]) for r in geometry),
+        "geometry_as_equivalent": sum(bool(r["as_equivalent"]) for r in geometry),
         "seconds_max": max(r["seconds"] for r in rows),
         "seconds_median": float(np.median([r["seconds"] for r in rows])),
     }
 
 
-COLUMNS = ("effect", "strength", "condition", "verdict", "pieces", "best_rejected", "margin",
-           "rms_before_um", "rms_after_um", "rms_w_before", "rms_w_after", "seconds", "reason")
+COLUMNS = ("effect", "strength", "condition", "verdict", "pieces", "wrong_names", "missed", "stand_ins",
+           "best_rejected", "margin", "rms_before_um", "rms_after_um", "rms_w_before", "rms_w_after", "seconds", "reason")
 
 
 def fmt(v) -> str:
@@ -269,13 +215,17 @@ def fmt(v) -> str:
 
 
 def table_markdown(rows: list[dict], acc: dict) -> str:
-    head = ["effect", "strength", "cond.", "verdict", "pieces named", "best rejected", "gain",
+    head = ["effect", "strength", "cond.", "verdict", "pieces named", "wrong names", "missed", "stand-ins",
+            "best rejected", "gain",
             "δ RMS before (µm)", "δ RMS after (µm)", "weighted RMS before", "weighted RMS after", "time (s)",
             "reason"]
     lines = ["# Hidden-effect study", "",
              "Held-out window: last 40 % of each 5-h run. Weighted RMS: all channels, each in units of "
              "its resolution (0.1 µm, 0.05 K). Strength in the effect's unit (see `gatetherm diagnose "
-             "--list-effects`); outside-catalogue cases: tie_heat_leak W, sensor_height m, flow_drop fraction.",
+             "--list-effects`); outside-catalogue cases: tie_heat_leak W, sensor_height m, flow_drop fraction, "
+             "sine_room K (period 3 h), unmarked_column_height and geometry.* a factor on the dimension. "
+             "Wrong names: named pieces neither hidden nor equivalent to a hidden one; missed: hidden pieces "
+             "neither named nor in a named piece's group.",
              "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += ["| " + " | ".join(fmt(r[k]) for k in COLUMNS) + " |" for r in rows]
     lines += ["", "## Acceptance", ""] + [f"- {k}: {fmt(v)}" for k, v in acc.items()]
@@ -293,7 +243,7 @@ def table_csv(rows: list[dict], columns=COLUMNS, cell=fmt) -> str:
     return buf.getvalue()
 
 
-ALL_CASES = (*EFFECTS, "none", *OUTSIDE, *MISMATCH)
+ALL_CASES = (*EFFECTS, "none", *OUTSIDE, *MISMATCH, *FRAME_GEOMETRY)
 """Every kind of case of the study, by name."""
 
 

@@ -45,7 +45,7 @@ from gatetherm.studies.control.regression import THETAS, fit_regression, regress
 from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.run.reduce import cached_rom, check_run, rom_outputs
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
-from gatetherm.validation.hidden_effects import Case, measured, truth
+from gatetherm.validation.truth import Case, measured, truth
 
 log = logging.getLogger(__name__)
 

@@ -51,6 +51,10 @@ def register(sub) -> None:
     p.add_argument("--parameters", metavar="NAME,...",
                    help="candidate existing parameters (default: all; 'none': no parameter)")
     p.add_argument("--no-sensors", action="store_true", help="do not try sensor faults")
+    p.add_argument("--uncertain", metavar="KEY,...",
+                   help="dimensions to try as hypotheses besides those the model marks: geometry.NAME of the paper "
+                   "frame (it marks geometry.l4, l_C, A_C, h, tank_wall), mesh.parameters.NAME of a case file (it "
+                   "marks those of [case] uncertain); each new value meshes the model again")
     p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M",
                    help="element size of the diagnosis mesh (2-D or 3-D, as --dim), m (default: the model file's)")
     p.add_argument("--mesh-factor", type=number(POSITIVE), metavar="F",
@@ -62,11 +66,11 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def list_effects(config, as_json: bool) -> str:
+def list_effects(config, as_json: bool, uncertain=()) -> str:
     from gatetherm.studies.diagnosis.hypotheses import catalogue
     from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 
-    pieces = catalogue(config, OUTPUT_COLUMNS)
+    pieces = catalogue(config, OUTPUT_COLUMNS, uncertain)
     if as_json:
         return json.dumps([p.describe() for p in pieces], indent=2)
     rows = [f"{'kind':<10} {'name':<34} {'parameter':<12} {'plausible range':<23} {'unit':<9}"]
@@ -89,7 +93,8 @@ def settings_from(args):
     from gatetherm.studies.diagnosis.discrepancy import Settings
 
     return Settings(train_fraction=args.train_fraction, effects=_names(args.effects, None),
-                    parameters=_names(args.parameters, None), sensors=not args.no_sensors)
+                    parameters=_names(args.parameters, None), sensors=not args.no_sensors,
+                    uncertain=_names(args.uncertain, ()))
 
 
 def load_model(args):
@@ -115,7 +120,7 @@ def load_model(args):
 
 def run(args: argparse.Namespace) -> int:
     if args.list_effects:
-        print(list_effects(load_model(args), args.json))
+        print(list_effects(load_model(args), args.json, _names(args.uncertain, ())))
         return 0
     if args.json:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")
@@ -139,6 +144,12 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {r.piece.kind} {r.piece.label}: {r.piece.param} = {r.value:.4g} ± {r.sigma:.2g} {r.piece.unit}, "
               f"{100 * r.share:.0f} % of the held-out residual"
               + (f" (or: {', '.join(q.label for q in r.alternatives)})" if r.alternatives else ""))
+    for g in diag.groups:
+        print(f"  cannot be told apart: {g.sentence()}")
+    for p, v, why in diag.stand_ins:
+        print(f"  stand-in, not a cause: {p.label} {p.param} = {v:.4g} {p.unit} ({why})")
+    if diag.cause:
+        print(f"  what kind of cause would fit: {diag.cause}")
     if s["best_rejected"]:
         print(f"best rejected: {s['best_rejected']} (gain {s['margin']:.1f} < margin {diag.margin_min:g})")
     if s["rms_after_um"] is not None:

@@ -3,16 +3,25 @@
 1. *Replay* the measured inputs through the model (:mod:`replay`).
 2. *Locate* significant residuals per channel and phase (:mod:`locate`).
 3. *Select*: forward selection over every hypothesis (catalogue effects, existing
-   parameters off, sensor faults; :mod:`hypotheses`), fitted on the training window (the
-   first ``train_fraction`` of the run) and scored on the held-out rest, each
-   channel group weighing the same (:mod:`calibrate`, :mod:`select`).
-4. *Name*. The verdict is
+   parameters off, dimensions marked as uncertain, sensor faults; :mod:`hypotheses`), fitted
+   on the training window (the first ``train_fraction`` of the run) and scored on the
+   held-out rest, each channel group weighing the same (:mod:`calibrate`, :mod:`select`).
+4. *Check*: the model-form checks (:mod:`checks`): the chosen set must hold on each input
+   phase when fitted on the others, with the same values, plausible ones, and a sensor fault
+   needs evidence of a sensor; a piece that fails is a stand-in, not a cause, and is not named.
+5. *Group*: hypotheses the data cannot tell from a named piece are one group with it, with
+   the measurement that would separate them (:mod:`identify`); a physical piece is named
+   before an equivalent sensor fault.
+6. *Name*. The verdict is
 
    * ``no-discrepancy``: the baseline residual is nowhere significant;
-   * ``explained``: the chosen pieces leave no significant residual, anywhere in the run;
-   * ``partly-explained``: pieces were found, but a significant residual remains (the
-     report says where and when);
-   * ``unexplained``: no hypothesis lowers the held-out score by the margin.
+   * ``explained``: the named pieces leave no significant residual anywhere in the run, and
+     hold on every input phase they were not fitted to;
+   * ``partly-explained``: pieces were named, but a significant residual remains or they do
+     not hold on a phase (the report says which channels and phases, and what kind of cause
+     would fit: :mod:`pattern`);
+   * ``unexplained``: no hypothesis lowers the held-out score by the margin, or those that do
+     are stand-ins.
 """
 from __future__ import annotations
 
@@ -25,9 +34,12 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.studies.diagnosis.calibrate import Objective, Scored, uncertainty
+from gatetherm.studies.diagnosis.checks import Checks, confirm
 from gatetherm.studies.diagnosis.hypotheses import (Piece, configure, effect_keys, effect_pieces, parameter_pieces,
                                                     sensor_pieces)
+from gatetherm.studies.diagnosis.identify import Group, groups, physical_first
 from gatetherm.studies.diagnosis.locate import Finding, Phase, input_phases, locate, noise_sd, phases
+from gatetherm.studies.diagnosis.pattern import kind_of_cause, unexplained
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
 from gatetherm.studies.diagnosis.select import Round, Selection, select
 from gatetherm.studies.run.case import Case
@@ -49,7 +61,10 @@ class Settings:
     effects: tuple[str, ...] | None = None
     """Candidate catalogue effects (None: every one that can act on the model)."""
     parameters: tuple[str, ...] | None = None
-    """Candidate existing parameters (None: all of the model file's or the case's)."""
+    """Candidate existing parameters and dimensions, by name (None: all of the model file's or the case's)."""
+    uncertain: tuple[str, ...] = ()
+    """Dimensions to try besides those the case marks (``geometry.NAME`` of the frame,
+    ``mesh.parameters.NAME`` of a case file); each new value meshes the case again."""
     sensors: bool = True
     """Try sensor faults of every compared channel."""
     max_pieces: int = 4
@@ -118,6 +133,14 @@ class Diagnosis:
     discretisation: dict[str, float] | None = None
     """A P1 case: the largest |P2 − P1| of the baseline per channel, in units of its resolution
     (above 1, the model's own discretisation error shows in the data)."""
+    checks: Checks | None = None
+    """The model-form checks of the named pieces (:mod:`checks`)."""
+    stand_ins: tuple[tuple[Piece, float, str], ...] = ()
+    """Pieces that made the model fit but failed a check: (piece, value, why)."""
+    groups: tuple[Group, ...] = ()
+    """Named pieces with the hypotheses the data cannot tell from them."""
+    cause: str = ""
+    """What kind of cause would fit the residual that stays unexplained (:mod:`pattern`)."""
 
     @property
     def too_coarse(self) -> list[str]:
@@ -159,6 +182,12 @@ class Diagnosis:
             "remaining": [f.sentence() for f in self.remaining if f.significant],
             "model_runs": self.runs, "wall_time_s": round(self.seconds, 1), "dim": self.dim,
             "discretisation_p2_minus_p1_in_resolutions": self.discretisation,
+            "checks": self.checks.summary() if self.checks else None,
+            "stand_ins": [{"name": p.label, "kind": p.kind, "value": float(v), "why": why}
+                          for p, v, why in self.stand_ins],
+            "groups": [g.entry() for g in self.groups],
+            "unexplained": unexplained(self.remaining if self.pieces else self.findings),
+            "kind_of_cause": self.cause,
         }
 
 
@@ -171,36 +200,47 @@ def candidates(case: Case, channels, has_ambient: bool, settings: Settings) -> l
         raise InputError("--effects", f"'{bad[0]}' is not an effect this case can have",
                          f"choose from {', '.join(known)}")
     effects = effect_pieces(case, asked, has_ambient)
-    params = parameter_pieces(case)
+    params = parameter_pieces(case, uncertain=settings.uncertain)
     names = [p.name for p in params]
     bad = [n for n in settings.parameters or () if n not in names]
     if bad:
         raise InputError("--parameters", f"unknown parameter {', '.join(bad)}", f"choose from {', '.join(names)}")
     if settings.parameters is not None:
-        params = [p for p in params if p.name in settings.parameters]
+        params = [p for p in params if p.name in settings.parameters or p.name in settings.uncertain]
     return effects + params + (sensor_pieces(channels, case) if settings.sensors else [])
 
 
-def _shares(obj: Objective, sel) -> list[float]:
-    """Per chosen piece: how much the held-out score rises when it alone is taken out of the
+def _shares(obj: Objective, final: Scored) -> list[float]:
+    """Per named piece: how much the held-out score rises when it alone is taken out of the
     final set (the others keep their values), as a fraction of the sum over the pieces."""
-    values = sel.final.values
-    rise = [max(obj.scored({q: v for q, v in values.items() if q != p}).fit - sel.final.fit, 0.0) for p in sel.order]
+    values = final.values
+    rise = [max(obj.scored({q: v for q, v in values.items() if q != p}).fit - final.fit, 0.0) for p in values]
     total = sum(rise)
     return [r / total if total > 0 else float("nan") for r in rise]
 
 
-def _verdict(discrepant: bool, sel) -> tuple[str, str]:
+def _verdict(discrepant: bool, sel, final: Scored | None = None, stand=(), checks: Checks | None = None
+             ) -> tuple[str, str]:
+    """The verdict and its reason from the selection ``sel``, the named set ``final`` (default: the
+    selection's), the stand-ins (labels) and the model-form ``checks`` of the named set."""
+    final = sel.final if final is None else final
     if not discrepant:
         return "no-discrepancy", "the baseline residual is within the sensor resolution"
-    if not sel.order:
+    if not final.values:
+        if stand:
+            return "unexplained", (f"{' + '.join(stand)} make the model fit, but fail the model-form checks: "
+                                   "stand-ins, not causes")
         rej = sel.best_rejected
         return "unexplained", ("no hypothesis lowers the held-out score by the margin"
                                + (f" (best: {rej[0].label})" if rej else ""))
-    names = " + ".join(p.label for p in sel.order)
-    if sel.final.explains:
-        return "explained", f"{names} leave no significant residual"
-    return "partly-explained", f"{names} lower the held-out score, but a significant residual remains"
+    names = " + ".join(p.label for p in final.values)
+    failed = [f"{f.phase.label} {f.phase.span()}" for f in (checks.folds if checks else ()) if not f.holds]
+    if final.explains and not failed:
+        return "explained", f"{names} leave no significant residual" + (
+            " and hold on every phase they were not fitted to" if checks and checks.folds else "")
+    why = ([] if final.explains else ["a significant residual remains"]) + \
+        ([f"fitted on the other phases they do not hold on {', '.join(failed)}"] if failed else [])
+    return "partly-explained", f"{names} lower the held-out score, but " + " and ".join(why)
 
 
 def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Diagnosis:
@@ -238,22 +278,32 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     findings = locate(t, res0, run_phases)
     obj = Objective(rep, ts, channels, scale, train)
     discrepant = any(f.significant for f in findings)
+    chk, stand, grp = None, {}, []
     if discrepant:
         sel = select(obj, pool, settings.margin_min, settings.max_pieces, settings.screen_top)
+        named, stand, chk = confirm(obj, sel.final.values, run_phases, settings.margin_min, sel.base.score)
+        solo = {p: s.values[p] for p, s in sel.rounds[0].trials} if sel.rounds else {}
+        named, grp = physical_first(named, groups(obj, named, pool, sel.alternatives, solo, settings.margin_min))
+        final = sel.final if named == sel.final.values else obj.scored(named)
     else:
         base = obj.scored({})
         sel = Selection(base, base, [])
-    verdict, reason = _verdict(discrepant, sel)
-    sigma = uncertainty(obj, sel.final.values)
-    pieces = tuple(PieceResult(p, sel.final.values[p], sigma[p], share, tuple(sel.alternatives.get(p, ())))
-                   for p, share in zip(sel.order, _shares(obj, sel)))
-    after = obj.residuals(sel.final.values, solve=False)[0] if pieces else None
+        final = base
+    verdict, reason = _verdict(discrepant, sel, final, [p.label for p in stand], chk)
+    sigma = uncertainty(obj, final.values)
+    by_piece = {g.piece: g for g in grp}
+    pieces = tuple(PieceResult(p, v, sigma[p], share, by_piece[p].members if p in by_piece else ())
+                   for (p, v), share in zip(final.values.items(), _shares(obj, final)))
+    after = obj.residuals(final.values, solve=False)[0] if pieces else None
+    remaining = tuple(locate(t, after, run_phases)) if after else ()
+    cause = kind_of_cause(t, after or res0, base_cols, list(remaining or findings)) if verdict != "explained" else ""
     check = discretisation(rep, base_cols, channels) if case.problem.order == 1 and settings.p2_check else None
     log.info("diagnosis: %s (%s), %d model runs", verdict, reason, rep.runs)
-    return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, sel.final, tuple(sel.rounds),
+    return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, final, tuple(sel.rounds),
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
-                     tuple(locate(t, after, run_phases)) if after else (), res0, after, rep.runs,
-                     time.perf_counter() - t0, rep.has_ambient, settings.margin_min, rep.dim, inputs, check)
+                     remaining, res0, after, rep.runs, time.perf_counter() - t0, rep.has_ambient, settings.margin_min,
+                     rep.dim, inputs, check, chk, tuple((p, v, why) for p, (v, why) in stand.items()), tuple(grp),
+                     cause)
 
 
 def discretisation(rep: Replayer, base: dict, channels) -> dict[str, float]:

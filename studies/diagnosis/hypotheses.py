@@ -7,6 +7,9 @@
   lag and (with a boundary mean ``base``) a drifting sensor stand;
 * ``parameter``: a number of the case off its value (:mod:`gatetherm.studies.run.parameters`:
   film coefficients, fluid films, sources, initial temperature, material factors);
+* ``geometry``: a dimension marked as uncertain off its value (the paper frame's tie bar, column
+  width and tank wall; a case file's ``[case] uncertain`` parameters of its geometry script): a
+  parameter whose every new value meshes the case again;
 * ``sensor``: a fault of one recorded channel (:mod:`solvers.sensors`): thermocouple
   offset, gain, lag; displacement-sensor offset, gain, drift.
 
@@ -100,10 +103,13 @@ def effect_pieces(case: Case, keys=None, has_ambient: bool = False) -> list[Piec
     return out
 
 
-def parameter_pieces(case: Case, names=None) -> list[Piece]:
-    """The case's parameters ``names`` (default: all) as hypotheses."""
-    return [Piece("parameter", q.name, q.param, q.unit, q.lo, q.hi, q.log_scale, q.value, q.doc, target=q.target,
-                  source=q) for q in case.origin.parameters(case) if names is None or q.name in names]
+def parameter_pieces(case: Case, names=None, uncertain=()) -> list[Piece]:
+    """The case's parameters ``names`` (default: all), and the dimensions ``uncertain`` (keys such as
+    ``geometry.l_C``, ``mesh.parameters.table_height``) besides those it marks, as hypotheses."""
+    own = case.origin.parameters(case)
+    more = case.origin.uncertain(case, [k for k in uncertain if k not in {q.name for q in own}]) if uncertain else ()
+    return [Piece("geometry" if q.remesh else "parameter", q.name, q.param, q.unit, q.lo, q.hi, q.log_scale, q.value,
+                  q.doc, target=q.target, source=q) for q in (*own, *more) if names is None or q.name in names]
 
 
 def sensor_pieces(channels, case: Case | None = None) -> list[Piece]:
@@ -118,9 +124,9 @@ def sensor_pieces(channels, case: Case | None = None) -> list[Piece]:
     return out
 
 
-def catalogue(case: Case, channels) -> list[Piece]:
-    """Every hypothesis, as ``--list-effects`` shows them."""
-    return effect_pieces(case) + parameter_pieces(case) + sensor_pieces(channels)
+def catalogue(case: Case, channels, uncertain=()) -> list[Piece]:
+    """Every hypothesis, as ``--list-effects`` shows them (``uncertain``: further dimensions)."""
+    return effect_pieces(case) + parameter_pieces(case, uncertain=uncertain) + sensor_pieces(channels)
 
 
 PROPORTIONAL = (frozenset({"parameter:expansion", "sensor:sensor_gain@delta_um"}),)
@@ -148,7 +154,7 @@ def configure(case: Case, values: dict) -> Case:
             effects[p.name] = float(v)
         elif p.kind == "sensor":
             faults.setdefault(p.channel, {})[p.param] = float(v)
-        else:
+        else:  # a parameter or a dimension
             overrides.update(p.source.overrides(v))
     made = case.with_overrides(overrides) if overrides else case
     return dataclasses.replace(made, effects=effects, sensors=compose(case.sensors, faults))

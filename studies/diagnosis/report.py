@@ -10,10 +10,13 @@ from gatetherm.studies.diagnosis.replay import DELTA, label, resolution, unit
 
 VERDICT_TEXT = {
     "no-discrepancy": "The model agrees with the measurement within the sensor resolution; nothing to add.",
-    "explained": "The pieces below, together, leave no significant residual anywhere in the run.",
-    "partly-explained": "The pieces below lower the held-out residual, but a significant part remains "
-                        "(section 5 says where and when): something outside the hypotheses is missing too.",
-    "unexplained": "The model and the measurement disagree, and no hypothesis clearly lowers the held-out residual.",
+    "explained": "The pieces below, together, leave no significant residual anywhere in the run, and hold on "
+                 "every input phase when fitted on the others, with the same, plausible values.",
+    "partly-explained": "The pieces below lower the held-out residual, but a significant part remains or they do "
+                        "not hold on every phase (sections 5 and 6 say where and when, and what kind of cause "
+                        "would fit): something outside the hypotheses is missing too.",
+    "unexplained": "The model and the measurement disagree, and no hypothesis lowers the held-out residual as a "
+                   "cause would (section 6 says where and when, and what kind of cause would fit).",
 }
 SHOWN, SHOWN_PAIRS = 8, 3
 """Single and two-piece additions shown per selection round."""
@@ -58,6 +61,11 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
             p = r.piece
             L.append(f"| {i} | {p.kind} | {p.label} | {p.param} = {_num(r.value)} ± {_num(r.sigma, 2)} {p.unit} | "
                      f"{100 * r.share:.0f} % | {', '.join(q.label for q in r.alternatives) or '—'} |")
+    for g in d.groups:
+        L += ["", f"**Cannot be told apart:** {g.sentence()}."]
+    if d.stand_ins:
+        L += ["", "**Stand-ins, not causes** (they make the model fit, but fail a model-form check; section 6): "
+              + "; ".join(f"{p.label} {p.param} = {_num(v)} {p.unit} ({why})" for p, v, why in d.stand_ins) + "."]
     if d.best_rejected:
         L += ["", f"Best rejected: {d.best_rejected[0].label} (score gain {_num(d.margin)} < margin {d.margin_min:g})."]
     if d.removed:
@@ -109,7 +117,7 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     if "scores" in files:
         L += ["", f"![selection rounds]({files['scores']})"]
     if not d.pieces:
-        return "\n".join(L) + "\n"
+        return "\n".join(L + _checks(d)) + "\n"
     L += ["", "## 4. Add and show", ""]
     if "model" in files:
         L += [f"Model file with every piece: `{files['model']}` — run it with "
@@ -128,4 +136,28 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     L += [f"- {f.sentence()}" for f in d.remaining if f.significant] \
         or ["- Nothing significant: the residual with the pieces stays within the resolution."]
     L += [""] + _table(d, _cells(d.remaining))
+    L += _checks(d)
     return "\n".join(L) + "\n"
+
+
+def _checks(d: Diagnosis) -> list[str]:
+    """Section 6: the model-form checks, what stays unexplained and what kind of cause would fit."""
+    L = ["", "## 6. Model-form checks", "",
+         "An explanation is only `explained` when it holds on every input phase fitted on the others (one phase "
+         "left out at a time, the pieces refitted by a Gauss–Newton step on the whole run's Jacobian), with the "
+         "same values in every phase, none at an end of its plausible range, each piece needed (held-out score "
+         "with the penalty k·ln N, a Bayesian information criterion), and a sensor fault only where its own "
+         "channel is then explained."]
+    if d.checks and d.checks.folds:
+        L += ["", "| phase left out | holds | channels unexplained | " + " | ".join(p.label for p in d.checks.folds[0].values)
+              + " |", "|---|---|---|" + "---|" * len(d.checks.folds[0].values)]
+        for f in d.checks.folds:
+            L.append(f"| {f.phase.label} {f.phase.span()} | {'yes' if f.holds else '**no**'} | "
+                     f"{', '.join(label(c) for c in f.unexplained) or '—'} | "
+                     + " | ".join(_num(v) for v in f.values.values()) + " |")
+    left = d.summary()["unexplained"]
+    if left and d.verdict != "explained":
+        L += ["", "Unexplained: " + "; ".join(f"{label(c)} in {', '.join(ph)}" for c, ph in left.items()) + "."]
+    if d.cause:
+        L += ["", f"What kind of cause would fit: {d.cause}"]
+    return L

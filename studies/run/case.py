@@ -34,6 +34,7 @@ from gatetherm.studies.run import case_mech
 from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
                                        Relative, Signals, Source, Support, inputs, values)
+from gatetherm.studies.run.parameters import UNCERTAIN_FIX, mesh_parameter
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
 from gatetherm.studies.run.timeseries import read_timeseries
 
@@ -172,6 +173,12 @@ class CaseFile:
         from gatetherm.studies.run.parameters import case_parameters
 
         return case_parameters(case)
+
+    def uncertain(self, case: Case, keys) -> tuple:
+        """Further geometry parameters (``--uncertain mesh.parameters.NAME``)."""
+        from gatetherm.studies.run.parameters import marked
+
+        return marked(case, keys)
 
     def model_file(self, case: Case, header: str = "") -> None:
         """None: a case file is not rewritten (its comments and layout are the user's); the
@@ -472,7 +479,11 @@ def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> 
 def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: FrameMesh | None = None) -> Case:
     """The case of a parsed case file ``data`` read from ``path`` (``mesh``: its mesh, already made)."""
     top = Table(path, "", data, SECTIONS)
-    head = top.sub("case", ("name", "order", "plane"))
+    head = top.sub("case", ("name", "order", "plane", "uncertain"))
+    uncertain = head.data.get("uncertain", [])
+    bad = [k for k in uncertain if mesh_parameter(data, k) is None] if isinstance(uncertain, list) else [uncertain]
+    if bad:
+        head.fail("uncertain", f"{bad[0]!r} is not a non-zero number of [mesh.parameters]", UNCERTAIN_FIX)
     order = head.data.get("order", 1)
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gatetherm import write_text_atomic
+from gatetherm import InputError, write_text_atomic
 from gatetherm.geometry.build import build_mesh
+from gatetherm.geometry.frame import FrameParams
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.frame import AMBIENT, GEOMETRY_FREE, check_mesh, frame_problem, frame_targets
 from gatetherm.studies.control.actuator import ActuatorParams
@@ -24,12 +25,20 @@ from gatetherm.studies.run.case import Case, TimeSettings, nested
 from gatetherm.studies.run.casefile import case_toml
 from gatetherm.studies.run.conditions import condition
 from gatetherm.studies.run.config import Config, config_toml, load_config, parse_config
-from gatetherm.studies.run.parameters import SHIFT, Parameter
+from gatetherm.studies.run.parameters import GEOMETRY, SHIFT, Parameter, geometry
 from gatetherm.studies.run.schedules import condition_schedule
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
 
 SCHEDULE_STEP_S = 15.0
 """Sampling of the written schedule, s (the solver's finest step after a pump switch)."""
+#: The frame's dimensions a diagnosis moves unless told otherwise (``geometry.NAME``: what they are).
+FRAME_GEOMETRY = {
+    "geometry.l4": "height of the tie-bar centreline above the mounting face",
+    "geometry.l_C": "tie-bar length (clear span between the columns)",
+    "geometry.A_C": "tie-bar cross-section",
+    "geometry.h": "column width (distance between the sensor faces A and B)",
+    "geometry.tank_wall": "wall thickness between face A and the oil tank",
+}
 
 
 def gate_frame(dim: int = 2, config: Config | str | os.PathLike | None = None, condition: int = 1, *,
@@ -89,7 +98,11 @@ class FrameOrigin:
         return made if previous is None else dataclasses.replace(made, schedule=previous.schedule)
 
     def parameters(self, case: Case) -> tuple[Parameter, ...]:
-        return frame_parameters(self.config)
+        return frame_parameters(self.config) + frame_geometry(self.config, FRAME_GEOMETRY)
+
+    def uncertain(self, case: Case, keys) -> tuple[Parameter, ...]:
+        """Further dimensions as parameters (``--uncertain geometry.NAME``)."""
+        return frame_geometry(self.config, keys)
 
     def model_file(self, case: Case, header: str = "") -> str:
         """The model file of ``case`` (made by this origin): its parameters, effects and sensor faults."""
@@ -133,6 +146,35 @@ def frame_parameters(cfg: Config) -> tuple[Parameter, ...]:
         material("heat_capacity", "rho_c", "J/(m3 K)", (0.8, 1.25), "volumetric heat capacity ρc of the frame "
                  "material"),
     )
+
+
+def frame_geometry(cfg: Config, keys) -> tuple[Parameter, ...]:
+    """The frame's dimensions ``keys`` (``geometry.NAME`` of its model file) as geometry parameters, each
+    within :data:`~gatetherm.studies.run.parameters.GEOMETRY` of its value, narrowed to what makes a
+    valid frame."""
+    free = sorted(f.name for f in dataclasses.fields(FrameParams) if f.name not in GEOMETRY_FREE)
+    out = []
+    for key in keys:
+        name = key.removeprefix("geometry.")
+        value = getattr(cfg.model.frame, name, 0.0) if key.startswith("geometry.") and name in free else 0.0
+        if not value:
+            raise InputError("--uncertain", f"'{key}' is not a dimension of the frame with a value",
+                             f"give geometry.NAME, NAME one of {', '.join(free)}")
+        rng = tuple(_admissible(cfg, key, value, f) for f in GEOMETRY)
+        doc = FRAME_GEOMETRY.get(key, f"frame dimension {name} (FrameParams)")
+        out.append(geometry(key, value, "m2" if name.startswith("A_") else "m", doc, rng))
+    return tuple(out)
+
+
+def _admissible(cfg: Config, key: str, value: float, factor: float) -> float:
+    """``factor``, or the largest step towards 1 from it (of four) that still makes a valid frame."""
+    for f in np.linspace(factor, 1.0, 5)[:-1]:
+        try:
+            parse_config(nested({key: value * f}), cfg.source, base=cfg)
+            return float(f)
+        except InputError:
+            continue
+    return 1.0
 
 
 def write_frame_case(case: Case, number: int, out: Path) -> None:

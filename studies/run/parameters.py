@@ -5,6 +5,9 @@ new value writes (:attr:`Parameter.overrides`), so a diagnosis or a study moves 
 the case again (:meth:`~gatetherm.studies.run.case.Case.with_overrides`). A case file's are
 found from its document (:func:`case_parameters`); the paper frame's generator declares its
 own (:func:`gatetherm.studies.run.frame_case.frame_parameters`).
+
+*Geometry* parameters (:func:`geometry`) are dimensions the user marks as uncertain: a new value
+makes the mesh again (``remesh``), so every model run of one costs a remeshing too.
 """
 from __future__ import annotations
 
@@ -13,6 +16,9 @@ from typing import Callable
 
 FILM, FLUID_FILM, SOURCE, SHIFT = (0.4, 2.5), (0.2, 5.0), (0.5, 2.0), 3.0
 """Plausible ranges of films, fluid films and sources (factors) and of the initial temperature (shift, K)."""
+GEOMETRY = (0.8, 1.25)
+"""Plausible range of a dimension marked as uncertain (a factor on the model's value): a drawing
+and a machine differ by less than a fifth."""
 #: One factor on every region's material property: name -> (key, range, doc).
 MATERIAL = {
     "conductivity": ("k", 0.6, 1.6, "thermal conductivity k of every region (one factor)"),
@@ -53,6 +59,41 @@ def factor(name, param, unit, value, rng, doc, write, target=None) -> Parameter:
     return Parameter(name, param, unit, value, value * rng[0], value * rng[1], True, doc, write, target)
 
 
+def geometry(key: str, value: float, unit: str, doc: str, rng=GEOMETRY) -> Parameter:
+    """The dimension at ``key`` (``geometry.l_C``, ``mesh.parameters.table_height``) as a parameter named
+    by its key: ``rng`` times its value (log scale), a new value meshes the case again."""
+    return Parameter(key, key.rsplit(".", 1)[-1], unit, value, value * rng[0], value * rng[1], True, doc,
+                     lambda v: {key: v}, remesh=True)
+
+
+def mesh_parameter(document: dict, key) -> float | None:
+    """The value of ``key`` (``mesh.parameters.NAME``) in a case file's ``document``; None unless it is a
+    non-zero number there."""
+    value = document.get("mesh", {}).get("parameters", {}).get(key.removeprefix("mesh.parameters."), None) \
+        if isinstance(key, str) and key.startswith("mesh.parameters.") else None
+    return None if isinstance(value, bool) or not isinstance(value, (int, float)) or value == 0 else float(value)
+
+
+UNCERTAIN_FIX = ("name a number of [mesh.parameters] (a parameter of the geometry script), e.g. "
+                 "uncertain = [\"mesh.parameters.table_height\"] with table_height = 0.1 in [mesh.parameters]")
+
+
+def marked(case, keys=()) -> tuple[Parameter, ...]:
+    """The ``mesh.parameters`` of a case file marked as uncertain (``[case] uncertain``, and ``keys``,
+    e.g. from ``--uncertain``) as geometry parameters."""
+    from gatetherm import InputError
+
+    doc = case.origin.document
+    out = []
+    for key in dict.fromkeys([*doc.get("case", {}).get("uncertain", []), *keys]):
+        value = mesh_parameter(doc, key)
+        if value is None:
+            raise InputError("--uncertain", f"'{key}' is not a non-zero number of [mesh.parameters] of {case.path}",
+                             UNCERTAIN_FIX)
+        out.append(geometry(key, value, "", f"geometry parameter '{key.rsplit('.', 1)[-1]}' of {doc['mesh']['file']}"))
+    return tuple(out)
+
+
 def _scaled(v, f: float):
     """A file value (a number or an expression) times ``f``."""
     return float(v) * f if isinstance(v, (int, float)) else f"{f!r} * ({v})"
@@ -61,7 +102,8 @@ def _scaled(v, f: float):
 def case_parameters(case) -> tuple[Parameter, ...]:
     """A case file's own numbers as parameters: every film coefficient (per boundary, and the
     2-D faces'), every fluid's films, every source (a factor), the initial temperature of a
-    transient case, and one factor on every region's k, α, c."""
+    transient case, one factor on every region's k, α, c, and the geometry parameters the case marks
+    as uncertain (:func:`marked`)."""
     doc, pr, out = case.origin.document, case.problem, []
     for f in pr.films:
         if f.h > 0:
@@ -89,4 +131,4 @@ def case_parameters(case) -> tuple[Parameter, ...]:
     for name, (key, lo, hi, text) in MATERIAL.items():
         out.append(factor(name, "factor", "1", 1.0, (lo, hi), text, lambda v, k=key: {
             f"materials.{r}.{k}": getattr(m, k) * v for r, m in pr.materials.items()}))
-    return tuple(out)
+    return tuple(out) + marked(case)
