@@ -97,31 +97,13 @@ def test_field_in_2d_is_the_nodal_field(cframe):
         gt.plot.field(cframe, "T", t=30.0)
 
 
-BOX = 'SetFactory("OpenCASCADE");\nBox(1) = {0, 0, 0, 1, 2, 3};\n'
-BOX_CASE = """[mesh]
-file = "box.geo"
-size = 0.5
-[mesh.groups.hot]
-dim = 2
-box = [-1e-6, -1e-6, -1e-6, 1e-6, 2.000001, 3.000001]
-[mesh.groups.cooled]
-dim = 2
-rest = true
-[materials.solid]
-k = 50.0
-[thermal.hot]
-temperature = 100.0
-[thermal.cooled]
-film = 10.0
-ambient = 20.0
-"""
-
-
 def test_field_in_3d_is_a_surface_picture_and_leaves_pyvista_on_screen(tmp_path):
     import pyvista as pv
 
+    from test_assembly_mesh import BOX, CASE_GROUPS  # a 1 x 2 x 3 m box, one face at 100 °C, a film elsewhere
+
     (tmp_path / "box.geo").write_text(BOX)
-    (tmp_path / "case.toml").write_text(BOX_CASE)
+    (tmp_path / "case.toml").write_text(CASE_GROUPS)
     run = gt.run(gt.load_case(tmp_path / "case.toml"))
     before = pv.OFF_SCREEN
     ax = gt.plot.field(run, "T", ax=axes())
