@@ -26,7 +26,6 @@ from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_
 from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
 from gatetherm.solvers.effects import Targets
-from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
@@ -415,7 +414,7 @@ def _time(top: Table, base: Path):
     """The time settings, the scheme and the schedule file's series (None: no schedule)."""
     if "time" not in top.data:
         return None, TimeScheme(), None
-    from gatetherm.studies.run.timeseries import check_steps, read_timeseries
+    from gatetherm.studies.run.timeseries import check_steps
 
     t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
     end = t.number("end", SECONDS)
