@@ -12,7 +12,6 @@ values to put into the case file).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import logging
 from pathlib import Path
