@@ -26,11 +26,9 @@ held-out RMS of δ before/after, wall time) and prints the acceptance figures.
 from __future__ import annotations
 
 import csv
-import dataclasses
 import io
 import logging
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
