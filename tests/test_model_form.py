@@ -153,3 +153,13 @@ def test_frame_dimensions_as_hypotheses_stay_valid_frames(coarse):
     assert cut.hi == pytest.approx(0.67)  # the arm's top may not pass the column's: no longer arm
     with pytest.raises(InputError, match="'geometry.l1' is not a dimension of the frame"):
         frame_geometry(coarse, ["geometry.l1"])
+
+
+#: Two hidden pieces, one of them α or the δ sensor's gain (the pair the data cannot separate), the
+#: other of each kind; conditions 1–3 (the compound study's cases, on the coarse mesh).
+ALPHA_GAIN_PAIRS = (
+    (("parameter:expansion", 1.1 * 1.05e-05), ("effect:joint_resistance", 400.0), 2),
+    (("sensor:sensor_gain@delta_um", 1.06), ("parameter:air_film", 11.0), 1),
+    (("parameter:expansion", 0.92 * 1.05e-05), ("sensor:sensor_offset@theta_B_degC", 0.4), 3),
+    (("sensor:sensor_gain@delta_um", 0.94), ("sensor:sensor_offset@theta_A_degC", -0.4), 2),
+)

@@ -95,7 +95,8 @@ def visible(config: Config, conditions=(1, 2, 3), dim: int = 2) -> dict[tuple[in
     the catalogue's criterion (δ changes by more than 0.4 µm RMS over the last two hours or
     a thermocouple by more than 0.3 K at its peak; ``solvers.effects.Effect``)?"""
     case = frame_case(config, dim)
-    pieces = pieces_by_key(config, case)
+    drawn = {k for pair in KIND_PAIRS for k in pair}  # a dimension is never drawn: no remeshing for it
+    pieces = {k: p for k, p in pieces_by_key(config, case).items() if p.kind in drawn}
     out = {(c, k): True for c in conditions for k in pieces}
     cache = ScenarioCache(2)
     for cond in conditions:
@@ -121,7 +122,7 @@ def pairs(config: Config, n: int = 48, seed: int = 14, conditions=(1, 2, 3), sho
         cond = int(rng.choice(conditions))
         by_kind: dict[str, list[Piece]] = {}
         for k, p in known.items():
-            if shows is None or shows[cond, k]:
+            if shows is None or shows.get((cond, k), False):
                 by_kind.setdefault(p.kind, []).append(p)
         ka, kb = KIND_PAIRS[i % len(KIND_PAIRS)]
         while True:
