@@ -309,12 +309,16 @@ def diagnose(case: Case, measured, **settings):
         The measurement: every input the case reads, and the channels to compare.
     **settings
         Fields of :class:`gatetherm.studies.diagnosis.discrepancy.Settings` (``train_fraction``,
-        ``effects``, ``parameters``, ``sensors``, ``max_pieces`` …).
+        ``effects``, ``parameters``, ``sensors``, ``max_pieces``, ``uncertain``: dimensions to try
+        besides those the case marks, e.g. ``("mesh.parameters.table_height",)`` …).
 
     Returns
     -------
     Diagnosis
-        ``.verdict``, ``.pieces`` (each with its fitted value), ``.summary()``.
+        ``.verdict``, ``.pieces`` (each with its fitted value), ``.groups`` (what the data cannot
+        tell from a named piece, and what would), ``.stand_ins`` (pieces that make the model fit
+        but fail a model-form check), ``.cause`` (what kind of cause would fit what stays
+        unexplained), ``.summary()``; docs/diagnosis.md.
     """
     from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose as run_diagnosis
     from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
