@@ -17,30 +17,33 @@ def _row(effect: str, k: int = 0) -> dict:
     return run_case(case, paper_model(size=MESH))
 
 
-#: Hidden dimension -> (factor hidden, held-out δ RMS before, after, µm) of the study's run.
+#: Hidden dimension -> (factor hidden, value fitted, held-out δ RMS before, after in µm) of the study's run.
 GEOMETRY = {
-    "geometry.l4": (1.089, 1.672, 0.1044),
-    "geometry.l_C": (0.935, 0.7865, 0.09998),
-    "geometry.A_C": (1.05, 0.5915, 0.1105),
-    "geometry.h": (1.09, 2.905, 0.1114),
+    "geometry.l4": (1.0888, 0.3693, 1.672, 0.1044),
+    "geometry.l_C": (0.9350, 0.3750, 0.7865, 0.09998),
+    "geometry.A_C": (1.0503, 6.173e-4, 0.5915, 0.1105),
+    "geometry.h": (1.0899, 0.2455, 2.905, 0.1114),
+    "geometry.tank_wall": (0.9348, 0.01364, 0.1387, 0.1058),
 }
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("key", list(GEOMETRY))
 def test_a_hidden_dimension_is_named_as_itself(key):
-    """Tie-bar height, length and section, column width off by 5–10 %: named as that dimension and
-    nothing else, explained, the change fitted within a fifth (the band), δ down to the noise."""
+    """Tie-bar height, length and section, column width, tank wall off by 5–10 %: named as that
+    dimension and nothing else, explained, the change fitted within a fifth (the band; achieved
+    1.4–9.0 %), δ down to the noise."""
     row = _row(key)
-    factor, before, after = GEOMETRY[key]
+    factor, fitted, before, after = GEOMETRY[key]
     model = getattr(paper_model().model.frame, key.removeprefix("geometry."))
-    assert row["strength"] == pytest.approx(factor, abs=5e-4)
+    assert row["strength"] == pytest.approx(factor, abs=5e-5)
     assert (row["verdict"], row["pieces"], row["wrong_names"], row["missed"]) == ("explained", [f"geometry:{key}"], [],
                                                                                   [])
     value = next(iter(row["fitted"].values()))
     assert abs(value - model * factor) <= 0.2 * abs(model * factor - model) and row["within_20pct"]  # the band
+    assert value == pytest.approx(fitted, rel=4e-4)  # achieved (4 digits)
     assert (row["rms_before_um"], row["rms_after_um"]) == (pytest.approx(before, rel=1e-3),
-                                                           pytest.approx(after, rel=1e-3))  # achieved
+                                                           pytest.approx(after, rel=1e-3))
 
 
 #: (effect, which of its cases) -> held-out δ RMS before, after (µm): the same before the model-form
