@@ -1,7 +1,7 @@
 """Issue 27's acceptance checks as the hidden-effect study runs them: the paper frame on 12-mm
 elements, condition 2, the study's strengths and noise seeds (``gatetherm validate hidden-effects
 --conditions 2 --mesh-size 0.012 --effects ...``, docs/diagnosis.md). Each case is one blind
-diagnosis of 3–15 min on the shared cores: all slow."""
+diagnosis of 3–54 min on the shared cores: all slow."""
 from __future__ import annotations
 
 import pytest
