@@ -42,15 +42,42 @@ __all__ = ["Case", "Run", "Schedule", "check_rom", "check_schedules", "compensat
 
 
 def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:
-    """The paper's condition ``number`` (1, 2 or 3): the oil supply unit's set points and pump
-    states, sampled every ``step_s`` (s). ``case``: a frame case whose supply unit drives it
-    (default: the shipped paper model's)."""
+    """The paper's condition ``number``: the oil supply unit's set points and pump states.
+
+    Parameters
+    ----------
+    number : int
+        1, 2 or 3 (``docs/paper.md``).
+    case : Case, optional
+        A frame case whose supply unit drives it (default: the shipped paper model's).
+    step_s : float
+        Sample interval, s.
+
+    Returns
+    -------
+    Schedule
+        5 h of ``oil_degC`` (°C), ``pump`` (0/1) and ``ambient_degC`` (°C) samples.
+    """
     supply = getattr(getattr(case, "origin", None), "config", None)
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
 
 
 def schedule_file(path: str | os.PathLike, case: Case, step_s: float = 60.0) -> Schedule:
-    """A schedule file (the data format) of the inputs ``case`` reads, sampled every ``step_s``."""
+    """A schedule file of the inputs ``case`` reads.
+
+    Parameters
+    ----------
+    path : str or path
+        A time-series file (``docs/data-format.md``) with a column for every input the case reads.
+    case : Case
+        The case it drives.
+    step_s : float
+        Sample interval, s (linear between the file's samples; a pump keeps its last one).
+
+    Returns
+    -------
+    Schedule
+    """
     return file_schedule(path, sorted(case.inputs()), case.held(), case.defaults, step_s)
 
 
@@ -99,8 +126,20 @@ class Run:
         return kept, U
 
     def field(self, name: str, t: float | None = None) -> np.ndarray:
-        """The nodal field ``name`` at time ``t`` (default: the last sample): ``"T"`` (°C), ``"u"``
-        (m, nodes × 3), ``"sigma_xx"`` … and ``"von_mises"`` (Pa)."""
+        """A nodal field at a kept time.
+
+        Parameters
+        ----------
+        name : str
+            ``"T"`` (°C), ``"u"`` (m, nodes × 3), ``"sigma_xx"`` … and ``"von_mises"`` (Pa).
+        t : float, optional
+            Time, s (default: the last sample); one of :attr:`kept`.
+
+        Returns
+        -------
+        numpy.ndarray
+            One value (a row for ``"u"``) per mesh node.
+        """
         from gatetherm.studies.run.output import nodal_fields
 
         t = float(self.time[-1]) if t is None else float(t)
@@ -130,9 +169,22 @@ class Run:
         return out
 
     def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None) -> dict:
-        """Write the run directory ``out``: ``timeseries.csv``, ``summary.json``, the fields at
-        every ``fields_every`` s (default: the case's field interval) and the last sample
-        (``fields/``, ParaView), and the pictures; returns the summary."""
+        """Write the run directory that ``gatetherm run`` writes.
+
+        Parameters
+        ----------
+        out : str or path
+            The folder: ``timeseries.csv``, ``summary.json``, ``fields/`` (ParaView) and the pictures.
+        pictures : bool
+            Write ``channels.png`` and ``deformed.png``.
+        fields_every : float, optional
+            Interval of the fields, s (default: the case's field interval); the last sample always.
+
+        Returns
+        -------
+        dict
+            The summary (:meth:`summary`).
+        """
         from gatetherm.studies.run.output import write_json, write_run
 
         out = Path(out)
@@ -210,7 +262,14 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
 
 
 def reduce(case: Case, states: int = 30):
-    """The reduced heat model of ``case`` (its effects on): balanced truncation to ``states`` states.
+    """The reduced heat model of ``case`` (its effects on): balanced truncation.
+
+    Parameters
+    ----------
+    case : Case
+        Any case with a transient heat solve.
+    states : int
+        States of the reduced model.
 
     Returns
     -------
@@ -235,8 +294,22 @@ def check_schedules(case: Case) -> list[Schedule]:
 
 
 def check_rom(case: Case, rom, schedules=None) -> list:
-    """The reduced model ``rom`` of ``case`` against full FE runs of ``schedules`` (default
-    :func:`check_schedules`): the largest error of every output per schedule."""
+    """The reduced model ``rom`` of ``case`` against full FE runs.
+
+    Parameters
+    ----------
+    case : Case
+        The case it was reduced from.
+    rom : ReducedModel
+        ``reduce(case).rom``, or one read with ``gatetherm.studies.run.reduce.load_rom``.
+    schedules : list of Schedule, optional
+        What to run (default :func:`check_schedules`).
+
+    Returns
+    -------
+    list
+        Per schedule, the largest error of every output (δ in µm, temperatures in K).
+    """
     from gatetherm.studies.run.reduce import check
     from gatetherm.studies.run.scenario import ScenarioCache
 
@@ -244,7 +317,28 @@ def check_rom(case: Case, rom, schedules=None) -> list:
 
 
 def write_reduction(out: str | os.PathLike, red, checks, case: Case, states: int, seconds: float) -> dict:
-    """``out/rom.npz``, ``out/rom.key`` and, last, ``out/summary.json``; returns the summary."""
+    """Write a reduction: ``out/rom.npz``, ``out/rom.key`` and, last, ``out/summary.json``.
+
+    Parameters
+    ----------
+    out : str or path
+        The folder.
+    red : Reduction
+        :func:`reduce`'s result.
+    checks : list
+        :func:`check_rom`'s result (may be empty).
+    case : Case
+        The case it was reduced from.
+    states : int
+        Its states (in the key that later runs reuse it by).
+    seconds : float
+        Wall time of the reduction, s.
+
+    Returns
+    -------
+    dict
+        The summary: states, bounds (µm), the static-gain error, timings and checks.
+    """
     from gatetherm.studies.run.output import write_json
     from gatetherm.studies.run.reduce import rom_key, save_rom
 

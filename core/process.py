@@ -1,5 +1,5 @@
 """Process-wide settings a command makes before its numerics, each measured on the 3-D
-frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; README, Speed):
+frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.md):
 
 * BLAS threads: :data:`BLAS_THREADS` (``GATETHERM_BLAS_THREADS`` overrides), through
   threadpoolctl;
@@ -20,7 +20,7 @@ from gatetherm import InputError
 log = logging.getLogger(__name__)
 
 BLAS_THREADS = 1
-"""BLAS threads of a command; see README, Speed, for the measurement."""
+"""BLAS threads of a command; see docs/performance.md for the measurement."""
 THREADS_ENV = "GATETHERM_BLAS_THREADS"
 _M_MMAP_THRESHOLD = -3
 

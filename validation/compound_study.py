@@ -184,7 +184,7 @@ def _fmt(v) -> str:
 
 
 def kinds_markdown(rows: list[dict]) -> str:
-    """The pairs by the kinds of their hidden pieces (README, "Compound diagnosis")."""
+    """The pairs by the kinds of their hidden pieces (docs/diagnosis.md, "Compound diagnosis")."""
     L = ["| hidden kinds | cases | verdict `explained` | both pieces named | both named, or a stated equivalent "
          "| a wrong piece named | a wrong catalogue effect |", "|---|---|---|---|---|---|---|"]
     groups = [(" + ".join(k), [r for r in rows if r["kinds"] == "+".join(k)]) for k in KIND_PAIRS]

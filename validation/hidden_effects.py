@@ -55,7 +55,7 @@ TRUTH_MESH_FACTOR = 0.75
 """Element size of the "measured" runs relative to the diagnosis mesh."""
 SETTINGS = Settings(p2_check=False)
 """The diagnosis of the study (the frame's own discretisation is below the resolution at its mesh:
-README, Verification; the P2 run would only cost time)."""
+docs/model.md, Verification; the P2 run would only cost time)."""
 
 #: Effects outside the catalogue: name -> (parameter, unit, strengths tried).
 OUTSIDE = {
