@@ -37,7 +37,7 @@ log = logging.getLogger(__name__)
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
-__all__ = ["Case", "Run", "Schedule", "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose",
+__all__ = ["Case", "Run", "Schedule", "beam_coefficients", "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose",
            "gate_frame", "load_case", "reduce", "run", "schedule_file", "write_reduction"]
 
 
@@ -60,6 +60,31 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
     """
     supply = getattr(getattr(case, "origin", None), "config", None)
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
+
+
+def beam_coefficients(case: Case, source: str = "theory") -> tuple[float, float]:
+    """The paper's predictor coefficients, δ = K_i (θ_A − θ_B) − K_C θ_C, of the paper's frame.
+
+    Parameters
+    ----------
+    case : Case
+        A frame from :func:`gate_frame` (a case file has no beam model).
+    source : str
+        ``"theory"``: the beam theory (eqs. 22–29) on the frame's dimensions; ``"fe"``: the FE
+        frame under the theory's two load cases (θ_A − θ_B = 1 K over the heated height, +1 K on
+        the tie bar), δ at the tips.
+
+    Returns
+    -------
+    tuple of float
+        K_i, K_C in µm/K.
+    """
+    from gatetherm.studies.control.methods import Settings, coefficients
+
+    if source not in ("theory", "fe"):
+        raise InputError("source", f"unknown source {source!r}", "choose 'theory' or 'fe'")
+    ki, kc, _ = coefficients(case, None, Settings(k_source=source))
+    return float(ki), float(kc)
 
 
 def schedule_file(path: str | os.PathLike, case: Case, step_s: float = 60.0) -> Schedule:
