@@ -123,10 +123,12 @@ class Run:
 
     @property
     def time(self) -> np.ndarray:
+        """Sample times, s from the start."""
         return self.scenario.columns["time_s"]
 
     @property
     def columns(self) -> dict[str, np.ndarray]:
+        """Every column of the run in the data format (``docs/data-format.md``), name → array."""
         return self.scenario.columns
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -308,8 +310,18 @@ def reduce(case: Case, states: int = 30):
 
 
 def check_schedules(case: Case) -> list[Schedule]:
-    """What a reduced model of ``case`` is checked on: its own schedule and, where the case reads
-    only the inputs they drive (the oil supply, the pump, the room), the paper's conditions 1-3."""
+    """What a reduced model of ``case`` is checked on (:func:`check_rom`'s default).
+
+    Parameters
+    ----------
+    case : Case
+
+    Returns
+    -------
+    list of Schedule
+        Its own schedule and, where the case reads only the inputs they drive (the oil supply,
+        the pump, the room), the paper's conditions 1-3.
+    """
     from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
 
     out = [case.schedule] if len(case.schedule.times) > 1 else []

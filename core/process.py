@@ -26,7 +26,16 @@ _M_MMAP_THRESHOLD = -3
 
 
 def configure() -> None:
-    """Apply the settings of this module to the running process."""
+    """Set up the running process for gatetherm's numerics, as every command does first.
+
+    One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
+    sweeps and studies do not oversubscribe the cores, and glibc's mmap threshold at 4 MiB, so
+    that freed large arrays go back to the system at once. Optional in a script.
+
+    Returns
+    -------
+    None
+    """
     try:
         ctypes.CDLL("libc.so.6").mallopt(_M_MMAP_THRESHOLD, 4 << 20)
     except (OSError, AttributeError):  # not glibc

@@ -19,6 +19,7 @@ import gatetherm as gt
 import numpy as np
 
 out = Path(sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp(prefix="gatetherm-"))
+out.mkdir(parents=True, exist_ok=True)
 case = gt.load_case(Path(__file__).resolve().parents[1] / "validation/examples/c_frame/case.toml")
 truth = gt.run(case, effects={"heat_source@arm": 40.0}, keep=())
 

@@ -1,7 +1,8 @@
 """The docs against the code: every case-file key the readers accept is in docs/case-file.md
 and every key documented there is accepted; the page's examples are the shipped files or
 cases that load and solve to the closed forms the page states; docs/cli.md is what the
-argument parsers make; nothing in the README is rewritten by the package."""
+argument parsers make and docs/api.md what the public docstrings make, every public name documented;
+nothing in the README is rewritten by the package."""
 from __future__ import annotations
 
 import math
@@ -135,3 +136,27 @@ def test_nothing_rewrites_the_readme():
 
     assert "<!-- report:" not in (ROOT / "README.md").read_text(encoding="utf-8")
     assert "--readme" not in build_parser().format_help() + (DOCS / "cli.md").read_text(encoding="utf-8")
+
+
+def test_api_reference_is_what_the_docstrings_make():
+    from gatetherm.cli.api_reference import markdown
+
+    assert (DOCS / "api.md").read_text(encoding="utf-8") == markdown(), \
+        "docs/api.md is stale: python -m gatetherm.cli.api_reference > docs/api.md"
+
+
+def test_every_public_name_is_documented_in_numpydoc():
+    import inspect
+
+    import gatetherm as gt
+    from gatetherm.cli.api_reference import public
+
+    text = (DOCS / "api.md").read_text(encoding="utf-8")
+    names = public()
+    assert len(names) == len(gt.API) + len(gt.plot.__all__) == 27
+    for prefix, name, obj in names:
+        assert f"### `{prefix}{name}" in text, name
+        doc = inspect.getdoc(obj) or ""
+        assert len(doc) > 40, f"{prefix}{name}: no docstring"
+        if not inspect.isclass(obj) and inspect.signature(obj).parameters:
+            assert "Parameters\n----------" in doc and "Returns\n-------" in doc, f"{prefix}{name}: not numpydoc"

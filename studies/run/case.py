@@ -483,9 +483,24 @@ def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
 
 
 def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
-    """Read and check a case file (paths inside it are relative to its folder); with
-    ``mesh_factor``, a geometry is meshed with its element sizes times that factor;
-    ``overrides`` ({dotted key: value}) change keys of the file as it is read."""
+    """Read and check a case file (``docs/case-file.md``); paths inside it are relative to its folder.
+
+    Parameters
+    ----------
+    path : str or path
+        The ``.toml`` case file.
+    mesh_factor : float
+        A geometry (``.geo``, CAD) is meshed with its element sizes times this factor (a ``.msh``
+        is read as it is).
+    overrides : dict, optional
+        ``{dotted key: value}`` changing keys of the file as it is read, e.g.
+        ``{"thermal.free.film": 8.0}``.
+
+    Returns
+    -------
+    Case
+        Bad input raises :class:`gatetherm.InputError` naming the file, the key and the fix.
+    """
     path = Path(path)
     text = read_text(path, "CASE.toml", "give the path of a .toml case file")
     try:
