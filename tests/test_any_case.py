@@ -169,4 +169,4 @@ def test_simulate_and_the_api_give_the_same_run(tmp_path):
     assert set(ts.names) == set(run.columns)
     for name in ("delta_um", "theta_A_degC", "theta_C_degC", "T_tank_oil_degC"):
         np.testing.assert_allclose(run[name], ts[name], rtol=1e-15, atol=1e-12)
-    assert run.summary()["first_peak_um"] == pytest.approx(48.25, abs=5e-3)  # README: 48.25 µm at 13.0 min
+    assert run.summary()["first_peak_um"] == pytest.approx(48.25, abs=5e-3)  # README's `gatetherm simulate --condition 1`: 48.25 µm at 13.0 min

@@ -1,5 +1,5 @@
 """Mechanical loads, joints of an assembly and axisymmetric sections, through case files
-written as a user writes them from README "Case files": closed forms with the achieved
+written as a user writes them from docs/case-file.md: closed forms with the achieved
 values pinned beside the bands, and the refusals of a part held by nothing."""
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """Library plots: ``gt.plot`` draws what the run holds on the Axes it is given (or a new pyplot
-figure's) and returns them; the README snippet leaves a notebook's matplotlib backend as it
-was; pyvista's global off-screen switch is not touched; the pictures are written by one writer."""
+figure's) and returns them; the snippet of gt.plot's docstring leaves a notebook's matplotlib
+backend as it was; pyvista's global off-screen switch is not touched; the pictures are written by
+one writer."""
 from __future__ import annotations
 
 import os
@@ -32,7 +33,7 @@ def cframe():
     return gt.run(gt.load_case(CASE))
 
 
-def test_the_readme_snippet_keeps_the_svg_backend(tmp_path):
+def test_the_documented_snippet_keeps_the_svg_backend(tmp_path):
     """The snippet in a fresh interpreter with ``MPLBACKEND=svg``: the plots made without ``ax=``
     are pyplot figures (they show in a notebook), and the backend is still svg afterwards."""
     snippet = textwrap.dedent(f"""
