@@ -69,7 +69,7 @@ def examples() -> list[tuple[str, str, str]]:
 
 def test_examples_quoting_shipped_files_are_those_files():
     quoted = [(p, t) for label, p, t in examples() if label == "file" and p.startswith("validation/")]
-    assert len(quoted) == 3
+    assert len(quoted) == 5
     for path, text in quoted:
         shipped = (ROOT / path).read_text(encoding="utf-8")
         assert text.split("\n", 1)[1] == shipped, path
@@ -91,8 +91,8 @@ def _final(path: Path) -> dict:
     return run(case_reader.load_case(path)).summary()["probes"]
 
 
-def test_assembly_example_is_the_series_resistance_closed_form(written):
-    p = _final(written / "joint/case.toml")
+def test_assembly_example_is_the_series_resistance_closed_form():
+    p = _final(ROOT / "validation/examples/joint/case.toml")
     q = 100.0 / (0.1 / 50 + 1 / 2000 + 0.1 / 15)
     assert p["a"]["T_degC"] == pytest.approx(100 - q * 0.05 / 50, rel=1e-9)   # 89.09 °C, as the page says
     assert p["b"]["T_degC"] == pytest.approx(q * 0.05 / 15, rel=1e-9)         # 36.36 °C

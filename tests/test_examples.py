@@ -1,7 +1,7 @@
 """The examples gallery (examples/*.py): each script runs as a user runs it, in a fresh process
 from a folder outside the checkout, writes its one figure into the folder it is given, and prints
 the figures pinned here (the acceptance band beside the value achieved). The first example's
-figure is the picture the README shows."""
+figure is the picture the README shows; every figure is the one examples/README.md shows."""
 from __future__ import annotations
 
 import re
@@ -32,6 +32,11 @@ def run_example(name: str, tmp_path: Path) -> tuple[list[str], Path]:
     figure = next(f for f in figures if f.suffix == ".png")
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and figure.stat().st_size > 20_000
     assert lines[-1] == f"figure: {figure}"
+    shown = ROOT / "docs/images" / figure.name
+    assert f"(../docs/images/{figure.name})" in (EXAMPLES / "README.md").read_text(encoding="utf-8")
+    new, old = image(figure), image(shown)
+    assert new.shape == old.shape and np.abs(new - old).mean() < 2e-3, \
+        f"docs/images/{figure.name} is stale: python examples/{name} docs/images"
     return lines[:-1], figure
 
 
@@ -45,7 +50,7 @@ def test_every_example_has_a_docstring_and_uses_only_the_public_api():
     import ast
 
     scripts = sorted(EXAMPLES.glob("*.py"))
-    assert len(scripts) >= 6
+    assert len(scripts) >= 7
     for path in scripts:
         tree = ast.parse(path.read_text(encoding="utf-8"))
         assert ast.get_docstring(tree), path.name
@@ -58,11 +63,7 @@ def test_c_frame_transient_is_the_readme_picture(tmp_path):
     (line,), figure = run_example("01_c_frame_transient.py", tmp_path)
     delta, T, largest, at = numbers(line.replace("6 h", ""))
     assert (delta, T, largest, at) == (32.16, 28.41, 54.89, 4.93)  # achieved; tests/test_cases.py pins the run
-    shown = ROOT / "docs/images/c_frame_transient.png"
-    assert f"({shown.relative_to(ROOT).as_posix()})" in (ROOT / "README.md").read_text(encoding="utf-8")
-    new, old = image(figure), image(shown)
-    assert new.shape == old.shape and np.abs(new - old).mean() < 2e-3, \
-        f"the README's picture is stale: python examples/01_c_frame_transient.py {shown.parent}"
+    assert f"(docs/images/{figure.name})" in (ROOT / "README.md").read_text(encoding="utf-8")
 
 
 def test_nafems_t4(tmp_path):
@@ -100,3 +101,9 @@ def test_reduced_model(tmp_path):
     states, bound, delta, theta_C = numbers(line.replace("6-h", ""))[:4]
     assert (states, delta, theta_C) == (30, 0.0015, 0.00031)   # acceptance: δ within 0.5 µm of FE
     assert bound == pytest.approx(5.5e-6, rel=0.05)
+
+
+def test_assembly(tmp_path):
+    (a, b, end), _ = run_example("07_assembly.py", tmp_path)
+    assert numbers(a.replace("T_a", "")) == [89.0909, 89.0909] and numbers(b.replace("T_b", "")) == [36.3636, 36.3636]
+    assert numbers(end) == [112.46]          # tests/test_docs.py: the same case against its closed form
