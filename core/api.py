@@ -37,8 +37,8 @@ log = logging.getLogger(__name__)
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
-__all__ = ["Case", "Run", "Schedule", "beam_coefficients", "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose",
-           "gate_frame", "load_case", "reduce", "run", "schedule_file", "write_reduction"]
+__all__ = ["Case", "Run", "Schedule", "beam_coefficients", "check_rom", "check_schedules", "compensate", "condition",
+           "configure", "diagnose", "gate_frame", "load_case", "reduce", "run", "schedule_file", "write_reduction"]
 
 
 def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:

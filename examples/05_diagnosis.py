@@ -5,8 +5,8 @@ does not have, recorded at the sensors' resolution (0.1 µm, 0.05 K) with noise.
 replays the case with the measured inputs, finds where model and data disagree, and looks for the
 missing piece among hypotheses of the case (here, to keep it short: a heat source in the
 column, the arm or the table, the free surfaces' film coefficient and the spindle's power; by
-default every effect, parameter and sensor fault the case lists). Prints the verdict and the piece it names with its fitted value; draws
-the residuals per channel (``diagnosis.png``).
+default every effect, parameter and sensor fault the case lists). Prints the verdict and the
+piece it names with its fitted value; draws the residuals per channel (``diagnosis.png``).
 
     python examples/05_diagnosis.py [OUT_DIR]
 """
@@ -37,7 +37,8 @@ with open(measured, "w", newline="") as f:
 
 d = gt.diagnose(case, measured, effects=("heat_source@column", "heat_source@arm", "heat_source@table"),
                 parameters=("film_free", "source_spindle"), sensors=False, p2_check=False)
-print(f"verdict: {d.verdict}; pieces: " + ", ".join(f"{p.piece.name} = {p.value:.1f} ± {p.sigma:.1f}" for p in d.pieces))
+pieces = ", ".join(f"{p.piece.name} = {p.value:.1f} ± {p.sigma:.1f}" for p in d.pieces)
+print(f"verdict: {d.verdict}; pieces: {pieces}")
 axes = gt.plot.residuals(d)
 gt.plot.save(axes, out / "diagnosis.png")
 print(f"figure: {out / 'diagnosis.png'}")

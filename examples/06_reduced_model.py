@@ -21,7 +21,8 @@ case = gt.load_case(Path(__file__).resolve().parents[1] / "validation/examples/c
 reduction = gt.reduce(case, states=30)
 check, = gt.check_rom(case, reduction.rom)
 bound = max(reduction.error_bound.values())
-print(f"{reduction.rom.states} states, balanced-truncation bound {bound:.1e}; largest error against FE: delta {check.errors['delta_um']:.4f} um, "
+print(f"{reduction.rom.states} states, balanced-truncation bound {bound:.1e}; "
+      f"largest error against FE: delta {check.errors['delta_um']:.4f} um, "
       f"theta_C {check.errors['theta_C_degC']:.5f} K; 6-h run {check.rom_ms:.1f} ms against {check.fe_seconds:.2f} s")
 
 fig = Figure(figsize=(10, 4))
