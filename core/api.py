@@ -37,8 +37,9 @@ log = logging.getLogger(__name__)
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
-__all__ = ["Case", "Run", "Schedule", "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose",
-           "gate_frame", "load_case", "reduce", "run", "schedule_file", "write_reduction"]
+__all__ = ["Case", "Run", "Schedule", "check_placement", "check_rom", "check_schedules", "compensate", "condition",
+           "configure", "diagnose", "gate_frame", "load_case", "place_sensors", "reduce", "run", "schedule_file",
+           "write_reduction"]
 
 
 def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:
@@ -321,3 +322,61 @@ def diagnose(case: Case, measured, **settings):
 
     ts = measured if isinstance(measured, TimeSeries) else read_timeseries(measured, required=("time_s",))
     return run_diagnosis(case, ts, Settings(**settings))
+
+
+def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, **settings):
+    """Where to put ``count`` thermocouples on ``case``: the surface points whose temperatures
+    predict every relative displacement best on held-out duty cycles (README "Sensor placement").
+
+    Parameters
+    ----------
+    case : Case
+        Any case with a heat solve and relative displacements: a case file's, or the paper's frame.
+    count : int
+        Sensors to place; the held-out error is reported for 1 ... ``count``.
+    schedules : sequence of Schedule, optional
+        Training duty cycles (:func:`schedule_file`) instead of the generated family; the case's
+        own schedule is added unless it is held out.
+    held_out : sequence of Schedule, optional
+        Loads to judge on (default: the paper's conditions 1-3 for a case driven by the frame's
+        inputs, else a generated family of its own).
+    **settings
+        Fields of :class:`gatetherm.studies.sensors.place.PlacementSettings` (``boundaries``,
+        ``spacing_m``, ``exclude`` (boxes ``Box(lo, hi)``), ``min_distance_m``, ``noise_K``,
+        ``loads``, ``held_out_loads``, ``ranges`` ({input: (lo, hi)}), ``seed``, ``states``,
+        ``neighbours``); ``form`` (``auto``,
+        ``static``, ``dynamic``) and ``max_inputs`` of the error-model family.
+
+    Returns
+    -------
+    Placement
+        ``.sensors`` (name, node, coordinates, boundary), ``.model`` (the errormodel ``ErrorModel``),
+        ``.curve`` (per count: form, leave-one-load-out and held-out MAE per target), ``.failed``,
+        ``.signals`` (the same family given the case's θ_A, θ_B, θ_C), ``.write(dir)``.
+    """
+    from gatetherm.studies.errormodel.fit import FitParams
+    from gatetherm.studies.sensors.place import PlacementSettings, place_sensors as place
+
+    fit = {k: settings.pop(k) for k in ("form", "max_inputs") if k in settings}
+    if isinstance(settings.get("ranges"), Mapping):
+        settings["ranges"] = tuple((k, float(lo), float(hi)) for k, (lo, hi) in settings["ranges"].items())
+    for key in ("boundaries", "exclude"):
+        if key in settings:
+            settings[key] = tuple(settings[key])
+    return place(case, PlacementSettings(count=count, fit=FitParams(**fit), **settings), schedules, held_out)
+
+
+def check_placement(case: Case, placement):
+    """The independent check of a :func:`place_sensors` result by full FE runs: the case with the
+    chosen points as probes, every training and held-out load run in full, the placement model's
+    terms refitted on the training runs and scored on the held-out ones.
+
+    Returns
+    -------
+    FECheck
+        ``.held_out_mae_um`` against ``.placement_mae_um`` per target (``.ratio``), the largest
+        temperature error of the reduced model at the chosen points (``.temperature_error_K``).
+    """
+    from gatetherm.studies.sensors.check import fe_check
+
+    return fe_check(case, placement)
