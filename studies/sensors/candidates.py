@@ -3,8 +3,9 @@ to a spacing, minus boxes that are not allowed.
 
 The outer surface is every facet that belongs to one cell only (in a 2-D section: its outline;
 interfaces between regions are inside). Each candidate carries the name of the boundary it lies
-on: the first named boundary of the mesh whose facets are all outer that holds the node, else the
-first named boundary that holds it, else ``surface`` (an unnamed, adiabatic part of the outline).
+on: the first named boundary of the mesh whose facets are all outer that holds the node; else, for
+a node of the outer surface, ``surface`` (an unnamed part of the outline, where an interface may
+end); else the first named boundary that holds it.
 """
 from __future__ import annotations
 
@@ -62,11 +63,15 @@ def outer_facets(cells: np.ndarray) -> np.ndarray:
 
 def boundary_names(mesh, nodes: np.ndarray) -> tuple[str, ...]:
     """The boundary each of ``nodes`` lies on (module docstring)."""
-    outer = {tuple(f) for f in outer_facets(mesh.cells)}
-    ranked = sorted(mesh.boundaries, key=lambda b: not all(tuple(sorted(f)) in outer for f in mesh.boundaries[b]))
-    label = {}
-    for b in reversed(ranked):  # the first-ranked name wins
+    facets = outer_facets(mesh.cells)
+    outer = {tuple(f) for f in facets}
+    is_outer = {b: all(tuple(sorted(f)) in outer for f in mesh.boundaries[b]) for b in mesh.boundaries}
+    label = dict.fromkeys(np.unique(facets).tolist(), UNNAMED)
+    for b in reversed([b for b in mesh.boundaries if is_outer[b]]):  # the first in mesh order wins
         label.update(dict.fromkeys(np.unique(mesh.boundaries[b]).tolist(), b))
+    for b in (b for b in mesh.boundaries if not is_outer[b]):
+        for n in np.unique(mesh.boundaries[b]).tolist():
+            label.setdefault(n, b)
     return tuple(label.get(int(n), UNNAMED) for n in nodes)
 
 

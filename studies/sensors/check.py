@@ -4,7 +4,7 @@ The case is made again with the chosen points as ``[probes]`` (for a case file t
 reading, as a user pastes ``sensors.toml``: ``probes.S1.point = [x, y]``; for a generated case by
 adding the probes to its problem). Every training and held-out load is run in full
 (:func:`~gatetherm.studies.run.scenario.run_scenario`); the probes' temperatures get the same
-noise as in the placement (same seed, node and load); the placement model's terms are fitted by
+noise as in the placement (same seed, node and load key); the placement model's terms are fitted by
 least squares on the training runs and the held-out runs are predicted with them.
 """
 from __future__ import annotations
@@ -21,7 +21,7 @@ from gatetherm.studies.errormodel.terms import evaluate
 from gatetherm.studies.run.case import CaseFile
 from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 from gatetherm.studies.sensors.models import held_out_mae
-from gatetherm.studies.sensors.screen import noise
+from gatetherm.studies.sensors.screen import load_key, noise
 
 
 @dataclass(frozen=True)
@@ -69,8 +69,8 @@ def fe_check(case, placement, cache: ScenarioCache | None = None) -> FECheck:
     checked = with_probes(case, placement.sensors)
     cache = cache or ScenarioCache()
     runs = {x.label: run_scenario(checked, x, cache=cache).columns for x in (*placement.training, *placement.held_out)}
-    train = [_noisy(runs[x.label], placement, x.label) for x in placement.training]
-    held = [_noisy(runs[x.label], placement, x.label) for x in placement.held_out]
+    train = [_noisy(runs[x.label], placement, load_key("training", i)) for i, x in enumerate(placement.training)]
+    held = [_noisy(runs[x.label], placement, load_key("held-out", i)) for i, x in enumerate(placement.held_out)]
     model = placement.model
     refitted = []
     for m in model.targets:

@@ -38,7 +38,7 @@ from gatetherm.studies.sensors.loads import duty_cycles, input_ranges
 from gatetherm.studies.sensors.models import error_model, held_out_mae, lag_columns, lag_terms, settings_of
 from gatetherm.studies.sensors.reduced import candidate_rows, simulate
 from gatetherm.studies.sensors.result import CurvePoint, Placement, Sensor
-from gatetherm.studies.sensors.screen import noise, shortlist as screen
+from gatetherm.studies.sensors.screen import load_key, noise, shortlist as screen
 
 log = logging.getLogger(__name__)
 
@@ -170,8 +170,8 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
     secs["reduced_model"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     names, steps = sorted(case.inputs()), {}
-    tr = [simulate(rom, x, names, case.defaults, steps) for x in train]
-    ho = [simulate(rom, x, names, case.defaults, steps) for x in held]
+    tr = [simulate(rom, x, names, load_key("training", i), case.defaults, steps) for i, x in enumerate(train)]
+    ho = [simulate(rom, x, names, load_key("held-out", i), case.defaults, steps) for i, x in enumerate(held)]
     ti = [rom.output(t) for t in targets]
     X, Y = np.vstack([x.states for x in tr]), np.vstack([x.outputs[:, ti] for x in tr])
     edges = np.cumsum([0] + [len(x.states) for x in tr])
@@ -184,7 +184,7 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
 
     def temps(loads, idx):  # rises of shortlist members idx over loads, with their noise
         return [x.states @ rows[sl[idx]].T + np.column_stack(
-            [noise(s.seed, keys[i], x.label, len(x.states), s.noise_K) for i in idx]) for x in loads]
+            [noise(s.seed, keys[i], x.key, len(x.states), s.noise_K) for i in idx]) for x in loads]
 
     every = np.arange(len(sl))
     terms = lag_terms([x.columns for x in tr], names, case.held(), fit) if fit.form != "static" else []
@@ -262,7 +262,7 @@ def _signals(case, rom, design, tr, ho, terms, targets, truth, fit, s, span, sou
 
     def theta(x):
         return np.column_stack([np.mean([x.outputs[:, rom.output(col)] - case.problem.T0 +
-                                         noise(s.seed, f"probe {probe}", x.label, len(x.states), s.noise_K)
+                                         noise(s.seed, f"probe {probe}", x.key, len(x.states), s.noise_K)
                                          for col, probe in chans[c]], axis=0) for c in chans])
 
     d = greedy.Design(np.vstack([theta(x) for x in tr]), design.Z[:, 1 + design.s:], design.Y,

@@ -35,6 +35,8 @@ class Simulated:
     """One load marched through the reduced model, at its output samples."""
 
     label: str
+    key: str
+    """Its noise key (:func:`.screen.load_key`)."""
     columns: dict
     """``time_s`` (s) and the case's inputs."""
     states: np.ndarray
@@ -63,8 +65,10 @@ def output_samples(schedule: Schedule) -> np.ndarray:
     return np.unique(np.r_[0:n:max(schedule.every, 1), n - 1])
 
 
-def simulate(rom: ReducedModel, schedule: Schedule, names, defaults=None, _steps: dict | None = None) -> Simulated:
-    """March ``schedule`` (the inputs ``names`` of the case) through ``rom`` from rest (uniform T0)."""
+def simulate(rom: ReducedModel, schedule: Schedule, names, key: str, defaults=None,
+             _steps: dict | None = None) -> Simulated:
+    """March ``schedule`` (the inputs ``names`` of the case; noise key ``key``) through ``rom`` from
+    rest (uniform T0)."""
     cols = columns(schedule, names, defaults)
     t = cols["time_s"]
     h = np.diff(t)
@@ -78,4 +82,4 @@ def simulate(rom: ReducedModel, schedule: Schedule, names, defaults=None, _steps
     u, modes = series_inputs(rom, cols)
     X = march_rom(steps[dt], u, modes)
     keep = output_samples(schedule)
-    return Simulated(schedule.label, {k: v[keep] for k, v in cols.items()}, X[keep], outputs(rom, X, u)[keep])
+    return Simulated(schedule.label, key, {k: v[keep] for k, v in cols.items()}, X[keep], outputs(rom, X, u)[keep])

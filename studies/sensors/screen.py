@@ -19,9 +19,16 @@ import scipy.linalg as sla
 from scipy.spatial import cKDTree
 
 
+def load_key(role: str, index: int) -> str:
+    """The noise key of the ``index``-th (from 0) load of ``role`` (``training``, ``held-out``): its
+    place, not its label (a schedule file's label holds its path, which differs from copy to copy)."""
+    return f"{role} {index + 1}"
+
+
 def noise(seed: int, key: str, load: str, n: int, sigma_K: float) -> np.ndarray:
-    """The sensor noise of channel ``key`` (a node or a probe) in load ``load``: ``n`` normal
-    samples of standard deviation ``sigma_K`` (K), the same for the same seed, channel and load."""
+    """The sensor noise of channel ``key`` (a node or a probe) in load ``load`` (:func:`load_key`):
+    ``n`` normal samples of standard deviation ``sigma_K`` (K), the same for the same seed, channel
+    and load."""
     if sigma_K == 0:
         return np.zeros(n)
     rng = np.random.default_rng([int(seed), zlib.crc32(key.encode()), zlib.crc32(load.encode())])
