@@ -3,10 +3,8 @@ reduced model: the surface points whose temperatures predict every relative disp
 held-out duty cycles (README "Sensor placement"; the library is gatetherm.studies.sensors).
 
 Writes ``DIR/sensors.toml`` (the chosen points as ``[probes]`` to paste into a case),
-``DIR/model.json`` (the fitted error model, as ``gatetherm errormodel fit`` writes it),
-``DIR/curve.csv`` and ``DIR/curve.png`` (held-out error against the number of sensors),
-``DIR/machine.png`` (the machine with its candidates and the chosen points) and, last,
-``DIR/summary.json``.
+``DIR/model.json``, ``DIR/curve.csv``, ``DIR/curve.png``, ``DIR/machine.png`` and, last,
+``DIR/summary.json`` (:func:`gatetherm.api.write_placement`).
 """
 from __future__ import annotations
 
@@ -64,15 +62,13 @@ def register(sub) -> None:
 
 
 def _settings(args, dim: int) -> dict:
-    from gatetherm.studies.sensors.candidates import Box
-
     boxes = []
     for text in args.exclude:
         v = _floats(text, "--exclude", "0,0,0.2,0.1" if dim == 2 else "0,0,0,0.2,0.1,0.1")
         if len(v) != 2 * dim or any(a > b for a, b in zip(v[:dim], v[dim:])):
             raise InputError(f"--exclude {text}", f"is not a {dim}-D box", f"give {2 * dim} numbers: the low "
                              "corner, then the high one")
-        boxes.append(Box(tuple(v[:dim]), tuple(v[dim:])))
+        boxes.append((v[:dim], v[dim:]))
     ranges = {}
     for text in args.range:
         name, _, span = text.partition("=")
@@ -89,8 +85,6 @@ def _settings(args, dim: int) -> dict:
 def run(args) -> int:
     import gatetherm as gt
     from gatetherm.outdir import output_dir
-    from gatetherm.validation.plots import save
-    from gatetherm.validation.plots.sensors import plot_curve, plot_machine
 
     if args.case is not None:
         refuse_model_options(args)
@@ -108,11 +102,7 @@ def run(args) -> int:
         placement = gt.place_sensors(case, args.count, schedules=schedules or None, held_out=held or None, **settings)
         seconds = time.perf_counter() - t0
         check = gt.check_placement(case, placement) if args.check else None
-        save(plot_curve(placement).figure, out / "curve.png")
-        probes = {p.name: p.xyz for p in case.problem.probes if "T" in p.quantities}
-        save(plot_machine(case.mesh, placement, probes=probes).figure, out / "machine.png")
-        summary = placement.write(out, extra={"seconds_total": round(seconds, 2),
-                                              **({"fe_check": check.summary()} if check else {})})
+        summary = gt.write_placement(out, placement, case, check, {"seconds_total": round(seconds, 2)})
     _report(placement, summary, check, out, seconds)
     return 0
 

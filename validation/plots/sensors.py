@@ -3,19 +3,14 @@ with its candidates and the chosen points (:mod:`gatetherm.studies.sensors`)."""
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
-from matplotlib.figure import Figure
 
 from gatetherm.studies.sensors.candidates import outer_facets
+from gatetherm.validation.plots import figure
 
 
 def _axes(ax, size):
-    if ax is not None:
-        return ax
-    fig = Figure(figsize=size)
-    FigureCanvasAgg(fig)
-    return fig.subplots()
+    return figure(size) if ax is None else ax
 
 
 def plot_curve(placement, ax=None):
