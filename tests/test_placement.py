@@ -300,6 +300,35 @@ def test_the_placement_does_not_depend_on_where_the_case_lies(blocks, tmp_path):
     assert again.sensors == p.sensors and again.curve[-1].held_out_mae_um == p.curve[-1].held_out_mae_um
 
 
+def test_the_curve_stops_and_says_why(blocks):
+    """Six sensors asked: with 0.08 m between sensors on a 0.2 m body only three fit; with a 30 %
+    least gain the second is refused (27 %); otherwise the leave-one-load-out and held-out curves fall to 6."""
+    case, _, _ = blocks
+    spaced = gt.place_sensors(case, 6, loads=5, held_out_loads=2, states=12, min_distance_m=0.08)
+    assert len(spaced.curve) == 3 and spaced.stopped == ("no candidate is left 0.08 m or more from the 3 chosen: "
+                                                         "the curve stops at 3")
+    d = [np.linalg.norm(np.subtract(a.xyz, b.xyz)) for i, a in enumerate(spaced.sensors) for b in spaced.sensors[:i]]
+    assert min(d) >= 0.08
+    greedy_ = gt.place_sensors(case, 6, loads=5, held_out_loads=2, states=12, min_gain=0.3)
+    assert greedy_.stopped == ("a sensor 2 lowers the leave-one-load-out error by less than 30% (0.0777 -> 0.0568 um): "
+                               "the curve stops at 1") and len(greedy_.curve) == 1
+    full = gt.place_sensors(case, 6, loads=5, held_out_loads=2, states=12)
+    held = [c.held_out_mean_um for c in full.curve]
+    assert not full.stopped and held == sorted(held, reverse=True)
+    assert held == pytest.approx([0.0648, 0.0490, 0.0383, 0.0341, 0.0289, 0.0260], abs=5e-4)  # achieved
+
+
+def test_cli_writes_the_outputs_and_says_why_the_curve_stops(blocks, tmp_path, capsys):
+    _, _, d = blocks
+    out = tmp_path / "o"
+    assert cli("sensors", "--case", d / "case.toml", "--count", 6, "--min-distance", 0.08, "--loads", 5,
+               "--states", 12, "--out", out) == 0
+    text = capsys.readouterr().out
+    assert "stopped: no candidate is left 0.08 m or more from the 3 chosen: the curve stops at 3" in text
+    assert sorted(f.name for f in out.iterdir()) == ["curve.csv", "curve.png", "machine.png", "model.json",
+                                                      "sensors.toml", "summary.json"]
+
+
 # --- slow: the C-frame, the paper frame, timing ------------------------------------------------
 
 @pytest.fixture(scope="module")
@@ -359,13 +388,22 @@ def test_screening_loses_little_against_every_candidate(coarse):
 
 @pytest.mark.slow
 def test_paper_frame_three_points_beat_A_B_and_the_C_mean():
-    """2-D frame, 3 sensors from its whole outer surface, trained on 20 generated duty cycles:
-    the held-out δ error over conditions 1-3 is below the same family's given A, B and the C mean."""
-    p = gt.place_sensors(gt.gate_frame(2), 3)
+    """2-D frame, 3 sensors from its whole outer surface (824 nodes), trained on 20 generated duty
+    cycles: the held-out δ error over conditions 1-3 is below the same family's given A, B and the
+    C mean (the acceptance band); the points lie on A's face, on B's face and at the tool tip F_L."""
+    frame = gt.gate_frame(2)
+    p = gt.place_sensors(frame, 3)
     assert [x.label.split(":")[0] for x in p.held_out] == ["condition 1", "condition 2", "condition 3"]
+    assert len(p.candidates) == 824 and len(p.training) == 20
     ours, paper = p.curve[-1].held_out_mae_um["delta_um"], p.signals["held_out_mae_um"]["delta_um"]
     assert ours <= paper
-    assert ours == pytest.approx(0.613, abs=0.05) and paper == pytest.approx(1.40, abs=0.1)  # achieved 0.613, 1.40 um
+    assert ours == pytest.approx(0.849, abs=0.01) and paper == pytest.approx(1.368, abs=0.01)  # achieved 0.849, 1.368 um
+    held = [c.held_out_mae_um["delta_um"] for c in p.curve]
+    assert held == pytest.approx([8.19, 1.71, 0.849], abs=0.01)  # achieved 8.193, 1.710, 0.849 um: falls
+    at = {q.name: np.array(q.xyz) for q in frame.problem.probes}
+    s1, s2, s3 = (np.array(s.xyz) for s in p.sensors)
+    assert s1[0] == at["A"][0] and s2[0] == at["B"][0]  # achieved: x = 0 and 0.225 m, A's and B's faces
+    assert np.linalg.norm(s3 - at["F_L"]) < 0.02  # achieved 15 mm from the tool tip
 
 
 @pytest.mark.slow
