@@ -350,8 +350,8 @@ def test_fe_check_reproduces_the_held_out_error(coarse, tmp_path):
     assert check.runs == 9
     for target, ratio in check.ratio.items():
         assert 0.9 < ratio < 1.1, (target, ratio)
-    assert check.ratio["delta_um"] == pytest.approx(1.003, abs=0.01)  # achieved 1.0031
-    assert check.ratio["drift_x_um"] == pytest.approx(1.000, abs=0.01)  # achieved 0.9997
+    assert check.ratio["delta_um"] == pytest.approx(1.003, abs=0.002)  # achieved 1.0032
+    assert check.ratio["drift_x_um"] == pytest.approx(1.000, abs=0.002)  # achieved 0.9996
     assert check.temperature_error_K < 0.005  # achieved 0.0012 K
     summary = placement.write(tmp_path)
     probes = tomllib.loads((tmp_path / "sensors.toml").read_text())["probes"]
@@ -372,7 +372,7 @@ def test_the_curve_falls_and_beats_the_case_thermocouples(coarse):
     _, p, _ = coarse
     held = [c.held_out_mean_um for c in p.curve]
     assert held == sorted(held, reverse=True) and not p.stopped
-    assert held == pytest.approx([0.595, 0.274, 0.225], abs=0.02)  # achieved 0.5946, 0.2739, 0.2252 um
+    assert held == pytest.approx([0.597, 0.266, 0.229], abs=0.005)  # achieved 0.5968, 0.2660, 0.2287 um
     assert p.signals["held_out_mae_um"]["drift_x_um"] > 3 * p.curve[-1].held_out_mae_um["drift_x_um"]
     assert max(np.mean(list(e.values())) for e in p.failed.values()) > 1.5 * held[-1]
 
@@ -383,7 +383,8 @@ def test_screening_loses_little_against_every_candidate(coarse):
     case, p, _ = coarse
     full = gt.place_sensors(case, 3, loads=6, held_out_loads=2, states=20, neighbours=None)
     assert len(full.shortlist) == len(p.candidates) > 2 * len(p.shortlist)
-    assert p.curve[-1].cv_mean_um <= 1.05 * full.curve[-1].cv_mean_um  # achieved ratio 1.00
+    ratio = p.curve[-1].cv_mean_um / full.curve[-1].cv_mean_um
+    assert ratio <= 1.05 and ratio == pytest.approx(1.049, abs=0.005)  # achieved 1.049
 
 
 @pytest.mark.slow
@@ -414,4 +415,6 @@ def test_a_5000_node_case_with_6_sensors_and_20_loads_in_under_2_minutes():
     p = gt.place_sensors(case, 6, loads=20)
     seconds = time.perf_counter() - t0
     assert len(p.training) == 21 and len(p.sensors) == 6
-    assert seconds < 120  # achieved 17 s at load 5.7
+    held = [c.held_out_mean_um for c in p.curve]
+    assert not p.stopped and held == sorted(held, reverse=True)  # achieved 0.651 ... 0.209 um
+    assert seconds < 120  # achieved 18.5 s in pytest at load 11 on the 2 cores (11.5 s in the command)
