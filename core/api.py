@@ -415,7 +415,8 @@ def write_placement(out: str | os.PathLike, placement, case: Case, check=None, e
     ``[probes]``), ``model.json`` (the fitted error model, as ``gatetherm errormodel fit``
     writes it), ``curve.csv``, ``curve.png`` (held-out error against the number of sensors),
     ``machine.png`` (the machine with the chosen points and the case's thermocouples) and, last,
-    ``summary.json`` (with the FE check's figures if ``check`` is given, and ``extra``).
+    ``summary.json`` (with the mesh's node count, the FE check's figures if ``check`` is given,
+    and ``extra``).
 
     Parameters
     ----------
@@ -442,4 +443,5 @@ def write_placement(out: str | os.PathLike, placement, case: Case, check=None, e
     out.mkdir(parents=True, exist_ok=True)
     save(sensor_curve(placement, ax=figure((6.0, 3.6))), out / "curve.png")
     save(sensors(placement, case, ax=figure((6.0, 5.0))), out / "machine.png")
-    return placement.write(out, extra={**(extra or {}), **({"fe_check": check.summary()} if check else {})})
+    more = {"mesh_nodes": len(case.mesh.points), **(extra or {}), **({"fe_check": check.summary()} if check else {})}
+    return placement.write(out, extra=more)

@@ -418,3 +418,23 @@ def test_a_5000_node_case_with_6_sensors_and_20_loads_in_under_2_minutes():
     held = [c.held_out_mean_um for c in p.curve]
     assert not p.stopped and held == sorted(held, reverse=True)  # achieved 0.651 ... 0.209 um
     assert seconds < 120  # achieved 18.5 s in pytest at load 11 on the 2 cores (11.5 s in the command)
+
+
+@pytest.mark.slow
+def test_report_section_puts_the_frame_answer_next_to_A_B_C(tmp_path):
+    """The report section (small scope: 2 sensors, 3 loads, seeds 0 and 1): the chosen points'
+    rows and the A, B, C row of the same family, where the points lie, one row per seed, the
+    C-frame curve with its TF, TB, TS, the FE check in the notes; its figures written."""
+    from gatetherm.validation.report.registry import Context
+    from gatetherm.validation.report.sections import sensors
+
+    scope = {"frame_count": 2, "case_count": 2, "loads": 3, "case": "examples/c_frame/case.toml", "seeds": [0, 1]}
+    res = sensors.compute(Context(tmp_path, scope, 1))
+    answer, where, seeds, curve = res.tables
+    assert [r[0] for r in answer.rows] == ["1 chosen: S1", "2 chosen: S1, S2", "the paper's A, B and C mean (C1-C10)"]
+    assert [r[0] for r in where.rows] == ["S1", "S2"] and {r[3] for r in where.rows} <= {"A", "B", "F_L", "F_R"} | {
+        f"C{i}" for i in range(1, 11)}
+    assert [r[0] for r in seeds.rows] == ["0", "1"]
+    assert [r[0] for r in curve.rows] == ["1", "2", "its TF, TB, TS"]
+    assert any(n.startswith("FE check") and "of the reduced model's" in n for n in res.notes)
+    assert all((tmp_path / f.file).stat().st_size > 1e4 for f in res.figures)

@@ -108,9 +108,10 @@ def run(args) -> int:
 
 
 def _report(placement, summary, check, out, seconds) -> None:
-    print(f"wrote {out}/sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json in {seconds:.1f} s: "
-          f"{len(placement.sensors)} sensors of {len(placement.candidates)} candidates ({len(placement.shortlist)} "
-          f"screened), {len(placement.training)} training and {len(placement.held_out)} held-out loads")
+    print(f"{len(placement.sensors)} sensors of {len(placement.candidates)} candidates ({len(placement.shortlist)} "
+          f"screened) on a mesh of {summary['mesh_nodes']} nodes, placed in {seconds:.1f} s from "
+          f"{len(placement.training)} training loads, judged on {len(placement.held_out)} held-out loads; wrote {out}/"
+          "sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json")
     for c in placement.curve:
         errs = ", ".join(f"{k} {v:.3g}" for k, v in c.held_out_mae_um.items())
         where = "; ".join(f"{s.name} ({', '.join(f'{v:.3f}' for v in s.xyz)}) on {s.boundary}" for s in c.sensors)

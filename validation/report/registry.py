@@ -128,7 +128,10 @@ SECTIONS: tuple[Section, ...] = (
                   "25 min and 13 GB)",
             inputs=(PAPER_MODEL,), also="gatetherm validate rom --out DIR", readme=("rom-check", "rom")),
     Section("sensors", "Sensor placement: where to put the thermocouples", "sensors:compute",
-            subset={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml"},
+            subset={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml", "seeds": [0]},
+            full={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml",
+                  "seeds": [0, 1, 2, 3, 4]},
+            about="the paper frame for seed 0 only (--full: seeds 0-4 of the generated loads and the noise)",
             inputs=(PAPER_MODEL, "gatetherm.validation:examples/c_frame/*"), readme=("sensors",),
             also="gatetherm sensors --dim 2 --count 3 --check --out s; "
                  "gatetherm sensors --case validation/examples/c_frame/case.toml --count 4 --out cs"),

@@ -9,6 +9,9 @@ import numpy as np
 
 from gatetherm.validation.report.result import Figure, Result, table
 
+TIPS = ("F_L", "F_R")
+"""The frame's tool and workpiece tips (probes), where a chosen point may lie."""
+
 
 def _mm(v) -> str:
     return ", ".join(f"{1e3 * x:.0f}" for x in v)
@@ -22,6 +25,10 @@ def _relative(placement, probes) -> list[list[str]]:
         d = np.subtract(s.xyz, xyz)
         rows.append([s.name, _mm(s.xyz), s.boundary, name, _mm(d), f"{1e3 * np.linalg.norm(d):.0f}"])
     return rows
+
+
+def _delta(placement) -> float:
+    return placement.curve[-1].held_out_mae_um["delta_um"]
 
 
 def _errors(label, form, held, cv, targets) -> list[str]:
@@ -39,8 +46,11 @@ def compute(ctx) -> Result:
 
     sc = ctx.scope
     frame = gate_frame(2)
-    pf = place_sensors(frame, PlacementSettings(count=sc["frame_count"], loads=sc["loads"]))
+    by_seed = {seed: place_sensors(frame, PlacementSettings(count=sc["frame_count"], loads=sc["loads"], seed=seed))
+               for seed in sc["seeds"]}
+    pf = by_seed[sc["seeds"][0]]
     paper = {p.name: p.xyz for p in frame.problem.probes if p.name in ("A", "B") or p.name.startswith("C")}
+    marks = {**paper, **{p.name: p.xyz for p in frame.problem.probes if p.name in TIPS}}
     save(plot_machine(frame.mesh, pf, probes=paper).figure, ctx.work / "frame_sensors.png")
     check = fe_check(frame, pf)
     case = load_case(Path(gatetherm.validation.__path__[0]) / sc["case"])
@@ -62,8 +72,14 @@ def compute(ctx) -> Result:
                    heads, rows, readme="sensors",
                    note=f"Fitted on {len(pf.training)} generated duty cycles of the oil supply (20-40 °C) and the "
                         f"pump; sensor noise {pf.settings.noise_K:g} K on every thermocouple.")
-    where = table("Where the chosen points lie (mm; the offset is from the nearest of A, B, C1-C10)",
-                  ["sensor", "x, y", "boundary", "nearest", "offset x, y", "distance"], _relative(pf, paper))
+    where = table("Where the chosen points lie (mm; the offset is from the nearest of A, B, C1-C10 and the tips "
+                  "F_L (tool), F_R (workpiece))",
+                  ["sensor", "x, y", "boundary", "nearest", "offset x, y", "distance"], _relative(pf, marks))
+    seeds = table("Paper frame: the answer over seeds of the generated duty cycles and the sensor noise",
+                  ["seed", "held-out δ, chosen [µm]", "held-out δ, A, B, C mean [µm]", "ratio", "chosen points (mm)"],
+                  [[str(k), f"{_delta(q):.3g}", f"{q.signals['held_out_mae_um']['delta_um']:.3g}",
+                    f"{_delta(q) / q.signals['held_out_mae_um']['delta_um']:.2f}",
+                    "; ".join(f"{x.name} ({_mm(x.xyz)})" for x in q.sensors)] for k, q in by_seed.items()])
     ct = list(pc.curve[-1].held_out_mae_um)
     curve = table(f"C-frame example: held-out error against the number of sensors ({len(pc.held_out)} held-out "
                   "duty cycles)", ["sensors", "form", *(f"held-out {t} [µm]" for t in ct),
@@ -81,7 +97,7 @@ def compute(ctx) -> Result:
              + f"; the chosen points' temperatures within {check.temperature_error_K:.2g} K of FE.",
              f"If {worst} fails, the model refitted on the other two predicts δ to {pf.failed[worst]['delta_um']:.3g} µm.",
              *(f"C-frame: {n}" for n in pc.notes), *([f"C-frame: {pc.stopped}"] if pc.stopped else []))
-    return Result(tables=(answer, where, curve), notes=notes, figures=(
+    return Result(tables=(answer, where, seeds, curve), notes=notes, figures=(
         Figure("frame_sensors.png", "Paper frame, 2-D: candidates (grey), screened (circles), the chosen points (red) "
                                     "and the paper's A, B, C1-C10 (blue)"),
         Figure("cframe_sensors.png", "C-frame example: the chosen points and the example's thermocouples TF, TB, TS"),
