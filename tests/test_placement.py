@@ -329,6 +329,68 @@ def test_cli_writes_the_outputs_and_says_why_the_curve_stops(blocks, tmp_path, c
                                                       "sensors.toml", "summary.json"]
 
 
+BLOCK_3D_GEO = """SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 0.2, 0.05, 0.05};
+e = 1e-6;
+Physical Volume("steel") = {1};
+Physical Surface("hot") = Surface In BoundingBox {-e, -e, -e, e, 0.05 + e, 0.05 + e};
+Physical Surface("cold") = Surface In BoundingBox {0.2 - e, -e, -e, 0.2 + e, 0.05 + e, 0.05 + e};
+Physical Surface("top") = Surface In BoundingBox {-e, 0.05 - e, -e, 0.2 + e, 0.05 + e, 0.05 + e};
+Mesh.MeshSizeMax = 0.012;
+"""
+BLOCK_3D = """[case]
+name = "3-D block"
+[mesh]
+file = "block.geo"
+[materials.steel]
+k = 50.0
+rho = 7800.0
+c = 460.0
+E = 2.1e11
+nu = 0.3
+alpha = 1.2e-5
+[initial]
+temperature = 20.0
+[thermal.top]
+film = 15.0
+ambient = "room_degC"
+[thermal.hot]
+flux = "heat_W"
+[supports.cold]
+type = "clamped"
+[probes.tip]
+point = [0.0, 0.025, 0.025]
+[probes.base]
+point = [0.2, 0.025, 0.025]
+[relative.lift]
+a = "tip"
+b = "base"
+axis = "y"
+[time]
+end = 7200.0
+step = 120.0
+output = 120.0
+schedule = "schedule.csv"
+"""
+
+
+@pytest.mark.slow
+def test_a_3d_case_places_and_checks(tmp_path):
+    """A 3-D steel bar (547 nodes, tetrahedra), heated through one end, clamped at the other: the
+    candidates are the nodes of its outer triangles; 2 sensors; the FE check within 10 %."""
+    (tmp_path / "block.geo").write_text(BLOCK_3D_GEO)
+    (tmp_path / "case.toml").write_text(BLOCK_3D)
+    (tmp_path / "schedule.csv").write_text('time_s,heat_W,room_degC\n0,0,20\n1800,400,20.5\n3600,400,21\n5400,0,21\n7200,0,20.5\n')
+    case = gt.load_case(tmp_path / "case.toml")
+    p = gt.place_sensors(case, 2, loads=4, states=10)
+    assert case.dim == 3 and len(case.mesh.points) == 547 and len(p.candidates) == 448
+    assert all(len(s.xyz) == 3 for s in p.sensors)
+    check = gt.check_placement(case, p)
+    assert 0.9 < check.ratio["lift_um"] < 1.1 and check.ratio["lift_um"] == pytest.approx(0.926, abs=0.01)  # achieved
+    gt.write_placement(tmp_path / "o", p, case, check)
+    assert (tmp_path / "o" / "machine.png").stat().st_size > 1e4
+
+
 # --- slow: the C-frame, the paper frame, timing ------------------------------------------------
 
 @pytest.fixture(scope="module")

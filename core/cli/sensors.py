@@ -1,6 +1,6 @@
 """``gatetherm sensors``: where to put the thermocouples of any case (or the paper's frame), from its
 reduced model: the surface points whose temperatures predict every relative displacement best on
-held-out duty cycles (README "Sensor placement"; the library is gatetherm.studies.sensors).
+held-out duty cycles (docs/sensors.md; the library: gatetherm.place_sensors).
 
 Writes ``DIR/sensors.toml`` (the chosen points as ``[probes]`` to paste into a case),
 ``DIR/model.json``, ``DIR/curve.csv``, ``DIR/curve.png``, ``DIR/machine.png`` and, last,

@@ -1,5 +1,5 @@
 """Sensor placement: which few surface points, measured, predict a machine's thermal drift best
-(``gatetherm sensors``; README "Sensor placement").
+(``gatetherm sensors``; docs/sensors.md).
 
 :mod:`.candidates` where a sensor may go, :mod:`.loads` the duty cycles it is trained and judged
 on, :mod:`.reduced` the candidates' temperatures from the case's reduced model, :mod:`.screen`

@@ -8,7 +8,7 @@ the candidates as read-out rows of the linear heat model before the reduction: s
 out of the outputs balanced truncation weighs, would give the very same projected rows; put into
 them, thousands of rows would swamp the weighing of the displacements and cost an observability
 Gramian with as many right-hand sides. The basis holds every mode's static response, so steady
-states are exact at every node; the transients are checked against FE (README "Sensor placement").
+states are exact at every node; the transients are checked against FE (docs/sensors.md).
 
 A load is marched once (:func:`simulate`): its reduced states (samples x states) and every output
 of the reduced model; any candidate's history is then one product with its row.
