@@ -292,7 +292,7 @@ def test_fe_runs_with_the_pasted_probes_reproduce_the_held_out_error(blocks, tmp
 def test_the_placement_does_not_depend_on_where_the_case_lies(blocks, tmp_path):
     """The same case file in another directory (its schedule's label holds the path): the same
     points and errors (the noise is keyed by a load's place, not its label)."""
-    case, p, d = blocks
+    _, p, d = blocks
     for f in ("two_blocks.geo", "case.toml", "schedule.csv"):
         shutil.copy(d / f, tmp_path)
     again = gt.place_sensors(gt.load_case(tmp_path / "case.toml"), 2, loads=5, held_out_loads=2, states=12)

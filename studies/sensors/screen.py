@@ -48,7 +48,7 @@ def shortlist(X: np.ndarray, Y: np.ndarray, rows: np.ndarray, xyz: np.ndarray, s
               neighbours: int = 4) -> tuple[np.ndarray, np.ndarray]:
     """(shortlist, pivots): indices into the candidates (``rows``, ``xyz``) of the output-weighted
     Q-DEIM pivots and their nearest neighbours, sorted; and the pivots in pivot order."""
-    w, s, Wt = mode_weights(X, Y, rows, sigma_K)
+    w, _, Wt = mode_weights(X, Y, rows, sigma_K)
     rank = int(np.sum(w > 1e-9 * w.max())) if w.max() > 0 else 1
     _, _, piv = sla.qr(w[:rank, None] * Wt[:rank], mode="economic", pivoting=True)
     pivots = piv[:rank]

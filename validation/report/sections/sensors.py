@@ -55,7 +55,8 @@ def compute(ctx) -> Result:
     check = fe_check(frame, pf)
     case = load_case(Path(gatetherm.validation.__path__[0]) / sc["case"])
     pc = place_sensors(case, PlacementSettings(count=sc["case_count"], loads=sc["loads"]))
-    own = {p.name: p.xyz for p in case.problem.probes if p.name in sum(pc.signals["sensors"].values(), [])}
+    named = {n for names in pc.signals["sensors"].values() for n in names}
+    own = {p.name: p.xyz for p in case.problem.probes if p.name in named}
     save(plot_machine(case.mesh, pc, probes=own).figure, ctx.work / "cframe_sensors.png")
     save(plot_curve(pc).figure, ctx.work / "cframe_curve.png")
 
