@@ -381,7 +381,8 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
     if "exclude" in settings:
         settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
     if "boundaries" in settings:
-        settings["boundaries"] = tuple(settings["boundaries"])
+        b = settings["boundaries"]
+        settings["boundaries"] = (b,) if isinstance(b, str) else tuple(b)
     return place(case, PlacementSettings(count=count, fit=FitParams(**fit), **settings), schedules, held_out)
 
 
