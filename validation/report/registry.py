@@ -122,6 +122,14 @@ SECTIONS: tuple[Section, ...] = (
             about="2-D only: no 3-D reduced model and no 3-D data on the 2-D model (the 3-D reduction took "
                   "25 min and 13 GB)",
             inputs=(PAPER_MODEL,), also="gatetherm validate rom --out DIR"),
+    Section("sensors", "Sensor placement: where to put the thermocouples", "sensors:compute",
+            subset={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml", "seeds": [0]},
+            full={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml",
+                  "seeds": [0, 1, 2, 3, 4]},
+            about="the paper frame for seed 0 only (--full: seeds 0-4 of the generated loads and the noise)",
+            inputs=(PAPER_MODEL, "gatetherm.validation:examples/c_frame/*"),
+            also="gatetherm sensors --dim 2 --count 3 --check --out s; "
+                 "gatetherm sensors --case validation/examples/c_frame/case.toml --count 4 --out cs"),
     Section("compound", "Compound diagnosis: several missing pieces at once", "compound:compute",
             subset={"seed": 14, "pairs": 2, "single": False, "mesh_size": 0.012},
             full={"seed": 14, "pairs": 48, "single": True, "mesh_size": None},
