@@ -305,8 +305,18 @@ def march(system: HeatSystem | HeatSolver, drive: Drive, times: np.ndarray, sche
         yield float(t1), U
 
 
-def _facets(mesh, name: str, e, q: int):
-    return FacetBasis(mesh, e, facets=mesh.boundaries[name], intorder=q)
+def boundary_terms(mesh, name: str, e, q: int, thickness: Field) -> tuple[sp.csr_matrix, np.ndarray]:
+    """``(∫ t u v, ∫ t v)`` over the named boundary (``t`` the 2-D thickness of the element
+    beside each facet): a film of unit coefficient and its load. Linear elements in numpy
+    (:func:`~gatetherm.solvers.p1.facet_terms`), others by scikit-fem's facet basis."""
+    facets = mesh.boundaries[name]
+    if e.maxdeg == 1:
+        t = thickness.values[mesh.f2t[0, facets]] if np.ptp(thickness.values) else np.full(len(facets),
+                                                                                           thickness.values[0])
+        return p1.facet_terms(mesh.p.T, mesh.facets[:, facets].T, t, mesh.nvertices)
+    fb = FacetBasis(mesh, e, facets=facets, intorder=q)
+    tf = thickness.at(fb)
+    return asm(film, fb, h=1.0, t=tf), asm(film_load, fb, h=1.0, t=tf)
 
 
 def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None,
@@ -335,13 +345,11 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
 
     loads: list[tuple[np.ndarray, Value, str]] = []
     for fl in problem.films:
-        fb = _facets(mesh, fl.boundary, e, q)
-        tf = th.at(fb)
-        K = K + asm(film, fb, h=fl.h, t=tf)
-        loads.append((asm(film_load, fb, h=fl.h, t=tf), fl.ambient, "film"))
+        A_f, a_f = boundary_terms(mesh, fl.boundary, e, q, th)
+        K = K + fl.h * A_f
+        loads.append((fl.h * a_f, fl.ambient, "film"))
     for fx in problem.fluxes:
-        fb = _facets(mesh, fx.boundary, e, q)
-        loads.append((asm(film_load, fb, h=1.0, t=th.at(fb)), fx.value, "flux"))
+        loads.append((boundary_terms(mesh, fx.boundary, e, q, th)[1], fx.value, "flux"))
     if problem.faces is not None and mesh.dim() == 2:
         cb = cells()
         K = K + asm(film, cb, h=problem.faces.h, t=2.0)
@@ -353,12 +361,10 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
     for fluid in problem.fluids:
-        wb = _facets(mesh, fluid.boundary, e, q)
-        tw = th.at(wb)
         lumped[fluid.name] = n_solid + len(caps)
         caps.append(fluid.capacity)
         losses.append((0.0, None))
-        couplings.append((asm(film, wb, h=1.0, t=tw), asm(film_load, wb, h=1.0, t=tw)))
+        couplings.append(boundary_terms(mesh, fluid.boundary, e, q, th))
         if fluid.hose_capacity > 0:
             lumped[fluid.hose_name or f"{fluid.name}_hose"] = n_solid + len(caps)
             caps.append(fluid.hose_capacity)
