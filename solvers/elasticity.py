@@ -19,8 +19,7 @@ from skfem.helpers import ddot, div, sym_grad
 from gatetherm import InputError
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element
-from gatetherm.solvers.linsolve import (Factor, expand_order, nd_order, restrict_order, rigid_body_modes,
-                                       spd_solver)
+from gatetherm.solvers.linsolve import SPDSolver, expand_order, nd_order, restrict_order, rigid_body_modes
 from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
 
 log = logging.getLogger(__name__)
@@ -72,7 +71,7 @@ class ElasticSystem:
     B: sp.csr_matrix
     """Thermal load per unit temperature rise (all DOFs × heat DOFs)."""
     free: np.ndarray
-    solve: Factor
+    solve: SPDSolver
     """Solves with the stiffness on the free DOFs (one or more right-hand sides)."""
     plane: str = "stress"
     """2-D: "stress" or "strain"."""
@@ -172,9 +171,12 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     K = K.tocsr()
     dof_order = nd_order(K, dim) if node_order is None else expand_order(node_order, dim)
     perm = restrict_order(dof_order, free, vb.N)
-    K = K[free][:, free]
+    K = K[free]  # in two steps: the full matrix goes before the columns are taken
+    K = K[:, free]
     rbm = rigid_body_modes(vb.doflocs, vb.split_indices())[free]
     log.info("elastic system: %d free DOFs (P%d, %d-D%s)", len(free), order, dim,
              f" plane {plane}" if dim == 2 else "")
-    solve = Factor(lambda: spd_solver(K, dim, rbm, order=perm))
+    nodal = len(free) % dim == 0 and bool(np.all(free.reshape(-1, dim) == (free[::dim] // dim * dim)[:, None]
+                                                   + np.arange(dim)))
+    solve = SPDSolver(K, dim, rbm, perm, nodal)
     return ElasticSystem(vb, K, B.tocsr(), free, solve, plane)

@@ -49,7 +49,8 @@ class Pattern:
         A = sp.csr_matrix((np.ones(len(i), dtype=np.int8), (i, j)), shape=(n_nodes, n_nodes))  # sorted, summed
         self.indices, self.indptr = A.indices.astype(np.int32), A.indptr.astype(np.int32)
         rows = np.repeat(np.arange(n_nodes, dtype=np.int64) * n_nodes, np.diff(A.indptr))
-        self.inv = np.searchsorted(rows + A.indices, i.astype(np.int64) * n_nodes + j)
+        inv = np.searchsorted(rows + A.indices, i.astype(np.int64) * n_nodes + j)
+        self.inv = inv.astype(np.int32) if A.nnz < 2 ** 31 else inv
         """Position of every element entry (element-major, row-major within) in the pattern."""
         self.n, self.nnz, self.k = n_nodes, A.nnz, k
 

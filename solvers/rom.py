@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from gatetherm import InputError
+from gatetherm.solvers import krylov
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 
 log = logging.getLogger(__name__)
@@ -38,6 +39,9 @@ INPUTS = ("oil_degC", "ambient_degC")
 """Input names of a reduced model: supply oil and room temperature, as deviations from T0."""
 KEY_OUTPUTS = ("delta_um", "delta_E_um", "theta_A_K", "theta_B_K", "theta_C_K", "T_tank_wall_K", "T_tank_oil_K")
 """The outputs balanced truncation weighs; the others (further sensors) are carried along."""
+KRYLOV_ABOVE = 100_000
+"""Unknowns above which :func:`reduce` builds its basis by :func:`gatetherm.solvers.krylov.basis`
+(a cost linear in the unknowns) instead of balanced truncation of the full model."""
 UM_PER_K = 10.0
 """Output weight of a temperature against a displacement in the balancing: 0.1 K ~ 1 µm (the
 sensors' resolutions)."""
@@ -190,6 +194,13 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
     key = [lhm.output_names.index(k) for k in KEY_OUTPUTS]
     Cw = _weights(KEY_OUTPUTS)[:, None] * lhm.C[key]
     modes = {"on": True, "off": False}
+    if lhm.M.shape[0] > KRYLOV_ABOVE:  # a large model: rational Krylov, then balanced truncation of its projection
+        V, info = krylov.basis(lhm.M, {m: (lhm.K(p), lhm.B(p)) for m, p in modes.items()}, Cw, states, 3, handover,
+                               horizon_s)
+        rom, d = project(lhm, V), lhm.output_names.index("delta_um")
+        dc = {m: float(np.max(np.abs(lhm.C[d] @ info["static"][m] - rom.C[d] @ np.linalg.solve(-rom.A(p), rom.B(p)[
+            :, np.abs(lhm.B(p)).sum(axis=0) > 0])))) for m, p in modes.items()}
+        return Reduction(rom, V, info["bound"], info["hankel"], dc, info["seconds"])
     B = {m: lhm.B(p)[:, np.abs(lhm.B(p)).sum(axis=0) > 0] for m, p in modes.items()}  # no dead supply column
     secs, t0 = {}, time.perf_counter()
     # the slowest rate of either mode is close to the pump-off frame cooling uniformly to the room
