@@ -59,7 +59,11 @@ def dof_basis(mesh: skfem.Mesh, elem: skfem.Element) -> skfem.CellBasis:
     so none of the per-element arrays of a full basis (0.3 GB for the vector P1 basis of
     the 3-D frame), for matrices assembled by :mod:`gatetherm.solvers.p1`."""
     d = mesh.dim()
-    return skfem.CellBasis(mesh, elem, quadrature=(np.zeros((d, 0)), np.zeros(0)))
+    linear = elem.maxdeg == 1 and elem.interior_dofs == 0 and elem.edge_dofs == 0 and elem.facet_dofs == 0
+    basis = skfem.CellBasis(mesh, elem, quadrature=(np.zeros((d, 0)), np.zeros(0)), disable_doflocs=linear)
+    if linear:  # the nodes, each repeated for its interleaved components (mapping every element: 1 s in 3-D)
+        basis.doflocs = np.repeat(mesh.p, elem.nodal_dofs, axis=1)
+    return basis
 
 
 def element(dim: int, order: int) -> skfem.Element:

@@ -91,11 +91,14 @@ def stiffness(pattern: Pattern, G: np.ndarray, vol: np.ndarray, lam: np.ndarray,
     ``K[d i + a, d j + b] = vol (λ G_ia G_jb + μ G_ib G_ja + μ δ_ab G_i·G_j)``, v test (i), u trial (j)."""
     dim = G.shape[2]
     dot = conduction(G, vol, mu)
+    Gl, Gm = (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
 
     def entry(a, b):
-        out = (lam * vol)[:, None, None] * (G[:, :, a][:, :, None] * G[:, :, b][:, None, :])
-        out += (mu * vol)[:, None, None] * (G[:, :, b][:, :, None] * G[:, :, a][:, None, :])
-        return out + dot if a == b else out
+        out = Gl[:, :, a][:, :, None] * G[:, :, b][:, None, :]
+        out += Gm[:, :, b][:, :, None] * G[:, :, a][:, None, :]
+        if a == b:
+            out += dot
+        return out
 
     return pattern.blocks(entry, dim, dim)
 

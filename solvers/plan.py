@@ -1,6 +1,7 @@
 """Which path solves an SPD system: a sparse Cholesky factor or AMG-preconditioned conjugate
-gradients (:mod:`.iterative`), chosen by predicted time for the right-hand sides expected among
-the paths whose predicted memory fits the budget, and logged in one line.
+gradients (:mod:`.iterative`), chosen by predicted time for the right-hand sides expected and
+predicted memory (of the paths that fit the budget and are about as fast as the fastest, the
+one needing less memory), and logged in one line.
 
 The predictions are those of :mod:`gatetherm.geometry.sizing` (memory) and the time constants
 below, measured on the 3-D frame at 1, 2 and 4 times its default nodes (52 812 to 177 283,
@@ -23,20 +24,25 @@ log = logging.getLogger(__name__)
 PATH_ENV = "GATETHERM_SOLVER"
 BUDGET_ENV = "GATETHERM_MEMORY_GB"
 PATHS = ("direct", "iterative")
-FLOP_RATE = 20e9
+FLOP_RATE = 22e9
 """Flops per second of the numerical factorisation (PARDISO, one thread)."""
 SECONDS_PER_ENTRY = {"analysis": 2.5e-8, "solve": 2e-9}
 """Seconds per entry of the factor: the analysis and allocation of a factorisation, and one
 forward and backward substitution."""
-SECONDS_PER_NONZERO = {"setup": {1: 3e-7, 3: 8e-7}, "iteration": {1: 1.2e-8, 3: 2e-8}}
+SECONDS_PER_NONZERO = {"setup": {1: 3e-7, 3: 5e-7}, "iteration": {1: 1e-8, 3: 9e-9}}
 """Seconds per matrix nonzero, by DOFs per node: the AMG set-up and one preconditioned CG
-iteration (V-cycle and product)."""
-ITERATIONS = {"warm": {1: 6, 3: 20}, "cold": {1: 15, 3: 23}}
+iteration (V-cycle and product): 6.6 and 48 ms on the heat matrices of 0.72 and 4.8 million
+nonzeros, 56 ms on the elastic one of 6.3 million."""
+ITERATIONS = {"warm": {1: 6, 3: 20}, "cold": {1: 15, 3: 25}}
 """CG iterations of a solve at the default mesh, by DOFs per node: started from the Galerkin
-projection onto the previous solutions of a sequence (a heat step: 4 to 8 measured), or from
-zero (a heat step matrix 13, elasticity 23)."""
+projection onto the previous solutions of a sequence (a heat step: 4.4 measured at the
+default mesh, 5.8 at 8 times its nodes), or from zero (a heat step matrix 13, elasticity 25)."""
 ITERATION_GROWTH = 0.25
 """Iterations grow as nodes to this power (elastic: 23, 30, 32 at 1, 2, 4 × the default nodes)."""
+CLOSE = 1.25
+"""A path predicted within this factor of the fastest's time counts as fast: of those, the one
+needing less memory is taken (the elastic system of the 3-D frame for its two adjoint
+solves: a factor 5.8 s and 0.88 GB, AMG-CG 6.0 s and 0.24 GB)."""
 
 
 @dataclass(frozen=True)
@@ -107,9 +113,10 @@ def resident_bytes() -> float:
 
 def plan(n: int, nnz: int, block: int, dim: int, rhs: int, held: float | None = None,
          factored: bool = False, warm: bool = False) -> Plan:
-    """The path for ``rhs`` solves (see :func:`predict`): the faster of those that fit the
-    :func:`budget` beside ``held`` (bytes held already; default: this process's resident
-    memory), else the smaller."""
+    """The path for ``rhs`` solves (see :func:`predict`): of those that fit the :func:`budget`
+    beside ``held`` (bytes held already; default: this process's resident memory), the one
+    needing less memory among those within :data:`CLOSE` of the fastest; if none fits, the
+    smaller."""
     seconds, nbytes = predict(n, nnz, block, dim, rhs, factored, warm)
     room = budget()
     held = resident_bytes() if held is None else held
@@ -117,7 +124,8 @@ def plan(n: int, nnz: int, block: int, dim: int, rhs: int, held: float | None = 
     if forced:
         return Plan(forced, seconds, nbytes, room, True)
     fits = [p for p in PATHS if nbytes[p] + held <= room]
-    path = min(fits, key=seconds.get) if fits else min(PATHS, key=nbytes.get)
+    fast = [p for p in fits if seconds[p] <= CLOSE * min(seconds[q] for q in fits)]
+    path = min(fast or PATHS, key=nbytes.get)
     if not fits:
         log.warning("no solver path fits the memory budget of %.3g GB: %s (%.3g GB)", room / 1e9, path,
                     nbytes[path] / 1e9)
