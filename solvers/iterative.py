@@ -91,9 +91,10 @@ class PCG:
     :data:`RECYCLE` solutions. ``iterations`` counts them all."""
 
     def __init__(self, A: sp.spmatrix, near_null: np.ndarray | None = None, block: int = 1, rtol: float = RTOL,
-                 recycle: int = RECYCLE):
+                 recycle: int = RECYCLE, amg: AMG | None = None):
+        """``amg``: a hierarchy to precondition with instead of ``A``'s own (of a nearby matrix)."""
         self.A = A.tocsr()
-        self.amg = AMG(self.A, near_null, block)
+        self.amg = AMG(self.A, near_null, block) if amg is None else amg
         self.rtol, self.recycle = rtol, recycle
         self._X: list[np.ndarray] = []
         self._AX: list[np.ndarray] = []
@@ -104,6 +105,12 @@ class PCG:
     def nbytes(self) -> int:
         """Memory held: the matrix, the hierarchy and the kept solutions, bytes."""
         return _nbytes(self.A) + self.amg.nbytes + 16 * self.A.shape[0] * len(self._X)
+
+    def seed(self, X: np.ndarray) -> None:
+        """Start the Galerkin projection from the columns of ``X`` (solutions of a nearby
+        problem), as many as :attr:`recycle` allows."""
+        X = np.asarray(X, dtype=float).reshape(self.A.shape[0], -1)[:, -self.recycle:] if self.recycle else X[:, :0]
+        self._X, self._AX = list(X.T), list((self.A @ X).T)
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)

@@ -29,6 +29,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from gatetherm.solvers.iterative import AMG, PCG
 from gatetherm.solvers.linsolve import Bordered, planned_solver
 
 log = logging.getLogger(__name__)
@@ -59,11 +60,43 @@ def shifts(K: sp.spmatrix, M: sp.spmatrix) -> np.ndarray:
     return np.r_[0.0, np.logspace(lo, hi, max(int(np.ceil((hi - lo) * PER_DECADE)) + 1, 2))]
 
 
-def _solves(K, M, s: float, n_inner: int, dim: int, rhs: int):
-    """Solvers of ``K + s M`` and of its transpose, sharing the solid block's solver."""
-    A = (K + s * M).tocsr() if s else K.tocsr()
-    inner = planned_solver(A[:n_inner, :n_inner], dim, rhs, f"Krylov shift {s:.3g} 1/s", rtol=RTOL)[0]
-    return Bordered(A, n_inner, inner), Bordered(A.T.tocsr(), n_inner, inner)
+class _Sweep:
+    """Solvers of ``K + s M`` and of its transpose for the shifts of one mode in turn, sharing the
+    solid block's solver: a factor per shift, or AMG-CG with one hierarchy for all shifts (the
+    conduction dominates every shift's matrix on a fine mesh) started from the Galerkin
+    projection onto the previous shift's solutions; which, planned once for the whole sweep."""
+
+    def __init__(self, K, M, n_inner: int, dim: int, rhs: int):
+        self.K, self.M, self.n, self.dim, self.rhs = K.tocsr(), M.tocsr(), n_inner, dim, rhs
+        self.amg: AMG | None = None
+        self.prev: np.ndarray | None = None
+
+    def solvers(self, s: float, count: int):
+        """``(solve, solve with the transpose)`` at shift ``s``, ``count`` shifts to go."""
+        A = (self.K + s * self.M).tocsr() if s else self.K
+        S = A[:self.n, :self.n]
+        if self.amg is None and self.prev is None:
+            solve, path = planned_solver(S, self.dim, self.rhs * count, f"Krylov shifts ({count})", rtol=RTOL)
+            if path == "direct":
+                self.prev = np.zeros((self.n, 0))  # factor every shift
+                return Bordered(A, self.n, solve), Bordered(A.T.tocsr(), self.n, solve)
+            self.amg = solve.amg
+            inner = solve
+        elif self.amg is None:
+            inner = planned_solver(S, self.dim, self.rhs, f"Krylov shift {s:.3g} 1/s", allow=("pardiso", "cholmod",
+                                                                                               "superlu"))[0]
+            return Bordered(A, self.n, inner), Bordered(A.T.tocsr(), self.n, inner)
+        else:
+            inner = PCG(S, rtol=RTOL, recycle=4 * self.rhs, amg=self.amg)
+        inner.recycle = 4 * self.rhs
+        if self.prev is not None and self.prev.size:
+            inner.seed(self.prev)
+        return Bordered(A, self.n, inner), Bordered(A.T.tocsr(), self.n, inner)
+
+    def keep(self, *solutions: np.ndarray) -> None:
+        """The solutions of this shift, to start the next one's (iterative path)."""
+        if self.amg is not None:
+            self.prev = np.column_stack([x[:self.n] for x in solutions])
 
 
 def m_orthonormal(M: sp.spmatrix, X: np.ndarray, first: int = 0, tol: float = 1e-9) -> np.ndarray:
@@ -138,14 +171,18 @@ def basis(M: sp.spmatrix, modes: dict[str, tuple[sp.spmatrix, np.ndarray]], C: n
     B = {m: Bm[:, np.abs(Bm).sum(axis=0) > 0] for m, (_, Bm) in modes.items()}  # no dead input column
     Ct = np.ascontiguousarray(C.T)
     rhs = {m: B[m].shape[1] + sum(B[q].shape[1] for q in modes if q != m) + len(C) for m in modes}
-    zero = {m: _solves(K, M, 0.0, n_inner, dim, rhs[m]) for m, (K, _) in modes.items()}
+    sweeps = {m: _Sweep(K, M, n_inner, dim, rhs[m]) for m, (K, _) in modes.items()}
+    zero = {m: sweeps[m].solvers(0.0, len(s_all)) for m in modes}
     static = {m: zero[m][0](B[m]) for m in modes}  # the other mode's handover, and exact static gains
     cols = list(static.values())  # spanned exactly: exact static gains
-    for m, (K, _) in modes.items():
+    for m in modes:
         given = np.column_stack([M @ static[q] for q in modes if q != m] or [np.zeros((M.shape[0], 0))])
-        for s in s_all:
-            direct, adjoint = zero.pop(m) if s == 0 else _solves(K, M, s, n_inner, dim, rhs[m])
-            cols += ([] if s == 0 else [direct(B[m])]) + [direct(given), adjoint(Ct)]
+        for j, s in enumerate(s_all):
+            direct, adjoint = zero.pop(m) if s == 0 else sweeps[m].solvers(s, len(s_all) - j)
+            new = [static[m] if s == 0 else direct(B[m]), direct(given), adjoint(Ct)]
+            sweeps[m].keep(*new)
+            cols += new[1:] if s == 0 else new
+        sweeps[m] = None  # its hierarchy
     seconds = {"krylov_solves": time.perf_counter() - t0}
     t1 = time.perf_counter()
     W = m_orthonormal(M, np.column_stack(cols), first=sum(x.shape[1] for x in static.values()))
