@@ -38,7 +38,7 @@ def main() -> None:
     args = ap.parse_args()
     work = Path(tempfile.mkdtemp(prefix="backends-"))
     atexit.register(shutil.rmtree, work, True)
-    subprocess.run([sys.executable, "-m", "gatetherm.studies.cli", "mesh", "--dim", "3", "--out", str(work)],
+    subprocess.run([sys.executable, "-m", "gatetherm.cli", "mesh", "--dim", "3", "--out", str(work)],
                    check=True, stdout=subprocess.DEVNULL)
     from gatetherm.geometry.mesh import load_mesh
 

@@ -4,7 +4,7 @@ one and with two BLAS threads (``GATETHERM_BLAS_THREADS``), interleaved.
     python benchmarks/blas_threads.py [--rounds 3] [--threads 1 2] [--json FILE]
 
 Prints the medians of wall time, CPU time and peak memory per thread count; the default of
-``gatetherm.studies.cli.process.BLAS_THREADS`` is chosen from this table (README, Speed).
+``gatetherm.process.BLAS_THREADS`` is chosen from this table (README, Speed).
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def main() -> None:
     atexit.register(shutil.rmtree, work, True)
     runs = {n: [] for n in args.threads}
     for r, n in interleaved(args.threads, args.rounds):
-        cmd = [sys.executable, "-m", "gatetherm.studies.cli", "simulate", "--condition", "1", "--dim", "3",
+        cmd = [sys.executable, "-m", "gatetherm.cli", "simulate", "--condition", "1", "--dim", "3",
                "--out", str(work / f"r{r}-t{n}")]
         res = rusage_run(cmd, env=dict(os.environ, GATETHERM_BLAS_THREADS=str(n)))
         runs[n].append(res)

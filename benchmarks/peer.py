@@ -15,7 +15,7 @@ that the load of these shared cores falls on all of them alike:
 Prints per job the medians of wall time, CPU time and peak memory (``wait4`` of each
 process), the ratios gatetherm / DOLFINx (end to end: ``simulate`` over ``dolfinx``; equal
 work: ``equal`` over ``dolfinx``) and the agreement of T_A, T_B and δ between ``equal`` and
-DOLFINx. BLAS threads are whatever each process sets (gatetherm: one, see studies/cli).
+DOLFINx. BLAS threads are whatever each process sets (gatetherm: one, see gatetherm.cli).
 The table is also written to ``--json`` (default ``benchmarks/results/peer.json``), which
 ``gatetherm report`` shows.
 """
@@ -61,13 +61,12 @@ def equal_work(case_path: str) -> dict:
         from gatetherm.solvers.heat import HeatSolver, march
         from gatetherm.solvers.model import build
         from gatetherm.studies.run.case import load_case
-        from gatetherm.studies.run.scenario import case_schedule
 
         case = load_case(case_path)
         parts = {"mesh_read": time.perf_counter() - t0}
         model = build(case.problem, case.mesh)
         parts.update(model.timings)
-        sched = case_schedule(case)
+        sched = case.schedule
         t = time.perf_counter()
         solver = HeatSolver(model.heat)
         *_, (_, U) = march(solver, sched.drive, sched.times, case.problem.scheme)
@@ -95,7 +94,7 @@ def main() -> None:
         return
     work = Path(tempfile.mkdtemp(prefix="peer-"))
     atexit.register(shutil.rmtree, work, True)
-    gt = [sys.executable, "-m", "gatetherm.studies.cli"]
+    gt = [sys.executable, "-m", "gatetherm.cli"]
     subprocess.run([*gt, "mesh", "--dim", "3", "--out", str(work / "m")], check=True, stdout=subprocess.DEVNULL)
     from gatetherm.geometry.mesh import load_mesh
 

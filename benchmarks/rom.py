@@ -20,6 +20,7 @@ import numpy as np
 
 from gatetherm.solvers.rom_time import discretise, march_rom
 from gatetherm.studies.run.config import load_config
+from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.run.reduce import build_rom, check_run, series_inputs
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 
@@ -34,8 +35,9 @@ def main() -> None:
     ap.add_argument("--fine-step", type=float, metavar="S", help="also compare with FE runs of S-second steps")
     args = ap.parse_args()
     cfg, cache = load_config(), ScenarioCache()
+    case = frame_case(cfg, args.dim)
     t0 = time.perf_counter()
-    red = build_rom(cfg, args.dim, args.states, cache)
+    red = build_rom(case, args.states, cache)
     total = time.perf_counter() - t0
     parts = ", ".join(f"{k} {v:.1f} s" for k, v in red.seconds.items())
     print(f"{args.dim}-D: {red.basis.shape[0]} unknowns -> {red.rom.states} states in {total:.1f} s ({parts}); "
@@ -43,8 +45,8 @@ def main() -> None:
     disc = discretise(red.rom, 60.0)
     print(f"{'cond':>4} {'FE march s':>10} {'rom ms':>8} {'FE/rom':>8} {'rom/target':>10}")
     for n in (1, 2, 3):
-        fe = run_scenario(cfg, args.dim, condition_schedule(n, cfg), cache=cache)
-        u, modes = series_inputs(red.rom, fe.result.columns, cfg.supply.T_room)
+        fe = run_scenario(case, condition_schedule(n, cfg.supply), cache=cache)
+        u, modes = series_inputs(red.rom, fe.result.columns)
         rom_s = []
         for _ in range(args.repeats):
             t = time.perf_counter()
@@ -54,11 +56,11 @@ def main() -> None:
         print(f"{n:>4} {fe.result.seconds:>10.2f} {ms:>8.3f} {1e3 * fe.result.seconds / ms:>8.0f} {ms / TARGET_MS:>10.3f}")
         if args.fine_step:
             every = int(round(60.0 / args.fine_step))
-            fine = run_scenario(cfg, args.dim, condition_schedule(n, cfg, args.fine_step), cache=cache)
+            fine = run_scenario(case, condition_schedule(n, cfg.supply, args.fine_step), cache=cache)
             sub = {k: v[::every] for k, v in fine.result.columns.items()}
             coarse = fe.result.columns
-            print(f"     max |δ| difference, µm: rom vs FE 60 s {check_run(red.rom, n, coarse).max_delta_error_um:.3f}, "
-                  f"rom vs FE {args.fine_step:g} s {check_run(red.rom, n, sub).max_delta_error_um:.3f}, "
+            print(f"     max |δ| difference, µm: rom vs FE 60 s {check_run(red.rom, str(n), coarse).max_delta_error_um:.3f}, "
+                  f"rom vs FE {args.fine_step:g} s {check_run(red.rom, str(n), sub).max_delta_error_um:.3f}, "
                   f"FE 60 s vs {args.fine_step:g} s {np.max(np.abs(coarse['delta_um'] - sub['delta_um'])):.3f}")
 
 

@@ -48,10 +48,11 @@ f^0.93 of the factor f: 0.78 million at 20)."""
 def job(dim: int, factor: float) -> dict:
     """Condition 1 on the refined mesh; part times (s) and node counts."""
     from gatetherm.geometry.frame import MeshParams
-    from gatetherm.studies.cli.process import configure
+    from gatetherm.process import configure
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.run.output import displacements
-    from gatetherm.studies.run.scenario import condition_schedule, prepare
+    from gatetherm.studies.run.frame_case import frame_case
+    from gatetherm.studies.run.scenario import prepare
     from gatetherm.studies.run.simulate import delta_figures, run_model
 
     key = DEFAULT_SIZE[dim]
@@ -60,10 +61,11 @@ def job(dim: int, factor: float) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "mesh.toml").write_text(f"[mesh]\n{key} = {size!r}\n")
         cfg = load_config(Path(tmp) / "mesh.toml")
-        schedule = condition_schedule(1, cfg)
-        p = prepare(cfg, dim, schedule.drive)
+        case = frame_case(cfg, dim)
+        schedule = case.schedule
+        p = prepare(case)
         out_times = schedule.times[::60]
-        res = run_model(p.model, p.drive, schedule.times, keep_times=out_times, solver=p.solver)
+        res = run_model(p.model, schedule.drive, schedule.times, keep_times=out_times, solver=p.solver)
         model, factor_s = p.model, p.solver.factor_seconds
         del p  # the heat factors go, as in ``simulate``, before the output-time elastic solves
         t = time.perf_counter()

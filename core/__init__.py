@@ -4,10 +4,12 @@ The package root holds what every layer shares and nothing else: the version, th
 user-facing error type and atomic file output (``gatetherm.checks``: admissible values,
 ``gatetherm.files``: reading input files, ``gatetherm.outdir``: output directories). The
 layers, each a sub-package, depend only on those before them: ``gatetherm.geometry`` →
-``gatetherm.solvers`` → ``gatetherm.studies`` → ``gatetherm.validation`` → ``gatetherm.studies.cli``.
+``gatetherm.solvers`` → ``gatetherm.studies`` → ``gatetherm.validation`` → ``gatetherm.cli``.
 
-Importing this package is kept cheap (no third-party or slow standard modules), so that the
-console command is inside its own error handling almost at once.
+The public API (:mod:`gatetherm.api`: ``gt.load_case``, ``gt.gate_frame``, ``gt.run`` …, and
+``gt.plot``) is reached through this package's names, imported on first use: importing it stays
+cheap (no third-party or slow standard modules), so that the console command is inside its own
+error handling almost at once, and a notebook pays only for what it uses.
 """
 from __future__ import annotations
 
@@ -20,7 +22,19 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
+API = ("Case", "Run", "Schedule", "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose",
+       "gate_frame", "load_case", "reduce", "run", "schedule_file", "write_reduction")
+"""Names of :mod:`gatetherm.api` offered here (imported on first use)."""
+
+
 def __getattr__(name: str):
+    if name in API or name == "plot":
+        import importlib
+
+        value = (importlib.import_module("gatetherm.validation.plots.api") if name == "plot"
+                 else getattr(importlib.import_module("gatetherm.api"), name))
+        globals()[name] = value
+        return value
     if name == "__version__":  # looked up on first use: importlib.metadata is slow to import
         from importlib import metadata
 

@@ -9,6 +9,7 @@ options) calls these, so a parameter has one range everywhere and every refusal 
 from __future__ import annotations
 
 import dataclasses
+import math
 import numbers
 from dataclasses import dataclass
 
@@ -53,9 +54,14 @@ class Range:
     def admits(self, value) -> bool:
         """Is ``value`` (a number, not a bool) admissible?"""
         try:
-            return _number(value) and bool(self.mask(float(value)))
+            return _number(value) and self.holds(float(value))
         except OverflowError:  # an integer beyond any float
             return False
+
+    def holds(self, x: float) -> bool:
+        """Is the float ``x`` admissible? (:meth:`mask` for one number, without numpy: fast)"""
+        return math.isfinite(x) and (x > self.lo if self.lo_open else x >= self.lo) and \
+            (x < self.hi if self.hi_open else x <= self.hi) and (not self.whole or x == round(x))
 
     def __str__(self) -> str:
         if self.whole and np.isfinite(self.hi) and self.hi - self.lo <= 1:
@@ -124,3 +130,41 @@ def check_fields(obj, prefix: str = "", names=None):
         if value is not None and (names is None or name in names):
             rng.check(f"{prefix}{name}", value)
     return obj
+
+
+def check_linear_system(where: str, modes, C, D=None, inputs=None, outputs=None) -> None:
+    """InputError naming ``where`` unless ``ẋ = A x + B u, y = C x (+ D u)`` is a sound
+    linear system in every mode of ``modes`` ({mode: (A, B)}, any number of modes): consistent
+    shapes (and as many ``inputs``/``outputs`` names as B has columns and C rows, where given),
+    finite entries, and every A stable (its eigenvalues' real parts negative)."""
+    fix = "write it again with 'gatetherm reduce'"
+
+    def fail(what: str):
+        raise InputError(where, what, fix)
+
+    if not modes:
+        fail("no mode (no A, B matrices)")
+    arrays = {"C": C, **({"D": D} if D is not None else {})}
+    for mode, (A, B) in modes.items():
+        arrays.update({f"A_{mode}": A, f"B_{mode}": B})
+    for name, M in arrays.items():
+        M = np.asarray(M)
+        if M.ndim != 2 or 0 in M.shape:
+            fail(f"{name} is not a matrix (shape {M.shape})")
+        if not np.issubdtype(M.dtype, np.number) or not np.isfinite(M).all():
+            fail(f"{name} has entries that are not finite numbers")
+    def usual(sizes):  # the size most matrices agree on: the others are wrong
+        return max(sizes, key=sizes.count)
+    n = usual([np.shape(A)[0] for A, _ in modes.values()] + [np.shape(C)[1]])
+    m, p = usual([np.shape(B)[1] for _, B in modes.values()]), np.shape(C)[0]
+    want = {**{f"A_{k}": (n, n) for k in modes}, **{f"B_{k}": (n, m) for k in modes}, "C": (p, n), "D": (p, m)}
+    for name, M in arrays.items():
+        if np.shape(M) != want[name]:
+            fail(f"{name} has shape {np.shape(M)}, expected {want[name]} ({n} states, {m} inputs, {p} outputs)")
+    for names, count, what in ((inputs, m, "inputs"), (outputs, p, "outputs")):
+        if names is not None and len(names) != count:
+            fail(f"{len(names)} {what} named for {count} {what} of the matrices")
+    for mode, (A, _) in modes.items():
+        eig = np.linalg.eigvals(np.asarray(A, float))
+        if not eig.real.max() < -1e-9 * np.abs(eig).max():  # a zero eigenvalue is zero only to round-off
+            fail(f"A_{mode} is not stable (an eigenvalue with real part {eig.real.max():.3g} >= 0)")

@@ -88,17 +88,30 @@ def _clean(out: Path, owns, keep) -> None:
         log.info("%s: removed %d files of a previous run", out, removed)
 
 
+def _refuse_overwriting(out: Path, owns, keep, option: str) -> None:
+    """InputError if an input file of the run (``keep``) is one of the files it writes."""
+    if not out.is_dir():
+        return
+    written = {p.resolve() for g in owns for p in out.glob(g)}
+    for k in keep:
+        if k is not None and Path(k).resolve() in written:
+            raise InputError(option, f"the run would overwrite its input '{k}' in '{out}'",
+                             "choose another output directory, or move the input out of it")
+
+
 @contextlib.contextmanager
 def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out"):
     """Yield ``path`` as a :class:`~pathlib.Path`, ready for this run's files: created if
     needed, writable, locked against other runs, with stale temporaries and the files
     matching the glob patterns ``owns`` (the command's output set, relative to ``path``)
-    removed, except the run's input files ``keep`` (None entries are skipped). A directory
+    removed. The run's input files ``keep`` (None entries are skipped) are never removed or
+    overwritten: one that is among the files the command writes is refused. A directory
     this call created is removed again if the run fails before writing anything into it;
     temporaries left by a failed or interrupted run are removed at once. Raises InputError
     (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
     out = Path(path)
     created = _check_path(out, option)
+    _refuse_overwriting(out, owns, keep, option)
     try:
         out.mkdir(parents=True, exist_ok=True)
         os.unlink(_new_temporary(out / "probe"))

@@ -1,46 +1,24 @@
 """Build and mesh the frame with gmsh (OpenCASCADE kernel), 2-D or 3-D.
 
-gmsh is process-global state; :func:`gmsh_session` confines it to a ``with``
-block and always finalises. The result is a :class:`FrameMesh` whose regions,
-boundaries and sensors are referred to by name only.
+gmsh runs in a child process (:func:`gatetherm.geometry.isolate.run_isolated`), inside
+:func:`gmsh_session`, so that a signal stops it at once. The result is a :class:`FrameMesh`
+whose regions, boundaries and sensors are referred to by name only.
 """
 from __future__ import annotations
 
-import contextlib
+import functools
 import logging
-import signal
-import threading
 
 import numpy as np
 
 from gatetherm.geometry.frame import (FrameParams, MeshParams, part_boxes, sensor_points,
                             tank_box, validate, validate_mesh)
-from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.geometry.isolate import gmsh_session, run_isolated  # noqa: F401 (gmsh_session: the API's)
+from gatetherm.geometry.mesh import FrameMesh, from_arrays, snap_points, to_arrays
 from gatetherm.geometry.sizing import check_mesh_size
 
 log = logging.getLogger(__name__)
 _TOL = 1e-7
-
-
-@contextlib.contextmanager
-def gmsh_session(name: str = "frame", verbosity: int = 0):
-    """Initialise gmsh for the duration of the block, quietly, and finalise it."""
-    import gmsh
-
-    if gmsh.isInitialized():
-        gmsh.finalize()
-    gmsh.initialize(interruptible=False)
-    if threading.current_thread() is threading.main_thread():  # gmsh resets SIGTERM: Python's handler back
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            if signal.getsignal(sig) is not None:
-                signal.signal(sig, signal.getsignal(sig))
-    try:
-        gmsh.option.setNumber("General.Terminal", int(verbosity > 0))
-        gmsh.option.setNumber("General.Verbosity", verbosity)
-        gmsh.model.add(name)
-        yield gmsh
-    finally:
-        gmsh.finalize()
 
 
 def _inside(c, box, dim) -> bool:
@@ -82,57 +60,68 @@ def build_mesh(p: FrameParams, dim: int = 2, mesh: MeshParams = MeshParams()) ->
     validate(p, dim)
     validate_mesh(mesh)
     check_mesh_size(p, mesh, dim)  # before gmsh runs
+    meta, arrays = run_isolated(functools.partial(_build, p, dim, mesh), "the frame's mesh")
+    fm = from_arrays(meta, arrays)
+    log.info("meshed %d-D frame: %d nodes, %d elements", dim, len(fm.points), len(fm.cells))
+    return FrameMesh(fm.dim, fm.points, fm.cells, fm.regions, fm.boundaries, fm.sensors, {"frame": p})
+
+
+def _build(p: FrameParams, dim: int, mesh: MeshParams, gmsh) -> tuple[dict, dict]:
+    """Mesh the frame in the current gmsh model (in the child process)."""
     boxes = part_boxes(p, dim)
     tank = tank_box(p, dim)
     sensors = sensor_points(p, dim)
-    with gmsh_session() as gmsh:
-        occ = gmsh.model.occ
-        tags = {name: _add_box(occ, b, dim) for name, b in boxes.items()}
-        hole = _add_box(occ, tank, dim)
-        occ.cut([(dim, tags["column_L"])], [(dim, hole)])
-        pts = [(0, occ.addPoint(*xyz)) for xyz in sensors.values()]
-        occ.fragment(occ.getEntities(dim), pts)
-        occ.synchronize()
+    occ = gmsh.model.occ
+    tags = {name: _add_box(occ, b, dim) for name, b in boxes.items()}
+    hole = _add_box(occ, tank, dim)
+    occ.cut([(dim, tags["column_L"])], [(dim, hole)])
+    pts = [(0, occ.addPoint(*xyz)) for xyz in sensors.values()]
+    occ.fragment(occ.getEntities(dim), pts)
+    occ.synchronize()
 
-        region_ents: dict[str, list[int]] = {n: [] for n in boxes}
-        for d, t in gmsh.model.getEntities(dim):
-            c = occ.getCenterOfMass(d, t)
-            name = next(n for n, b in boxes.items() if _inside(c, b, dim))
-            region_ents[name].append(t)
-        bnd = gmsh.model.getBoundary(gmsh.model.getEntities(dim), combined=True, oriented=False)
-        facet_ents: dict[str, list[int]] = {"mounting_face": [], "tank_wall": [], "free_surface": []}
-        refine = []
-        for d, t in bnd:
-            c = occ.getCenterOfMass(d, abs(t))
-            if abs(c[1]) < _TOL:
-                facet_ents["mounting_face"].append(abs(t))
-            elif _on_box_surface(c, tank, dim):
-                facet_ents["tank_wall"].append(abs(t))
-                refine.append((d, abs(t)))
-            else:
-                facet_ents["free_surface"].append(abs(t))
-        # joints: internal facets shared by a column and an arm or tie bar
-        for d, t in gmsh.model.getEntities(dim - 1):
-            up, _ = gmsh.model.getAdjacencies(d, t)
-            if len(up) == 2:
-                refine.append((d, t))
-        for name, ents in region_ents.items():
-            gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, ents), name)
-        for name, ents in facet_ents.items():
-            gmsh.model.setPhysicalName(dim - 1, gmsh.model.addPhysicalGroup(dim - 1, ents), name)
-        point_of = {}
-        for name, xyz in sensors.items():
-            found = gmsh.model.getEntitiesInBoundingBox(
-                *(v - _TOL for v in xyz), *(v + _TOL for v in xyz), dim=0)
-            point_of[name] = found[0][1]
-        _size_field(gmsh, mesh.size if dim == 2 else mesh.size_3d, mesh, refine)
-        gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fast Delaunay
-        gmsh.option.setNumber("General.NumThreads", 1)  # threads make meshes differ run to run
-        gmsh.model.mesh.generate(dim)
-        return _extract(gmsh, dim, region_ents, facet_ents, point_of, p)
+    region_ents: dict[str, list[int]] = {n: [] for n in boxes}
+    for d, t in gmsh.model.getEntities(dim):
+        c = occ.getCenterOfMass(d, t)
+        name = next(n for n, b in boxes.items() if _inside(c, b, dim))
+        region_ents[name].append(t)
+    bnd = gmsh.model.getBoundary(gmsh.model.getEntities(dim), combined=True, oriented=False)
+    facet_ents: dict[str, list[int]] = {"mounting_face": [], "tank_wall": [], "free_surface": []}
+    refine = []
+    for d, t in bnd:
+        c = occ.getCenterOfMass(d, abs(t))
+        if abs(c[1]) < _TOL:
+            facet_ents["mounting_face"].append(abs(t))
+        elif _on_box_surface(c, tank, dim):
+            facet_ents["tank_wall"].append(abs(t))
+            refine.append((d, abs(t)))
+        else:
+            facet_ents["free_surface"].append(abs(t))
+    # joints: internal facets shared by a column and an arm or tie bar
+    for d, t in gmsh.model.getEntities(dim - 1):
+        up, _ = gmsh.model.getAdjacencies(d, t)
+        if len(up) == 2:
+            refine.append((d, t))
+    for name, ents in region_ents.items():
+        gmsh.model.setPhysicalName(dim, gmsh.model.addPhysicalGroup(dim, ents), name)
+    for name, ents in facet_ents.items():
+        gmsh.model.setPhysicalName(dim - 1, gmsh.model.addPhysicalGroup(dim - 1, ents), name)
+    point_of = {}
+    for name, xyz in sensors.items():
+        found = gmsh.model.getEntitiesInBoundingBox(
+            *(v - _TOL for v in xyz), *(v + _TOL for v in xyz), dim=0)
+        point_of[name] = found[0][1]
+    _size_field(gmsh, mesh.size if dim == 2 else mesh.size_3d, mesh, refine)
+    gmsh.option.setNumber("Mesh.Algorithm3D", 10)  # HXT: fast Delaunay
+    gmsh.option.setNumber("General.NumThreads", 1)  # threads make meshes differ run to run
+    gmsh.model.mesh.generate(dim)
+    fm, notes = _extract(gmsh, dim, region_ents, facet_ents, point_of)
+    return to_arrays(fm, notes)
 
 
-def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
+def _extract(gmsh, dim, region_ents, facet_ents, point_of, line_ents=None) -> tuple[FrameMesh, list[str]]:
+    """The mesh of the current model with the named groups (entity tags; ``line_ents``: curves of a
+    3-D model), and the notes of point groups snapped to nodes
+    (:func:`~gatetherm.geometry.mesh.snap_points`)."""
     tags, xyz, _ = gmsh.model.mesh.getNodes()
     index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
     index[tags.astype(np.int64)] = np.arange(len(tags))
@@ -154,11 +143,13 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
         regions[name] = np.arange(offset, offset + len(cells))
         offset += len(cells)
     boundaries = {name: elements(dim - 1, ents) for name, ents in facet_ents.items()}
+    lines = {name: elements(1, ents) for name, ents in (line_ents or {}).items()}
     sensors = {}
     for name, t in point_of.items():
         ntags, _, _ = gmsh.model.mesh.getNodes(0, t)
         sensors[name] = int(index[int(ntags[0])])
     cells = np.vstack(chunks)
+    sensors, notes = snap_points(points, cells, sensors)
     used = np.unique(cells)
     if len(used) != len(points):  # drop nodes of geometry not in any element
         remap = -np.ones(len(points), dtype=np.int64)
@@ -166,5 +157,5 @@ def _extract(gmsh, dim, region_ents, facet_ents, point_of, p) -> FrameMesh:
         points, cells = points[used], remap[cells]
         boundaries = {k: remap[v] for k, v in boundaries.items()}
         sensors = {k: int(remap[v]) for k, v in sensors.items()}
-    log.info("meshed %d-D frame: %d nodes, %d elements", dim, len(points), len(cells))
-    return FrameMesh(dim, points, cells, regions, boundaries, sensors, {"frame": p} if p is not None else {})
+        lines = {k: remap[v] for k, v in lines.items()}
+    return FrameMesh(dim, points, cells, regions, boundaries, sensors, lines=lines), notes

@@ -1,16 +1,24 @@
 """Mesh a user's geometry with gmsh: a ``.geo`` script or a CAD file (``.step``, ``.stp``,
 ``.brep``, ``.iges``), with a target element size, finer elements near named groups, the
-``.geo`` script's own parameters, and groups selected by bounding box (a CAD file has
-no names). The mesh comes back with every physical group under its name."""
+``.geo`` script's own parameters, and groups selected by boxes, outward normal or as the
+rest of the boundary. Several solids (surfaces in 2-D) are made conformal (OpenCASCADE
+fragments) and each is a region; the interface of two regions is the boundary ``A/B``.
+gmsh runs sandboxed in a child process (:mod:`gatetherm.geometry.isolate`); the element
+count is estimated and checked against the machine's memory before it meshes."""
 from __future__ import annotations
 
+import functools
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.geometry.build import _extract, gmsh_session
-from gatetherm.geometry.mesh import FrameMesh, group_name
+from gatetherm.geometry.build import _extract
+from gatetherm.geometry.geoscan import scan
+from gatetherm.geometry.groups import GroupRule, fragment, interfaces, physical, regions
+from gatetherm.geometry.isolate import run_isolated
+from gatetherm.geometry.mesh import FrameMesh, check_mesh, from_arrays, to_arrays
+from gatetherm.geometry.sizing import check_estimate, model_estimate
 
 log = logging.getLogger(__name__)
 
@@ -31,16 +39,6 @@ class Refinement:
 
 
 @dataclass(frozen=True)
-class BoxGroup:
-    """A physical group made of the entities of one dimension inside a box."""
-
-    name: str
-    dim: int
-    box: tuple[float, ...]
-    """xmin, ymin, zmin, xmax, ymax, zmax, m."""
-
-
-@dataclass(frozen=True)
 class MeshSpec:
     """How to mesh a geometry file."""
 
@@ -50,15 +48,17 @@ class MeshSpec:
     parameters: dict[str, float] = field(default_factory=dict)
     """``.geo`` numbers set before the script runs (``If (!Exists(h)) h = ...; EndIf``)."""
     refine: tuple[Refinement, ...] = ()
-    groups: tuple[BoxGroup, ...] = ()
+    groups: tuple[GroupRule, ...] = ()
+    include: tuple[Path, ...] = ()
+    """Files outside the case's folder that the script may read."""
+    root: Path | None = None
+    """The case's folder (default: the file's)."""
+    factor: float = 1.0
+    """The factor ``size`` and the refinements' sizes were multiplied by; it scales the file's own sizes too."""
 
 
-def _physical(gmsh) -> dict[tuple[int, int], str]:
-    """Name of every physical group by (dimension, tag)."""
-    return {(d, t): gmsh.model.getPhysicalName(d, t) or group_name(d, t, {}) for d, t in gmsh.model.getPhysicalGroups()}
-
-
-def _refine(gmsh, spec: MeshSpec, names: dict, dim: int) -> None:
+def _refine(gmsh, spec: MeshSpec, names: dict) -> dict[int, int]:
+    """Size fields of the refinements; their field tags and numbers (from 1)."""
     f = gmsh.model.mesh.field
     big = spec.size or 1e22
     fields = []
@@ -83,55 +83,108 @@ def _refine(gmsh, spec: MeshSpec, names: dict, dim: int) -> None:
         f.setNumbers(low, "FieldsList", fields)
         f.setAsBackgroundMesh(low)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    return {tag: i for i, tag in enumerate(fields, start=1)}
+
+
+def _scale_own(gmsh, factor: float, sized: bool) -> None:
+    """Multiply the file's own element sizes by ``factor``: the points' sizes, the size
+    fields' and, unless the case gives ``size``, ``Mesh.MeshSizeMax`` (the case's sizes
+    come scaled)."""
+    for p in gmsh.model.getEntities(0):
+        (s,) = gmsh.model.mesh.getSizes([p])
+        if s > 0:
+            gmsh.model.mesh.setSize([p], s * factor)
+    f = gmsh.model.mesh.field
+    for tag in f.list():
+        for key in {"Threshold": ("SizeMin", "SizeMax"), "Box": ("VIn", "VOut"), "Ball": ("VIn", "VOut"),
+                    "Cylinder": ("VIn", "VOut")}.get(f.getType(tag), ()):
+            f.setNumber(tag, key, f.getNumber(tag, key) * factor)
+    if not sized and gmsh.option.getNumber("Mesh.MeshSizeMax") < 1e22:
+        gmsh.option.setNumber("Mesh.MeshSizeMax", gmsh.option.getNumber("Mesh.MeshSizeMax") * factor)
+
+
+def _size_key(spec: MeshSpec, tag: int | None, size: float, mine: dict[int, int]) -> tuple[str, float]:
+    """The key (and its value) that sets the largest part of the element estimate."""
+    if spec.factor != 1.0:
+        return "--mesh-factor", spec.factor
+    if tag is None:
+        return ("mesh.size", spec.size) if spec.size else (f"{spec.path.name}: element size", size)
+    return (f"mesh.refine[{mine[tag]}].size" if tag in mine else f"{spec.path.name}: Field[{tag}].SizeMin"), size
+
+
+def _read(gmsh, spec: MeshSpec) -> int:
+    for k, v in spec.parameters.items():
+        gmsh.parser.setNumber(k, [float(v)])
+    try:
+        if spec.path.suffix.lower() == SCRIPT:
+            gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)
+        else:
+            gmsh.model.occ.importShapes(str(spec.path))
+            gmsh.model.occ.synchronize()
+    except Exception as err:  # gmsh reports a bad file as a plain Exception
+        raise InputError(str(spec.path), f"gmsh cannot read it ({err})", "check the file in gmsh") from None
+    dim = max((d for d, _ in gmsh.model.getEntities()), default=0)
+    if dim < 2:
+        raise InputError(str(spec.path), "has no surfaces or volumes", "give a 2-D or 3-D geometry")
+    return dim
+
+
+def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
+    """Read, name, check the size of and mesh the geometry (in the sandboxed child)."""
+    dim = _read(gmsh, spec)
+    try:
+        fragment(gmsh, dim)
+    except Exception as err:  # noqa: BLE001 - OpenCASCADE's own failure
+        raise InputError(str(spec.path), f"its solids cannot be made conformal ({err})",
+                         "check the CAD model") from None
+    regions(gmsh, spec.groups, dim)
+    interfaces(gmsh, dim)
+    if spec.factor != 1.0:
+        _scale_own(gmsh, spec.factor, bool(spec.size))
+    if spec.size:
+        gmsh.option.setNumber("Mesh.MeshSizeMax", spec.size)
+    names = physical(gmsh)
+    mine = _refine(gmsh, spec, names)
+    parts = model_estimate(gmsh, dim)
+    _, tag, size = max(parts, key=lambda p: p[0])
+    check_estimate(sum(p[0] for p in parts), dim, *_size_key(spec, tag, size, mine))
+    gmsh.option.setNumber("General.NumThreads", 1)  # threads make meshes differ run to run
+    try:
+        gmsh.model.mesh.generate(dim)
+    except Exception as err:  # noqa: BLE001
+        raise InputError(str(spec.path), f"gmsh cannot mesh it ({err})", "check the geometry in gmsh") from None
+    groups = {d: {names[(d, t)]: [int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(d, t)]
+                  for dd, t in names if dd == d} for d in range(dim + 1)}
+    owner: dict[int, str] = {}
+    for name, ents in groups[dim].items():
+        for e in ents:
+            if e in owner:
+                raise InputError(f"mesh region {name}", f"shares entities with region {owner[e]}",
+                                 "give every part of the body to one region only")
+            owner[e] = name
+    if not any(len(gmsh.model.mesh.getElements(dim, e)[0]) for e in owner):
+        raise InputError(str(spec.path), "gmsh made no elements", "check the geometry and the element size")
+    points = {name: ents[0] for name, ents in groups[0].items()}
+    if dim == 2:
+        _, xyz, _ = gmsh.model.mesh.getNodes()
+        if abs(xyz[2::3]).max(initial=0.0) > 1e-12:
+            raise InputError(str(spec.path), "a 2-D geometry must lie in the x-y plane", "draw it in z = 0")
+    fm, notes = _extract(gmsh, dim, groups[dim], groups[dim - 1], points, groups[1] if dim == 3 else None)
+    return to_arrays(fm, notes)
 
 
 def mesh_geometry(spec: MeshSpec) -> FrameMesh:
     """Mesh ``spec.path`` and return the named mesh (2-D if the geometry is planar)."""
-    suffix = spec.path.suffix.lower()
-    with gmsh_session("case") as gmsh:
-        for k, v in spec.parameters.items():
-            gmsh.parser.setNumber(k, [float(v)])
-        try:
-            if suffix == SCRIPT:
-                gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)
-            else:
-                gmsh.model.occ.importShapes(str(spec.path))
-                gmsh.model.occ.synchronize()
-        except Exception as err:  # gmsh reports a bad file as a plain Exception
-            raise InputError(str(spec.path), f"gmsh cannot read it ({err})", "check the file in gmsh") from None
-        dim = max((d for d, _ in gmsh.model.getEntities()), default=0)
-        if dim < 2:
-            raise InputError(str(spec.path), "has no surfaces or volumes", "give a 2-D or 3-D geometry")
-        for g in spec.groups:
-            ents = gmsh.model.getEntitiesInBoundingBox(*g.box, dim=g.dim)
-            if not ents:
-                raise InputError(f"mesh.groups.{g.name}", f"no {g.dim}-D entity inside the box {list(g.box)}",
-                                 "enlarge the box or check its coordinates (m)")
-            gmsh.model.setPhysicalName(g.dim, gmsh.model.addPhysicalGroup(g.dim, [t for _, t in ents]), g.name)
-        if not gmsh.model.getPhysicalGroups(dim):  # a CAD file without groups: one region
-            tag = gmsh.model.addPhysicalGroup(dim, [t for _, t in gmsh.model.getEntities(dim)])
-            gmsh.model.setPhysicalName(dim, tag, "solid")
-        if spec.size:
-            gmsh.option.setNumber("Mesh.MeshSizeMax", spec.size)
-        names = _physical(gmsh)
-        _refine(gmsh, spec, names, dim)
-        gmsh.option.setNumber("General.NumThreads", 1)  # threads make meshes differ run to run
-        gmsh.model.mesh.generate(dim)
-        groups = {d: {names[(d, t)]: [int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(d, t)]
-                      for dd, t in names if dd == d} for d in range(dim + 1)}
-        owner: dict[int, str] = {}
-        for name, ents in groups[dim].items():
-            for e in ents:
-                if e in owner:
-                    raise InputError(f"mesh region {name}", f"shares entities with region {owner[e]}",
-                                     "give every part of the body to one region only")
-                owner[e] = name
-        points = {name: ents[0] for name, ents in groups[0].items()}
-        if dim == 2:
-            _, xyz, _ = gmsh.model.mesh.getNodes()
-            if abs(xyz[2::3]).max(initial=0.0) > 1e-12:
-                raise InputError(str(spec.path), "a 2-D geometry must lie in the x-y plane", "draw it in z = 0")
-        fm = _extract(gmsh, dim, groups[dim], groups[dim - 1], points, None)
-        log.info("meshed %s: %d nodes, %d elements, regions %s", spec.path.name, len(fm.points), len(fm.cells),
-                 ", ".join(fm.regions))
-        return fm
+    root = spec.root or spec.path.parent
+    script = spec.path if spec.path.suffix.lower() == SCRIPT else None
+    if script is not None:
+        scan(script, root, spec.include)  # every file it reads inside the case's folder or named
+    meta, arrays = run_isolated(functools.partial(_mesh_in_gmsh, spec), str(spec.path), script,
+                                functools.partial(scan, root=root, allowed=spec.include, commands=True))
+    for note in meta.pop("notes", []):
+        log.warning(note)
+    fm = from_arrays(meta, arrays)
+    check_mesh(fm, str(spec.path))
+    log.info("meshed %s: %d nodes, %d elements, regions %s", spec.path.name, len(fm.points), len(fm.cells),
+             ", ".join(fm.regions))
+    return fm

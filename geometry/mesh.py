@@ -1,6 +1,8 @@
-"""The neutral mesh handed from gmsh to the solvers, and its meshio round trip."""
+"""The neutral mesh handed from gmsh to the solvers, its meshio and array round trips,
+and the checks every mesh read from a user's file passes."""
 from __future__ import annotations
 
+import logging
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,6 +15,14 @@ from gatetherm import atomic_path
 _CELL = {2: "triangle", 3: "tetra"}
 _FACET = {2: "line", 3: "triangle"}
 _MASK = "group:"
+SNAP_TOLERANCE = 0.01
+"""A point group off the mesh's nodes is moved to the nearest node if that is within this
+fraction of the body's size (its bounding-box diagonal) or within the longest edge of the
+elements at that node; refused beyond."""
+DEGENERATE = 1e-10
+"""An element whose area (volume) is below this fraction of its longest edge squared (cubed)
+is degenerate."""
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -33,6 +43,8 @@ class FrameMesh:
     meta: dict = field(default_factory=dict, compare=False)
     """What the mesh was made from, when known: ``{"frame": FrameParams}`` for a mesh built
     by :func:`gatetherm.geometry.build.build_mesh` (not kept in files)."""
+    lines: dict[str, np.ndarray] = field(default_factory=dict)
+    """3-D: named curves as (L, 2) node pairs (a support on a line)."""
 
     def sensor_xyz(self, name: str) -> np.ndarray:
         return self.points[self.sensors[name]]
@@ -52,6 +64,8 @@ def _groups(m: FrameMesh):
         yield name, d - 1, _FACET[d], fac
     for name, node in m.sensors.items():
         yield name, 0, "vertex", np.array([[node]])
+    for name, pairs in m.lines.items():
+        yield name, 1, "line", pairs
 
 
 def to_meshio(m: FrameMesh, point_data: dict | None = None):
@@ -126,7 +140,7 @@ def _named_blocks(mm):
 def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
     """A :class:`FrameMesh` from (name, dimension, connectivity) groups; nodes in no
     element are dropped."""
-    regions, boundaries, sensors, chunks, offset = {}, {}, {}, [], 0
+    regions, boundaries, sensors, lines, chunks, offset = {}, {}, {}, {}, [], 0
     for name, d, conn in groups:
         if d == dim:
             chunks.append(conn)
@@ -137,18 +151,123 @@ def from_groups(dim: int, points: np.ndarray, groups) -> FrameMesh:
             boundaries[name] = np.vstack([boundaries[name], conn]) if name in boundaries else conn
         elif d == 0:
             sensors[name] = int(conn[0, 0])
+        elif d == 1:
+            lines[name] = np.vstack([lines[name], conn]) if name in lines else conn
     if not chunks:
         raise InputError("mesh", f"holds no named {_KIND[dim]} groups", f"add a Physical {_KIND[dim].title()}")
     cells = np.vstack(chunks)
     used = np.unique(cells)
     remap = -np.ones(len(points), dtype=np.int64)
     remap[used] = np.arange(len(used))
-    orphans = [k for k, v in sensors.items() if remap[v] < 0]
-    if orphans:
-        raise InputError(f"mesh point {orphans[0]}", "is not a node of the mesh's elements",
-                         "put the point inside the meshed body (embed it in gmsh)")
+    sensors, notes = snap_points(points[:, :dim], cells, sensors)
+    for note in notes:
+        log.warning(note)
     return FrameMesh(dim, points[used][:, :dim].copy(), remap[cells], regions,
-                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()})
+                     {k: remap[v] for k, v in boundaries.items()}, {k: int(remap[v]) for k, v in sensors.items()},
+                     lines={k: remap[v] for k, v in lines.items()})
+
+
+def snap_points(points: np.ndarray, cells: np.ndarray, sensors: dict[str, int]) -> tuple[dict[str, int], list[str]]:
+    """Point groups at nodes of the elements: one at a node in no element moves to the
+    nearest node of an element (:data:`SNAP_TOLERANCE`), with a note giving the distance;
+    beyond the tolerance an InputError. Returns the nodes and the notes."""
+    used = np.zeros(len(points), dtype=bool)
+    used[cells.ravel()] = True
+    out, notes = dict(sensors), []
+    idx = np.flatnonzero(used)
+    for name, node in sensors.items():
+        if used[node]:
+            continue
+        dist = np.linalg.norm(points[idx] - points[node], axis=1)
+        near = int(idx[np.argmin(dist)])
+        at = cells[(cells == near).any(axis=1)]
+        edge = max(np.linalg.norm(points[at[:, i]] - points[at[:, j]], axis=1).max()
+                   for i in range(cells.shape[1]) for j in range(i))
+        tol = max(SNAP_TOLERANCE * float(np.linalg.norm(np.ptp(points[idx], axis=0))), edge)
+        where = ", ".join(f"{v:.6g}" for v in points[node])
+        if dist.min() > tol:
+            raise InputError(f"mesh point {name}", f"at ({where}) is {dist.min():.3g} m from the nearest node of the "
+                             f"mesh's elements, more than the tolerance {tol:.3g} m",
+                             "put the point on the meshed body (embed it in gmsh)")
+        out[name] = near
+        notes.append(f"mesh point {name} at ({where}) is not a node of the mesh's elements: read at the nearest "
+                     f"node, {dist.min():.3g} m away (embed the point in gmsh to read it exactly)")
+    return out, notes
+
+
+def check_mesh(fm: FrameMesh, where: str) -> None:
+    """Refuse a mesh that cannot be solved on: coordinates that are not finite, degenerate
+    (zero-area or zero-volume) elements, boundary facets that are not facets of the elements."""
+    if not np.isfinite(fm.points).all():
+        raise InputError(where, "has node coordinates that are not finite numbers", "check the file")
+    X = fm.points[fm.cells]
+    E = X[:, 1:] - X[:, :1]
+    size = np.abs(np.linalg.det(E))
+    edge = np.linalg.norm(X[:, :, None] - X[:, None, :], axis=-1).max(axis=(1, 2))
+    bad = np.flatnonzero(size <= DEGENERATE * edge ** fm.dim)
+    if len(bad):
+        at = ", ".join(f"{v:.4g}" for v in X[bad[0]].mean(axis=0))
+        raise InputError(where, f"has {len(bad)} element(s) of zero {'area' if fm.dim == 2 else 'volume'} "
+                         f"(the first at ({at}))", "check the geometry for coincident points or collapsed entities")
+    rows = np.sort(np.vstack([np.delete(fm.cells, i, axis=1) for i in range(fm.dim + 1)]), axis=1)
+    key = lambda a: np.ascontiguousarray(a, dtype=np.int64).view(f"V{8 * a.shape[1]}").ravel()  # noqa: E731
+    facets = np.unique(key(rows))
+    for name, fac in fm.boundaries.items():
+        fac = np.asarray(fac)
+        if fac.size and ((fac < 0).any() or not np.isin(key(np.sort(fac, axis=1)), facets).all()):
+            raise InputError(f"{where}: boundary {name}", "has facets that are not facets of the mesh's elements "
+                             "(a surface or curve that is not part of the meshed body?)",
+                             "remove it from the group or make it part of the body (fragment it in gmsh)")
+
+
+def components(fm: FrameMesh) -> list[set[str]]:
+    """The regions of each connected part of the mesh (elements connected through shared
+    nodes), largest part first; a region split into several parts is in each of them."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n_cells, k = fm.cells.shape
+    cell_ids = np.repeat(np.arange(n_cells), k)
+    incidence = coo_matrix((np.ones(n_cells * k), (cell_ids, fm.cells.ravel())),
+                           shape=(n_cells, len(fm.points))).tocsr()
+    _, label = connected_components(incidence @ incidence.T, directed=False)
+    parts = sorted(np.unique(label), key=lambda c: -np.count_nonzero(label == c))
+    return [{r for r, idx in fm.regions.items() if np.any(label[np.asarray(idx, dtype=np.int64)] == c)}
+            for c in parts]
+
+
+def to_arrays(fm: FrameMesh, notes=()) -> tuple[dict, dict[str, np.ndarray]]:
+    """The mesh as a JSON-able header and numeric arrays (for a pipe), with ``notes``."""
+    meta = {"dim": fm.dim, "regions": list(fm.regions), "boundaries": list(fm.boundaries), "lines": list(fm.lines),
+            "sensors": {k: int(v) for k, v in fm.sensors.items()}, "notes": list(notes)}
+    arrays = {"points": np.asarray(fm.points, dtype=np.float64), "cells": np.asarray(fm.cells, dtype=np.int64)}
+    arrays |= {f"region{i}": np.asarray(v, dtype=np.int64) for i, v in enumerate(fm.regions.values())}
+    arrays |= {f"boundary{i}": np.asarray(v, dtype=np.int64).reshape(-1, fm.dim)
+               for i, v in enumerate(fm.boundaries.values())}
+    arrays |= {f"line{i}": np.asarray(v, dtype=np.int64).reshape(-1, 2) for i, v in enumerate(fm.lines.values())}
+    return meta, arrays
+
+
+def from_arrays(meta: dict, arrays: dict[str, np.ndarray]) -> FrameMesh:
+    """The mesh of :func:`to_arrays`, its indices checked (the arrays may come from a
+    sandboxed process)."""
+    dim = int(meta["dim"])
+    points, cells = arrays["points"], arrays["cells"]
+    regions = {name: arrays[f"region{i}"] for i, name in enumerate(meta["regions"])}
+    boundaries = {name: arrays[f"boundary{i}"] for i, name in enumerate(meta["boundaries"])}
+    sensors = {str(k): int(v) for k, v in meta["sensors"].items()}
+    lines = {name: arrays[f"line{i}"] for i, name in enumerate(meta.get("lines", []))}
+    ok = dim in (2, 3) and points.ndim == 2 and points.shape[1] == dim and cells.ndim == 2 and \
+        cells.shape[1] == dim + 1 and cells.dtype.kind == "i" and points.dtype.kind == "f"
+    n, e = len(points), len(cells)
+    ok = ok and (cells.size == 0 or 0 <= cells.min() and cells.max() < n) and all(
+        v.ndim == 1 and (v.size == 0 or 0 <= v.min() and v.max() < e) for v in regions.values()) and all(
+        v.ndim == 2 and v.shape[1] == dim and (v.size == 0 or v.min() >= -1 and v.max() < n)
+        for v in boundaries.values()) and all(0 <= v < n for v in sensors.values()) and all(
+        v.ndim == 2 and v.shape[1] == 2 and (v.size == 0 or 0 <= v.min() and v.max() < n) for v in lines.values())
+    if not ok:
+        raise ValueError("inconsistent mesh arrays")
+    return FrameMesh(dim, points, cells, regions, boundaries, sensors, lines=lines)
 
 
 def load_mesh(path: str | os.PathLike) -> FrameMesh:
@@ -157,10 +276,22 @@ def load_mesh(path: str | os.PathLike) -> FrameMesh:
     import meshio
 
     path = Path(path)
-    mm = meshio.read(path, file_format="gmsh" if path.suffix == ".msh" else None)
-    dim = max((b.dim for b in mm.cells if b.type in _CORNERS), default=0)
-    if dim < 2:
-        raise InputError(str(path), "holds no triangles or tetrahedra", "mesh a surface (2-D) or a volume (3-D)")
-    if dim == 2 and np.ptp(mm.points[:, 2]) > 1e-12 * max(np.ptp(mm.points[:, :2]), 1.0):
-        raise InputError(str(path), "a 2-D mesh must lie in the x-y plane", "mesh the section in z = 0")
-    return from_groups(dim, mm.points, _named_blocks(mm))
+    if path.suffix not in (".msh", ".vtu"):
+        raise InputError(str(path), f"unknown mesh format '{path.suffix}'", "give a .msh or .vtu file")
+    try:
+        # the format's reader itself: meshio.read prints an unreadable file's error and exits
+        mm = (meshio.gmsh if path.suffix == ".msh" else meshio.vtu).read(str(path))
+        dim = max((b.dim for b in mm.cells if b.type in _CORNERS), default=0)
+        if dim < 2:
+            raise InputError(str(path), "holds no triangles or tetrahedra", "mesh a surface (2-D) or a volume (3-D)")
+        if dim == 2 and np.ptp(mm.points[:, 2]) > 1e-12 * max(np.ptp(mm.points[:, :2]), 1.0):
+            raise InputError(str(path), "a 2-D mesh must lie in the x-y plane", "mesh the section in z = 0")
+        fm = from_groups(dim, np.asarray(mm.points, dtype=np.float64), _named_blocks(mm))
+    except (InputError, OSError):
+        raise
+    except Exception as err:  # noqa: BLE001 - a broken file: meshio's errors are of any type
+        raise InputError(str(path), f"is not a readable {path.suffix or 'mesh'} file ({type(err).__name__}: "
+                         f"{str(err)[:200]})", "write it again with gmsh (.msh 2.2 or 4.1) or gatetherm mesh (.vtu)") \
+            from None
+    check_mesh(fm, str(path))
+    return fm

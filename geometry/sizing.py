@@ -1,19 +1,22 @@
-"""How big a frame mesh will be, estimated before gmsh runs, so that a mesh that cannot fit
-in memory is refused at once instead of exhausting the machine."""
+"""How big a mesh will be, estimated before gmsh meshes, so that a mesh that cannot fit in
+memory is refused at once instead of exhausting the machine: the frame's from its
+parameters, a user's geometry from the gmsh model (in gmsh's process)."""
 from __future__ import annotations
 
 import math
 import os
+
+import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry.frame import Box, FrameParams, MeshParams, part_boxes, tank_box
 
 REFERENCE_NODES = 52_812
 """Nodes of the default 3-D frame mesh, at which the constants below were measured."""
-NODES_PER_ELEMENT = {2: 0.52, 3: 0.21}
-"""Nodes per *estimated* element (:func:`element_estimate`) of the frame's meshes: 2-D 7 509
-nodes for 14 400 estimated triangles; 3-D 52 812 to 332 616 nodes for 2.5 to 1.6 × 10⁵
-estimated tetrahedra per 10⁵ nodes (the estimate is high by 1.5-2.1)."""
+NODES_PER_ELEMENT = {2: 0.6, 3: 0.12}
+"""Nodes per *estimated* element (:func:`element_estimate`, :func:`model_estimate`): the frame's
+2-D meshes 0.60-0.53 (7 509 to 53 592 nodes), 3-D 0.116-0.086 (52 812 to 779 457 nodes); the
+larger, so that memory is not underestimated."""
 NONZEROS_PER_NODE = {2: 7.0, 3: 13.6}
 """Entries per row of a scalar P1 matrix (the node graph plus the diagonal); the elastic
 matrix has ``block²`` times as many per node."""
@@ -30,15 +33,20 @@ million entries and 155 664 unknowns; 5.9 MB for 0.17 million and 7 509)."""
 AMG_BYTES_PER_NONZERO = 36.0
 """AMG-CG's memory per matrix nonzero: the matrix (12) and the hierarchy (21-23 measured, heat
 and elasticity)."""
-BASE_BYTES_PER_NODE = {2: 6_000.0, 3: 5_000.0}
-"""What a P1 condition holds besides its solvers, per node: mesh, bases, matrices, load and
-weight vectors, kept states and the libraries' own (measured ``simulate --dim 3``: 0.4 GB at the
-reference)."""
-HEAT_FACTORS = 2
-"""Heat step factors held at once on the direct path (the long steps of each pump state; the
-short steps after a switch are solved iteratively, see :mod:`gatetherm.solvers.heat`)."""
+BASE_BYTES = 0.15e9
+"""The libraries and the interpreter, bytes (a 2-D condition of 7 509 nodes peaks at 0.16 GB)."""
+BASE_BYTES_PER_NODE = {2: 6_500.0, 3: 8_000.0}
+"""What a P1 condition holds besides its solvers' memory, per node: mesh, bases, matrices, load
+and weight vectors, kept states and the transients of assembly and of the AMG set-up; fitted to
+``benchmarks/scaling.py``'s peaks (3-D iterative: 2.58, 4.63 and 13.2 GB at 0.18, 0.33 and 0.96
+million nodes; 2-D: 0.46 GB at 53 592 nodes)."""
+HEAT_FACTORS = 4
+"""Heat step matrices of a condition (a paper condition's: 60-s and 15-s steps, pump on and
+off), each with a factor of its own on the direct path."""
 FALLBACK_MEMORY = 8e9
 """Memory assumed where the operating system does not report it, bytes."""
+CELL = {2: math.sqrt(3) / 4, 3: 1 / (6 * math.sqrt(2))}
+"""Area (volume) of an equilateral triangle (regular tetrahedron) of unit edge."""
 
 
 def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
@@ -51,7 +59,62 @@ def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
 
     total = sum(map(measure, part_boxes(p, dim).values())) - measure(tank_box(p, dim))
     s = m.size if dim == 2 else m.size_3d
-    return total / (math.sqrt(3) / 4 * s ** 2 if dim == 2 else s ** 3 / (6 * math.sqrt(2)))
+    return total / (CELL[dim] * s ** dim)
+
+
+def _measure(gmsh, d: int, t: int) -> float:
+    """Length, area or volume of an entity (its bounding box's for the built-in kernel); 1 for a point."""
+    if d == 0:
+        return 1.0
+    try:
+        return float(gmsh.model.occ.getMass(d, t))
+    except Exception:  # noqa: BLE001 - not an OpenCASCADE entity
+        box = np.reshape(gmsh.model.getBoundingBox(d, t), (2, 3))
+        return float(np.prod(np.sort(box[1] - box[0])[::-1][:d]))
+
+
+def model_estimate(gmsh, dim: int) -> list[tuple[float, int | None, float]]:
+    """Elements of the current gmsh model, by contribution, as (elements, field, size):
+    the solids at their element size (field None: ``Mesh.MeshSizeMax``, the geometric mean
+    of their points' sizes, the size factor, the size fields' far size) and each Threshold
+    field (its tag: the elements within its distance of the entities it measures from, the
+    size growing linearly from SizeMin to SizeMax; a solid in it all at SizeMin). The area
+    (volume) per element of :func:`element_estimate`. Transfinite counts are not seen.
+    Against gmsh: 1.26 (T4), 2.03 (T1), 1.54 (the C-frame example) times its count."""
+    opt, f = gmsh.option.getNumber, gmsh.model.mesh.field
+    box = np.reshape(gmsh.model.getBoundingBox(-1, -1), (2, 3))
+    lo, hi, factor = opt("Mesh.MeshSizeMin"), opt("Mesh.MeshSizeMax"), opt("Mesh.MeshSizeFactor")
+    clip = lambda h: min(max(h * factor, lo), hi)  # noqa: E731
+    thresholds = [t for t in f.list() if f.getType(t) == "Threshold"]
+    far = min((clip(f.getNumber(t, "SizeMax")) for t in thresholds), default=hi)
+    solids = [t for _, t in gmsh.model.getEntities(dim)]
+    base, h_base = 0.0, math.inf
+    for t in solids:
+        pts = [p for p in gmsh.model.getBoundary([(dim, t)], recursive=True) if p[0] == 0]
+        lc = [s for s in gmsh.model.mesh.getSizes(pts) if s > 0] if pts and opt("Mesh.MeshSizeFromPoints") else []
+        h = min(clip(math.exp(np.mean(np.log(lc))) if lc else float(np.linalg.norm(box[1] - box[0]))), far)
+        base += _measure(gmsh, dim, t) / (CELL[dim] * h ** dim)
+        h_base = min(h_base, h)
+    out = [(base, None, h_base)]
+    total = sum(_measure(gmsh, dim, t) for t in solids)
+    for tag in thresholds:
+        src = int(f.getNumber(tag, "InField"))
+        smin, smax = clip(f.getNumber(tag, "SizeMin")), clip(f.getNumber(tag, "SizeMax"))
+        d0, d1 = f.getNumber(tag, "DistMin"), max(f.getNumber(tag, "DistMax"), f.getNumber(tag, "DistMin"))
+        near = [(d, int(e)) for d, key in enumerate(("PointsList", "CurvesList", "SurfacesList"))
+                for e in f.getNumbers(src, key)] if src in f.list() and f.getType(src) == "Distance" else []
+        r = np.linspace(0.0, d1, 201)[1:]
+        h = np.where(r <= d0, smin, smin + (smax - smin) * (r - d0) / max(d1 - d0, 1e-300))
+        n = 0.0
+        for d, e in near:
+            if d == dim:  # inside a solid: all at SizeMin, then the ramp outside its boundary
+                n += _measure(gmsh, d, e) / (CELL[dim] * smin ** dim)
+                near += [(b, abs(t)) for b, t in gmsh.model.getBoundary([(d, e)], oriented=False)]
+                continue
+            shell = {1: 2.0 * np.ones_like(r), 2: 2 * np.pi * r, 3: 4 * np.pi * r ** 2}[dim - d]
+            n += float(np.sum(_measure(gmsh, d, e) * shell / (CELL[dim] * h ** dim)) * (r[1] - r[0]))
+        out.append((min(n, total / (CELL[dim] * smin ** dim)), int(tag), float(f.getNumber(tag, "SizeMin"))))
+    return out
 
 
 def memory_bytes() -> float:
@@ -90,22 +153,30 @@ def path_memory(nodes: float, dim: int) -> dict[str, float]:
     """Predicted peak memory of a P1 condition on ``nodes`` nodes, bytes, by solver path: the
     larger of the heat factors and the elastic factor ("direct"), or AMG-CG for both
     ("iterative"), over what the condition holds besides (:data:`BASE_BYTES_PER_NODE`)."""
-    base = BASE_BYTES_PER_NODE[dim] * nodes
+    base = BASE_BYTES + BASE_BYTES_PER_NODE[dim] * nodes
     nnz1 = NONZEROS_PER_NODE[dim] * nodes
     direct = max(HEAT_FACTORS * factor_bytes(nodes, dim, 1) + amg_bytes(nodes, nnz1), factor_bytes(nodes, dim, dim))
     iterative = amg_bytes(nodes, nnz1) + amg_bytes(dim * nodes, dim ** 2 * nnz1)
     return {"direct": base + direct, "iterative": base + iterative}
 
 
-def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> dict[str, float]:
-    """Raise InputError naming the element size if the mesh would need more memory than the
-    machine has on both solver paths; else the predicted peak of each path (bytes)."""
-    n = element_estimate(p, m, dim)
-    need, have = path_memory(n * NODES_PER_ELEMENT[dim], dim), memory_bytes()
-    if min(need.values()) > have:
-        key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
-        low = min(need.values())
-        raise InputError(key, f"{s:g} m gives about {n:.2g} {'triangles' if dim == 2 else 'tetrahedra'} needing "
-                         f"~{low / 1e9:.3g} GB, more than the {have / 1e9:.3g} GB of memory of this machine",
-                         f"raise it to at least {s * (low / have) ** (1 / dim):.2g} m")
+def check_estimate(elements: float, dim: int, key: str, size: float) -> dict[str, float]:
+    """Raise InputError naming ``key`` (an element size of ``size`` m, or a factor on the
+    sizes) if a mesh of about ``elements`` elements of dimension ``dim`` needs more memory
+    than the machine has on both solver paths (:func:`path_memory`); the fix gives the
+    smallest admissible value (elements ∝ size^-dim). Else the predicted peak of each path."""
+    need, have = path_memory(elements * NODES_PER_ELEMENT[dim], dim), memory_bytes()
+    low = min(need.values())
+    unit = "" if "factor" in key else " m"
+    if low > have:
+        raise InputError(key, f"{size:g}{unit} gives about {elements:.2g} "
+                         f"{'triangles' if dim == 2 else 'tetrahedra'} needing ~{low / 1e9:.3g} GB, more than the "
+                         f"{have / 1e9:.3g} GB of memory of this machine",
+                         f"raise it to at least {size * (low / have) ** (1 / dim):.2g}{unit}")
     return need
+
+
+def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
+    """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
+    key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
+    check_estimate(element_estimate(p, m, dim), dim, key, s)

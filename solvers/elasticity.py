@@ -9,6 +9,7 @@ solve per output): sensors need no elastic solve per time step.
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,7 +75,9 @@ class ElasticSystem:
     solve: SPDSolver
     """Solves with the stiffness on the free DOFs (one or more right-hand sides)."""
     plane: str = "stress"
-    """2-D: "stress" or "strain"."""
+    """2-D: "stress", "strain" or "axisymmetric"."""
+    K_fixed: sp.csr_matrix | None = None
+    """Stiffness columns of the held DOFs (all rows), where a support prescribes a displacement."""
 
     def displacement(self, dT: np.ndarray) -> np.ndarray:
         """Displacement field (m) for the temperature rise ``dT`` (K) on the heat basis
@@ -102,49 +105,117 @@ class ElasticSystem:
         return W[0] if np.ndim(g) == 1 else W
 
 
-def fixed_dofs(vb: CellBasis, mesh, supports) -> np.ndarray:
-    """Displacement DOFs held at zero by the supports without a foundation stiffness. With
-    DOFs at the nodes only (P1), the facets' nodes give them directly, interleaved as
-    scikit-fem numbers them (its general path builds the mesh's edges: 0.6 s on the 3-D frame)."""
+def support_dofs(vb: CellBasis, mesh, boundary: str, components, lines=None) -> np.ndarray:
+    """The displacement DOFs of ``components`` on a boundary, or (3-D) on a line of
+    ``lines`` (name: node pairs). With DOFs at the nodes only (P1), the facets' nodes give
+    them directly, interleaved as scikit-fem numbers them (its general path builds the
+    mesh's edges: 0.6 s on the 3-D frame)."""
     dim = mesh.dim()
+    if lines and boundary in lines:
+        pairs = np.sort(lines[boundary], axis=1)
+        out = [vb.nodal_dofs[c, np.unique(pairs)] for c in components]
+        if vb.edge_dofs.size:
+            index = {tuple(e): i for i, e in enumerate(np.sort(mesh.edges, axis=0).T.tolist())}
+            edges = [index[tuple(e)] for e in pairs.tolist()]
+            out += [vb.edge_dofs[c, edges] for c in components]
+        return np.concatenate(out)
     if vb.N == dim * mesh.nvertices:
-        out = [(dim * np.unique(mesh.facets[:, mesh.boundaries[s.boundary]])[:, None] + list(s.components)).ravel()
-               for s in supports if s.stiffness is None]
-        return np.unique(np.concatenate(out)) if out else np.zeros(0, dtype=np.int64)
+        return (dim * np.unique(mesh.facets[:, mesh.boundaries[boundary]])[:, None] + list(components)).ravel()
     names = [f"u^{c + 1}" for c in range(dim)]
-    out = [vb.get_dofs(mesh.boundaries[s.boundary]).all([names[c] for c in s.components])
-           for s in supports if s.stiffness is None]
+    return vb.get_dofs(mesh.boundaries[boundary]).all([names[c] for c in components])
+
+
+def fixed_dofs(vb: CellBasis, mesh, supports, lines=None) -> np.ndarray:
+    """Displacement DOFs held (at zero or a prescribed value) by the supports without a
+    foundation stiffness."""
+    out = [support_dofs(vb, mesh, s.boundary, s.components, lines) for s in supports if s.stiffness is None]
     return np.unique(np.concatenate(out)) if out else np.zeros(0, dtype=np.int64)
 
 
-def free_modes(vb: CellBasis, fixed: np.ndarray, K_found: sp.spmatrix | None) -> list[str]:
-    """Rigid-body modes the supports leave free (names of :data:`MODE_NAMES`)."""
+def parts(vb: CellBasis) -> list[np.ndarray]:
+    """The DOFs of every connected piece of the mesh (elements sharing a DOF)."""
+    from scipy.sparse.csgraph import connected_components
+
+    ed = vb.element_dofs
+    e = ed.shape[1]
+    graph = sp.coo_matrix((np.ones(ed.size), (np.tile(np.arange(e), ed.shape[0]), e + ed.ravel())),
+                          shape=(e + vb.N, e + vb.N))
+    label = connected_components(graph, directed=False)[1][e:]
+    return [np.flatnonzero(label == k) for k in np.unique(label)]
+
+
+def free_modes(vb: CellBasis, fixed: np.ndarray, springs=(), pieces=None,
+               axisymmetric: bool = False) -> list[tuple[int, str]]:
+    """Rigid-body modes the supports and the spring matrices (foundations, joints) leave
+    free, as (piece, name of :data:`MODE_NAMES`): ``pieces`` are the DOF sets of the
+    mesh's connected pieces (None: one). An axisymmetric body has one: translation y."""
     dim = vb.mesh.dim()
-    R = rigid_body_modes(vb.doflocs, vb.split_indices())
+    R0 = rigid_body_modes(vb.doflocs, vb.split_indices())
+    names = MODE_NAMES[dim]
+    if axisymmetric:
+        R0, names = R0[:, [1]], names[1:2]
+    blocks = []
+    for p in pieces or [np.arange(vb.N)]:
+        R = np.zeros_like(R0)
+        R[p] = R0[p]
+        blocks.append(R)
+    R = np.hstack(blocks)
     R = R / np.linalg.norm(R, axis=0)
     G = R[fixed].T @ R[fixed]
-    if K_found is not None:
-        F = R.T @ (K_found @ R)
+    for K in springs:
+        F = R.T @ (K @ R)
         scale = np.abs(F).max()
         G = G + (F / scale if scale > 0 else F)
     w, V = np.linalg.eigh(G)
     loose = V[:, w < 1e-10 * max(w.max(), 1.0)]
-    return [MODE_NAMES[dim][int(np.argmax(np.abs(v)))] for v in loose.T]
+    m = len(names)
+    return [(int(i) // m, names[int(i) % m]) for i in np.argmax(np.abs(loose), axis=0)]
+
+
+def _refuse_loose(vb: CellBasis, mesh, loose, pieces) -> None:
+    """The first free part as an :class:`~gatetherm.InputError` naming its regions."""
+    piece = loose[0][0]
+    modes = ", ".join(dict.fromkeys(n for p, n in loose if p == piece))
+    if pieces is None:
+        regions = list(mesh.subdomains)
+    else:
+        regions = [r for r, els in mesh.subdomains.items() if np.isin(vb.element_dofs[0, els[0]], pieces[piece])]
+    raise InputError("supports", f"the part made of region{'s' * (len(regions) > 1)} {', '.join(regions)} is free to "
+                     f"move ({modes})", "hold more displacement components (clamped, normal, fixed) or add a "
+                     "foundation, or join the part to a held one (a contact stiffness in both directions)")
+
+
+class _Solver(SPDSolver):
+    """:class:`~gatetherm.solvers.linsolve.SPDSolver`, a singular matrix (zero pivot) refused as bad input."""
+
+    def _make(self, rhs: int):
+        try:
+            return super()._make(rhs)
+        except (RuntimeError, ArithmeticError) as err:
+            if not re.search("pivot|singular|definite", str(err), re.I):
+                raise
+            raise InputError("supports", f"the elastic system is singular ({err})",
+                             "a part is not held: hold every part, or join it to a held one") from None
 
 
 def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, alpha: Field,
                      thickness: Field, supports, plane: str = "stress",
-                     simplices: p1.Simplices | None = None) -> ElasticSystem:
+                     simplices: p1.Simplices | None = None, lines=None, contacts=()) -> ElasticSystem:
     """Assemble on a scikit-fem mesh with named boundaries; the temperature lives on
-    ``T_basis`` (same mesh). ``supports`` are :class:`~gatetherm.solvers.problem.Support`.
-    A rigid-body mode the supports leave free is an :class:`~gatetherm.InputError`.
+    ``T_basis`` (same mesh). ``supports`` are :class:`~gatetherm.solvers.problem.Support`
+    (on a boundary, or on a line of ``lines``, 3-D: name to node pairs); ``contacts`` the
+    :class:`~gatetherm.solvers.problem.Contact` joints of a mesh cut open along them. A part
+    the supports and joints leave free to move is an :class:`~gatetherm.InputError` naming it.
     Linear elements use ``simplices`` (:func:`~gatetherm.solvers.p1.simplices` of the
     mesh, found if not given)."""
-    dim = mesh.dim()
-    q = 2 * order - 1  # exact for the stiffness and the thermal load on affine simplices
+    from gatetherm.solvers import axisym
+    from gatetherm.solvers.contact import joints
+
+    dim, axi = mesh.dim(), plane == "axisymmetric"
+    q = 2 * order + 1 if axi else 2 * order - 1  # exact for stiffness and thermal load on affine simplices
     lam, mu, b = moduli(E.values, nu.values, alpha.values, dim, plane)
     node_order = None
-    if order == 1 and T_basis.elem.maxdeg == 1:  # the same matrices, vectorised (solvers/p1.py)
+    if order == 1 and T_basis.elem.maxdeg == 1 and not axi:  # the same matrices, vectorised (solvers/p1.py)
         s, th = simplices or p1.simplices(mesh), thickness.values
         vb, node_order = dof_basis(mesh, ElementVector(element(dim, order))), s.order
         K = p1.stiffness(s.pattern, s.G, s.vol, lam * th, mu * th)
@@ -152,23 +223,23 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     else:
         vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
         T_basis, t = CellBasis(mesh, T_basis.elem, intorder=q), thickness.at(vb)
-        K = asm(stiffness, vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
-        B = asm(thermal_load, T_basis, vb, b=Field(b).at(vb), t=t)
-    K_found = None
+        forms = (axisym.stiffness, axisym.thermal_load) if axi else (stiffness, thermal_load)
+        K = asm(forms[0], vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
+        B = asm(forms[1], T_basis, vb, b=Field(b).at(vb), t=t)
+    springs = []
     for s in supports:
         if s.stiffness is not None:
             fb = FacetBasis(mesh, vb.elem, facets=mesh.boundaries[s.boundary])
-            Kf = asm(foundation, fb, k=s.stiffness, t=thickness.at(fb), comps=s.components)
-            K_found = Kf if K_found is None else K_found + Kf
-    fixed = fixed_dofs(vb, mesh, supports)
-    loose = free_modes(vb, fixed, K_found)
+            springs.append(asm(foundation, fb, k=s.stiffness, t=thickness.at(fb), comps=s.components))
+    springs += joints(vb, mesh, contacts, thickness, float(np.nanmax(E.values)))
+    fixed = fixed_dofs(vb, mesh, supports, lines)
+    pieces = parts(vb) if contacts else None
+    loose = free_modes(vb, fixed, springs, pieces, axi)
     if loose:
-        raise InputError("supports", f"the supports leave rigid-body motion free ({', '.join(loose)})",
-                         "hold more displacement components (clamped, normal, fixed) or add a foundation")
-    if K_found is not None:
-        K = K + K_found
+        _refuse_loose(vb, mesh, loose, pieces)
+    K = (K + sum(springs[1:], springs[0]) if springs else K).tocsr()
     free = np.setdiff1d(np.arange(vb.N), fixed)
-    K = K.tocsr()
+    K_fixed = K[:, fixed] if any(s.values for s in supports) else None
     dof_order = nd_order(K, dim) if node_order is None else expand_order(node_order, dim)
     perm = restrict_order(dof_order, free, vb.N)
     K = K[free]  # in two steps: the full matrix goes before the columns are taken
@@ -178,5 +249,4 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
              f" plane {plane}" if dim == 2 else "")
     nodal = len(free) % dim == 0 and bool(np.all(free.reshape(-1, dim) == (free[::dim] // dim * dim)[:, None]
                                                    + np.arange(dim)))
-    solve = SPDSolver(K, dim, rbm, perm, nodal)
-    return ElasticSystem(vb, K, B.tocsr(), free, solve, plane)
+    return ElasticSystem(vb, K, B.tocsr(), free, _Solver(K, dim, rbm, perm, nodal), plane, K_fixed)

@@ -24,6 +24,7 @@ from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.frame import FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth, width
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers import linsolve
+from gatetherm.solvers.effects import JointLayer, Named, Targets
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import FC300, Material
@@ -38,6 +39,16 @@ GEOMETRY_FREE = ("l1",)
 """FrameParams fields the mesh does not depend on (the beam theory's heated height)."""
 RELATIVE = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
 """Relative x-displacements (left minus right) of sensor pairs: δ at the tips and at E."""
+EFFECTS = ("ambient_drift", "joint_resistance", "joint_compliance", "compliant_base", "base_conduction",
+           "piezo_heat", "thermocouple_lag", "stand_drift")
+"""The frame's catalogue of effects, in the order the studies list them."""
+TARGETS = Targets(
+    named={"piezo_heat": Named("heat_source", "arm_R", "heat released in the workpiece-side arm by the piezo stack, "
+                               "its spring member and drive, constant from the start of the run", 0.5, 5.0,
+                               log_scale=True)},
+    defaults={"joint_resistance": "tie", "joint_compliance": "tie", "compliant_base": "mounting_face",
+              "base_conduction": "mounting_face"}, candidates=EFFECTS)
+"""The names the frame's effects act on (the tie-bar joints' layers are added per mesh: :func:`frame_targets`)."""
 
 
 @admissible(T0=CELSIUS, h_air=NONNEGATIVE, h_base=NONNEGATIVE, h_oil_on=NONNEGATIVE, h_oil_off=NONNEGATIVE,
@@ -120,6 +131,14 @@ def frame_materials(cfg: ModelConfig, regions) -> dict[str, Material]:
     if cfg.joint_stiffness is not None:  # contact compliance in series with the end layer
         joint = dataclasses.replace(joint, E=L / (L / tie.E + 1.0 / cfg.joint_stiffness))
     return {r: (joint if "joint" in r else tie) if is_tie(r) else cfg.material for r in regions}
+
+
+def frame_targets(cfg: ModelConfig, regions) -> Targets:
+    """:data:`TARGETS` with the joint ``tie``: both tie-bar end layers of the mesh's ``regions``, in
+    series with the tie material."""
+    tie = cfg.tie_material or cfg.material
+    layers = tuple(JointLayer(r, cfg.frame.joint_layer, tie) for r in regions if is_tie(r) and "joint" in r)
+    return dataclasses.replace(TARGETS, joints={"tie": layers})
 
 
 def enclosed_volume(fm: FrameMesh, boundary: str, thickness: float = 1.0) -> float:

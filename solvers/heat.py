@@ -364,7 +364,7 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     q = intorder or 2 * order
     th = fields["thickness"]
     node_order = None
-    if order == 1:  # the same matrices, vectorised (solvers/p1.py)
+    if order == 1 and problem.plane != "axisymmetric":  # the same matrices, vectorised (solvers/p1.py)
         s = simplices or p1.simplices(mesh)
         M = s.pattern.scalar(p1.mass(s.G, s.vol, fields["rho_c"].values * th.values))
         K = s.pattern.scalar(p1.conduction(s.G, s.vol, fields["k"].values * th.values))
@@ -373,6 +373,12 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         basis = CellBasis(mesh, e, intorder=q)
         M = asm(capacity, basis, rc=fields["rho_c"].at(basis), t=th.at(basis))
         K = asm(conduction, basis, k=fields["k"].at(basis), t=th.at(basis))
+
+    if problem.contacts:  # thermal contact layers (on a mesh cut open along them)
+        from gatetherm.solvers.contact import conductances
+
+        Kc = conductances(basis, mesh, problem.contacts, th)
+        K = K if Kc is None else K + Kc
 
     def cells():  # a basis with quadrature, made only where a volume integral needs it
         return CellBasis(mesh, e, intorder=q) if order == 1 else basis
@@ -391,7 +397,8 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     for src in problem.sources:
         cb = cells()
         on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
-        loads.append((asm(film_load, cb, h=on.at(cb), t=th.at(cb)), src.density, "source"))
+        vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
     for fluid in problem.fluids:

@@ -29,7 +29,7 @@ RECYCLE = 6
 
 
 class SolverError(RuntimeError):
-    """An iterative solve did not converge."""
+    """An iterative solve did not converge, or a matrix cannot be factorised."""
 
 
 def _nbytes(A) -> int:

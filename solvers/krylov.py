@@ -99,6 +99,10 @@ class _Sweep:
             self.prev = np.column_stack([x[:self.n] for x in solutions])
 
 
+def _solve(solve, X: np.ndarray) -> np.ndarray:
+    return solve(X) if X.shape[1] else np.zeros(X.shape)
+
+
 def m_orthonormal(M: sp.spmatrix, X: np.ndarray, first: int = 0, tol: float = 1e-9) -> np.ndarray:
     """An M-orthonormal basis of the span of the columns of ``X``, the first ``first`` of them
     spanned exactly (orthonormalised alone, then projected out of the others); twice: Gram
@@ -173,13 +177,13 @@ def basis(M: sp.spmatrix, modes: dict[str, tuple[sp.spmatrix, np.ndarray]], C: n
     rhs = {m: B[m].shape[1] + sum(B[q].shape[1] for q in modes if q != m) + len(C) for m in modes}
     sweeps = {m: _Sweep(K, M, n_inner, dim, rhs[m]) for m, (K, _) in modes.items()}
     zero = {m: sweeps[m].solvers(0.0, len(s_all)) for m in modes}
-    static = {m: zero[m][0](B[m]) for m in modes}  # the other mode's handover, and exact static gains
+    static = {m: _solve(zero[m][0], B[m]) for m in modes}  # the other modes' handover, and exact static gains
     cols = list(static.values())  # spanned exactly: exact static gains
     for m in modes:
         given = np.column_stack([M @ static[q] for q in modes if q != m] or [np.zeros((M.shape[0], 0))])
         for j, s in enumerate(s_all):
             direct, adjoint = zero.pop(m) if s == 0 else sweeps[m].solvers(s, len(s_all) - j)
-            new = [static[m] if s == 0 else direct(B[m]), direct(given), adjoint(Ct)]
+            new = [static[m] if s == 0 else _solve(direct, B[m]), _solve(direct, given), adjoint(Ct)]
             sweeps[m].keep(*new)
             cols += new[1:] if s == 0 else new
         sweeps[m] = None  # its hierarchy

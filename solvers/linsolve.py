@@ -45,6 +45,10 @@ HINTS = {"pardiso": "pip install py-mkl-pardiso (Linux x86_64, Windows)", "cholm
          "metis": "pip install pymetis"}
 
 
+class NoBackend(SolverError):
+    """No sparse Cholesky backend of those asked for is installed."""
+
+
 def _say_once(key: str, level: int, msg: str, *args, _said: set = set()) -> None:  # noqa: B006
     """Log ``msg`` the first time ``key`` is seen in this process (backend choices)."""
     if key not in _said:
@@ -109,7 +113,11 @@ def _pardiso(A: sp.spmatrix, order) -> Solve:
     else:
         solver.set_iparm(4, 1)  # the given order
         solver.set_perm(np.asarray(order, dtype=np.int64))
-    solver.factor(U.data.astype(float))
+    try:
+        solver.factor(U.data.astype(float))
+    except RuntimeError as err:
+        raise SolverError(f"the matrix cannot be factorised ({err}): material constants or thicknesses many "
+                          "orders of magnitude apart?") from None
     return solver.solve
 
 
@@ -163,7 +171,7 @@ def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACK
             continue
         _say_once(f"use {name}", logging.INFO, "sparse Cholesky backend: %s", name)
         return solve, name
-    raise SolverError(f"no sparse Cholesky backend of {', '.join(names)} is installed")
+    raise NoBackend(f"no sparse Cholesky backend of {', '.join(names)} is installed")
 
 
 class Bordered:
@@ -204,7 +212,7 @@ def planned_solver(A: sp.spmatrix, dim: int, rhs: int, what: str, block: int = 1
     if p.path == "direct":
         try:
             return spd_factor(A, order, allow)[0], "direct"
-        except SolverError:
+        except NoBackend:
             _say_once(f"amg {what}", logging.INFO, "no Cholesky backend for the %s: AMG-CG; %s", what, HINTS["pardiso"])
     return PCG(A, near_null, amg_block, rtol), "iterative"
 

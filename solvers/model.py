@@ -20,7 +20,10 @@ import scipy.sparse as sp
 from skfem import CellBasis, asm
 
 from gatetherm.geometry.mesh import FrameMesh
-from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, moduli, thermal_load_at
+from gatetherm.solvers.axisym import Revolution
+from gatetherm.solvers.contact import split_contacts
+from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, moduli, support_dofs, thermal_load_at
+from gatetherm.solvers.loads import Terms, mechanical_terms, unit_responses
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
 from gatetherm.solvers.heat import HeatSystem, assemble_heat, boundary_terms
@@ -39,9 +42,11 @@ def region_fields(problem: Problem, mesh) -> dict[str, Field]:
     m = problem.materials
     out = {name: Field.by_region(mesh, {r: get(mat) for r, mat in m.items()}, np.nan) for name, get in (
         ("k", lambda a: a.k), ("rho_c", lambda a: a.rho * a.c), ("E", lambda a: a.E), ("nu", lambda a: a.nu),
-        ("alpha", lambda a: a.alpha))}
+        ("alpha", lambda a: a.alpha), ("rho", lambda a: a.rho))}
     thick = problem.thickness if problem.dim == 2 else {}
-    out["thickness"] = Field.by_region(mesh, thick, 1.0)
+    out["thickness"] = Revolution.of(mesh) if problem.axisymmetric else Field.by_region(mesh, thick, 1.0)
+    if not problem.thermal:  # no thermal strain
+        out["alpha"] = Field(np.zeros(mesh.nelements))
     return out
 
 
@@ -53,7 +58,8 @@ def boundary_mean(mesh, basis: CellBasis, name: str, thickness: Field) -> np.nda
 
 @dataclass(frozen=True)
 class Readout:
-    """``y = L @ U + W @ (U_solid − T_ref)``: the outputs :attr:`keys` of a heat state."""
+    """``y = L @ U + W @ (U_solid − T_ref) + R @ loads(env)``: the outputs :attr:`keys` of a
+    heat state and the mechanical loads' values (:class:`~gatetherm.solvers.loads.Terms`)."""
 
     keys: tuple[Key, ...]
     L: sp.csr_matrix
@@ -62,10 +68,16 @@ class Readout:
     """Rows on the solid's temperature rise (displacements in m, stresses in Pa)."""
     n_L: int
     """The first ``n_L`` keys are rows of ``L``, the rest rows of ``W``."""
+    R: np.ndarray | None = None
+    """Rows of ``W``'s outputs on the mechanical loads' values (None: no loads)."""
+    terms: Terms | None = None
 
-    def __call__(self, U: np.ndarray, n_solid: int, T_ref: float) -> np.ndarray:
+    def __call__(self, U: np.ndarray, n_solid: int, T_ref: float, env=None) -> np.ndarray:
         y = self.L @ U
-        return np.concatenate([y, self.W @ (U[:n_solid] - T_ref)]) if len(self.W) else y
+        if not len(self.W):
+            return y
+        mech = self.R @ self.terms.at(env or {}) if self.R is not None else 0.0
+        return np.concatenate([y, self.W @ (U[:n_solid] - T_ref) + mech])
 
 
 @dataclass(frozen=True)
@@ -86,54 +98,83 @@ class Model:
     """Seconds spent building: mesh, heat_assembly, elastic_setup, adjoint_solves."""
     simplices: p1.Simplices | None = field(default=None, compare=False)
     """Linear elements: what all P1 matrices and factors on the mesh share."""
+    terms: Terms | None = None
+    """The mechanical loads (None: none)."""
+    unit: np.ndarray | None = field(default=None, compare=False)
+    """The displacement of every load term for a unit value (elastic DOFs × terms)."""
 
     @property
     def dim(self) -> int:
         return self.fmesh.dim
 
-    def read(self, U: np.ndarray) -> np.ndarray:
-        """All outputs of the heat state ``U`` (order of ``readout.keys``)."""
-        return self.readout(U, self.heat.n_solid, self.problem.T_ref)
+    def read(self, U: np.ndarray, env=None) -> np.ndarray:
+        """All outputs of the heat state ``U`` with the inputs ``env`` (the variables of
+        the load values; order of ``readout.keys``)."""
+        return self.readout(U, self.heat.n_solid, self.problem.T_ref, env)
+
+    def loads_displacement(self, env) -> np.ndarray | float:
+        """The displacement (m) of the mechanical loads for the inputs ``env`` (0 without loads)."""
+        return self.unit @ self.terms.at(env or {}) if self.terms is not None else 0.0
 
     def rise(self, U: np.ndarray) -> np.ndarray:
         """Temperature rise of the solid above the stress-free temperature, K."""
         return U[:self.heat.n_solid] - self.problem.T_ref
 
-    def displacement_field(self, U: np.ndarray) -> np.ndarray:
-        """Full displacement field (m) on the elastic basis: one elastic solve (``U`` (n, k): k fields)."""
-        return self.elastic.displacement(self.rise(U))
+    def displacement_field(self, U: np.ndarray, envs=None) -> np.ndarray:
+        """Full displacement field (m) on the elastic basis: one elastic solve (``U`` (n, k): k
+        fields), plus the mechanical loads' for the inputs ``envs`` (one, or k of them)."""
+        u = self.elastic.displacement(self.rise(U))
+        if self.terms is None:
+            return u
+        if np.ndim(U) == 1:
+            return u + self.loads_displacement(envs)
+        return u + np.column_stack([self.loads_displacement(e) for e in (envs or [None] * u.shape[1])])
 
     def stress_field(self, u: np.ndarray, U: np.ndarray | None = None,
                      rec: Recovery | None = None) -> dict[str, np.ndarray]:
         """Stress components and von Mises (Pa) at the nodes, projected over the whole mesh
         (``rec``: :func:`field_recovery` of this model, set up once for many states)."""
         rec = rec or field_recovery(self)
-        rhs = rec.thermal_rhs(self.rise(U)) if U is not None else rec.thermal_rhs(np.ones(1))
+        rhs = rec.thermal_rhs(self.rise(U)) if U is not None else \
+            rec.thermal_rhs(np.ones(1)) if self.problem.thermal else {}  # the prescribed rise, or none
         comps = rec.field(u, rhs)
         nodal = {c: v[rec.scalar.nodal_dofs[0]] for c, v in comps.items()}
         return {**nodal, "von_mises": von_mises(nodal)}
 
-    def static(self) -> dict[Key, float]:
-        """The outputs of a prescribed-temperature problem: one elastic solve."""
+    def static(self, envs=(None,)) -> list[dict[Key, float]]:
+        """The outputs of a problem without a heat solve (a prescribed temperature, or none)
+        for each of the inputs ``envs`` of its loads: one elastic solve in all."""
         p = self.problem
         out: dict[Key, float] = {}
-        T = prescribed_at(self, np.array([pr.xyz for pr in p.probes]).T) if p.probes else []
+        T = prescribed_at(self, np.array([pr.xyz for pr in p.probes]).T) if p.probes and p.thermal else []
         for pr, Tp in zip(p.probes, T):
             if "T" in pr.quantities:  # on a region's side where the prescribed temperature jumps
                 out[("T", pr.name)] = float(p.prescribed_regions.get(pr.region, Tp))
         if self.elastic is None:
-            return out
-        u = self.elastic.from_load(_prescribed_load(self))
-        stresses = {}  # per region: its recovery and the projected components
+            return [out for _ in envs]
+        recoveries: dict = {}
+        out.update(self._mechanical(static_displacement(self, None, loads=False), p.thermal, recoveries))
+        units = [self._mechanical(u, False, recoveries) for u in (self.unit.T if self.terms is not None else ())]
+        rows = []
+        for env in envs:
+            values = self.terms.at(env or {}) if units else ()
+            rows.append({k: y + sum(unit[k] * v for unit, v in zip(units, values) if k in unit)
+                         for k, y in out.items()})
+        return rows
+
+    def _mechanical(self, u: np.ndarray, thermal: bool, recoveries: dict) -> dict[Key, float]:
+        """Displacement, stress and relative outputs of the displacement ``u`` (with the
+        prescribed thermal strain if ``thermal``); ``recoveries`` by region, filled on use."""
+        p, out = self.problem, {}
         for pr in p.probes:
             if "u" in pr.quantities:
                 for c in range(self.dim):
                     out[("u", pr.name, AXES[c])] = float(self.elastic.point_functional(pr.xyz, c) @ u)
             if "sigma" in pr.quantities:
-                if pr.region not in stresses:
-                    rec = _probe_recovery(self, pr.region)
-                    stresses[pr.region] = rec, rec.field(u, rec.thermal_rhs(np.ones(1)))
-                rec, comps = stresses[pr.region]
+                if pr.region not in recoveries:
+                    recoveries[pr.region] = _probe_recovery(self, pr.region)
+                rec = recoveries[pr.region]
+                comps = rec.field(u, rec.thermal_rhs(np.ones(1)) if thermal else {})
                 phi = rec.at(pr.xyz)
                 out.update({("sigma", pr.name, c): float(phi @ v) for c, v in comps.items()})
         for r in p.relative:
@@ -143,13 +184,21 @@ class Model:
         return out
 
 
-def static_fields(model: Model) -> dict[str, np.ndarray]:
-    """Nodal temperature (°C), displacement (m, 3 components) and stress (Pa) of a
-    prescribed-temperature problem (the temperature interpolated at the nodes)."""
+def static_displacement(model: Model, env=None, loads: bool = True) -> np.ndarray:
+    """The displacement (m) of a problem without a heat solve for the inputs ``env`` (only
+    the prescribed temperature's if not ``loads``)."""
+    p, el = model.problem, model.elastic
+    u = el.from_load(_prescribed_load(model)) if p.thermal else np.zeros(el.basis.N)
+    return u + model.loads_displacement(env) if loads else u
+
+
+def static_fields(model: Model, env=None) -> dict[str, np.ndarray]:
+    """Nodal temperature (°C, interpolated at the nodes; none without a temperature),
+    displacement (m, 3 components) and stress (Pa) of a problem without a heat solve."""
     X = model.fmesh.points.T
-    out = {"T": prescribed_at(model, X)}
+    out = {"T": prescribed_at(model, X)} if model.problem.thermal else {}
     if model.elastic is not None:
-        u_dofs = model.elastic.from_load(_prescribed_load(model))
+        u_dofs = static_displacement(model, env)
         u = np.zeros((X.shape[1], 3))
         u[:, :model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
         out["u"] = u
@@ -181,10 +230,13 @@ def _prescribed_rise(model: Model):
 
 
 def _prescribed_load(model: Model) -> np.ndarray:
-    el, f = model.elastic, model.fields
-    vb = CellBasis(model.mesh, el.basis.elem, intorder=2 * model.problem.order)
-    b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim, model.problem.plane)[2]
-    return asm(thermal_load_at, vb, b=Field(b).at(vb), t=f["thickness"].at(vb), T=_prescribed_rise(model)(vb))
+    from gatetherm.solvers import axisym
+
+    el, f, p = model.elastic, model.fields, model.problem
+    vb = CellBasis(model.mesh, el.basis.elem, intorder=2 * p.order + p.axisymmetric)
+    b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim, p.plane)[2]
+    return asm(axisym.thermal_load_at if p.axisymmetric else thermal_load_at, vb, b=Field(b).at(vb),
+               t=f["thickness"].at(vb), T=_prescribed_rise(model)(vb))
 
 
 def _recovery_for(model: Model, elements) -> Recovery:
@@ -245,7 +297,8 @@ def _readout(model: Model) -> Readout:
     for i, gT in enumerate(GT):
         if gT is not None:
             W[i] += gT
-    return Readout(tuple(keys), L, W, n_L)
+    R = np.array(G) @ model.unit if G and model.terms is not None else None
+    return Readout(tuple(keys), L, W, n_L, R, model.terms)
 
 
 def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float = 0.0) -> Model:
@@ -258,18 +311,25 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
         timings[name] = now - clock[0]
         clock[0] = now
 
+    if problem.contacts:
+        fmesh = split_contacts(fmesh, problem.contacts)
     mesh = to_skfem(fmesh)
     f = region_fields(problem, mesh)
     s = p1.simplices(mesh) if problem.order == 1 else None
-    heat = assemble_heat(mesh, problem, f, simplices=s) if problem.heat else None
+    axi = problem.axisymmetric
+    heat = assemble_heat(mesh, problem, f, 2 * problem.order + 1 if axi else None, s) if problem.heat else None
     lap("heat_assembly")
-    el = None
+    el, terms, unit = None, None, None
     if problem.elastic:
         T_basis = heat.basis if heat is not None else dof_basis(mesh, element(problem.dim, problem.order))
         el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
-                              problem.supports, problem.plane, simplices=s)
+                              problem.supports, problem.plane, simplices=s, lines=fmesh.lines,
+                              contacts=problem.contacts)
+        terms = mechanical_terms(problem, mesh, el.basis, f, fmesh.sensors, lambda sup, c: support_dofs(
+            el.basis, mesh, sup.boundary, (c,), fmesh.lines))
+        unit = unit_responses(el, terms) if terms is not None else None
     lap("elastic_setup")
-    model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s)
+    model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s, terms, unit)
     if heat is not None:
         model = dataclasses.replace(model, readout=_readout(model))
     lap("adjoint_solves")

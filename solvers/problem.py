@@ -52,7 +52,9 @@ class Source:
 
     region: str
     density: Value
-    """Power density, W/m³."""
+    """Power density, W/m³ (times :attr:`per`)."""
+    per: float = 1.0
+    """The density is ``per × density``: 1 for a density, 1/volume (1/m³) for a power (W) in the region."""
 
 
 @dataclass(frozen=True)
@@ -99,13 +101,54 @@ class Fluid:
 
 @dataclass(frozen=True)
 class Support:
-    """Displacement components of a boundary held at zero, or an elastic foundation."""
+    """Displacement components of a boundary (or, in 3-D, of a line) held at zero or at a
+    prescribed displacement, or an elastic foundation."""
 
     boundary: str
     components: tuple[int, ...]
     """Displacement components (0 = x, 1 = y, 2 = z) concerned."""
     stiffness: float | None = None
     """Foundation stiffness per unit area, N/m³ (None: the components are fixed)."""
+    values: tuple[Value, ...] = ()
+    """Prescribed displacement of each of ``components``, m (empty: held at zero)."""
+
+
+@dataclass(frozen=True)
+class BoundaryLoad:
+    """A mechanical load on a boundary: a pressure, a traction or a total force."""
+
+    boundary: str
+    kind: str
+    """"pressure" (one value, Pa, positive into the body), "traction" (per component, Pa)
+    or "force" (per component, N: the total, spread uniformly over the boundary's area)."""
+    values: tuple[Value, ...]
+
+
+@dataclass(frozen=True)
+class PointLoad:
+    """A force on the node of a point group."""
+
+    point: str
+    force: tuple[Value, ...]
+    """Force per component, N."""
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Two regions touching on their interface (the boundary ``"A/B"``, names sorted): a
+    thermal contact conductance and, with ``stiffness``, an elastic joint layer instead of a
+    perfect bond."""
+
+    name: str
+    between: tuple[str, str]
+    conductance: float | None = None
+    """Contact conductance, W/(m² K) (None: no heat solve)."""
+    stiffness: tuple[float, float] | None = None
+    """Normal and tangential stiffness per unit area, N/m³ (None: bonded)."""
+
+    @property
+    def boundary(self) -> str:
+        return "/".join(sorted(self.between))
 
 
 @dataclass(frozen=True)
@@ -163,7 +206,8 @@ class Problem:
     thickness: dict[str, float] = field(default_factory=dict)
     """2-D: out-of-plane thickness by region, m (default 1)."""
     plane: str = "stress"
-    """2-D: "stress" or "strain"."""
+    """2-D: "stress", "strain" or "axisymmetric" (x = r ≥ 0, y = z; every integral over the
+    full revolution)."""
     T0: float = 20.0
     """Initial temperature of solid and fluids, °C."""
     T_ref: float = 20.0
@@ -188,16 +232,33 @@ class Problem:
     """Solve the thermoelastic problem (needs E, ν, α of every region and supports)."""
     scheme: TimeScheme = TimeScheme()
     """Time stepping of a transient heat solve."""
+    gravity: tuple[Value, ...] = ()
+    """Acceleration of gravity per component, m/s² (the body force ρ g; empty: none)."""
+    loads: tuple[BoundaryLoad, ...] = ()
+    point_loads: tuple[PointLoad, ...] = ()
+    contacts: tuple[Contact, ...] = ()
+    thermal: bool = True
+    """False: a purely mechanical problem (no temperature, no thermal strain)."""
 
     @property
     def heat(self) -> bool:
-        """The temperature is solved for (not prescribed)."""
-        return self.prescribed is None and not self.prescribed_regions
+        """The temperature is solved for (not prescribed, not absent)."""
+        return self.thermal and self.prescribed is None and not self.prescribed_regions
+
+    @property
+    def axisymmetric(self) -> bool:
+        return self.dim == 2 and self.plane == "axisymmetric"
+
+
+def values(problem: Problem) -> list[Value]:
+    """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
+    out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
+    out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
+    out += [*problem.gravity, *(v for x in (*problem.loads, *problem.supports) for v in x.values)]
+    return out + [v for pl in problem.point_loads for v in pl.force]
 
 
 def inputs(problem: Problem) -> set[str]:
     """The schedule columns the problem's values read (not time ``t``)."""
-    values = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
-    values += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
-    values += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
-    return set().union(*(v.names() for v in values)) - {"t"}
+    return set().union(*(v.names() for v in values(problem))) - {"t"}

@@ -1,29 +1,34 @@
-"""Reduced-order heat model: the frame as a switched linear system, reduced by balanced truncation.
+"""Reduced-order heat model of any problem: a switched linear system, reduced by balanced truncation.
 
-In deviations from the reference temperature T0, ``x = U − T0`` (every unknown: solid nodes,
-tank oil, hose) and ``u = (T_supply − T0, T_amb − T0)``, the heat model of each pump state p is
-the linear descriptor system
+In deviations from the initial temperature T0, ``x = U_free − T0`` (every unknown not held by a
+fixed temperature: solid nodes, fluids, hoses), and inputs ``u_j = value_j − offset_j`` (every
+value the problem's heat transfer reads: a film's or the faces' ambient, a fluid's supply, a
+hose's ambient, a fixed temperature (offset T0), a flux or a source density (offset 0)), the
+heat model of each pump mode p (every fluid's pump on or off) is the descriptor system
 
-    M ẋ = −K_p x + B_p u,    y = C x
+    M ẋ = −K_p x + B_p u,    y = C x + D u + y0
 
-with the outputs y rises from T0 (K) at the sensors, and δ, δ_E in µm (δ is a fixed linear
-functional of the temperature). :func:`linear_heat_model` is the ONE place that reads these
-operators off an assembled frame model; everything else works on :class:`LinearHeatModel`.
+with y every output in the data format's units (temperatures °C, displacements µm, stresses
+MPa; von Mises, not linear, is left out). The displacements are fixed linear functionals of the
+temperature (the adjoint read-out of :mod:`gatetherm.solvers.model`). :func:`linear_heat_model`
+is the ONE place that reads these operators off an assembled model; everything else works on
+:class:`LinearHeatModel`.
 
-:func:`reduce` builds one basis for both modes, so that the reduced state is continuous across
+:func:`reduce` builds one basis for all modes, so that the reduced state is continuous across
 pump switches: per mode, balanced truncation (pyMOR ``BTReductor``) of the system whose inputs
-are augmented by the other mode's dominant reachable states (what a switch hands over; the
+are augmented by the other modes' dominant reachable states (what a switch hands over; the
 initial-condition augmentation of Heinkenschloss, Reis and Antoulas 2011), the static responses
-``K_p⁻¹ B_p`` of both modes (so that the static gain is exact), then Galerkin projection onto the
-M-orthonormal union. With ``Vᵀ M V = I`` the reduced ``A_p = −Vᵀ K_p V`` has a negative definite
-symmetric part in both modes (the pump term ``G(x_o² − x_o x_i + x_i²)`` is positive), so
-``|x|²`` is a common Lyapunov function: the reduced model is stable under any switching.
+``K_p⁻¹ B_p`` of every mode (so that the static gains are exact), then Galerkin projection onto
+the M-orthonormal union. With ``Vᵀ M V = I`` the reduced ``A_p = −Vᵀ K_p V`` has a negative
+definite symmetric part in every mode, so ``|x|²`` is a common Lyapunov function: the reduced
+model is stable under any switching.
 """
 from __future__ import annotations
 
 import logging
 import time
 from dataclasses import dataclass, field
+from itertools import product
 
 import numpy as np
 import scipy.sparse as sp
@@ -35,106 +40,160 @@ from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 
 log = logging.getLogger(__name__)
 
-INPUTS = ("oil_degC", "ambient_degC")
-"""Input names of a reduced model: supply oil and room temperature, as deviations from T0."""
-KEY_OUTPUTS = ("delta_um", "delta_E_um", "theta_A_K", "theta_B_K", "theta_C_K", "T_tank_wall_K", "T_tank_oil_K")
-"""The outputs balanced truncation weighs; the others (further sensors) are carried along."""
 KRYLOV_ABOVE = 100_000
 """Unknowns above which :func:`reduce` builds its basis by :func:`gatetherm.solvers.krylov.basis`
 (a cost linear in the unknowns) instead of balanced truncation of the full model."""
 UM_PER_K = 10.0
 """Output weight of a temperature against a displacement in the balancing: 0.1 K ~ 1 µm (the
 sensors' resolutions)."""
+TEMPERATURE_KINDS = ("film", "faces", "hose", "supply", "fixed")
+"""Load kinds whose value is a temperature: their inputs are deviations from T0."""
+
+
+@dataclass(frozen=True)
+class Input:
+    """One input of a reduced model: a value the problem reads."""
+
+    text: str
+    """The expression it is (a schedule column, an expression of ``t`` and columns, or a number)."""
+    offset: float
+    """Subtracted from the value: the input is ``value − offset`` (T0 for a temperature, else 0)."""
 
 
 @dataclass(frozen=True)
 class LinearHeatModel:
-    """``M ẋ = −K_p x + B_p u``, ``y = C x``, for the pump on and off."""
+    """``M ẋ = −K_p x + B_p u``, ``y = C x + D u + y0`` for every pump mode p."""
 
     M: sp.csr_matrix
     """Capacity matrix, J/K."""
-    K_on: sp.csr_matrix
-    """Conductance matrix with the pump on, W/K."""
-    K_off: sp.csr_matrix
-    """Conductance matrix with the pump off, W/K."""
-    B_on: np.ndarray
-    """Input matrix with the pump on (n × inputs), W/K."""
-    B_off: np.ndarray
-    """Input matrix with the pump off, W/K."""
+    K: dict[str, sp.csr_matrix]
+    """Conductance matrix of every mode, W/K."""
+    B: dict[str, np.ndarray]
+    """Input matrix of every mode (n × inputs), W per input unit."""
     C: np.ndarray
-    """Output matrix (outputs × n): K per K, or µm per K for displacements."""
-    input_names: tuple[str, ...]
-    output_names: tuple[str, ...]
+    """Output matrix (outputs × n), output unit per K."""
+    D: np.ndarray
+    """Feed-through (outputs × inputs)."""
+    y0: np.ndarray
+    """Outputs of the state x = 0 with u = 0 (every unknown at T0)."""
+    inputs: tuple[Input, ...]
+    outputs: tuple[str, ...]
+    key_outputs: tuple[str, ...]
+    """The outputs balanced truncation weighs: relative displacements, the signals θ, fluids and
+    the means of their walls (else every output)."""
+    pumps: tuple[str, ...]
+    """The pump expression of every fluid; a mode is their on/off states."""
     T0: float
-    """Reference temperature, °C: x = 0 is the frame, oil and hose at T0."""
 
-    def K(self, pump: bool) -> sp.csr_matrix:
-        return self.K_on if pump else self.K_off
-
-    def B(self, pump: bool) -> np.ndarray:
-        return self.B_on if pump else self.B_off
+    @property
+    def modes(self) -> tuple[str, ...]:
+        return tuple(self.K)
 
 
-def linear_heat_model(model) -> LinearHeatModel:
-    """The seam: read the switched linear system off an assembled model of the paper's frame
-    (:func:`gatetherm.solvers.frame.build_model`): one pumped fluid, inputs oil and room."""
-    from gatetherm.solvers.frame import AMBIENT, SUPPLY
+def mode_name(states) -> str:
+    """``"on"``/``"off"`` per fluid, joined by ``_`` (``""`` without fluids)."""
+    return "_".join("on" if s else "off" for s in states)
 
-    h, prob = model.heat, model.problem
-    if any(load.kind == "source" for load in h.loads) or h.fixed or len(h.pumped) != 1:
-        raise InputError("model heat sources", "a reduced model has the oil and the room as its only inputs",
-                         "reduce the model without [model] source / piezo_heat")
-    n, ns = h.n, h.n_solid
-    B = {}
-    for pump in (True, False):
-        zero = h.f({SUPPLY: 0.0, AMBIENT: 0.0}, (pump,))  # f is affine in the inputs
-        B[pump] = np.column_stack([h.f({SUPPLY: 1.0, AMBIENT: 0.0}, (pump,)) - zero,
-                                   h.f({SUPPLY: 0.0, AMBIENT: 1.0}, (pump,)) - zero])
-    r = model.readout
-    L, W = r.L.toarray(), np.hstack([r.W, np.zeros((len(r.W), n - ns))])
-    row = {k: (L[i] if i < r.n_L else W[i - r.n_L]) for i, k in enumerate(r.keys)}
+
+def linear_heat_model(model, columns) -> LinearHeatModel:
+    """The seam: read the switched linear system off an assembled model (heat solve with a read-out).
+    ``columns(problem, key) -> (name, scale)`` names each read-out key as a data-format column."""
+    h, prob, r = model.heat, model.problem, model.readout
+    T0, n = float(prob.T0), h.n
+    fixed = h.fixed_dofs
+    free = np.setdiff1d(np.arange(n), fixed)
+    groups: dict = {}  # (value, temperature?) -> [(kind, vector over n or callable of mode)]
+    for p in h.pumped:
+        groups.setdefault((p.supply, True), [])
+    for load in h.loads:
+        groups.setdefault((load.value, load.kind in TEMPERATURE_KINDS), []).append(load.vector)
+    modes = {mode_name(s): s for s in product((True, False), repeat=len(h.pumped))}
+    K = {m: h.K(s).tocsr() for m, s in modes.items()}
+    inputs, cols = [], {m: [] for m in modes}
+    for (value, temp), vectors in groups.items():
+        if value.is_constant and (value.constant == T0 if temp else value.constant == 0.0):
+            continue  # at its offset: drives nothing
+        inputs.append(Input(value.text or repr(value.constant), T0 if temp else 0.0))
+        base = np.zeros(n)
+        for v in vectors:
+            base += v
+        for m, states in modes.items():
+            col = base.copy()
+            for p, on in zip(h.pumped, states):
+                if p.supply == value:
+                    col[p.inlet] += p.coefficients(on)[1]
+            cols[m].append(col)
+    for dofs, value in h.fixed:  # a fixed temperature drives the free unknowns through K
+        inputs.append(Input(value.text or repr(value.constant), T0))
+        held = np.zeros(n)
+        held[dofs] = 1.0
+        for m in modes:
+            cols[m].append(-(K[m] @ held))
+    B = {m: np.column_stack(c)[free] if c else np.zeros((len(free), 0)) for m, c in cols.items()}
+    L, W = r.L.toarray(), np.hstack([r.W, np.zeros((len(r.W), n - h.n_solid))])
+    rows, names = [], []
+    for i, key in enumerate(r.keys):
+        if key[0] == "sigma" and key[2] == "von_mises":
+            continue
+        name, scale = columns(prob, key)
+        rows.append((L[i] if i < r.n_L else W[i - r.n_L]) * scale)
+        names.append(name)
     s = prob.signals
-    rows = {"delta_um": row[("relative", "delta")] * 1e6, "delta_E_um": row[("relative", "delta_E")] * 1e6,
-            "theta_A_K": row[("T", s.theta_A)], "theta_B_K": row[("T", s.theta_B)],
-            "theta_C_K": np.mean([row[("T", c)] for c in s.theta_C], axis=0),
-            "T_tank_wall_K": row[("mean", "tank_wall")], "T_tank_oil_K": row[("fluid", "tank_oil")]}
-    rows.update({f"T_{p.name}_K": row[("T", p.name)] for p in prob.probes if p.name not in (s.theta_A, s.theta_B)})
-    if ("fluid", "hose") in row:
-        rows["T_hose_K"] = row[("fluid", "hose")]
-    rows["T_base_K"] = row[("mean", "base")]
-    return LinearHeatModel(h.M.tocsr(), h.K((True,)).tocsr(), h.K((False,)).tocsr(), B[True], B[False],
-                           np.array(list(rows.values())), INPUTS, tuple(rows), float(prob.T0))
+    if s.theta_C:
+        rows.append(np.mean([rows[names.index(columns(prob, ("T", c))[0])] for c in s.theta_C], axis=0))
+        names.append("theta_C_degC")
+    R = np.array(rows)
+    is_W = np.array([i >= r.n_L for i, k in enumerate(r.keys) if not (k[0] == "sigma" and k[2] == "von_mises")]
+                    + ([False] if s.theta_C else []))
+    ref = np.where(is_W, R.sum(axis=1) * prob.T_ref, 0.0)  # W acts on the rise above T_ref
+    D = np.zeros((len(names), len(inputs)))
+    for j, (dofs, _) in enumerate(h.fixed):
+        D[:, len(inputs) - len(h.fixed) + j] = R[:, dofs].sum(axis=1)
+    walls = {f"T_{m}_degC" for m, b in prob.means if b in {f.boundary for f in prob.fluids}}
+    key = [nm for nm in names if nm.endswith("_um") and any(k[0] == "relative" and columns(prob, k)[0] == nm
+                                                            for k in r.keys)]
+    key += [c for c in ("theta_A_degC", "theta_B_degC", "theta_C_degC") if c in names]
+    key += [nm for nm in names if nm in walls] + [f"T_{f.name}_degC" for f in prob.fluids if f"T_{f.name}_degC" in names]
+    M = h.M.tocsr()
+    if fixed.size:
+        M, K = M[free][:, free].tocsr(), {m: k[free][:, free].tocsr() for m, k in K.items()}
+    return LinearHeatModel(M, K, B, R[:, free], D, R.sum(axis=1) * T0 - ref, tuple(inputs), tuple(names),
+                           tuple(key) or tuple(names), tuple(p.pump.text or repr(p.pump.constant) for p in h.pumped),
+                           T0)
 
 
 @dataclass(frozen=True)
 class ReducedModel:
-    """``ẋ = A_p x + B_p u``, ``y = C x`` (E = identity); x = 0 is the frame at T0."""
+    """``ẋ = A_p x + B_p u``, ``y = C x + D u + y0`` (E = identity); x = 0 is every unknown at T0."""
 
-    A_on: np.ndarray
-    B_on: np.ndarray
-    A_off: np.ndarray
-    B_off: np.ndarray
+    A: dict[str, np.ndarray]
+    B: dict[str, np.ndarray]
     C: np.ndarray
-    T0: float
-    """Reference temperature, °C."""
-    inputs: tuple[str, ...] = INPUTS
-    outputs: tuple[str, ...] = KEY_OUTPUTS
+    D: np.ndarray
+    y0: np.ndarray
+    inputs: tuple[Input, ...]
+    outputs: tuple[str, ...]
+    pumps: tuple[str, ...] = ()
+    T0: float = 20.0
+    defaults: dict = field(default_factory=dict)
+    """Input columns a series may leave out, with the value they keep (the frame's room)."""
+    room: int | None = None
+    """Index of the input that is the room temperature (the films' ambient), if one is."""
 
     @property
     def states(self) -> int:
-        return self.A_on.shape[0]
+        return self.C.shape[1]
 
-    def A(self, pump: bool) -> np.ndarray:
-        return self.A_on if pump else self.A_off
-
-    def B(self, pump: bool) -> np.ndarray:
-        return self.B_on if pump else self.B_off
+    @property
+    def modes(self) -> tuple[str, ...]:
+        return tuple(self.A)
 
     def output(self, name: str) -> int:
         """Row of C of an output."""
         if name not in self.outputs:
             raise InputError("reduced model output", f"no {name!r}", f"choose from {', '.join(self.outputs)}")
         return self.outputs.index(name)
+
 
 @dataclass(frozen=True)
 class Reduction:
@@ -149,7 +208,7 @@ class Reduction:
     hankel: dict[str, list[float]]
     """Per mode: the leading Hankel singular values."""
     static_gain_error: dict[str, float]
-    """Per mode: largest |static gain of δ, reduced − full|, µm/K."""
+    """Per mode: largest |static gain of the first key output, reduced − full| per input unit."""
     seconds: dict[str, float]
 
 
@@ -180,10 +239,22 @@ def _orthonormal_union(M, columns, count: int, tol: float = 1e-8) -> tuple[np.nd
     return np.column_stack(basis), used
 
 
+def _slowest(lhm: LinearHeatModel) -> float:
+    """The slowest rate of every mode is close to the body cooling uniformly to its temperature
+    inputs with every pump off (the last mode); a body with none never settles."""
+    temp = [j for j, u in enumerate(lhm.inputs) if u.offset == lhm.T0]
+    B = lhm.B[lhm.modes[-1]]
+    loss = float(sum(B[:, j] for j in temp).sum()) if temp else 0.0
+    if not loss > 0:
+        raise InputError("reduced model", "the case loses no heat to an ambient or a fixed temperature: it never "
+                         "settles", "give a film, a fixed temperature or a fluid with a supply")
+    return loss / float(lhm.M.sum())
+
+
 def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s: float = 3600.0,
            adi_tol: float = 1e-10) -> Reduction:
     """Reduce ``lhm`` to ``states`` states (see the module docstring); ``handover`` dominant
-    reachable states of each mode are added to the other mode's inputs, scaled to the state a
+    reachable states of each mode are added to the other modes' inputs, scaled to the state a
     unit input reaches in ``horizon_s``. The Gramian factors come from :mod:`.gramians` (ADI to a
     relative residual ``adi_tol``); pyMOR's ``BTReductor`` balances them."""
     from pymor.core.logger import set_log_levels
@@ -191,21 +262,19 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
     from pymor.reductors.bt import BTReductor
 
     set_log_levels({"pymor": "WARN"})
-    key = [lhm.output_names.index(k) for k in KEY_OUTPUTS]
-    Cw = _weights(KEY_OUTPUTS)[:, None] * lhm.C[key]
-    modes = {"on": True, "off": False}
-    if lhm.M.shape[0] > KRYLOV_ABOVE:  # a large model: rational Krylov, then balanced truncation of its projection
-        V, info = krylov.basis(lhm.M, {m: (lhm.K(p), lhm.B(p)) for m, p in modes.items()}, Cw, states, 3, handover,
-                               horizon_s)
-        rom, d = project(lhm, V), lhm.output_names.index("delta_um")
-        dc = {m: float(np.max(np.abs(lhm.C[d] @ info["static"][m] - rom.C[d] @ np.linalg.solve(-rom.A(p), rom.B(p)[
-            :, np.abs(lhm.B(p)).sum(axis=0) > 0])))) for m, p in modes.items()}
+    key = [lhm.outputs.index(k) for k in lhm.key_outputs]
+    Cw = _weights(lhm.key_outputs)[:, None] * lhm.C[key]
+    modes = lhm.modes
+    B = {m: lhm.B[m][:, np.abs(lhm.B[m]).sum(axis=0) > 0] for m in modes}  # no dead supply column
+    if lhm.M.shape[0] > KRYLOV_ABOVE:  # large: rational Krylov, then balanced truncation of its projection
+        V, info = krylov.basis(lhm.M, {m: (lhm.K[m], lhm.B[m]) for m in modes}, Cw, states, 3, handover, horizon_s)
+        rom = project(lhm, V)
+        dc = {m: float(np.max(np.abs(lhm.C[key[0]] @ info["static"][m] - rom.C[key[0]] @ np.linalg.solve(
+            -rom.A[m], V.T @ B[m])))) if B[m].shape[1] else 0.0 for m in modes}
         return Reduction(rom, V, info["bound"], info["hankel"], dc, info["seconds"])
-    B = {m: lhm.B(p)[:, np.abs(lhm.B(p)).sum(axis=0) > 0] for m, p in modes.items()}  # no dead supply column
     secs, t0 = {}, time.perf_counter()
-    # the slowest rate of either mode is close to the pump-off frame cooling uniformly to the room
-    slowest = float(lhm.B_off[:, 1].sum() / lhm.M.sum())
-    solves = {m: ShiftedSolves(lhm.K(p), lhm.M, slowest=slowest) for m, p in modes.items()}
+    slowest = _slowest(lhm)
+    solves = {m: ShiftedSolves(lhm.K[m], lhm.M, slowest=slowest) for m in modes}
     Zc = {m: gramian_factor(solves[m], B[m], tol=adi_tol) for m in modes}
     Zo = {m: gramian_factor(solves[m], Cw.T, observability=True, tol=adi_tol) for m in modes}
     reach = {}
@@ -214,14 +283,14 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
         reach[m] = lhm.M @ (U[:, :handover] * (s[:handover] / np.sqrt(horizon_s)))
     secs["gramians"] = time.perf_counter() - t0
     V, bound, hankel = {}, {}, {}
-    for m, p in modes.items():
+    for m in modes:
         t0 = time.perf_counter()
-        other = "off" if m == "on" else "on"
-        Zh = gramian_factor(solves[m], reach[other], tol=adi_tol)
+        others = [reach[o] for o in modes if o != m]
+        Zh = [gramian_factor(solves[m], np.column_stack(others), tol=adi_tol)] if others else []
         solves[m] = None  # the factorisations are no longer needed
-        aug = LTIModel.from_matrices(-lhm.K(p), np.column_stack([B[m], reach[other]]), Cw, E=lhm.M)
+        aug = LTIModel.from_matrices(-lhm.K[m], np.column_stack([B[m], *others]), Cw, E=lhm.M)
         space = aug.A.source
-        aug = aug.with_(presets={"c_lr": space.from_numpy(np.column_stack([Zc[m], Zh])),
+        aug = aug.with_(presets={"c_lr": space.from_numpy(np.column_stack([Zc[m], *Zh])),
                                  "o_lr": space.from_numpy(Zo[m])})
         red = BTReductor(aug)
         hsv = red._hankel_svd()[1]
@@ -230,31 +299,32 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
         V[m] = red.V.to_numpy()
         bound[m] = [float(b) for b in red.error_bounds()[:r]]
         hankel[m] = [float(x) for x in hsv[:20]]
-        secs[f"balancing_{m}"] = time.perf_counter() - t0
-        log.info("mode %s: Gramian ranks %d/%d, Hankel singular values %s", m, Zc[m].shape[1] + Zh.shape[1],
-                 Zo[m].shape[1], np.array2string(hsv[:8], precision=3))
+        secs[f"balancing_{m or 'single'}"] = time.perf_counter() - t0
+        log.info("mode %s: Gramian ranks %d/%d, Hankel singular values %s", m or "-",
+                 Zc[m].shape[1] + sum(z.shape[1] for z in Zh), Zo[m].shape[1], np.array2string(hsv[:8], precision=3))
     t0 = time.perf_counter()
-    static = {m: splu(lhm.K(p).tocsc()).solve(lhm.B(p)) for m, p in modes.items()}
-    # static responses first, then the balanced directions of the two modes in turn
-    r_max = max(V["on"].shape[1], V["off"].shape[1])
-    order = [("static", None)] * 4 + [(m, j) for j in range(r_max) for m in modes if j < V[m].shape[1]]
-    cols = [*static["on"].T, *static["off"].T] + [V[m][:, j] for m, j in order[4:]]
+    static = {m: splu(lhm.K[m].tocsc()).solve(lhm.B[m]) for m in modes}
+    # static responses first, then the balanced directions of the modes in turn
+    r_max = max(V[m].shape[1] for m in modes)
+    n_static = sum(static[m].shape[1] for m in modes)
+    order = [("static", None)] * n_static + [(m, j) for j in range(r_max) for m in modes if j < V[m].shape[1]]
+    cols = [c for m in modes for c in static[m].T] + [V[m][:, j] for m, j in order[n_static:]]
     Vb, used = _orthonormal_union(lhm.M, np.column_stack(cols), states)
     rom = project(lhm, Vb)
     secs["projection"] = time.perf_counter() - t0
     # each mode's BT bound at the number of its balanced directions the union took
     taken = {m: sum(order[j][0] == m for j in used) for m in modes}
     err_bound = {m: bound[m][taken[m] - 1] if taken[m] else float("inf") for m in modes}
-    d = lhm.output_names.index("delta_um")
-    dc = {m: float(np.max(np.abs(lhm.C[d] @ static[m] - rom.C[d] @ np.linalg.solve(-rom.A(p), rom.B(p)))))
-          for m, p in modes.items()}
-    log.info("reduced %d -> %d states in %.1f s (BT bounds %s, static δ gain error %s µm/K)", lhm.M.shape[0],
-             rom.states, sum(secs.values()), err_bound, dc)
+    d = key[0]
+    dc = {m: float(np.max(np.abs(lhm.C[d] @ static[m] - rom.C[d] @ np.linalg.solve(-rom.A[m], rom.B[m]))))
+          if lhm.B[m].shape[1] else 0.0 for m in modes}
+    log.info("reduced %d -> %d states in %.1f s (BT bounds %s, static gain error of %s %s)", lhm.M.shape[0],
+             rom.states, sum(secs.values()), err_bound, lhm.key_outputs[0], dc)
     return Reduction(rom, Vb, err_bound, hankel, dc, secs)
 
 
 def project(lhm: LinearHeatModel, V: np.ndarray) -> ReducedModel:
     """Galerkin projection onto an M-orthonormal basis ``V`` (so E_r = Vᵀ M V = I)."""
-    A = {p: -(V.T @ (lhm.K(p) @ V)) for p in (True, False)}
-    B = {p: V.T @ lhm.B(p) for p in (True, False)}
-    return ReducedModel(A[True], B[True], A[False], B[False], lhm.C @ V, lhm.T0, lhm.input_names, lhm.output_names)
+    A = {m: -(V.T @ (lhm.K[m] @ V)) for m in lhm.modes}
+    B = {m: V.T @ lhm.B[m] for m in lhm.modes}
+    return ReducedModel(A, B, lhm.C @ V, lhm.D, lhm.y0, lhm.inputs, lhm.outputs, lhm.pumps, lhm.T0)

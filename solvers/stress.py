@@ -19,9 +19,11 @@ from gatetherm.solvers.elasticity import moduli
 from gatetherm.solvers.fem import Field, dof_basis, element
 
 COMPONENTS = {(2, "stress"): ("xx", "yy", "xy"), (2, "strain"): ("xx", "yy", "zz", "xy"),
+              (2, "axisymmetric"): ("xx", "yy", "tt", "xy"),
               (3, "stress"): ("xx", "yy", "zz", "xy", "yz", "xz"), (3, "strain"): ("xx", "yy", "zz", "xy", "yz", "xz")}
-"""Stress components reported, by (dimension, 2-D plane kind)."""
-_INDEX = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "xz": (0, 2)}
+"""Stress components reported, by (dimension, 2-D plane kind); axisymmetric: x radial, y
+axial, "tt" the hoop stress."""
+_INDEX = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "xz": (0, 2), "tt": (2, 2)}
 
 
 @BilinearForm
@@ -50,8 +52,10 @@ def stress_of_T_at(v, w):
 
 
 def von_mises(s: dict[str, np.ndarray]) -> np.ndarray:
-    """Von Mises stress from components (missing ones are zero)."""
+    """Von Mises stress from components (missing ones are zero; the hoop stress "tt" is the
+    third normal one)."""
     g = {k: np.asarray(s.get(k, 0.0)) for k in _INDEX}
+    g["zz"] = g["zz"] + g["tt"]
     return np.sqrt(0.5 * ((g["xx"] - g["yy"]) ** 2 + (g["yy"] - g["zz"]) ** 2 + (g["zz"] - g["xx"]) ** 2)
                    + 3.0 * (g["xy"] ** 2 + g["yz"] ** 2 + g["xz"] ** 2))
 
@@ -115,7 +119,7 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
     comps = COMPONENTS[(dim, plane)]
     normal = [c for c in comps if c[0] == c[1] and not (dim == 2 and plane == "stress" and c == "zz")]
     lam_e, mu_e, b_e = moduli(fields["E"].values, fields["nu"].values, fields["alpha"].values, dim, plane)
-    if order == 1:
+    if order == 1 and plane != "axisymmetric":
         return _p1_recovery(mesh, dim, comps, normal, lam_e, mu_e, b_e, elements, T_at, simplices)
     kw = {"intorder": q} if elements is None else {"intorder": q, "elements": elements}
     sb = CellBasis(mesh, element(dim, order), **kw)
@@ -123,8 +127,10 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
     lam, mu, b = (Field(v).at(sb) for v in (lam_e, mu_e, b_e))
     M = asm(mass, sb).tocsr()
     active = np.unique(sb.element_dofs)
-    S = {c: asm(stress_of_u, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr()
-         for c in comps}
+    from gatetherm.solvers import axisym
+
+    form = axisym.stress_of_u if plane == "axisymmetric" else stress_of_u
+    S = {c: asm(form, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr() for c in comps}
     if T_elem is not None:
         tb = CellBasis(mesh, T_elem, **kw)
         Q = {c: asm(stress_of_T, tb, sb, b=b).tocsr() for c in normal}

@@ -2,6 +2,8 @@
 verification tests record and the terminal summary prints."""
 from __future__ import annotations
 
+import functools
+
 import pytest
 
 from gatetherm.geometry.build import build_mesh
@@ -13,17 +15,24 @@ from gatetherm.validation.verification_time import COARSE_MESH as COARSE, FIXED_
 _ORDERS = pytest.StashKey[list]()
 
 
+@functools.lru_cache(maxsize=1)
+def fixed_case(dim: int = 2):
+    """The frame of :data:`FIXED_MODEL` as a case (meshed once per session)."""
+    from gatetherm.studies.run.config import Config
+    from gatetherm.studies.run.frame_case import frame_case
+
+    return frame_case(Config(model=FIXED_MODEL), dim)
+
+
 def fixed_condition(steps: int, condition: int = 1):
-    """The :data:`FIXED_MODEL` as a model file and the first ``steps`` minutes of a paper
+    """The frame of :data:`FIXED_MODEL` as a case and the first ``steps`` minutes of a paper
     condition's schedule."""
     import dataclasses
 
-    from gatetherm.studies.run.config import Config
-    from gatetherm.studies.run.scenario import condition_schedule
+    from gatetherm.studies.run.schedules import condition_schedule
 
-    cfg = Config(model=FIXED_MODEL)
-    sched = condition_schedule(condition, cfg)
-    return cfg, dataclasses.replace(sched, times=sched.times[:steps + 1])
+    sched = condition_schedule(condition)
+    return fixed_case(), dataclasses.replace(sched, times=sched.times[:steps + 1])
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""The layers: geometry → solvers → studies → validation → CLI, never back.
+"""The layers: geometry → solvers → studies → validation → the public API → CLI, never back.
 
 Every import of every module (top level and inside functions) is read from the source;
 a module may import gatetherm modules of its own layer or earlier ones only. Numerics
@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = {"core": "gatetherm", "geometry": "gatetherm.geometry", "solvers": "gatetherm.solvers",
            "studies": "gatetherm.studies", "validation": "gatetherm.validation"}
 LAYERS = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.validation",
-          "gatetherm.studies.cli")
+          "gatetherm.api", "gatetherm.cli")
 PLOTTING = ("matplotlib", "pyvista", "vtk", "vtkmodules")
 
 
@@ -51,7 +51,7 @@ MODULES = modules()
 
 
 def test_every_package_folder_is_mapped():
-    assert {"gatetherm.studies.cli", "gatetherm.studies.run", "gatetherm.solvers.heat"} <= set(MODULES)
+    assert {"gatetherm.cli", "gatetherm.studies.run", "gatetherm.solvers.heat"} <= set(MODULES)
     assert "gatetherm.validation.plots" in MODULES and len(MODULES) > 50
 
 
@@ -72,7 +72,21 @@ def test_numerics_do_not_plot(name):
 def test_the_walk_sees_a_back_edge(tmp_path):
     """The checker itself: a library module importing the CLI is caught."""
     path = tmp_path / "bad.py"
-    path.write_text("def f():\n    from gatetherm.studies.cli import main\n    from gatetherm.validation import plots\n")
-    assert {"gatetherm.studies.cli.main", "gatetherm.validation.plots"} <= imports(path)
-    assert layer("gatetherm.studies.cli.simulate") > layer("gatetherm.validation.paper_table") \
+    path.write_text("def f():\n    from gatetherm.cli import main\n    from gatetherm.validation import plots\n")
+    assert {"gatetherm.cli.main", "gatetherm.validation.plots"} <= imports(path)
+    assert layer("gatetherm.cli.simulate") > layer("gatetherm.validation.paper_table") \
         > layer("gatetherm.studies.run.scenario")
+
+
+def test_the_facade_offers_the_api_and_the_cli_calls_only_it_and_below():
+    """``import gatetherm as gt`` names exactly ``gatetherm.api.__all__`` (imported on first use, from the
+    API layer only); the CLI is the one module above the API."""
+    import gatetherm
+    import gatetherm.api
+
+    assert set(gatetherm.API) == set(gatetherm.api.__all__)
+    assert all(getattr(gatetherm, name) is getattr(gatetherm.api, name) for name in gatetherm.API)
+    root = imports(MODULES["gatetherm"])
+    assert not {m for m in root if m.startswith("gatetherm.")}  # the root imports no layer at import time
+    above = [m for m in MODULES if layer(m) > LAYERS.index("gatetherm.api")]
+    assert above and all(m.startswith("gatetherm.cli") for m in above)

@@ -18,7 +18,7 @@ import pytest
 from gatetherm import InputError
 from gatetherm.checks import ranges
 from gatetherm.outdir import LOCK, output_dir
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.config import SCHEMA, parse_config
 from gatetherm.studies.run.timeseries import read_timeseries
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate
@@ -193,7 +193,7 @@ SCHEDULES = {
     "thirty years": (_sched("7200,", "1e9,"), "column time_s: 1e+09 s are 16666666 steps of 60 s, more than 1000000"),
     "pump 2": (_sched("3600,40,0", "3600,40,2"), "column pump: value 2 is not 0 or 1"),
     "time backwards": (_sched("3600,", "9000,"), "column time_s: time 7200 s is not after the previous 9000 s"),
-    "no oil column": (_sched("oil_degC", "oil"), "missing required column 'oil_degC'"),
+    "no oil column": (_sched("oil_degC", "oil"), "column oil_degC: missing: the case reads it"),
     "empty": (b"", "no header row"),
     "header only": (_sched("0,40,1\n3600,40,0\n7200,40,1\n", ""), "no data rows"),
 }
@@ -384,12 +384,17 @@ def test_a_rerun_replaces_the_whole_output_set(tmp_path, capsys):
     assert files(tmp_path / "o") == sorted(files(tmp_path / "fresh") + ["my_notes.txt"])
 
 
-def test_a_rerun_keeps_its_input_files(tmp_path):
-    """diagnose --config DIR/model.toml --out DIR: the model file read is not removed as a
-    file of the previous run (it is replaced only if the run writes a new one)."""
+def test_a_run_never_overwrites_its_input_files(tmp_path):
+    """diagnose --config DIR/model.toml --out DIR would write a new DIR/model.toml over the
+    model file it read: refused in one line before anything is removed. An input that is
+    not among the files the command writes is kept while the previous run's files go."""
     _write(tmp_path / "model.toml", "[geometry]\n")
     _write(tmp_path / "report.md", "old")
-    with output_dir(tmp_path, ("model.toml", "report.md"), keep=(str(tmp_path / "model.toml"), None)):
+    with pytest.raises(InputError, match=f"would overwrite its input '{tmp_path / 'model.toml'}'"):
+        with output_dir(tmp_path, ("model.toml", "report.md"), keep=(str(tmp_path / "model.toml"), None)):
+            pass
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml", "report.md"]
+    with output_dir(tmp_path, ("report.md",), keep=(str(tmp_path / "model.toml"),)):
         pass
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml"]
 

@@ -240,7 +240,7 @@ def test_model_rejects_bad_fields(field, value):
 @pytest.fixture
 def cli(monkeypatch):
     """``studies.cli`` with only the beam command, independent of the other command modules."""
-    from gatetherm.studies import cli
+    from gatetherm import cli
 
     assert "beam" in cli.COMMAND_MODULES
     monkeypatch.setattr(cli, "COMMAND_MODULES", ("beam",))

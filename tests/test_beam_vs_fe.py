@@ -139,7 +139,7 @@ def test_slender_frame_without_cavity_matches_the_theory():
 @pytest.mark.slow
 def test_validate_beam_2d_meets_the_acceptance(tmp_path):
     """The whole `gatetherm validate beam --dim 2` (about 3 min on 2 cores)."""
-    from gatetherm.studies.cli import main
+    from gatetherm.cli import main
 
     assert main(["validate", "beam", "--dim", "2", "--out", str(tmp_path), "--workers", "2"]) == 0
     with open(tmp_path / "beam_vs_fe.csv", newline="") as fh:

@@ -11,11 +11,11 @@ import pytest
 
 from gatetherm import InputError
 from gatetherm.solvers.problem import inputs
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.diagnosis.hypotheses import catalogue, configure
 from gatetherm.studies.diagnosis.locate import input_phases
 from gatetherm.studies.run.case import load_case
-from gatetherm.studies.run.scenario import case_schedule, run_scenario
+from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, write_timeseries
 from gatetherm.validation.case_diagnosis import SCENARIOS, hidden, write_case_diagnosis
 from gatetherm.validation.hidden_effects import recorded
@@ -31,8 +31,8 @@ def case():
 
 def _measured(case, labels: dict, path: Path, seed: int = 3, keep=None) -> Path:
     """A P1 run of ``case`` with the hidden pieces ``labels``, as a rig records it."""
-    schedule = case_schedule(case)
-    cols = run_scenario(configure(case, hidden(case, labels)), 2, schedule).columns
+    schedule = case.schedule
+    cols = run_scenario(configure(case, hidden(case, labels)), schedule).columns
     keep = keep or ("time_s", *schedule.drive.columns, *OUTPUT_COLUMNS)
     write_timeseries(path, recorded(cols, keep, OUTPUT_COLUMNS, seed, {"source": "test"}))
     return path
@@ -42,7 +42,9 @@ def test_the_case_hypotheses_act_on_what_they_name(case):
     pieces = {p.label: p for p in catalogue(case, OUTPUT_COLUMNS)}
     assert {"film_free", "faces_film", "source_spindle", "initial_offset", "conductivity", "expansion",
             "heat_capacity", "thermocouple_lag", "sensor_offset(delta_um)"} <= set(pieces)
-    assert not {"joint_resistance", "ambient_drift", "stand_drift", "air_film"} & set(pieces)  # the paper frame's
+    assert {"heat_source@arm", "heat_source@table", "compliant_base@feet_fixed", "base_conduction@feet_sliding",
+            "ambient_drift"} <= set(pieces)  # effects by the case's own names
+    assert not {"joint_resistance", "stand_drift", "air_film", "piezo_heat", "heat_source@spindle"} & set(pieces)
     c = configure(case, {pieces["film_free"]: 12.5, pieces["source_spindle"]: 1.5, pieces["expansion"]: 1.1,
                          pieces["initial_offset"]: 21.0, pieces["sensor_offset(delta_um)"]: 0.3})
     film = {f.boundary: f.h for f in c.problem.films}
@@ -89,11 +91,11 @@ def test_bad_case_diagnosis_is_one_line_and_exit_2(case, tmp_path, capsys):
     data = _measured(case, {}, tmp_path / "m.csv")
     base = ["diagnose", "--case", CASE, "--data", data, "--out", tmp_path / "d"]
     refused(capsys, 2, base + ["--config", CASE], "--case/--config")
-    refused(capsys, 2, base + ["--dim", "3"], "a case file gives its own mesh")
+    refused(capsys, 2, base + ["--dim", "2"], "--case/--dim", "a case file gives its own model and mesh")
     refused(capsys, 2, ["diagnose", "--data", data, "--out", tmp_path / "d", "--mesh-factor", "0.5"],
             "--mesh-factor", "with --case only")
     refused(capsys, 2, base + ["--effects", "joint_resistance"], "--effects",
-            "joint_resistance acts on the paper frame")
+            "'joint_resistance' is not an effect this case can have; choose from ambient_drift, heat_source@base")
     refused(capsys, 2, base + ["--parameters", "air_film"], "--parameters", "unknown parameter air_film",
             "film_free")
     lacking = _measured(case, {}, tmp_path / "no_power.csv",

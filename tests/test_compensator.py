@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.studies import cli
+from gatetherm import cli
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import (CompensatorParams, compensate, extrapolate, held_ratio, predict,
                                  summarize)

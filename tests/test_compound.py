@@ -15,20 +15,21 @@ import numpy as np
 import pytest
 
 from gatetherm.geometry.frame import MeshParams
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.diagnosis.calibrate import Objective, group_weights
-from gatetherm.studies.diagnosis.discrepancy import Settings, adopted_config, candidates, diagnose
+from gatetherm.studies.diagnosis.discrepancy import Settings, adopted_case, candidates, diagnose
 from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels
 from gatetherm.studies.run.config import config_toml, load_config
-from gatetherm.studies.run.scenario import run_scenario, series_schedule
+from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.studies.run.scenario import measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
 from gatetherm.validation.compound_study import draw_value, kinds_markdown, pairs, pieces_by_key, visible
 from gatetherm.validation.hidden_effects import measured, truth_with
 
 FAST = dict(mesh_factor=1.0, step_s=120.0)
 SHORTLIST = Settings(effects=("joint_resistance", "stand_drift", "piezo_heat", "base_conduction"),
-                     parameters=("air_film", "conductivity", "initial_offset"))
+                     parameters=("air_film", "conductivity", "initial_offset"), p2_check=False)
 
 
 @pytest.fixture(scope="module")
@@ -54,7 +55,7 @@ def _keys(d) -> set[str]:
 ], ids=["joint+thetaB-offset", "joint+air-film", "joint+stand-drift"])
 def test_two_hidden_pieces_are_both_named(coarse, hidden, tmp_path):
     ts = _measured(coarse, hidden)
-    d = diagnose(coarse, ts, settings=SHORTLIST)
+    d = diagnose(frame_case(coarse, 2), ts, SHORTLIST)
     assert (d.verdict, _keys(d)) == ("explained", set(hidden))
     for r in d.pieces:
         assert r.value == pytest.approx(hidden[r.piece.key], rel=0.05, abs=0.03)
@@ -62,28 +63,30 @@ def test_two_hidden_pieces_are_both_named(coarse, hidden, tmp_path):
     assert d.summary()["rms_after_um"] < 0.3 * d.summary()["rms_before_um"]
     # the model file holds every piece and reproduces the diagnosis through the scenario path
     path = tmp_path / "model.toml"
-    path.write_text(config_toml(adopted_config(coarse, d)), encoding="utf-8")
+    adopted = adopted_case(frame_case(coarse, 2), d)
+    path.write_text(adopted.origin.model_file(adopted), encoding="utf-8")
     back = load_config(path)
     assert {**back.effects, **{f"{c}.{f}": v for c, fs in back.sensors.items() for f, v in fs.items()}} == {
         (r.piece.name if r.piece.kind == "effect" else f"{r.piece.channel}.{r.piece.param}"): r.value
         for r in d.pieces if r.piece.kind != "parameter"}
-    cols = run_scenario(back, 2, series_schedule(ts, back, "measured")).columns
+    case = frame_case(back, 2)
+    cols = run_scenario(case, measured_schedule(case, ts)).columns
     for c in d.channels:
         np.testing.assert_allclose(ts[c] - cols[c], d.residual_after[c], atol=1e-9)
 
 
 def test_conductivity_is_a_parameter_not_an_effect(coarse):
-    d = diagnose(coarse, _measured(coarse, {"parameter:conductivity": 38.0}, condition=1), settings=SHORTLIST)
+    d = diagnose(frame_case(coarse, 2), _measured(coarse, {"parameter:conductivity": 38.0}, condition=1), SHORTLIST)
     assert (d.verdict, _keys(d), d.named_effects) == ("explained", {"parameter:conductivity"}, [])
     assert d.pieces[0].value == pytest.approx(38.0, rel=0.03)
 
 
 def test_a_hypothesis_that_cannot_act_is_not_tried(coarse):
     ts = _measured(coarse, {})
-    names = {p.name for p in candidates(coarse, ("theta_A_degC", "delta_um"), False, Settings())}
+    names = {p.name for p in candidates(frame_case(coarse, 2), ("theta_A_degC", "delta_um"), False, Settings())}
     assert "ambient_drift" in names and {"sensor_lag", "sensor_drift", "conductivity"} <= names
-    assert "ambient_drift" not in {p.name for p in candidates(coarse, ("delta_um",), True, Settings())}
-    d = diagnose(coarse, ts.with_columns(ambient_degC=np.full(len(ts), 20.0)), settings=SHORTLIST)
+    assert "ambient_drift" not in {p.name for p in candidates(frame_case(coarse, 2), ("delta_um",), True, Settings())}
+    d = diagnose(frame_case(coarse, 2), ts.with_columns(ambient_degC=np.full(len(ts), 20.0)), SHORTLIST)
     assert d.verdict == "no-discrepancy" and d.has_ambient and not d.pieces
 
 
@@ -91,7 +94,7 @@ def test_channel_groups_weigh_the_same_and_the_score_counts_factors(coarse):
     w = group_weights(("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um"))
     assert w["delta_um"] == pytest.approx(3 * w["theta_A_degC"]) and sum(w.values()) == pytest.approx(4.0)
     ts = _measured(coarse, {})
-    rep = Replayer(coarse, ts)
+    rep = Replayer(frame_case(coarse, 2), ts)
     cols = rep.run()
     channels = compared_channels(ts, cols)
     obj = Objective(rep, ts, channels, {c: 0.1 if c.endswith("_um") else 0.05 for c in channels},
@@ -108,11 +111,11 @@ def test_channel_groups_weigh_the_same_and_the_score_counts_factors(coarse):
 def test_sensor_offsets_gains_and_drifts_in_closed_form(coarse):
     """Faults of the model's own run are recovered to round-off with no model rerun."""
     ts0 = _measured(coarse, {})
-    rep = Replayer(coarse, ts0)
+    rep = Replayer(frame_case(coarse, 2), ts0)
     cols = rep.run()
     faults = {"theta_A_degC": {"gain": 1.04, "offset": -0.2}, "delta_um": {"drift": 0.6, "offset": 0.5}}
-    exact = configure(coarse, {})
-    faulty = run_scenario(dataclasses.replace(exact, sensors=faults), 2, rep.schedule).columns
+    exact = configure(rep.config, {})
+    faulty = run_scenario(dataclasses.replace(exact, sensors=faults), rep.schedule).columns
     ts = ts0.with_columns(**{c: faulty[c] for c in ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")})
     channels = compared_channels(ts, cols)
     obj = Objective(rep, ts, channels, {c: 0.1 for c in channels}, rep.times <= 0.6 * rep.times[-1])

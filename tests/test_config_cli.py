@@ -6,7 +6,7 @@ import meshio
 import numpy as np
 import pytest
 
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.config import Config, load_config, parse_config
 from gatetherm import InputError
 from gatetherm.studies.run.timeseries import read_timeseries
@@ -93,7 +93,7 @@ REGRESSION = {"first_peak_um": 48.00, "first_peak_min": 13.0, "swing_um": 51.07}
 
 @pytest.mark.parametrize("argv, needle", [
     (["simulate", "--condition", "4"], "--condition: no condition 4"),
-    (["simulate", "--schedule", "SCHED"], "missing required column 'oil_degC'"),
+    (["simulate", "--schedule", "SCHED"], "column oil_degC: missing: the case reads it"),
 ])
 def test_simulate_bad_input(tmp_path, capsys, argv, needle):
     sched = tmp_path / "s.csv"

@@ -73,7 +73,7 @@ def test_validate_design_2d(tmp_path):
     """The whole `gatetherm validate design` on the paper model (a few minutes on 2 cores)."""
     import csv
 
-    from gatetherm.studies.cli import main
+    from gatetherm.cli import main
 
     assert main(["validate", "design", "--out", str(tmp_path), "--workers", "2"]) == 0
     with open(tmp_path / "second_tie_bar.csv", newline="") as fh:

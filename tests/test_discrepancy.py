@@ -7,6 +7,7 @@ inverse crime, for speed); the study uses a finer truth mesh."""
 from __future__ import annotations
 
 import dataclasses
+from types import SimpleNamespace
 import json
 
 import numpy as np
@@ -14,18 +15,20 @@ import pytest
 
 from gatetherm.geometry.frame import MeshParams
 from gatetherm.studies.diagnosis.calibrate import Scored
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.solvers.frame import build_model
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.studies.run.config import load_config
-from gatetherm.studies.diagnosis.discrepancy import Settings, _verdict, adopted_config, diagnose
+from gatetherm.studies.diagnosis.discrepancy import Settings, _verdict, adopted_case, diagnose
+from gatetherm.solvers.frame import TARGETS
 from gatetherm.studies.diagnosis.hypotheses import effect_pieces
 from gatetherm.studies.diagnosis.select import Selection
 from gatetherm.studies.diagnosis.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
 from gatetherm.studies.run.config import config_toml
 from gatetherm.studies.run.simulate import run_model
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels, residuals
-from gatetherm.studies.run.scenario import condition_schedule, run_scenario, series_schedule
+from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.studies.run.scenario import condition_schedule, measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.hidden_effects import Case, measured, truth
 
@@ -82,7 +85,7 @@ def test_locate_flags_only_the_disturbed_phase():
 
 def test_verdict_rules():
     base = Scored({}, 900.0, 900.0, {"delta_um": 1.0}, False)
-    piece = effect_pieces(("piezo_heat",))[0]
+    piece = effect_pieces(SimpleNamespace(targets=TARGETS), ["piezo_heat"])[0]
     some = Scored({piece: 2.0}, 300.0, 306.0, {"delta_um": 0.4}, False)
     assert _verdict(False, Selection(base, base, []))[0] == "no-discrepancy"
     assert _verdict(True, Selection(base, base, []))[0] == "unexplained"
@@ -93,8 +96,8 @@ def test_verdict_rules():
 
 def test_replay_reproduces_a_simulation(coarse_config):
     ts = _measured(coarse_config, "none", 0.0, condition=3)
-    rep = Replayer(coarse_config, ts.with_columns(ambient_degC=np.full(len(ts), 20.0)))
-    model = build_model(coarse_config.model, 2, rep.fmesh)  # the same mesh (gmsh may order nodes differently)
+    rep = Replayer(frame_case(coarse_config, 2), ts.with_columns(ambient_degC=np.full(len(ts), 20.0)))
+    model = build_model(coarse_config.model, 2, rep.config.mesh)  # the same mesh (gmsh may order nodes differently)
     clean = run_model(model, condition_drive(CONDITIONS[3], coarse_config.supply), ts.time_s).columns
     ts = ts.with_columns(**{c: clean[c] for c in ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")})
     cols = rep.run()
@@ -115,22 +118,22 @@ def test_model_file_round_trip(tmp_path):
 
 
 def test_noise_only_is_no_discrepancy(coarse_config):
-    d = diagnose(coarse_config, _measured(coarse_config, "none", 0.0, seed=11))
+    d = diagnose(frame_case(coarse_config, 2), _measured(coarse_config, "none", 0.0, seed=11), Settings(p2_check=False))
     assert (d.verdict, d.pieces, d.named_effects, d.runs) == ("no-discrepancy", (), [], 1)
     assert d.summary()["rms_before_um"] == pytest.approx(0.1, rel=0.25)
 
 
 def test_names_a_hidden_effect(coarse_config):
     ts = _measured(coarse_config, "piezo_heat", 3.0)
-    d = diagnose(coarse_config, ts, settings=Settings(effects=("piezo_heat", "stand_drift"), parameters=(),
-                                                       sensors=False))
+    d = diagnose(frame_case(coarse_config, 2), ts, Settings(effects=("piezo_heat", "stand_drift"), parameters=(),
+                                                       sensors=False, p2_check=False))
     s = d.summary()
     assert (d.verdict, d.named_effects, s["best_rejected"]) == ("explained", ["piezo_heat"], None)
     assert [p["kind"] for p in s["pieces"]] == ["effect"] and s["pieces"][0]["share_of_residual"] == pytest.approx(1)
     assert s["fitted"]["piezo_heat.power"] == pytest.approx(3.0, rel=0.05)
     assert s["uncertainty"]["piezo_heat.power"] < 0.1
     assert s["rms_after_um"] < 0.3 * s["rms_before_um"]
-    assert adopted_config(coarse_config, d).effects == {"piezo_heat": s["fitted"]["piezo_heat.power"]}
+    assert adopted_case(frame_case(coarse_config, 2), d).effects == {"piezo_heat": s["fitted"]["piezo_heat.power"]}
 
 
 def test_list_effects_json(capsys):
@@ -151,15 +154,18 @@ def test_diagnose_in_3d(tmp_path):
     cfg = load_config()
     cfg = dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, mesh=dataclasses.replace(
         cfg.model.mesh, size_3d=0.03)))
-    inputs = run_scenario(cfg, 3, condition_schedule(1, cfg, 300.0)).series({})
-    cols = run_scenario(cfg, 3, series_schedule(inputs, cfg, "inputs")).columns
+    case = frame_case(cfg, 3)
+    inputs = run_scenario(case, condition_schedule(1, cfg.supply, 300.0)).series({})
+    cols = run_scenario(case, measured_schedule(case, inputs)).columns
     data = tmp_path / "run3d.csv"
     write_timeseries(data, TimeSeries({c: cols[c] for c in ("time_s", "oil_degC", "pump", "theta_A_degC",
                                                             "theta_B_degC", "theta_C_degC", "delta_um")}, {}))
     assert main(["diagnose", "--data", str(data), "--out", str(tmp_path / "d3"), "--dim", "3",
                  "--mesh-size", "0.03"]) == 0
     s = json.loads((tmp_path / "d3" / "diagnosis.json").read_text())
-    assert (s["verdict"], s["dim"], s["model_runs"]) == ("no-discrepancy", 3, 1)
+    assert (s["verdict"], s["dim"], s["model_runs"]) == ("no-discrepancy", 3, 2)  # P1, and the P2 check
+    p2 = s["discretisation_p2_minus_p1_in_resolutions"]
+    assert p2["delta_um"] == pytest.approx(7.69, abs=0.3)  # achieved 7.69 resolutions of δ: a 3-cm 3-D mesh is coarse
     assert "3-D FE" in (tmp_path / "d3" / "report.md").read_text()
     assert main(["diagnose", "--data", str(data), "--out", str(tmp_path / "d2"), "--effects", "none",
                  "--parameters", "none", "--no-sensors"]) == 0
@@ -172,7 +178,7 @@ def test_parameter_mismatch(coarse_config):
     th = coarse_config.model.thermal
     wrong = dataclasses.replace(coarse_config, model=dataclasses.replace(
         coarse_config.model, thermal=dataclasses.replace(th, h_oil_on=th.h_oil_on * 1.6)))
-    d = diagnose(coarse_config, _measured(wrong, "none", 0.0, condition=2))
+    d = diagnose(frame_case(coarse_config, 2), _measured(wrong, "none", 0.0, condition=2))
     assert (d.verdict, [r.piece.name for r in d.pieces], d.named_effects) == ("explained", ["oil_film_on"], [])
     r = d.pieces[0]
     assert abs(r.value - 1.6 * th.h_oil_on) < max(3 * r.sigma, 0.05 * th.h_oil_on)
@@ -181,7 +187,7 @@ def test_parameter_mismatch(coarse_config):
 @pytest.mark.slow
 @pytest.mark.parametrize("effect, strength", [("tie_heat_leak", 1.5), ("sensor_height", 0.04)])
 def test_outside_catalogue_names_no_effect(coarse_config, effect, strength):
-    d = diagnose(coarse_config, _measured(coarse_config, effect, strength))
+    d = diagnose(frame_case(coarse_config, 2), _measured(coarse_config, effect, strength))
     assert d.verdict in ("unexplained", "partly-explained") and d.named_effects == []
 
 

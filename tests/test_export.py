@@ -9,7 +9,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.ccx import read_dat, relative_from_dat
 
 

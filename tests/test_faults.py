@@ -11,10 +11,10 @@ import sys
 import time
 from pathlib import Path
 
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.timeseries import read_timeseries
 
-GATETHERM = [sys.executable, "-m", "gatetherm.studies.cli"]
+GATETHERM = [sys.executable, "-m", "gatetherm.cli"]
 INTERRUPTED = {130, -signal.SIGINT}
 """Exit statuses of an interrupted command: 130, or death by SIGINT after its line, which a shell
 also reports as 130 (Python ends that way when a Ctrl-C passed through code that an extension
@@ -104,7 +104,17 @@ def test_ctrl_c_at_any_moment(tmp_path):
     a fast machine reached the output files, still no hidden or partial file and no
     summary.json, which marks a finished run."""
     def mapped(name):
-        return lambda pid: name in Path(f"/proc/{pid}/maps").read_text()
+        """``name`` is loaded in the process or in one of its children (gmsh runs in a child)."""
+        def fired(pid):
+            kids = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+            for p in (pid, *kids):
+                try:
+                    if name in Path(f"/proc/{p}/maps").read_text():
+                        return True
+                except OSError:  # the child has ended meanwhile
+                    pass
+            return False
+        return fired
 
     locked = {}
 

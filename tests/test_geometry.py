@@ -220,3 +220,99 @@ def test_facet_keys_order_rows_alike_past_int64():
     ordered = np.sort(big)
     assert np.array_equal(ordered[np.searchsorted(ordered, big)], big)
     assert _keys(np.array([[2_999_999] * 3]), 3_000_000)[0].tolist() == (2_999_999,) * 3  # no wrap-around
+
+
+SQUARE_MSH = """$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+1 1 "edge"
+2 2 "plate"
+$EndPhysicalNames
+$Nodes
+{nodes}
+$EndNodes
+$Elements
+{elements}
+$EndElements
+"""
+
+
+def _msh(nodes, tris, edges=((1, 2),)) -> str:
+    n = [f"{i + 1} {x} {y} 0" for i, (x, y) in enumerate(nodes)]
+    e = [f"{i + 1} 1 2 1 1 {a} {b}" for i, (a, b) in enumerate(edges)]
+    e += [f"{len(e) + i + 1} 2 2 2 1 {a} {b} {c}" for i, (a, b, c) in enumerate(tris)]
+    return SQUARE_MSH.format(nodes="\n".join([str(len(n))] + n), elements="\n".join([str(len(e))] + e))
+
+
+GOOD = _msh([(0, 0), (1, 0), (1, 1), (0, 1)], [(1, 2, 3), (1, 3, 4)])
+
+
+@pytest.mark.parametrize("name, body", [
+    ("truncated.msh", GOOD[: len(GOOD) // 2]),
+    ("garbage.msh", bytes(range(256)) * 4),
+    ("latin1.msh", GOOD.replace('"plate"', '"pl\xe4te"').encode("latin-1")),
+    ("empty.msh", b""),
+    ("text.vtu", "not a VTU file\n"),
+    ("broken.vtu", '<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid"><UnstructuredGrid>'),
+], ids=["truncated", "garbage", "not-utf8", "empty", "vtu-text", "vtu-cut"])
+def test_a_broken_mesh_file_is_one_input_error_naming_it(tmp_path, name, body):
+    path = tmp_path / name
+    path.write_bytes(body if isinstance(body, bytes) else body.encode())
+    with pytest.raises(InputError) as err:
+        load_mesh(path)
+    assert err.value.field == str(path) and "\n" not in str(err.value)
+
+
+def test_zero_area_elements_are_refused():
+    """A triangle on three collinear nodes (x = 0, 0.5, 1 on y = 0)."""
+    from gatetherm.geometry.mesh import check_mesh, from_groups
+
+    pts = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 0, 0]], dtype=float)
+    fm = from_groups(2, pts, [("plate", 2, np.array([[0, 1, 2], [0, 2, 3], [0, 4, 1]]))])
+    with pytest.raises(InputError, match=r"^m\.msh: has 1 element\(s\) of zero area \(the first at \(0\.5, 0\)\)"):
+        check_mesh(fm, "m.msh")
+
+
+def test_a_stray_patch_is_refused_naming_the_boundary(tmp_path):
+    """A 3-D body whose group 'flap' holds a surface outside it (built-in kernel: not fragmented)."""
+    from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+
+    (tmp_path / "a.geo").write_text(
+        'Point(1) = {0,0,0,0.5}; Point(2) = {1,0,0,0.5}; Point(3) = {1,1,0,0.5}; Point(4) = {0,1,0,0.5};\n'
+        'Line(1) = {1,2}; Line(2) = {2,3}; Line(3) = {3,4}; Line(4) = {4,1};\n'
+        'Curve Loop(1) = {1,2,3,4}; Plane Surface(1) = {1};\n'
+        'v[] = Extrude {0,0,1} { Surface{1}; };\n'
+        'Point(50) = {2,0,0,0.5}; Point(51) = {3,0,0,0.5}; Point(52) = {3,1,0,0.5};\n'
+        'Line(60) = {50,51}; Line(61) = {51,52}; Line(62) = {52,50};\n'
+        'Curve Loop(60) = {60,61,62}; Plane Surface(60) = {60};\n'
+        'Physical Volume("body") = {v[1]}; Physical Surface("base") = {1}; Physical Surface("flap") = {60};\n')
+    with pytest.raises(InputError, match=r"a\.geo: boundary flap: has facets that are not facets of the mesh's "):
+        mesh_geometry(MeshSpec(tmp_path / "a.geo"))
+
+
+POINTS = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 1, 1};
+Point(10) = {0.5037, 0.4991, 0};
+Physical Surface("plate") = {1};
+Physical Point("loose") = {10};
+"""
+
+
+def test_a_point_group_off_the_nodes_is_snapped_or_refused(tmp_path, caplog):
+    """A Physical Point not embedded in the surface: read at the nearest node with a warning
+    giving the distance (it was read at the last node before); far off the body, refused."""
+    from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+
+    (tmp_path / "a.geo").write_text(POINTS)
+    fm = mesh_geometry(MeshSpec(tmp_path / "a.geo", 0.1))
+    got = fm.points[fm.sensors["loose"]]
+    d = np.linalg.norm(fm.points - [0.5037, 0.4991], axis=1)
+    assert np.linalg.norm(got - [0.5037, 0.4991]) == d.min() < 0.1  # the nearest node of the mesh
+    assert "mesh point loose at (0.5037, 0.4991) is not a node of the mesh's elements: read at the nearest node, " \
+           f"{d.min():.3g} m away" in caplog.text
+    (tmp_path / "b.geo").write_text(POINTS.replace("0.5037, 0.4991", "3, 3"))
+    with pytest.raises(InputError, match=r"mesh point loose: at \(3, 3\) is 2\.83 m from the nearest node .* more "
+                                         r"than the tolerance 0\.\d+ m"):
+        mesh_geometry(MeshSpec(tmp_path / "b.geo", 0.1))

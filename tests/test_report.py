@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.report import build as b
 from gatetherm.validation.report import drift, readme
@@ -102,7 +102,7 @@ def test_only_computes_the_named_sections(tmp_path, registry):
 def test_code_digest_covers_the_numerics_not_the_presentation():
     files = b.source_files()
     assert "gatetherm/solvers/heat.py" in files and "gatetherm/validation/report/sections/paper.py" in files
-    assert "gatetherm/studies/cli/report.py" not in files and "gatetherm/validation/report/page.py" not in files
+    assert "gatetherm/cli/report.py" not in files and "gatetherm/validation/report/page.py" not in files
     assert len(b.code_digest()) == 64
 
 
@@ -172,7 +172,7 @@ def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypat
 
     monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)
     res = speed.compute(Context(tmp_path, {}, 1))
-    assert res.tables == () and len(res.notes) == 4 and all("not measured yet" in n for n in res.notes)
+    assert res.tables == () and len(res.notes) == 5 and all("not measured yet" in n for n in res.notes)
     assert "`python benchmarks/peer.py --rounds 3` writes it" in res.notes[0]
     (tmp_path / "peer.json").write_text(json.dumps(
         {"date": "2026-11-26", "machine": "2 cores", "command": "python benchmarks/peer.py --rounds 3",
@@ -184,7 +184,7 @@ def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypat
     assert t.columns == ("case", "gatetherm s", "ratio") and t.rows == (("3-D heat", "1.235", "0.5"),
                                                                         ("3-D elastic", "2", "—"))
     assert t.title == "peer.json: measured by `python benchmarks/peer.py --rounds 3` on 2 cores, 2026-11-26"
-    assert t.note == "median of 3 rounds" and len(notes) == 3 and t.readme == "speed-peer"
+    assert t.note == "median of 3 rounds" and len(notes) == 4 and t.readme == "speed-peer"
     assert t.markdown().splitlines()[0] == t.title + ":" and t.markdown().endswith("\n\nmedian of 3 rounds")
     assert notes[0].startswith("`benchmarks/results/scaling.json` is not a benchmark table (AttributeError: ")
     assert notes[0].endswith("rerun `python benchmarks/scaling.py`.")
@@ -297,7 +297,7 @@ def test_rom_section_is_the_rom_study(tmp_path):
 
 def test_readme_edits_made_during_a_run_are_kept(tmp_path, monkeypatch, capsys):
     """``report --full --readme`` rewrites its blocks in the README as it is when the run ends."""
-    from gatetherm.studies.cli import main
+    from gatetherm.cli import main
     from gatetherm.validation.report.sections import speed
 
     monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)

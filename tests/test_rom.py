@@ -7,13 +7,13 @@ import scipy.sparse as sp
 from gatetherm import InputError
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 from gatetherm.solvers.frame import build_model
-from gatetherm.solvers.rom import INPUTS, KEY_OUTPUTS, ReducedModel, linear_heat_model, reduce
-from gatetherm.studies.run.reduce import load_rom, write_rom
+from gatetherm.solvers.rom import Input, ReducedModel, linear_heat_model, reduce
+from gatetherm.studies.run.reduce import load_rom, series_inputs, write_rom
 from gatetherm.solvers.rom_time import discretise, march_rom, simulate_rom
 from gatetherm.studies.control.observer import ObserverParams, kalman, uniform_state
 from gatetherm.studies.control.predictive import PredictiveParams, event_updates, minimax, plan_threshold
 from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
-from gatetherm.studies.run.simulate import run_model, sample_times
+from gatetherm.studies.run.simulate import column, run_model, sample_times
 
 from conftest import FIXED_MODEL
 
@@ -22,7 +22,7 @@ from conftest import FIXED_MODEL
 def coarse(frame_2d):
     """The fixture frame's model, its linear heat model and a 20-state reduction."""
     model = build_model(FIXED_MODEL, 2, frame_2d)
-    lhm = linear_heat_model(model)
+    lhm = linear_heat_model(model, column)
     return model, lhm, reduce(lhm, 20)
 
 
@@ -31,11 +31,13 @@ def test_seam_uniform_rise_is_steady_and_read_as_one_kelvin(coarse):
     pump modes (K_p 1 = B_p [1, 1] to round-off), and every temperature output reads 1 K."""
     _, lhm, _ = coarse
     one = np.ones(lhm.M.shape[0])
-    for pump in (True, False):
-        assert np.max(np.abs(lhm.K(pump) @ one - lhm.B(pump) @ [1.0, 1.0])) < 1e-10 * np.abs(lhm.B(pump)).max()
-    temps = [i for i, n in enumerate(lhm.output_names) if n.endswith("_K")]
-    assert np.allclose(lhm.C[temps] @ one, 1.0, atol=1e-12)
-    assert lhm.input_names == INPUTS and lhm.output_names[:len(KEY_OUTPUTS)] == KEY_OUTPUTS
+    for mode in ("on", "off"):
+        assert np.max(np.abs(lhm.K[mode] @ one - lhm.B[mode] @ [1.0, 1.0])) < 1e-10 * np.abs(lhm.B[mode]).max()
+    temps = [i for i, n in enumerate(lhm.outputs) if n.endswith("_degC")]
+    assert np.allclose(lhm.C[temps] @ one, 1.0, atol=1e-12) and np.allclose(lhm.y0[temps], lhm.T0, atol=1e-12)
+    assert lhm.inputs == (Input("oil_degC", 20.0), Input("ambient_degC", 20.0)) and lhm.modes == ("on", "off")
+    assert lhm.key_outputs == ("delta_um", "delta_E_um", "theta_A_degC", "theta_B_degC", "theta_C_degC",
+                               "T_tank_wall_degC", "T_tank_oil_degC")
 
 
 def test_gramian_factor_solves_the_lyapunov_equation():
@@ -63,29 +65,30 @@ def test_reduction_static_gain_stability_and_fe_agreement(coarse):
     model, lhm, red = coarse
     rom = red.rom
     assert rom.states == 20 and max(red.static_gain_error.values()) < 1e-8
-    for pump in (True, False):
-        assert np.linalg.eigvalsh(rom.A(pump) + rom.A(pump).T).max() < 0
+    for mode in rom.modes:
+        assert np.linalg.eigvalsh(rom.A[mode] + rom.A[mode].T).max() < 0
     times = sample_times(5 * 3600.0)
     drive = condition_drive(CONDITIONS[1], SupplyParams())
     fe = run_model(model, drive, times).columns
-    u = np.column_stack([fe["oil_degC"], fe["ambient_degC"]]) - rom.T0
-    y = simulate_rom(rom, 60.0, u, fe["pump"][:-1] > 0.5)
-    assert np.max(np.abs(y[:, rom.output("delta_um")] - fe["delta_um"])) < 0.5
-    assert np.max(np.abs(y[:, rom.output("theta_A_K")] + rom.T0 - fe["theta_A_degC"])) < 0.1
+    u, modes = series_inputs(rom, fe)
+    y = simulate_rom(rom, 60.0, u, modes)
+    assert np.max(np.abs(y[:, rom.output("delta_um")] - fe["delta_um"])) == pytest.approx(0.1048, abs=0.01)  # ≤ 0.5
+    assert np.max(np.abs(y[:, rom.output("theta_A_degC")] - fe["theta_A_degC"])) < 0.1
     assert max(red.error_bound.values()) < 1.0
 
 
 def test_exact_step_for_linear_inputs():
     """One state, ẋ = −a x + b u with u a ramp: the closed form to round-off, both modes."""
     a, b, dt = 1e-3, 2e-3, 60.0
-    rom = ReducedModel(np.array([[-a]]), np.array([[b, 0.0]]), np.array([[-2 * a]]), np.array([[0.0, b]]),
-                       np.eye(1), 20.0, INPUTS, ("T_K",))
+    rom = ReducedModel({"on": np.array([[-a]]), "off": np.array([[-2 * a]])},
+                       {"on": np.array([[b, 0.0]]), "off": np.array([[0.0, b]])}, np.eye(1), np.zeros((1, 2)),
+                       np.zeros(1), (Input("a", 0.0), Input("b", 0.0)), ("T_degC",), ("pump",))
     t = np.arange(11) * dt
     u = np.column_stack([0.01 * t, 0.02 * t])
-    X = march_rom(discretise(rom, dt), u, np.ones(10, bool))
+    X = march_rom(discretise(rom, dt), u, np.zeros(10, int))
     exact = b * 0.01 * (t / a - (1 - np.exp(-a * t)) / a ** 2)
     assert np.max(np.abs(X[:, 0] - exact)) < 1e-12 * np.abs(exact).max()
-    X = march_rom(discretise(rom, dt), u, np.zeros(10, bool))
+    X = march_rom(discretise(rom, dt), u, np.ones(10, int))
     exact = b * 0.02 * (t / (2 * a) - (1 - np.exp(-2 * a * t)) / (2 * a) ** 2)
     assert np.max(np.abs(X[:, 0] - exact)) < 1e-12 * np.abs(exact).max()
 
@@ -94,10 +97,12 @@ def test_rom_file_round_trip_and_bad_file(coarse, tmp_path):
     rom = coarse[2].rom
     write_rom(rom, tmp_path / "rom.npz")
     back = load_rom(tmp_path / "rom.npz")
-    assert back.inputs == INPUTS and back.outputs == rom.outputs and back.T0 == rom.T0
-    assert all(np.array_equal(getattr(back, k), getattr(rom, k)) for k in ("A_on", "B_on", "A_off", "B_off", "C"))
+    assert back.inputs == rom.inputs and back.outputs == rom.outputs and back.T0 == rom.T0
+    assert all(np.array_equal(back.A[m], rom.A[m]) and np.array_equal(back.B[m], rom.B[m]) for m in rom.modes)
+    assert all(np.array_equal(getattr(back, k), getattr(rom, k)) for k in ("C", "D", "y0"))
     with np.load(tmp_path / "rom.npz") as d:
-        assert d["inputs"].dtype.kind == "U" and {"A_on", "B_on", "A_off", "B_off", "C", "T0"} <= set(d.files)
+        assert d["inputs"].dtype.kind == "U" and {"A_on", "B_on", "A_off", "B_off", "C", "D", "y0", "offsets",
+                                                  "modes", "pumps", "T0"} <= set(d.files)
     np.savez(tmp_path / "bad.npz", A_on=np.eye(2))
     with pytest.raises(InputError, match="not a reduced model"):
         load_rom(tmp_path / "bad.npz")
@@ -110,11 +115,11 @@ def test_observer_recovers_state_and_learns_a_wrong_delta_map(coarse):
     disc = discretise(rom, 60.0)
     t = sample_times(5 * 3600.0)
     oil = np.where((t // 3600) % 2 == 0, 20.0, 0.0)
-    u, modes = np.column_stack([oil, np.zeros_like(t)]), (t[:-1] // 3600) % 2 == 0
+    u, modes = np.column_stack([oil, np.zeros_like(t)]), np.where((t[:-1] // 3600) % 2 == 0, 0, 1)
     X = march_rom(disc, u, modes, 1.5 * uniform_state(rom, disc))
     Y = X @ rom.C.T
-    ch = [rom.output(k) for k in ("theta_A_K", "theta_B_K", "theta_C_K")]
-    delta = Y[:, rom.output("delta_um")] + 0.8 * Y[:, rom.output("theta_C_K")]
+    ch = [rom.output(k) for k in ("theta_A_degC", "theta_B_degC", "theta_C_degC")]
+    delta = Y[:, rom.output("delta_um")] + 0.8 * Y[:, rom.output("theta_C_degC")]
     rng = np.random.default_rng(0)
     est = kalman(rom, disc, u, modes, Y[:, ch] + rng.normal(0, 0.05, (len(t), 3)), ch,
                  delta + rng.normal(0, 0.1, len(t)), ObserverParams())

@@ -11,9 +11,10 @@ import pytest
 from conftest import COARSE, FIXED, FIXED_MODEL, fixed_condition
 from gatetherm import InputError
 from gatetherm.solvers.frame import build_model
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.run.config import config_toml, load_config
-from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.studies.run.frame_case import gate_frame
+from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 
 EFFECT = {"compliant_base": 3e10}
 
@@ -39,18 +40,17 @@ def test_simulate_and_compensate_see_the_model_files_effect(model_toml, tmp_path
     assert a["effects"] == EFFECT
     assert b["swing_um"] == pytest.approx(a["swing_um"], rel=1e-6)
     # and the effect matters: without it the swing differs by far more than that
-    base = run_scenario(dataclasses.replace(load_config(model_toml), effects={}), 2,
-                        condition_schedule(1, load_config()))
+    base = run_scenario(gate_frame(2, dataclasses.replace(load_config(model_toml), effects={})))
     assert abs(np.ptp(base.columns["delta_um"]) - a["swing_um"]) > 1.0
 
 
 def test_effects_of_the_file_and_of_the_caller_add_up():
     cfg, sched = fixed_condition(30, condition=2)
     cfg = dataclasses.replace(cfg, effects={"joint_resistance": 400.0})
-    both = run_scenario(cfg, 2, sched, {"stand_drift": 1.5})
+    both = run_scenario(cfg, sched, {"stand_drift": 1.5})
     assert both.effects.values == {"joint_resistance": 400.0, "stand_drift": 1.5}
-    explicit = run_scenario(dataclasses.replace(cfg, effects={}), 2, sched,
-                            {"joint_resistance": 400.0, "stand_drift": 1.5}, mesh=both.model.fmesh)
+    explicit = run_scenario(dataclasses.replace(cfg, effects={}), sched,
+                            {"joint_resistance": 400.0, "stand_drift": 1.5})
     np.testing.assert_array_equal(both.columns["delta_um"], explicit.columns["delta_um"])
     # the observation-side effect acts on what the sensors report, not on the model's own run
     assert not np.array_equal(both.columns["delta_um"], both.result.columns["delta_um"])
@@ -59,10 +59,10 @@ def test_effects_of_the_file_and_of_the_caller_add_up():
 def test_cache_reuses_the_model_and_the_run():
     cfg, sched = fixed_condition(10)
     cache = ScenarioCache()
-    a = run_scenario(cfg, 2, sched, cache=cache)
-    b = run_scenario(cfg, 2, sched, {"thermocouple_lag": 60.0}, cache=cache)  # observation only: no rerun
+    a = run_scenario(cfg, sched, cache=cache)
+    b = run_scenario(cfg, sched, {"thermocouple_lag": 60.0}, cache=cache)  # observation only: no rerun
     assert cache.runs == 1 and a.model is b.model
-    run_scenario(cfg, 2, sched, {"ambient_drift": 0.5}, cache=cache)  # the drive changes: a new run
+    run_scenario(cfg, sched, {"ambient_drift": 0.5}, cache=cache)  # the room changes: a new run
     assert cache.runs == 2
 
 

@@ -67,9 +67,9 @@ def test_model_file_sensors_section(tmp_path):
 def test_scenario_observes_the_sensor_faults_of_the_model_file():
     cfg, sched = fixed_condition(20)
     cache = ScenarioCache()
-    plain = run_scenario(cfg, 2, sched, cache=cache)
+    plain = run_scenario(cfg, sched, cache=cache)
     faults = {"theta_B_degC": {"offset": 0.3, "lag": 60.0}, "delta_um": {"gain": 1.05}}
-    faulty = run_scenario(dataclasses.replace(cfg, sensors=faults), 2, sched, cache=cache)
+    faulty = run_scenario(dataclasses.replace(cfg, sensors=faults), sched, cache=cache)
     assert cache.runs == 1  # observation only: the kept run is observed again
     expect = apply_faults(plain.columns, faults)
     for c in ("theta_A_degC", "theta_B_degC", "delta_um"):

@@ -18,7 +18,7 @@ import gatetherm
 from gatetherm import InputError
 from gatetherm.solvers import beam
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
-from gatetherm.studies.cli import main
+from gatetherm.cli import main
 from gatetherm.studies.sweeps import runner as sweep_runner
 from gatetherm.studies.sweeps.studyfile import parse_study
 from gatetherm.studies.run.config import parse_config
@@ -244,7 +244,7 @@ def test_killed_sweep_restarts_to_the_same_table(study_dir):
     study = study_dir / "study.toml"
     study.write_text(STUDY.replace('"derived.beta" = [0.1]', '"derived.beta" = [0.03, 0.3]'))
     out = study_dir / "killed"
-    cmd = [sys.executable, "-m", "gatetherm.studies.cli", "sweep", str(study), "--out", str(out), "--workers", "2",
+    cmd = [sys.executable, "-m", "gatetherm.cli", "sweep", str(study), "--out", str(out), "--workers", "2",
            "--no-plots"]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     deadline = time.monotonic() + 60
@@ -254,8 +254,8 @@ def test_killed_sweep_restarts_to_the_same_table(study_dir):
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     deadline = time.monotonic() + 10
-    while any(map(alive, workers)) and time.monotonic() < deadline:
-        time.sleep(0.01)
+    while (any(map(alive, workers)) or group(proc.pid)) and time.monotonic() < deadline:
+        time.sleep(0.01)  # the workers, and gmsh's processes they started, die with the sweep
     left = group(proc.pid)
     for pid in left:
         os.kill(pid, signal.SIGKILL)

@@ -15,7 +15,8 @@ import logging
 import numpy as np
 from scipy.optimize import minimize
 
-from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.studies.run.frame_case import condition_runs
+from gatetherm.studies.run.scenario import ScenarioCache
 from gatetherm.studies.run.simulate import delta_figures
 from gatetherm.validation import paper_model
 
@@ -54,9 +55,9 @@ def with_values(base, x):
 
 
 def figures(cfg, dim: int = 2) -> dict[int, dict]:
-    cache, out = ScenarioCache(), {}
-    for c in TARGETS:
-        cols = run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache).columns
+    out = {}
+    for c, run in condition_runs(cfg, dim, TARGETS, ScenarioCache()).items():
+        cols = run.columns
         out[c] = delta_figures(cols["time_s"], cols["delta_um"])
         out[c]["wall_rise_10min"] = float(cols["T_tank_wall_degC"][10] - cols["T_tank_wall_degC"][0])
     return out

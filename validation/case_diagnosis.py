@@ -17,7 +17,6 @@ named. Writes ``DIR/case_diagnosis.md`` and ``DIR/case_diagnosis.json``.
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 from pathlib import Path
 
@@ -26,7 +25,7 @@ from gatetherm.studies.diagnosis.discrepancy import diagnose
 from gatetherm.studies.diagnosis.hypotheses import catalogue, configure
 from gatetherm.studies.run.case import Case, load_case
 from gatetherm.studies.run.output import write_json
-from gatetherm.studies.run.scenario import case_schedule, run_scenario
+from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, write_timeseries
 from gatetherm.validation.hidden_effects import diagnosis_row, fmt, recorded
 
@@ -62,9 +61,9 @@ def hidden(case: Case, labels: dict) -> dict:
 
 def measured_run(case: Case, values: dict, seed: int, name: str):
     """The rig's record of ``case`` with the hidden pieces ``values``, run with P2 elements."""
-    truth = configure(dataclasses.replace(case, problem=dataclasses.replace(case.problem, order=2)), values)
-    schedule = case_schedule(case)
-    cols = run_scenario(truth, case.mesh.dim, schedule).columns
+    truth = configure(case.with_overrides({"case.order": 2}), values)
+    schedule = case.schedule
+    cols = run_scenario(truth, schedule).columns
     return recorded(cols, ("time_s", *schedule.drive.columns, *OUTPUT_COLUMNS), OUTPUT_COLUMNS, seed,
                     {"source": f"case-diagnosis study, scenario {name} (P2 truth of {case.path.name})"})
 

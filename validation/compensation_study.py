@@ -140,12 +140,11 @@ def _row(number: int, label: str, ts, predictor, params, actuator) -> tuple[Row,
 def study(cfg, dim: int = 2, conditions=(1, 2, 3), params: CompensatorParams = CompensatorParams(),
           actuator: piezo.ActuatorParams = piezo.ActuatorParams()) -> Study:
     """Simulate ``conditions`` on ``cfg``'s model and compensate each with every predictor."""
-    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.studies.run.scenario import ScenarioCache
     from gatetherm.studies.run.timeseries import FORMAT
 
-    cache = ScenarioCache()
-    sims = {n: run_scenario(cfg, dim, condition_schedule(n, cfg), cache=cache)
-            for n in sorted(set(conditions) | {FIT_ON})}
+    sims = condition_runs(cfg, dim, sorted(set(conditions) | {FIT_ON}), ScenarioCache())
     runs = {n: s.series({"format": FORMAT, "condition": str(n)}) for n, s in sims.items()}
     model = sims[FIT_ON].model
     baseline = fit_regression(runs[FIT_ON], THETAS)

@@ -30,12 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import write_text_atomic
-from gatetherm.geometry.build import build_mesh
 from gatetherm.studies.diagnosis.calibrate import coordinate
 from gatetherm.studies.diagnosis.discrepancy import diagnose
 from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece, catalogue, configure
 from gatetherm.studies.diagnosis.replay import DELTA
 from gatetherm.studies.run.config import Config
+from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 from gatetherm.studies.sweeps.pool import run_pool
@@ -60,9 +60,10 @@ class Pair:
     seed: int
 
 
-def pieces_by_key(config: Config) -> dict[str, Piece]:
-    """Every hypothesis of a diagnosis of the rig's channels, by key."""
-    return {p.key: p for p in catalogue(config, OUTPUT_COLUMNS)}
+def pieces_by_key(config: Config, case=None) -> dict[str, Piece]:
+    """Every hypothesis of a diagnosis of the rig's channels on the frame of ``config`` (``case``: that
+    frame, made already), by key."""
+    return {p.key: p for p in catalogue(case or frame_case(config, 2), OUTPUT_COLUMNS)}
 
 
 def _middle_half(p: Piece, u: float, side: int) -> float:
@@ -91,16 +92,17 @@ def visible(config: Config, conditions=(1, 2, 3), dim: int = 2) -> dict[tuple[in
     """For every condition and hypothesis: does it show at both :func:`weakest` values, by
     the catalogue's criterion (δ changes by more than 0.4 µm RMS over the last two hours or
     a thermocouple by more than 0.3 K at its peak; ``solvers.effects.Effect``)?"""
-    pieces = pieces_by_key(config)
+    case = frame_case(config, dim)
+    pieces = pieces_by_key(config, case)
     out = {(c, k): True for c in conditions for k in pieces}
-    cache = ScenarioCache(build_mesh(config.model.frame, dim, config.model.mesh), 2)
+    cache = ScenarioCache(2)
     for cond in conditions:
-        sched = condition_schedule(cond, config)
+        sched = condition_schedule(cond, config.supply)
         last = sched.times >= sched.times[-1] - 2 * 3600.0
-        base = run_scenario(config, dim, sched, cache=cache).columns
+        base = run_scenario(case, sched, cache=cache).columns
         for k, p in pieces.items():
             for v in weakest(p):
-                cols = run_scenario(configure(config, {p: v}), dim, sched, cache=cache).columns
+                cols = run_scenario(configure(case, {p: v}), sched, cache=cache).columns
                 d = float(np.sqrt(np.mean((cols[DELTA] - base[DELTA])[last] ** 2)))
                 th = max(float(np.max(np.abs(cols[c] - base[c]))) for c in THERMOCOUPLES)
                 out[cond, k] &= d > VISIBLE_DELTA_UM or th > VISIBLE_THETA_K
@@ -131,10 +133,11 @@ def pairs(config: Config, n: int = 48, seed: int = 14, conditions=(1, 2, 3), sho
 
 def run_pair(pair: Pair, config: Config) -> dict:
     """Make the measured run of ``pair``, diagnose it blind, return the study row."""
-    known = pieces_by_key(config)
+    case = frame_case(config, 2)
+    known = pieces_by_key(config, case)
     values = {known[k]: v for k, v in pair.pieces}
     ts = single.measured(single.truth_with(config, pair.condition, values), pair.seed, pair.condition)
-    row = single.diagnosis_row(diagnose(config, ts))
+    row = single.diagnosis_row(diagnose(case, ts, single.SETTINGS))
     hidden = [k for k, _ in pair.pieces]
     named = set(row["pieces"])
     either = named | set(row["alternatives"])

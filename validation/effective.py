@@ -54,10 +54,10 @@ def score(name: str, ki: float, kc: float, runs: dict[int, dict]) -> Source:
 
 def condition_runs(cfg: Config, dim: int) -> tuple[object, dict[int, dict]]:
     """The model and its run columns for conditions 1-3."""
-    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.studies.run.scenario import ScenarioCache
 
-    cache = ScenarioCache()
-    runs = {c: run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache) for c in CONDITIONS}
+    runs = condition_runs(cfg, dim, CONDITIONS, ScenarioCache())
     return runs[CONDITIONS[0]].model, {c: r.columns for c, r in runs.items()}
 
 

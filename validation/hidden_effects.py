@@ -32,8 +32,10 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import write_text_atomic
-from gatetherm.solvers.effects import CATALOGUE
+from gatetherm.solvers.effects import resolve
+from gatetherm.solvers.frame import EFFECTS, TARGETS
 from gatetherm.studies.run.config import Config, load_config
+from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
 from gatetherm.studies.diagnosis.replay import DELTA, resolution
 from gatetherm.studies.diagnosis.hypotheses import configure
@@ -51,6 +53,9 @@ NOISE_RMS_UM = 0.1 * np.sqrt(1 + 1 / 12)
 """RMS of the added δ noise: Gaussian at the resolution, then rounded to it, µm."""
 TRUTH_MESH_FACTOR = 0.75
 """Element size of the "measured" runs relative to the diagnosis mesh."""
+SETTINGS = Settings(p2_check=False)
+"""The diagnosis of the study (the frame's own discretisation is below the resolution at its mesh:
+README, Verification; the P2 run would only cost time)."""
 
 #: Effects outside the catalogue: name -> (parameter, unit, strengths tried).
 OUTSIDE = {
@@ -80,7 +85,7 @@ def draw_strengths(name: str, rng: np.random.Generator) -> tuple[float, float]:
     """One strength in the lower and one in the upper third of the plausible range
     (log scale for positive ranges; for a range through zero, |x| in 0.2–1 of the
     upper end with a random sign)."""
-    e = CATALOGUE[name]
+    e = resolve(name, TARGETS)
     if e.log_scale:
         a, b = np.log10(e.lo), np.log10(e.hi)
         return tuple(float(10 ** rng.uniform(a + k * (b - a) / 3, a + (k + 1) * (b - a) / 3)) for k in (0, 2))
@@ -94,7 +99,7 @@ def truth_setup(config: Config, condition: int, mesh_factor: float = TRUTH_MESH_
     """``config`` on the truth mesh (``mesh_factor`` × the model's element size) and the
     condition's schedule, over its duration unless ``duration`` (s) is given."""
     mesh = dataclasses.replace(config.model.mesh, size=config.model.mesh.size * mesh_factor)
-    sched = condition_schedule(condition, config, step_s)
+    sched = condition_schedule(condition, config.supply, step_s)
     if duration:
         sched = dataclasses.replace(sched, times=sample_times(duration, step_s))
     return dataclasses.replace(config, model=dataclasses.replace(config.model, mesh=mesh)), sched
@@ -104,7 +109,7 @@ def truth_with(config: Config, condition: int, values: dict, dim: int = 2, **set
     """The noise-free columns with the hypotheses ``values`` ({Piece: value}: effects,
     parameters, sensor faults) in the model, on the truth mesh (:func:`truth_setup`)."""
     cfg, sched = truth_setup(config, condition, **setup)
-    return run_scenario(configure(cfg, values), dim, sched).columns
+    return run_scenario(configure(frame_case(cfg, dim), values), sched).columns
 
 
 def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_MESH_FACTOR,
@@ -113,10 +118,10 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
     full, sched = truth_setup(config, case.condition, mesh_factor, duration)
     cfg = full.model
 
-    def run(model_cfg, schedule=sched, **kw):
-        return run_scenario(dataclasses.replace(config, model=model_cfg), dim, schedule, **kw)
+    def run(model_cfg, schedule=sched, mesh=None, **kw):
+        return run_scenario(frame_case(dataclasses.replace(config, model=model_cfg), dim, mesh=mesh), schedule, **kw)
 
-    if case.effect in CATALOGUE:
+    if case.effect in EFFECTS:
         return run(cfg, effects={case.effect: case.strength}).columns
     if case.effect == "tie_heat_leak":
         from gatetherm.geometry.frame import part_boxes
@@ -177,16 +182,16 @@ def diagnosis_row(d) -> dict:
             "fitted": s["fitted"], "runs": d.runs, "seconds": round(d.seconds, 1), "reason": d.reason}
 
 
-def run_case(case: Case, config: Config | None = None, settings: Settings = Settings(), mesh=None) -> dict:
-    """Make the measured run of ``case``, diagnose it blind, return the study row."""
+def run_case(case: Case, config: Config | None = None, settings: Settings = SETTINGS) -> dict:
+    """Make the measured run of ``case``, diagnose it blind (the frame of ``config``), return the study row."""
     config = config or load_config()
     ts = measured(truth(config, case), case.seed, case.condition)
-    d = diagnose(config, ts, mesh=mesh, settings=settings)
+    d = diagnose(frame_case(config, 2), ts, settings)
     return {"effect": case.effect, "strength": case.strength, "condition": case.condition, "seed": case.seed,
             **diagnosis_row(d)}
 
 
-def cases(seed: int = 6, conditions=(1, 2, 3), effects=tuple(CATALOGUE), noise_seeds: int = 2) -> list[Case]:
+def cases(seed: int = 6, conditions=(1, 2, 3), effects=EFFECTS, noise_seeds: int = 2) -> list[Case]:
     """The study: every effect at two strengths on every condition, noise-only runs
     and the out-of-catalogue effects."""
     rng = np.random.default_rng(seed)
@@ -215,7 +220,7 @@ def acceptance(rows: list[dict]) -> dict:
     def named(r) -> list[str]:
         return (r["named"] or "").split(",") if r["named"] else []
 
-    cat = [r for r in rows if r["effect"] in CATALOGUE]
+    cat = [r for r in rows if r["effect"] in EFFECTS]
     hit = [r for r in cat if r["effect"] in named(r)]
     on_delta = [r for r in hit if r["effect"] != "thermocouple_lag"]
     falls = [1 - r["rms_after_um"] / r["rms_before_um"] for r in on_delta]
@@ -288,7 +293,7 @@ def table_csv(rows: list[dict], columns=COLUMNS, cell=fmt) -> str:
     return buf.getvalue()
 
 
-ALL_CASES = (*CATALOGUE, "none", *OUTSIDE, *MISMATCH)
+ALL_CASES = (*EFFECTS, "none", *OUTSIDE, *MISMATCH)
 """Every kind of case of the study, by name."""
 
 

@@ -33,10 +33,10 @@ def within(key: str, got: float | None, want: float, dim: int) -> bool:
 
 def run_condition(cfg: Config, dim: int, c: int, cache=None, keep_times=()):
     """(the run, its summary: the figures of :data:`PAPER`, wall time, nodes) of condition ``c``."""
-    from gatetherm.studies.run.scenario import condition_schedule, run_scenario
+    from gatetherm.studies.run.frame_case import condition_runs
     from gatetherm.studies.run.simulate import delta_figures
 
-    run = run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache, keep_times=keep_times)
+    run = condition_runs(cfg, dim, (c,), cache, keep_times=keep_times)[c]
     cols = run.columns
     return run, {**delta_figures(cols["time_s"], cols["delta_um"]), "wall_time_s": round(run.seconds, 2),
                  "dim": dim, "nodes": len(run.model.fmesh.points), "config": cfg.source, "condition": c}

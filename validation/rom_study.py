@@ -35,13 +35,15 @@ import numpy as np
 
 from gatetherm import write_text_atomic
 from gatetherm.solvers.beam import theory_coefficients
-from gatetherm.solvers.effects import CATALOGUE
+from gatetherm.solvers.effects import resolve
+from gatetherm.solvers.frame import EFFECTS, TARGETS
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import CompensatorParams, close_loop, compensate, external_prediction, summarize
 from gatetherm.studies.control.observer import ObserverParams
 from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
 from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
-from gatetherm.studies.run.reduce import cached_rom, check_run, rom_run
+from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.studies.run.reduce import cached_rom, check_run, rom_outputs
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.validation.hidden_effects import Case, measured, truth
 
@@ -55,7 +57,7 @@ BUDGET = 60
 def mid_strength(name: str) -> float:
     """The middle of an effect's plausible range: geometric mean, or half the upper end of a
     range through zero."""
-    e = CATALOGUE[name]
+    e = resolve(name, TARGETS)
     return float(np.sqrt(e.lo * e.hi)) if e.log_scale else 0.5 * max(abs(e.lo), abs(e.hi))
 
 
@@ -82,7 +84,7 @@ class Row:
     """Largest one-step forecast error of the rom after the first 10 min."""
 
 
-def compare(ts, rom, mlr, K, T_room: float, params: CompensatorParams = CompensatorParams(),
+def compare(ts, rom, mlr, K, params: CompensatorParams = CompensatorParams(),
             actuator: ActuatorParams = ActuatorParams()) -> dict:
     """The four compensators on one series: residual bands, updates, threshold, rom forecast error."""
     band = lambda loop: summarize(loop, params.settle_s)  # noqa: E731
@@ -92,7 +94,7 @@ def compare(ts, rom, mlr, K, T_room: float, params: CompensatorParams = Compensa
                                      actuator))["residual_band_um"]}
     for mode in ("fixed", "event"):
         pr, cmds = rom_prediction(ts, rom, params, PredictiveParams(mode=mode, max_updates=BUDGET), ObserverParams(),
-                                  THETAS, T_room)
+                                  THETAS)
         s = band(close_loop(ts, pr, params, actuator))
         out["rom_5min_um" if mode == "fixed" else "rom_event_um"] = s["residual_band_um"]
         if mode == "event":
@@ -101,7 +103,7 @@ def compare(ts, rom, mlr, K, T_room: float, params: CompensatorParams = Compensa
     return out
 
 
-def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATALOGUE), on_row=None,
+def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=EFFECTS, on_row=None,
           checks: list | None = None, errors: dict | None = None) -> list[Row]:
     """Run every case (see the module docstring); ``on_row(row)`` as each finishes; each reduced
     model's check against the FE runs is appended to ``checks`` as (dim, seconds to build or
@@ -112,25 +114,26 @@ def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATAL
     roms, mlrs, runs = {}, {}, {}
     for dim in dims:
         cache = ScenarioCache()
+        case = frame_case(cfg, dim)
         t0 = time.perf_counter()
-        roms[dim] = cached_rom(cfg, dim, STATES, out, cache, name=f"rom_{dim}d")
+        roms[dim] = cached_rom(case, STATES, out, cache, name=f"rom_{dim}d")
         built = time.perf_counter() - t0
         for n in conditions:
-            fe = run_scenario(cfg, dim, condition_schedule(n, cfg), cache=cache)
+            fe = run_scenario(case, condition_schedule(n, cfg.supply), cache=cache)
             runs[dim, n] = fe.series({})
             cols = fe.result.columns
             if checks is not None:
                 checks.append((dim, built if built > 1.0 else None,
-                               check_run(roms[dim], n, cols, fe.result.seconds, cfg.supply.T_room)))
+                               check_run(roms[dim], f"condition {n}", cols, fe.result.seconds)))
             if errors is not None:
-                y, _ = rom_run(roms[dim], cols, cfg.supply.T_room)
+                y, _ = rom_outputs(roms[dim], cols)
                 errors[dim, n] = (cols["time_s"], y[:, roms[dim].output("delta_um")] - cols["delta_um"])
-        first = runs[dim, 1] if 1 in conditions else run_scenario(cfg, dim, condition_schedule(1, cfg), cache=cache).series({})
+        first = runs[dim, 1] if 1 in conditions else run_scenario(case, cache=cache).series({})
         mlrs[dim] = fit_regression(first, THETAS)
 
     def add(case, n, data, dim_rom, ts):
         row = Row(case, n, data, f"{dim_rom}-D, {roms[dim_rom].states} states",
-                  **compare(ts, roms[dim_rom], mlrs[dim_rom], K, cfg.supply.T_room))
+                  **compare(ts, roms[dim_rom], mlrs[dim_rom], K))
         rows.append(row)
         if on_row:
             on_row(row)
@@ -145,9 +148,9 @@ def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=tuple(CATAL
         for name in effects:
             v = mid_strength(name)
             for n in conditions:
-                seed = SEED + 100 * n + list(CATALOGUE).index(name)
+                seed = SEED + 100 * n + EFFECTS.index(name)
                 ts = measured(truth(cfg, Case(name, v, n, seed)), seed, n)
-                add("measured", n, f"{name} {v:.4g} {CATALOGUE[name].unit} + noise", 2, ts)
+                add("measured", n, f"{name} {v:.4g} {resolve(name, TARGETS).unit} + noise", 2, ts)
     return rows
 
 
@@ -167,7 +170,8 @@ LEGEND = (f"Residual band: largest |compensated δ| at every 1-min sample after 
 
 def check_rows(checks) -> list[tuple[str, ...]]:
     """Rows under :data:`CHECK_COLUMNS` of the checks of :func:`study`."""
-    return [(f"{dim}-D, {STATES} states{'' if built is None else f' (built in {built:.0f} s)'}", str(c.condition),
+    return [(f"{dim}-D, {STATES} states{'' if built is None else f' (built in {built:.0f} s)'}",
+             c.schedule.removeprefix("condition "),
              f"{c.max_delta_error_um:.3f}", f"{c.max_theta_error_K:.3f}", f"{c.rom_ms:.2f}", f"{c.fe_seconds:.1f}")
             for dim, built, c in checks]
 
@@ -222,7 +226,7 @@ class RomStudy:
 
 
 def write_rom_study(out: Path, cfg, dims=(2, 3), on_row=None, conditions=(1, 2, 3),
-                    effects=tuple(CATALOGUE)) -> RomStudy:
+                    effects=EFFECTS) -> RomStudy:
     """Run the study (``conditions`` and catalogue ``effects``: a subset of its cases), write
     ``rom_study.md`` and ``.csv``."""
     out = Path(out)

@@ -229,3 +229,17 @@ def hysteresis_cost_um(p: ActuatorParams, steps: int = 30) -> float:
     """What the hysteresis costs at the cutting area without the reset strategy, um:
     transmission x the open-loop width of the direct-drive loop."""
     return p.transmission * loop_width_um(replace(p, strategy="direct"), steps)
+
+
+def with_stroke(p: ActuatorParams, lo_um: float, hi_um: float) -> ActuatorParams:
+    """``p`` with the transmission and bias voltage that make its reach at the cutting area
+    ``lo_um`` (away, < 0) .. ``hi_um`` (towards, > 0): the whole reset-curve stroke times the
+    transmission spans the range, the bias voltage sits where its stroke times the transmission is
+    ``hi_um``."""
+    if not (math.isfinite(lo_um) and math.isfinite(hi_um) and lo_um < 0 <= hi_um):
+        raise InputError("actuator.stroke", f"[{lo_um:g}, {hi_um:g}] um is not a range around 0",
+                         "give [most negative (away), most positive (towards)], e.g. [-60, 20]")
+    full = float(reset_curve(p, p.max_voltage_V))
+    transmission = (hi_um - lo_um) / full
+    bias = float(voltage_for(replace(p, transmission=transmission), hi_um / transmission))
+    return replace(p, transmission=transmission, bias_voltage_V=bias)

@@ -150,10 +150,11 @@ def held_ratio(numerator: float, denominator: float, previous: float, threshold_
     return (float(np.clip(ratio, *limits)) if limits else ratio), False
 
 
-def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=()) -> tuple[TimeSeries, bool]:
-    """The needed columns and ``extra`` ones on the sampling grid from the first sample; linear
-    resampling if off it (``pump`` held from the sample before)."""
-    validate_complete(ts, NEEDED)
+def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=(), held=("pump",),
+                    needed=NEEDED) -> tuple[TimeSeries, bool]:
+    """The ``needed`` columns and ``extra`` ones on the sampling grid from the first sample; linear
+    resampling if off it (the ``held`` ones, pump states, from the sample before)."""
+    validate_complete(ts, needed)
     t, dt = ts.time_s, params.sample_interval_s
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
@@ -164,13 +165,13 @@ def controller_grid(ts: TimeSeries, params: CompensatorParams, extra=()) -> tupl
     if len(grid) < 3:
         raise InputError("time_s", f"the run covers fewer than 3 samples of {dt:g} s",
                          "the one-step extrapolation needs at least 3")
-    names = NEEDED + tuple(n for n in extra if n not in NEEDED)
+    names = tuple(needed) + tuple(n for n in extra if n not in needed)
     if len(grid) == len(t) and np.allclose(t, grid, rtol=0, atol=1e-6 * dt):
         return TimeSeries({n: ts[n] for n in names}), False
     log.info("data not on a %g s grid (%d samples, spacing %.4g..%.4g s): resampled linearly to %d",
              dt, len(t), np.diff(t).min(), np.diff(t).max(), len(grid))
     before = np.clip(np.searchsorted(t, grid + 1e-9 * dt, side="right") - 1, 0, len(t) - 1)
-    return TimeSeries({"time_s": grid, **{n: ts[n][before] if n == "pump" else np.interp(grid, t, ts[n])
+    return TimeSeries({"time_s": grid, **{n: ts[n][before] if n in held else np.interp(grid, t, ts[n])
                                           for n in names[1:]}}), True
 
 
@@ -225,12 +226,17 @@ def held_commands(pred_um: np.ndarray, params: CompensatorParams) -> np.ndarray:
     return -np.nan_to_num(pred_um[(np.arange(len(pred_um)) // every) * every], nan=0.0)
 
 
-def external_prediction(ts: TimeSeries, pred_um, params: CompensatorParams) -> Prediction:
+def external_prediction(ts: TimeSeries, pred_um, params: CompensatorParams, ahead: bool = False,
+                        needed=NEEDED) -> Prediction:
     """Wrap another predictor's delta (um, at ``ts``'s samples) for :func:`close_loop`;
-    it has no correction factors (R_i = R_C = NaN) and no theory term."""
-    grid, resampled = controller_grid(ts, params)
+    it has no correction factors (R_i = R_C = NaN) and no theory term. With ``ahead`` each grid
+    sample's value is forecast one sample earlier by the extrapolation (33) of the predictor's
+    values, the paper's latency (NaN for the first two). ``ts`` needs the ``needed`` columns."""
+    grid, resampled = controller_grid(ts, params, needed=needed)
     pred = np.asarray(pred_um, float)
     pred = np.interp(grid.time_s, ts.time_s, pred) if resampled else pred
+    if ahead:
+        pred = np.concatenate([[np.nan, np.nan], extrapolate(pred[:-2], pred[1:-1])])
     nan = np.full(len(pred), np.nan)
     return Prediction(grid.time_s, grid["delta_um"], nan, pred, nan, nan, held_commands(pred, params),
                       None, resampled)

@@ -2,7 +2,8 @@
 and an adaptive correction of δ from the measured δ.
 
 1. **State.** ``z = (x, d)``: the reduced state x and an offset d (K) of the room temperature
-   (the room is rarely measured, and a drifting room is the commonest disturbance). Between
+   (the reduced model's ``room`` input: the room is rarely measured, and a drifting room is the
+   commonest disturbance). Between
    samples (the reduced model's exact step for inputs linear between samples,
    :mod:`gatetherm.solvers.rom_time`)
 
@@ -13,7 +14,7 @@ and an adaptive correction of δ from the measured δ.
    ``input_K`` per step (through Γ0 + Γ1), the state by ``state_K`` RMS per step (isotropic in the
    M-orthonormal coordinates, i.e. an RMS temperature over the heat capacity), d is a random walk
    of ``room_K`` per step. The initial state is the frame uniformly at the first room
-   temperature, uncertain by ``initial_K``.
+   temperature, uncertain by ``initial_K``. Modes are indices into the reduced model's modes.
 2. **Output correction.** δ = C_δ x + Σ_j β_j C_j x + β_0 with the C_j the rows of θ_A, θ_B, θ_C
    and the mounting-face mean (:data:`CORRECTION`): the thermoelastic map the model may have
    wrong (a compliant joint or foundation, a sensor stand) corrected by a few coefficients, the
@@ -56,8 +57,8 @@ class ObserverParams:
     """Random-walk step of the δ bias β_0, µm."""
 
 
-CORRECTION = ("theta_A_K", "theta_B_K", "theta_C_K", "T_base_K")
-"""Outputs whose rises the δ correction weighs (β_1..β_4)."""
+CORRECTION = ("theta_A_degC", "theta_B_degC", "theta_C_degC", "T_base_degC")
+"""Outputs whose rises the δ correction weighs (β_1..β_4), those of them the model has."""
 
 
 @dataclass(frozen=True)
@@ -67,7 +68,7 @@ class Estimate:
     z: np.ndarray
     """(samples × (states + 1)): x and the room offset d (K)."""
     beta: np.ndarray
-    """(samples × (len(CORRECTION) + 1)): the correction coefficients β_j (µm/K) and β_0 (µm)."""
+    """(samples × (corrections + 1)): the correction coefficients β_j (µm/K) and β_0 (µm)."""
     correction: np.ndarray
     """Rows of C the β_j weigh, then zeros (β_0 multiplies 1)."""
 
@@ -77,37 +78,44 @@ class Estimate:
 
 
 def uniform_state(rom: ReducedModel, disc: Discrete) -> np.ndarray:
-    """The reduced state of the frame uniformly 1 K above T0: the steady state of the pump-off
-    mode for a room 1 K warmer (the static responses are in the basis)."""
-    return np.linalg.solve(np.eye(rom.states) - disc.Phi[False], disc.G0[False][:, 1] + disc.G1[False][:, 1])
+    """The reduced state of the body uniformly 1 K above T0: the steady state of the last mode
+    (every pump off) for every temperature input 1 K warmer (the static responses are in the basis)."""
+    off = len(rom.modes) - 1
+    g = sum((disc.G0[off] + disc.G1[off])[:, j] for j, u in enumerate(rom.inputs) if u.offset == rom.T0)
+    return np.linalg.solve(np.eye(rom.states) - disc.Phi[off], g)
+
+
+def room_column(rom: ReducedModel, g: np.ndarray) -> np.ndarray:
+    """The column of ``g`` (states × inputs) of the room input (zeros without one)."""
+    return g[:, rom.room] if rom.room is not None else np.zeros(len(g))
 
 
 def kalman(rom: ReducedModel, disc: Discrete, u: np.ndarray, modes: np.ndarray, readings: np.ndarray,
            channels: list[int], delta: np.ndarray | None, params: ObserverParams = ObserverParams()) -> Estimate:
-    """Filter a run: inputs ``u`` (samples × 2, deviations from T0), interval modes, temperature
-    ``readings`` (samples × channels, rises from T0; NaN = missing) of the outputs ``channels``
-    (rows of C), and the measured δ (µm; None: no correction)."""
+    """Filter a run: inputs ``u`` (samples × inputs, less their offsets), interval mode indices,
+    temperature ``readings`` (samples × channels, less the outputs' y0; NaN = missing) of the
+    outputs ``channels`` (rows of C), and the measured δ (µm; None: no correction)."""
     r, n = rom.states, rom.states + 1
     x1 = uniform_state(rom, disc)
     iso = (params.state_K * np.linalg.norm(x1)) ** 2 / r  # |x1|² is the total heat capacity
     F, Q = {}, {}
-    for p in (True, False):
+    for p in disc.Phi:
         g = disc.G0[p] + disc.G1[p]
         F[p] = np.eye(n)
-        F[p][:r, :r], F[p][:r, r] = disc.Phi[p], g[:, 1]
+        F[p][:r, :r], F[p][:r, r] = disc.Phi[p], room_column(rom, g)
         Q[p] = np.zeros((n, n))
         Q[p][:r, :r] = params.input_K ** 2 * g @ g.T + iso * np.eye(r)
         Q[p][r, r] = params.room_K ** 2
     H = np.zeros((len(channels), n))
     H[:, :r] = rom.C[channels]
-    z = np.r_[u[0, 1] * x1, 0.0]
+    z = np.r_[(u[0, rom.room] if rom.room is not None else 0.0) * x1, 0.0]
     P = np.zeros((n, n))
     P[:r, :r] = params.initial_K ** 2 * np.outer(x1, x1) + iso * np.eye(r)
     P[r, r] = params.initial_K ** 2
     out = np.empty((len(u), n))
     for k in range(len(u)):
         if k:
-            p = bool(modes[k - 1])
+            p = int(modes[k - 1])
             z = F[p] @ z
             z[:r] += disc.G0[p] @ u[k - 1] + disc.G1[p] @ u[k]
             P = F[p] @ P @ F[p].T + Q[p]
@@ -115,7 +123,7 @@ def kalman(rom: ReducedModel, disc: Discrete, u: np.ndarray, modes: np.ndarray, 
         if ok.any():
             z, P = _update(z, P, H[ok], readings[k][ok], np.full(ok.sum(), params.sensor_K ** 2))
         out[k] = z
-    correction = np.array([rom.C[rom.output(o)] for o in CORRECTION])
+    correction = np.array([rom.C[rom.output(o)] for o in CORRECTION if o in rom.outputs])
     beta = _correction(rom, out[:, :r], correction, delta, params)
     return Estimate(out, beta, correction)
 

@@ -2,8 +2,8 @@
 
 At every sample c (data known up to c) the Kalman filter (:mod:`.observer`) has estimated the
 state; the controller forecasts δ over the coming samples from that state and the known
-inputs (it knows when it will switch the pump and the oil set point; for a measured file, the
-file's own future oil, pump and room columns stand for that knowledge), holding the room
+inputs (it knows when it will switch the pump and the oil set point, or the spindle; for a
+measured file, the file's own future input columns stand for that knowledge), holding the room
 offset and the δ correction the filters estimated. A command decided at c acts from c + 1 on, one
 sample of latency as in the paper's procedure.
 
@@ -29,8 +29,9 @@ from gatetherm.solvers.rom import ReducedModel
 from gatetherm.solvers.rom_time import Discrete, discretise, march_rom
 from gatetherm.studies.control.compensator import CompensatorParams, Prediction, controller_grid
 from gatetherm.studies.control.observer import Estimate, ObserverParams, kalman
-from gatetherm.studies.run.reduce import output_of, series_inputs
-from gatetherm.studies.run.timeseries import TimeSeries, validate_complete
+from gatetherm.solvers.expr import Value
+from gatetherm.studies.run.reduce import series_inputs
+from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
 
@@ -69,7 +70,8 @@ def forecast(disc: Discrete, rom: ReducedModel, est: Estimate, c: int, u: np.nda
         return np.zeros(0)
     z = est.z[c]
     ud = u[c:end + 1].copy()
-    ud[:, 1] += z[r]  # the estimated room offset, held
+    if rom.room is not None:
+        ud[:, rom.room] += z[r]  # the estimated room offset, held
     return est.delta_of(rom, c, march_rom(disc, ud, modes[c:end], z[:r])[1:])
 
 
@@ -150,21 +152,21 @@ THERMOCOUPLES = ("theta_A_degC", "theta_B_degC", "theta_C_degC")
 
 
 def rom_prediction(ts: TimeSeries, rom: ReducedModel, params: CompensatorParams, control: PredictiveParams,
-                   observer: ObserverParams = ObserverParams(), sensors=THERMOCOUPLES,
-                   T_room: float = 20.0) -> tuple[Prediction, Commands]:
-    """Filter a series (inputs, ``sensors`` columns, δ) and run the controller on the
-    compensator's sampling grid; the result drives :func:`~.compensator.close_loop`."""
+                   observer: ObserverParams = ObserverParams(), sensors=THERMOCOUPLES) -> tuple[Prediction, Commands]:
+    """Filter a series (the reduced model's inputs, ``sensors`` columns, δ) and run the controller
+    on the compensator's sampling grid; the result drives :func:`~.compensator.close_loop`."""
     sensors = tuple(sensors)
-    validate_complete(ts, ("oil_degC", "pump"))
     missing = [s for s in sensors if s not in ts]
     if missing:
         raise InputError(f"column {missing[0]}", "named as an observer sensor but absent", "name columns of the file")
-    channels = [rom.output(output_of(s)) for s in sensors]
-    grid, resampled = controller_grid(ts, params, ("oil_degC", "pump", *sensors)
-                                      + (("ambient_degC",) if "ambient_degC" in ts else ()))
-    u, modes = series_inputs(rom, grid.columns, T_room)
+    channels = [rom.output(s) for s in sensors]
+    pumps = set().union(*(Value.of(p).names() for p in rom.pumps)) - {"t"}
+    read = set().union(*(Value.of(u.text).names() for u in rom.inputs)) | pumps
+    extra = tuple(sorted(k for k in read - {"t"} if k in ts)) + sensors
+    grid, resampled = controller_grid(ts, params, extra, held=tuple(pumps))
+    u, modes = series_inputs(rom, grid.columns)
     disc = discretise(rom, params.sample_interval_s)
-    readings = np.column_stack([grid[s] - rom.T0 for s in sensors])
+    readings = np.column_stack([grid[s] - rom.y0[c] for s, c in zip(sensors, channels)])
     est = kalman(rom, disc, u, modes, readings, channels, grid["delta_um"], observer)
     nominal = march_rom(disc, u, modes) @ rom.C[rom.output("delta_um")]
     cmds = commands(rom, disc, est, u, modes, control, nominal)

@@ -24,15 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.solvers.effects import CATALOGUE
-from gatetherm.solvers.frame import PUMP, SUPPLY
 from gatetherm.studies.diagnosis.calibrate import Objective, Scored, uncertainty
-from gatetherm.studies.diagnosis.hypotheses import Piece, configure, effect_pieces, parameter_pieces, sensor_pieces
+from gatetherm.studies.diagnosis.hypotheses import (Piece, configure, effect_keys, effect_pieces, parameter_pieces,
+                                                    sensor_pieces)
 from gatetherm.studies.diagnosis.locate import Finding, Phase, input_phases, locate, noise_sd, phases
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
 from gatetherm.studies.diagnosis.select import Round, Selection, select
 from gatetherm.studies.run.case import Case
-from gatetherm.studies.run.config import Config
 from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
@@ -57,6 +55,9 @@ class Settings:
     max_pieces: int = 4
     screen_top: int = 3
     """Hypotheses that need model runs fitted for real in each round after the first (the rest screened)."""
+    p2_check: bool = True
+    """A linear-element case is run once more with quadratic elements: its own discretisation error
+    against the sensors' resolution (:func:`discretisation`)."""
 
 
 @dataclass(frozen=True)
@@ -113,7 +114,7 @@ class Diagnosis:
     dim: int = 2
     """Dimension of the replayed model."""
     inputs: tuple[str, ...] | None = None
-    """The columns of the file that drove a case file's frame (None: the paper frame)."""
+    """The columns of the file that drove the case."""
     discretisation: dict[str, float] | None = None
     """A P1 case: the largest |P2 − P1| of the baseline per channel, in units of its resolution
     (above 1, the model's own discretisation error shows in the data)."""
@@ -161,26 +162,23 @@ class Diagnosis:
         }
 
 
-def candidates(config: Config | Case, channels, has_ambient: bool, settings: Settings) -> list[Piece]:
+def candidates(case: Case, channels, has_ambient: bool, settings: Settings) -> list[Piece]:
     """The hypotheses a diagnosis tries (those that can act on the file)."""
-    case = isinstance(config, Case)
-    asked = tuple(CATALOGUE) if settings.effects is None else settings.effects
-    bad = [n for n in asked if n not in CATALOGUE]
+    known = effect_keys(case)
+    asked = known if settings.effects is None else list(settings.effects)
+    bad = [n for n in asked if n not in known]
     if bad:
-        raise InputError("--effects", f"unknown effect {', '.join(bad)}", f"choose from {', '.join(CATALOGUE)}")
-    effects = effect_pieces(asked, has_ambient, config if case else None)
-    if case and settings.effects is not None and len(effects) < len(asked):
-        n = next(n for n in asked if n not in {p.name for p in effects})
-        raise InputError("--effects", f"{n} acts on the paper frame's model or room, or needs a [means] entry "
-                         "'base', not on this case", "model it in the case (materials, supports, sources) instead")
-    params = parameter_pieces(config)
-    known = [p.name for p in params]
-    bad = [n for n in settings.parameters or () if n not in known]
+        raise InputError("--effects", f"'{bad[0]}' is not an effect this case can have",
+                         f"choose from {', '.join(known)}")
+    effects = effect_pieces(case, asked, has_ambient)
+    params = parameter_pieces(case)
+    names = [p.name for p in params]
+    bad = [n for n in settings.parameters or () if n not in names]
     if bad:
-        raise InputError("--parameters", f"unknown parameter {', '.join(bad)}", f"choose from {', '.join(known)}")
+        raise InputError("--parameters", f"unknown parameter {', '.join(bad)}", f"choose from {', '.join(names)}")
     if settings.parameters is not None:
         params = [p for p in params if p.name in settings.parameters]
-    return effects + params + (sensor_pieces(channels, config) if settings.sensors else [])
+    return effects + params + (sensor_pieces(channels, case) if settings.sensors else [])
 
 
 def _shares(obj: Objective, sel) -> list[float]:
@@ -205,27 +203,38 @@ def _verdict(discrepant: bool, sel) -> tuple[str, str]:
     return "partly-explained", f"{names} lower the held-out score, but a significant residual remains"
 
 
-def diagnose(config: Config | Case, ts: TimeSeries, dim: int = 2, mesh=None,
-             settings: Settings = Settings()) -> Diagnosis:
-    """Run the whole workflow on a measured series ``ts``, replayed through a model file's
-    frame (at ``dim`` on ``mesh``) or a case file's frame (its own mesh)."""
+def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Diagnosis:
+    """Run the whole workflow on a measured series ``ts``, replayed through ``case``.
+
+    Parameters
+    ----------
+    case : Case
+        The model (a case file's, or the paper frame's: :func:`~gatetherm.studies.run.frame_case.gate_frame`).
+    ts : TimeSeries
+        The measurement: every input the case reads, and the channels to compare.
+    settings : Settings
+        Training window, margin, candidate effects and parameters.
+
+    Returns
+    -------
+    Diagnosis
+    """
     if not 0.2 <= settings.train_fraction <= 0.9:
         raise InputError("--train-fraction", f"must be between 0.2 and 0.9, got {settings.train_fraction}",
                          "e.g. 0.6: fit on the first 3 h of a 5-h run, score on the last 2 h")
     t0 = time.perf_counter()
-    rep = Replayer(config, ts, dim, mesh)
+    rep = Replayer(case, ts)
     t = rep.times
     base_cols = rep.run()
-    inputs = tuple(rep.drive.columns) if rep.case else None
-    channels = compared_channels(ts, base_cols, inputs or ())
-    pool = candidates(config, channels, rep.has_ambient, settings)
+    inputs = tuple(rep.drive.columns)
+    channels = compared_channels(ts, base_cols, inputs)
+    pool = candidates(case, channels, rep.has_ambient, settings)
     res0 = residuals(ts, base_cols, channels)
     scale = {c: max(resolution(c), noise_sd(res0[c])) for c in channels}
     train = t <= settings.train_fraction * t[-1]
     if (~train).sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
-    run_phases = (input_phases(t, rep.drive.columns) if rep.case
-                  else phases(t, rep.drive.columns[SUPPLY], rep.drive.columns[PUMP]))
+    run_phases = case_phases(case, t, rep.drive.columns)
     findings = locate(t, res0, run_phases)
     obj = Objective(rep, ts, channels, scale, train)
     discrepant = any(f.significant for f in findings)
@@ -239,7 +248,7 @@ def diagnose(config: Config | Case, ts: TimeSeries, dim: int = 2, mesh=None,
     pieces = tuple(PieceResult(p, sel.final.values[p], sigma[p], share, tuple(sel.alternatives.get(p, ())))
                    for p, share in zip(sel.order, _shares(obj, sel)))
     after = obj.residuals(sel.final.values, solve=False)[0] if pieces else None
-    check = discretisation(rep, base_cols, channels) if rep.case and config.problem.order == 1 else None
+    check = discretisation(rep, base_cols, channels) if case.problem.order == 1 and settings.p2_check else None
     log.info("diagnosis: %s (%s), %d model runs", verdict, reason, rep.runs)
     return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, sel.final, tuple(sel.rounds),
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
@@ -255,9 +264,19 @@ def discretisation(rep: Replayer, base: dict, channels) -> dict[str, float]:
     return {c: float(np.max(np.abs(p2[c] - base[c]))) / resolution(c) for c in channels}
 
 
-def adopted_config(config: Config | Case, diag: Diagnosis) -> Config | Case | None:
-    """The model with every chosen piece in it (parameters changed, effects on, sensor faults set)."""
+def adopted_case(case: Case, diag: Diagnosis) -> Case | None:
+    """The case with every chosen piece in it (parameters changed, effects on, sensor faults set)."""
     if not diag.pieces:
         return None
-    return configure(config, {r.piece: r.value for r in diag.pieces})
+    return configure(case, {r.piece: r.value for r in diag.pieces})
+
+
+def case_phases(case: Case, t: np.ndarray, columns: dict) -> list[Phase]:
+    """Phases of a run: a pumped fluid's (pump off, heating, forced cooling, supply steady) where
+    the case has one whose supply and pump are columns, else where an input steps."""
+    fluid = next((f for f in case.problem.fluids if len(f.supply.names()) == 1 and len(f.pump.names()) == 1
+                  and f.supply.text in columns and f.pump.text in columns), None)
+    if fluid is None:
+        return input_phases(t, columns)
+    return phases(t, columns[fluid.supply.text], columns[fluid.pump.text])
 

@@ -1,11 +1,10 @@
 """Replay a measured run through a model and line the outputs up with the measurement.
 
-The model is driven by the file's own inputs (oil, pump, ambient when present; for a
-case file, the schedule columns its values read) at the file's sample times; every
-measured output channel that the model also produces is compared. A :class:`Replayer`
-meshes the frame once (a case brings its mesh) and re-assembles
-only when a hypothesis changes the model itself, and reruns the model only when a
-hypothesis changes the model or the drive (sensor-side effects act on a kept run), so
+The case is driven by the file's own columns (every input its values read; an input it
+gives a default may be missing) at the file's sample times; every measured output channel
+that the model also produces is compared. A :class:`Replayer` re-assembles only when a
+hypothesis changes the model itself, and reruns the model only when a hypothesis changes
+the model (sensor-side effects act on a kept run), so
 the hundred-odd runs of a diagnosis cost well under a second each with the 2-D model.
 
 Residuals are *measured minus model*, in the channel's unit, and are judged
@@ -14,17 +13,13 @@ thermocouples (the paper's sensors).
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 
 import numpy as np
 
-from gatetherm.geometry.build import build_mesh
 from gatetherm import InputError
-from gatetherm.geometry.frame import MeshParams
 from gatetherm.studies.run.case import Case
-from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.scenario import ScenarioCache, case_series_schedule, run_scenario, series_schedule
+from gatetherm.studies.run.scenario import ScenarioCache, measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, TimeSeries
 
 log = logging.getLogger(__name__)
@@ -68,40 +63,37 @@ def compared_channels(ts: TimeSeries, model_columns, inputs=()) -> tuple[str, ..
 
 
 class Replayer:
-    """Runs ``config`` (a model file at ``dim`` on ``mesh``, or a case on its own mesh)
-    through the inputs of the measured series ``ts`` (the scenario path, one mesh and one
-    :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all hypotheses)."""
+    """Runs a case through the inputs of the measured series ``ts`` at its sample times (the
+    scenario path, one :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all hypotheses)."""
 
-    def __init__(self, config: Config | Case, ts: TimeSeries, dim: int = 2, mesh: MeshParams | None = None,
-                 cache: int = 4):
-        if isinstance(config, Case):
-            self.config, self.dim, self.fmesh = config, config.mesh.dim, config.mesh
-            self.schedule = case_series_schedule(config, ts, "measured inputs")
-        else:
-            self.config = dataclasses.replace(config, model=dataclasses.replace(
-                config.model, mesh=mesh or config.model.mesh))
-            self.dim = dim
-            self.schedule = series_schedule(ts, config, "measured inputs")
-            self.fmesh = build_mesh(self.config.model.frame, dim, self.config.model.mesh)
+    def __init__(self, case: Case, ts: TimeSeries, cache: int = 4):
+        self.config = case
+        self.schedule = measured_schedule(case, ts)
         self.times = self.schedule.times
         self.drive = self.schedule.drive
-        self.has_ambient = "ambient_degC" in ts
-        self.cache = ScenarioCache(self.fmesh, cache)
+        self.has_ambient = any(k in ts for k in room_inputs(case))
+        self.cache = ScenarioCache(cache)
 
     @property
-    def case(self) -> bool:
-        """The model is a case file's frame."""
-        return isinstance(self.config, Case)
+    def dim(self) -> int:
+        return self.config.dim
 
     @property
     def runs(self) -> int:
         """Model runs made so far."""
         return self.cache.runs
 
-    def run(self, config: Config | None = None) -> dict[str, np.ndarray]:
-        """Output columns (data-format names and units) of ``config`` (default: the replayer's,
-        which must be a variant of it on the same frame and mesh)."""
-        return run_scenario(config or self.config, self.dim, self.schedule, cache=self.cache).columns
+    def run(self, case: Case | None = None) -> dict[str, np.ndarray]:
+        """Output columns (data-format names and units) of ``case`` (default: the replayer's,
+        which must be a variant of it on the same mesh)."""
+        return run_scenario(case or self.config, self.schedule, cache=self.cache).columns
+
+
+def room_inputs(case: Case) -> set[str]:
+    """The inputs the room's temperature (the films' ambient) reads."""
+    p = case.problem
+    values = [f.ambient for f in p.films] + ([p.faces.ambient] if p.faces else [])
+    return set().union(*(v.names() for v in values)) - {"t"} if values else set()
 
 
 def residuals(ts: TimeSeries, cols: dict[str, np.ndarray], channels) -> dict[str, np.ndarray]:

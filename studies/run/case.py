@@ -11,6 +11,7 @@ valid. README "Case files" is the reference of every key.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -21,24 +22,33 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, ranges
 from gatetherm.files import read_text
-from gatetherm.geometry.gmshfile import CAD, SCRIPT, BoxGroup, MeshSpec, Refinement, mesh_geometry
+from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_geometry
+from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
+from gatetherm.solvers.effects import Targets
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
+from gatetherm.studies.run import case_mech
 from gatetherm.studies.run.tables import Table
 from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
-                                       Relative, Signals, Source, Support)
+                                       Relative, Signals, Source, Support, inputs, values)
+from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
+from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
-            "supports", "probes", "relative", "means", "signals", "time")
+            "supports", "probes", "relative", "means", "signals", "time", "actuator") + case_mech.SECTIONS
 MATERIAL_KEYS = {"k": "W/(m K)", "rho": "kg/m³", "c": "J/(kg K)", "E": "Pa", "nu": "1", "alpha": "1/K",
                  "thickness": "m"}
 MATERIAL = ranges(Material)
 """Admissible values of the material keys (those of the model file's [material])."""
 SCHEME = ranges(TimeScheme)
 METRES, SECONDS = Range(0.0, lo_open=True, unit="m"), Range(0.0, lo_open=True, unit="s")
+THICKNESS = Range(1e-6, 1e3, unit="m")
+"""Thickness of a 2-D section, from a micrometre to a kilometre: far beyond, the solid's
+matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
+C-frame example, whose other regions are 0.25–0.6 m thick)."""
 FILM = Range(0.0, unit="W/(m² K)")
 
 
@@ -60,38 +70,129 @@ class TimeSettings:
 
 @dataclass(frozen=True)
 class Case:
-    """A case file, read and checked against its mesh."""
+    """A model ready to run: a problem on its named mesh, what drives it, and how it was made.
 
-    path: Path
+    A case file is read into one (:func:`load_case`); so is the paper's frame
+    (:func:`gatetherm.studies.run.frame_case.gate_frame`). Every command, study and API
+    function runs a Case; nothing downstream asks which of the two it came from."""
+
     name: str
     problem: Problem
     mesh: FrameMesh
     time: TimeSettings | None = None
     """None: steady state (or a prescribed temperature)."""
+    schedule: Schedule = STEADY
+    """What drives a run by default (a case file's ``[time]`` and schedule file; a paper condition)."""
+    origin: object = None
+    """How the case was made (:class:`CaseFile` or the frame generator's origin): ``remake``
+    with some of its keys changed (:meth:`with_overrides`), and its ``parameters`` (the
+    hypotheses a diagnosis may move)."""
+    targets: Targets = Targets()
+    """The names the effects act on (joints, supports, regions; declared effects)."""
+    defaults: dict = field(default_factory=dict)
+    """Inputs that a recorded series may leave out, with the value they then keep."""
+    actuator: object = None
+    """The compensation actuator (``[actuator]``: an ActuatorParams), None: ideal (a correction sent
+    to the control as an offset)."""
+    parameters: object = None
+    """What a generator made the case from (the frame's ModelConfig), for analyses that only such a
+    model has (beam theory); None for a case file."""
     effects: dict = field(default_factory=dict)
-    """Catalogue effects switched on (the scenario path's interface; none from the file)."""
+    """Effects switched on, {key: value} (:mod:`gatetherm.solvers.effects`)."""
     sensors: dict = field(default_factory=dict)
-    """Sensor faults, {channel: {fault: value}} (the scenario path's interface; none from the file)."""
+    """Sensor faults, {channel: {fault: value}}."""
+    path: Path | None = None
+    """The case (or model) file, if any."""
+    files: tuple[Path, ...] = ()
+    """The files the case reads (itself, its mesh or geometry, its schedule): a run never overwrites them."""
+    source: str = ""
+    """Where the case came from, for metadata (a file path, or the generator and its model file)."""
 
     @property
-    def source(self) -> str:
-        return str(self.path)
+    def dim(self) -> int:
+        return self.mesh.dim
+
+    def with_overrides(self, overrides: dict) -> "Case":
+        """The case made again with ``overrides`` ({dotted key: value} of its file: ``materials.column.k``,
+        ``thermal.free.film``, ``mesh.parameters.h``, ``geometry.l4`` …); effects and sensor faults kept.
+        The mesh is reused when nothing it depends on changed."""
+        if not overrides:
+            return self
+        made = self.origin.remake(overrides, self)
+        return dataclasses.replace(made, effects={**made.effects, **self.effects},
+                                   sensors={**made.sensors, **self.sensors})
+
+    def with_schedule(self, schedule: Schedule) -> "Case":
+        return dataclasses.replace(self, schedule=schedule)
+
+    def inputs(self) -> set[str]:
+        """The schedule columns its values read."""
+        return inputs(self.problem)
+
+    def held(self) -> set[str]:
+        """Inputs that are pump states (they keep their last sample)."""
+        return {n for f in self.problem.fluids for n in f.pump.names()}
+
+
+def nested(overrides: dict) -> dict:
+    """``{"a.b": 1}`` as ``{"a": {"b": 1}}`` (a TOML document to overlay)."""
+    out: dict = {}
+    for key, value in overrides.items():
+        node, parts = out, key.split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise InputError(key, "overrides a value with a table", "check the key")
+        node[parts[-1]] = value
+    return out
+
+
+def overlay(document: dict, changes: dict) -> dict:
+    """``document`` with the tables of ``changes`` merged in (values replaced), as a new dict."""
+    out = dict(document)
+    for k, v in changes.items():
+        out[k] = overlay(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+@dataclass(frozen=True)
+class CaseFile:
+    """A case file as read: its parsed document, to be read again with keys changed."""
+
+    path: Path
+    document: dict = field(repr=False, compare=False)
+    mesh_factor: float = 1.0
+
+    def remake(self, overrides: dict, previous: Case | None = None) -> Case:
+        doc = overlay(self.document, nested(overrides))
+        same_mesh = previous is not None and doc.get("mesh") == self.document.get("mesh")
+        return case_from_document(doc, self.path, self.mesh_factor, previous.mesh if same_mesh else None)
+
+    def parameters(self, case: Case) -> tuple:
+        from gatetherm.studies.run.parameters import case_parameters
+
+        return case_parameters(case)
+
+    def model_file(self, case: Case, header: str = "") -> None:
+        """None: a case file is not rewritten (its comments and layout are the user's); the
+        diagnosis report lists the values to put into it."""
+        return None
 
 
 def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
-    m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups"))
+    m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups", "include"))
     path = base / m.string("file")
     if not path.is_file():
         m.fail("file", f"no such file '{path}'", "give a .msh, .geo or CAD file beside the case")
     suffix = path.suffix.lower()
     if suffix in (".msh", ".vtu"):
-        for k in ("size", "parameters", "refine", "groups"):
+        for k in ("size", "parameters", "refine", "groups", "include"):
             if k in m.data:
                 m.fail(k, f"applies only to a geometry that gatetherm meshes ({SCRIPT}, {', '.join(CAD)})",
                        "mesh the file again in gmsh, or give the .geo")
         if factor != 1.0:
             m.fail("file", "a mesh file cannot be refined", "give the .geo or CAD file to mesh it finer")
-        return load_mesh(path)
+        return _in_case(top, load_mesh, path)
     if suffix not in (SCRIPT, *CAD):
         m.fail("file", f"unknown mesh or geometry format '{suffix}'", f"use .msh, {SCRIPT} or {', '.join(CAD)}")
     params = m.sub("parameters")
@@ -100,16 +201,54 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
         rt = Table(top.file, f"mesh.refine[{i + 1}]", r, ("near", "size", "distance"))
         refine.append(Refinement(rt.string("near"), factor * rt.number("size", METRES),
                                  rt.number("distance", METRES)))
-    groups = []
-    for name in m.data.get("groups", {}):
-        g = m.sub("groups").sub(name, ("dim", "box"))
-        box = g.data.get("box")
-        if not (isinstance(box, list) and len(box) == 6 and all(isinstance(b, (int, float)) for b in box)):
-            g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax], got {box!r}", "give six numbers in m")
-        groups.append(BoxGroup(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(float(b) for b in box)))
+    include = m.data.get("include", [])
+    if not (isinstance(include, list) and all(isinstance(f, str) for f in include)):
+        m.fail("include", f"expected a list of file names, got {include!r}", 'e.g. include = ["../common.geo"]')
+    for f in include:
+        if not (base / f).is_file():
+            m.fail("include", f"no such file '{base / f}'",
+                   "name files the geometry script reads, relative to the case")
+    groups = tuple(_group(m.sub("groups").sub(name, ("dim", "box", "rest", "normal", "tolerance")), name)
+                   for name in m.data.get("groups", {}))
     size = factor * m.number("size", METRES, 0.0) or None
-    return mesh_geometry(MeshSpec(path, size, {k: params.number(k) for k in params.data}, tuple(refine),
-                                  tuple(groups)))
+    return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
+                                                 tuple(refine), groups, tuple(base / f for f in include), base, factor))
+
+
+def _in_case(top: Table, read, arg) -> FrameMesh:
+    """``read(arg)``, its errors about case keys (``mesh.…``, ``--mesh-factor``) naming the case file."""
+    try:
+        return read(arg)
+    except InputError as err:
+        raise err.at(str(top.file)) if err.field.startswith(("mesh", "--")) else err from None
+
+
+def _group(g: Table, name: str) -> GroupRule:
+    """A [mesh.groups.NAME] rule: box (one or a list), rest, normal (with tolerance)."""
+    box = g.data.get("box", [])
+    boxes = [box] if box and all(isinstance(b, (int, float)) for b in box) else box
+    if not (isinstance(boxes, list) and all(_numbers(b, (6,)) for b in boxes)):
+        g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax] or a list of them, got {box!r}",
+               "give six numbers in m per box")
+    rest = g.data.get("rest", False)
+    if not isinstance(rest, bool):
+        g.fail("rest", f"expected true or false, got {rest!r}")
+    normal = g.data.get("normal")
+    if normal is not None and not (_numbers(normal, (2, 3)) and any(normal)):
+        g.fail("normal", f"expected a direction [nx, ny(, nz)], got {normal!r}", "e.g. normal = [0, 0, 1]")
+    if not (boxes or rest or normal):
+        g.fail("box", "the group selects nothing", "give box, normal or rest = true")
+    if "tolerance" in g.data and normal is None:
+        g.fail("tolerance", "goes with normal only", "remove it or give normal")
+    return GroupRule(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(tuple(map(float, b)) for b in boxes),
+                     rest, tuple(map(float, normal)) if normal else None,
+                     g.number("tolerance", Range(0.0, math.pi, lo_open=True, unit="rad"), NORMAL_TOLERANCE))
+
+
+def _numbers(v, lengths) -> bool:
+    """Whether ``v`` is a list of finite numbers of one of ``lengths``."""
+    return isinstance(v, list) and len(v) in lengths and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
 
 
 def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
@@ -129,7 +268,7 @@ def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
         if "thickness" in t.data:
             if fm.dim == 3:
                 t.fail("thickness", "applies to 2-D sections only", "remove it")
-            thickness[region] = t.number("thickness", METRES)
+            thickness[region] = t.number("thickness", THICKNESS)
     return materials, thickness
 
 
@@ -180,12 +319,16 @@ def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
     return tuple(out)
 
 
-def _supports(top: Table, fm: FrameMesh) -> tuple:
-    sup = top.sub("supports", tuple(fm.boundaries))
+def _supports(top: Table, fm: FrameMesh, names) -> tuple:
+    sup = top.sub("supports", case_mech.support_names(fm))
     out = []
     for b in sup.data:
-        t = sup.sub(b, ("type", "components", "stiffness"))
-        kind = t.string("type", choices=("clamped", "normal", "fixed", "foundation"))
+        t = sup.sub(b, ("type", "components", "stiffness", "value"))
+        kind = t.string("type", choices=("clamped", "normal", "fixed", "foundation", "displacement"))
+        case_mech.check_support(t, fm, b, kind)
+        if kind == "displacement":
+            out.append(case_mech.displacement_support(t, fm, b, names))
+            continue
         comps = tuple(range(fm.dim))
         if kind in ("fixed", "foundation") and ("components" in t.data or kind == "fixed"):
             raw = t.data.get("components")
@@ -225,8 +368,7 @@ def _probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
                 t.fail("point", f"'{point}' is not a point group of the mesh", f"points: {', '.join(fm.sensors) or 'none'}"
                        "; or give coordinates [x, y(, z)] in m")
             xyz = tuple(float(v) for v in fm.points[fm.sensors[point]])
-        elif isinstance(point, list) and len(point) == fm.dim and all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in point):
+        elif _numbers(point, (fm.dim,)):
             xyz = tuple(float(v) for v in point)
             if finder is None:
                 from gatetherm.solvers.fem import to_skfem
@@ -269,50 +411,83 @@ def _signals(top: Table, probes, relative) -> Signals:
                    tuple(c), s.name("delta", [r.name for r in relative], "relative displacement", "") or None)
 
 
-def _time(top: Table, base: Path) -> tuple[TimeSettings | None, TimeScheme, tuple[str, ...]]:
+def _time(top: Table, base: Path):
+    """The time settings, the scheme and the schedule file's series (None: no schedule)."""
     if "time" not in top.data:
-        return None, TimeScheme(), ()
+        return None, TimeScheme(), None
+    from gatetherm.studies.run.timeseries import check_steps, read_timeseries
+
     t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
     end = t.number("end", SECONDS)
-    output = t.number("output", SECONDS, min(60.0, end))
-    step = t.number("step", SECONDS, output)
+    within = Range(0.0, end, lo_open=True, unit="s")  # an interval longer than the run is refused
+    output = t.number("output", within, min(60.0, end))
+    step = t.number("step", within, output)
+    check_steps(end, step, t.key("step"))
     if abs(output / step - round(output / step)) > 1e-9:
         t.fail("output", f"{output:g} s is not a whole multiple of the step {step:g} s", "change output or step")
     sch = t.sub("scheme", ("theta", "restart", "restart_intervals"))
     scheme = TimeScheme(sch.number("theta", SCHEME["theta"], 0.5), int(sch.number("restart", SCHEME["restart"], 4)),
                         int(sch.number("restart_intervals", SCHEME["restart_intervals"], 3)))
-    schedule, columns = None, ()
+    schedule, ts = None, None
     if "schedule" in t.data:
-        from gatetherm.studies.run.timeseries import read_timeseries
-
         schedule = base / t.string("schedule")
         if not schedule.is_file():
             t.fail("schedule", f"no such file '{schedule}'", "give a time-series file (docs/data-format.md)")
-        columns = tuple(n for n in read_timeseries(schedule, required=("time_s",)).names if n != "time_s")
-    return TimeSettings(end, step, output, t.number("fields", SECONDS, end),
-                        schedule), scheme, columns
+        ts = read_timeseries(schedule, required=("time_s",))
+        span = float(ts.time_s[-1] - ts.time_s[0])
+        if span < end * (1 - 1e-9):
+            t.fail("schedule", f"'{schedule}' spans {span:g} s, less than the run (end = {end:g} s)",
+                   "extend the schedule (its times are seconds) or shorten end")
+    return TimeSettings(end, step, output, t.number("fields", within, end), schedule), scheme, ts
 
 
-def load_case(path, mesh_factor: float = 1.0) -> Case:
+def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
+    """Every value that reads the schedule, at the schedule's samples within the run
+    (where its columns are recorded): in the range of its key; every column it reads recorded."""
+    t = np.asarray(ts.time_s - ts.time_s[0], float)
+    env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
+    for v in values(problem):
+        names = v.names() | {"t"}
+        empty = next((n for n in sorted(names) if not np.isfinite(env[n]).any()), None)
+        if empty:
+            raise InputError(f"{time.schedule}, column {empty}", "has no values", f"fill it ({v.key} reads it)")
+        rows = (t <= time.end) & np.logical_and.reduce([np.isfinite(env[n]) for n in names])
+        if not v.is_constant and rows.any():
+            v({n: env[n][rows] for n in names})
+
+
+def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
     """Read and check a case file (paths inside it are relative to its folder); with
-    ``mesh_factor``, a geometry is meshed with its element sizes times that factor."""
+    ``mesh_factor``, a geometry is meshed with its element sizes times that factor;
+    ``overrides`` ({dotted key: value}) change keys of the file as it is read."""
     path = Path(path)
     text = read_text(path, "CASE.toml", "give the path of a .toml case file")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise InputError(str(path), f"not valid TOML ({err})") from None
+    return case_from_document(overlay(data, nested(overrides or {})), path, mesh_factor)
+
+
+def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: FrameMesh | None = None) -> Case:
+    """The case of a parsed case file ``data`` read from ``path`` (``mesh``: its mesh, already made)."""
     top = Table(path, "", data, SECTIONS)
     head = top.sub("case", ("name", "order", "plane"))
     order = head.data.get("order", 1)
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")
-    fm = _mesh(top, path.parent, mesh_factor)
-    time, scheme, columns = _time(top, path.parent)
+    fm = _mesh(top, path.parent, mesh_factor) if mesh is None else mesh
+    plane = head.string("plane", "stress", ("stress", "strain", "axisymmetric"))
+    if plane == "axisymmetric":
+        case_mech.check_axisymmetric(top, fm, data)
+    time, scheme, schedule_ts = _time(top, path.parent)
+    columns = tuple(n for n in schedule_ts.names if n != "time_s") if schedule_ts is not None else ()
     prescribed = "temperature" in data
     elastic = "supports" in data
+    mechanical = case_mech.mechanical_only(data)  # no temperature at all
     need = ({"E", "nu", "alpha"} if elastic else set()) | (set() if prescribed else {"k"}) | \
         ({"rho", "c"} if time else set())
+    need = ({"E", "nu"} if mechanical else need) | ({"rho"} if "gravity" in data else set())
     materials, thickness = _materials(top, fm, need)
     names = ("t", *columns)
     init = top.sub("initial", ("temperature", "reference"))
@@ -341,8 +516,9 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
             if "density" in s.data:
                 sources.append(Source(r, s.value("density", names, unit="W/m³")))
             else:
-                vol = region_volume(fm, r, thickness.get(r, 1.0))
-                sources.append(Source(r, Value.of(f"({s.value('power', names, unit='W')}) / {vol!r}")))
+                vol = case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else \
+                    region_volume(fm, r, thickness.get(r, 1.0))
+                sources.append(Source(r, s.value("power", names, unit="W"), 1.0 / vol))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:
@@ -353,18 +529,79 @@ def load_case(path, mesh_factor: float = 1.0) -> Case:
     twice = _twice(kw)
     if twice:
         top.fail("thermal", f"boundary '{twice}' is given two conditions", "give each boundary one condition")
-    supports = _supports(top, fm) if elastic else ()
-    quantities = ("T",) + (("u", "sigma") if elastic else ())
+    supports = _supports(top, fm, names) if elastic else ()
+    if elastic:
+        kw.update(case_mech.read_loads(top, fm, names))
+    elif "gravity" in data or "loads" in data:
+        top.fail("gravity" if "gravity" in data else "loads", "a mechanical load needs [supports]",
+                 "hold the body with [supports.BOUNDARY] tables")
+    kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
+    quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
     probes = _probes(top, fm, quantities)
     relative = _relative(top, probes, fm.dim) if elastic or "relative" in data else ()
     means = top.sub("means", None)
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)
-    problem = Problem(fm.dim, materials, int(order), thickness,
-                      head.string("plane", "stress", ("stress", "strain")),
+    problem = Problem(fm.dim, materials, int(order), thickness, plane,
                       T0, init.number("reference", CELSIUS, T0),
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
-                      signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme, **kw)
-    return Case(path, head.string("name", path.stem), problem, fm, time)
+                      signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme,
+                      thermal=not mechanical, **kw)
+    case_mech.check_assembly(top, fm, problem, time is None)
+    if schedule_ts is not None:
+        _check_schedule(problem, schedule_ts, time)
+    if time is None:
+        schedule = STEADY
+    else:
+        drive = (series_drive(schedule_ts, columns, {n for f in problem.fluids for n in f.pump.names()},
+                              label=str(time.schedule)) if schedule_ts is not None else (lambda _: {}))
+        schedule = timed_schedule(time.end, time.step, time.output, drive,
+                                  f"schedule {time.schedule}" if time.schedule else "no schedule")
+    return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
+                case_targets(problem), actuator=_actuator(top), path=path, source=str(path),
+                files=(path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else [])))
+
+
+def _actuator(top: Table):
+    """``[actuator]``: the paper's piezo model with its reach, stiffnesses, preload, dead band,
+    hysteresis and drive set, or ``type = "none"`` (ideal: an offset to the control); None without it."""
+    from gatetherm.studies.control.actuator import ActuatorParams, with_stroke
+
+    if "actuator" not in top.data:
+        return None
+    a = top.sub("actuator", ("type", "stroke", "stack_stiffness", "spring_stiffness", "preload", "dead_band",
+                             "hysteresis", "reset"))
+    if a.string("type", "piezo", ("piezo", "none")) == "none":
+        if len(a.data) > 1:
+            a.fail(next(k for k in a.data if k != "type"), "goes with type = \"piezo\" only", "remove it")
+        return None
+    base, stiff = ActuatorParams(), Range(0.0, lo_open=True, unit="N/m")
+    reset = a.data.get("reset", True)
+    if not isinstance(reset, bool):
+        a.fail("reset", f"expected true/false, got {reset!r}", "true: back to 0 V before each new voltage")
+    h = a.number("hysteresis", Range(0.0, 4.0, unit="× the default"), 1.0)
+    p = dataclasses.replace(
+        base, stack_stiffness_N_per_m=a.number("stack_stiffness", stiff, base.stack_stiffness_N_per_m),
+        spring_stiffness_N_per_m=a.number("spring_stiffness", stiff, base.spring_stiffness_N_per_m),
+        preload_N=a.number("preload", Range(0.0, unit="N"), base.preload_N),
+        dead_band_unloaded_um=a.number("dead_band", Range(0.0, 100.0, unit="um"), base.dead_band_unloaded_um),
+        play_weights=(base.play_weights[0], *(w * h for w in base.play_weights[1:])),
+        strategy="reset" if reset else "direct")
+    if "stroke" not in a.data:
+        return p
+    st = a.data["stroke"]
+    if not (isinstance(st, list) and len(st) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                         for v in st)):
+        a.fail("stroke", f"expected [away, towards] in um, got {st!r}", "e.g. stroke = [-70.0, 10.0]")
+    try:
+        return with_stroke(p, float(st[0]), float(st[1]))
+    except InputError as err:
+        a.fail("stroke", err.problem, err.fix)
+
+
+def case_targets(problem: Problem) -> Targets:
+    """What a case file's effects act on by default: its one support, if it has only one."""
+    rigid = [s.boundary for s in problem.supports if s.stiffness is None]
+    return Targets(defaults={"compliant_base": rigid[0], "base_conduction": rigid[0]} if len(rigid) == 1 else {})
 
 
 def _twice(kw: dict) -> str | None:

@@ -47,7 +47,7 @@ def case_toml(problem: Problem, name: str, mesh_file: str, points: dict[str, str
     if p.faces is not None:
         L += _table("faces", {"film": p.faces.h, "ambient": p.faces.ambient})
     for s in p.sources:
-        L += _table(f"sources.{s.region}", {"density": s.density})
+        L += _table(f"sources.{s.region}", {"density": s.density} if s.per == 1.0 else {"power": s.density})
     for f in p.fluids:
         L += _table(f"fluids.{f.name}", {
             "boundary": f.boundary, "capacity": f.capacity, "conductance": f.conductance, "film_on": f.film_on,
@@ -55,9 +55,23 @@ def case_toml(problem: Problem, name: str, mesh_file: str, points: dict[str, str
             "hose_loss": f.hose_loss if f.hose_capacity else None, "hose_name": f.hose_name or None,
             "ambient": f.ambient})
     for s in p.supports:
+        if s.values:
+            held = dict(zip(s.components, s.values))
+            L += _table(f"supports.{s.boundary}", {"type": "displacement",
+                                                   "value": [held.get(c, "free") for c in range(p.dim)]})
+            continue
         kind = "foundation" if s.stiffness is not None else "fixed"
         L += _table(f"supports.{s.boundary}", {"type": kind, "components": [AXES[c] for c in s.components],
                                                "stiffness": s.stiffness})
+    if p.gravity:
+        L += _table("gravity", {"acceleration": list(p.gravity)})
+    for ld in p.loads:
+        L += _table(f"loads.{ld.boundary}", {ld.kind: ld.values[0] if ld.kind == "pressure" else list(ld.values)})
+    for pl in p.point_loads:
+        L += _table(f"loads.{pl.point}", {"force": list(pl.force)})
+    for c in p.contacts:
+        L += _table(f"contacts.{c.name}", {"between": list(c.between), "conductance": c.conductance,
+                                           "stiffness": list(c.stiffness) if c.stiffness else None})
     for pr in p.probes:
         L += _table(f"probes.{pr.name}", {"point": points.get(pr.name, list(pr.xyz)), "quantities": list(pr.quantities),
                                           "region": pr.region})

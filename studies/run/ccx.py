@@ -37,6 +37,10 @@ def job_inp(model: Model, U: np.ndarray | None, title: str) -> str:
     if any(s.stiffness is not None for s in p.supports):
         raise InputError("supports", "an elastic foundation has no CalculiX counterpart here",
                          "export a model with fixed supports")
+    if model.terms is not None or p.contacts or not p.thermal:
+        raise InputError("loads", "the export writes the thermal load only (no mechanical loads, joints or purely "
+                         "mechanical cases)", "export a case without [gravity], [loads], [contacts] and displacement "
+                         "supports")
     fm, order = model.fmesh, p.order
     cells = fm.cells.copy()
     X = fm.points[cells]
@@ -119,20 +123,22 @@ def probe_set(name: str) -> str:
     return f"P_{_set(name)}"
 
 
-def check_time(schedule, t: float) -> None:
-    """InputError unless ``t`` (s) is a step of ``schedule``."""
-    if not any(abs(t - s) < 1e-6 for s in schedule.times):
+def check_time(schedule, t: float) -> float:
+    """The step of ``schedule`` at ``t`` (s, within 1e-6 s); InputError if there is none."""
+    near = [float(s) for s in schedule.times if abs(t - s) < 1e-6]
+    if not near:
         raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
+    return near[0]
 
 
-def export_state(config, dim: int, schedule, t: float, title: str) -> tuple[str, dict]:
-    """Run ``config`` (a model file's Config or a Case) through ``schedule`` and export the state
+def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
+    """Run ``case`` through ``schedule`` and export the state
     at ``t`` (s, a step of the run): (``job.inp`` text, ``gatetherm.json`` content: gatetherm's
     relative displacements in m, the probe sets they compare and the mesh size)."""
     from gatetherm.studies.run.scenario import run_scenario
 
-    check_time(schedule, t)
-    run = run_scenario(config, dim, schedule, keep_times=[t])
+    t = check_time(schedule, t)
+    run = run_scenario(case, schedule, keep_times=[t])
     (_, U), = [s for s in run.result.states if abs(s[0] - t) < 1e-6]
     model = run.model
     u = {}

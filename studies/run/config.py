@@ -24,7 +24,7 @@ from gatetherm.checks import check_fields
 from gatetherm.files import read_text
 from gatetherm.geometry.frame import FrameParams, MeshParams, check_tie_depth, validate
 from gatetherm.solvers.effects import effects_from_table, effects_table
-from gatetherm.solvers.frame import ModelConfig, ThermalParams
+from gatetherm.solvers.frame import TARGETS, ModelConfig, ThermalParams
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
 from gatetherm.solvers.sensors import faults_from_table, faults_table_lines
@@ -145,7 +145,7 @@ def parse_config(data: dict, source: str = "<dict>", base: Config | None = None)
             current = _get(cfg, ("model", "material"))
         cfg = _set(cfg, sec.path, _apply(sec, table, current))
     check_config(cfg)
-    effects = {**cfg.effects, **effects_from_table(data.get("effects", {}))}
+    effects = {**cfg.effects, **effects_from_table(data.get("effects", {}), TARGETS)}
     sensors = {**cfg.sensors, **faults_from_table(data.get("sensors", {}))}
     return dataclasses.replace(cfg, source=source, effects=effects, sensors=sensors)
 
@@ -207,7 +207,7 @@ def config_toml(cfg: Config, header: str = "") -> str:
         lines += [f"[{sec.name}]", *rows, ""]
     if cfg.effects:
         lines += ["[effects]"] + [f"{name} = {{ {p} = {_value(v)} }}"
-                                  for name, table in effects_table(cfg.effects).items() for p, v in table.items()]
+                                  for name, table in effects_table(cfg.effects, TARGETS).items() for p, v in table.items()]
         lines += [""]
     lines += faults_table_lines(cfg.sensors)
     return "\n".join(lines).rstrip("\n") + "\n"

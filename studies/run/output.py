@@ -12,18 +12,18 @@ from gatetherm.solvers.model import Model, field_recovery, static_fields
 
 
 def nodal_fields(model: Model, U: np.ndarray | None, rec=None, stress: bool = True,
-                 u_dofs: np.ndarray | None = None) -> dict[str, np.ndarray]:
+                 u_dofs: np.ndarray | None = None, env=None) -> dict[str, np.ndarray]:
     """Temperature (°C), displacement (m, 3 components) and stress (Pa: components
     ``sigma_xx`` … and ``von_mises``) at the mesh nodes, for the heat state ``U`` (None:
     the prescribed temperature of a problem without a heat solve). ``rec``: the model's
     :func:`~gatetherm.solvers.model.field_recovery`, to share among states; ``u_dofs``:
-    the displacement of ``U``, if solved already."""
+    the displacement of ``U``, if solved already; ``env``: the inputs of the loads' values."""
     if U is None:
-        return static_fields(model)
+        return static_fields(model, env)
     T = U[:model.heat.n_solid][model.heat.basis.nodal_dofs[0]]
     out = {"T": T}
     if model.elastic is not None:
-        u_dofs = model.displacement_field(U) if u_dofs is None else u_dofs
+        u_dofs = model.displacement_field(U, env) if u_dofs is None else u_dofs
         u = np.zeros((len(T), 3))
         u[:, : model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
         out["u"] = u
@@ -33,32 +33,34 @@ def nodal_fields(model: Model, U: np.ndarray | None, rec=None, stress: bool = Tr
     return out
 
 
-def displacements(model: Model, states) -> dict[float, np.ndarray]:
-    """The displacement DOFs of the heat states ``[(t, U)]`` by time, in one elastic solve,
+def displacements(model: Model, states, envs=None) -> dict[float, np.ndarray]:
+    """The displacement DOFs of the heat states ``[(t, U)]`` by time (with the loads for
+    the inputs ``envs`` by time), in one elastic solve,
     after which the elastic factor is released: the writers and pictures that follow need
     memory of their own (in 3-D the factor holds 0.86 GB)."""
     if model.elastic is None or model.heat is None or not states:
         return {}
-    u = model.displacement_field(np.column_stack([U for _, U in states]))
+    u = model.displacement_field(np.column_stack([U for _, U in states]), [(envs or {}).get(t) for t, _ in states])
     model.elastic.solve.release()
     return {t: u[:, k] for k, (t, _) in enumerate(states)}
 
 
-def write_fields(model: Model, states, out: Path, solved: dict[float, np.ndarray] | None = None) -> list[Path]:
+def write_fields(model: Model, states, out: Path, solved: dict[float, np.ndarray] | None = None,
+                 envs=None) -> list[Path]:
     """One ``.vtu`` per saved state (point arrays of :func:`nodal_fields`) with a
     ``fields.pvd`` collection, and the same as one XDMF time series, ``fields.xdmf`` with
     ``fields.h5`` (one mesh, every step): ParaView opens either as one animated data set.
-    ``solved``: their :func:`displacements`, if found already."""
+    ``solved``: their :func:`displacements`, if found already; ``envs``: the inputs by time."""
     import meshio
 
     out.mkdir(parents=True, exist_ok=True)
     written, entries, steps = [], [], []
     minutes = all(abs(t / 60 - round(t / 60)) < 1e-9 for t, _ in states)
-    solved = displacements(model, states) if solved is None else solved
+    solved = displacements(model, states, envs) if solved is None else solved
     rec = field_recovery(model) if solved else None
     for k, (t, U) in enumerate(states):
         name = f"fields_{int(round(t / 60)):04d}min.vtu" if minutes else f"fields_{k:04d}.vtu"
-        data = nodal_fields(model, U, rec, u_dofs=solved.get(t))
+        data = nodal_fields(model, U, rec, u_dofs=solved.get(t), env=(envs or {}).get(t))
         with atomic_path(out / name) as tmp:
             meshio.write(tmp, to_meshio(model.fmesh, data), file_format="vtu", compression=None)  # zlib: 3 s in 3-D
         entries.append(f'    <DataSet timestep="{t:g}" file="{name}"/>')
@@ -117,12 +119,12 @@ def write_xdmf(model: Model, steps, path: Path) -> None:
                       + "\n".join(grids) + "\n</Grid></Domain></Xdmf>\n")
 
 
-def pyvista_grid(model: Model, U: np.ndarray, u_dofs: np.ndarray | None = None):
+def pyvista_grid(model: Model, U: np.ndarray, u_dofs: np.ndarray | None = None, env=None):
     """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``
     (``u_dofs``: the displacement of ``U``, if solved already)."""
     import pyvista as pv
 
-    mm = to_meshio(model.fmesh, nodal_fields(model, U, stress=False, u_dofs=u_dofs))
+    mm = to_meshio(model.fmesh, nodal_fields(model, U, stress=False, u_dofs=u_dofs, env=env))
     cell_type = "tetra" if model.dim == 3 else "triangle"
     grid = pv.from_meshio(mm)
     keep = np.flatnonzero(grid.celltypes == {"tetra": 10, "triangle": 5}[cell_type])
@@ -147,8 +149,9 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_tim
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
     states = [(t, U) for t, U in run.result.states if t in field_times]
     extra = {t: U for t, U in (nearest_state(run, tp) for tp in picture_times) if t not in field_times}
-    solved = displacements(run.model, states + list(extra.items()))
-    write_fields(run.model, states, out / "fields", solved)
+    envs = run.result.envs
+    solved = displacements(run.model, states + list(extra.items()), envs)
+    write_fields(run.model, states, out / "fields", solved, envs)
     return solved
 
 
@@ -156,7 +159,7 @@ def deformed_grid(run, t_pic: float, solved: dict[float, np.ndarray] | None = No
     """(time, pyvista grid with the point arrays of :func:`nodal_fields`) of the kept state
     nearest ``t_pic`` (s); ``solved``: :func:`displacements` that may include it."""
     t, U = nearest_state(run, t_pic)
-    return t, pyvista_grid(run.model, U, (solved or {}).get(t))
+    return t, pyvista_grid(run.model, U, (solved or {}).get(t), run.result.envs.get(t))
 
 
 def probe_summary(problem, cols: dict[str, np.ndarray]) -> dict:

@@ -13,7 +13,9 @@ from typing import Callable
 
 import numpy as np
 
-from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, march
+from gatetherm import InputError
+from gatetherm.checks import CELSIUS, show
+from gatetherm.solvers.heat import Drive, HeatSolver, TimeScheme, environment, march
 from gatetherm.solvers.model import Model
 from gatetherm.solvers.problem import Problem
 from gatetherm.solvers.stress import von_mises
@@ -31,6 +33,9 @@ class RunResult:
     columns: dict[str, np.ndarray]
     states: list[tuple[float, np.ndarray]] = field(default_factory=list)
     seconds: float = 0.0
+    envs: dict[float, dict] = field(default_factory=dict)
+    """The inputs (``t`` and the drive's) at the times of :attr:`states`: the mechanical
+    loads' values there."""
 
 
 def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
@@ -88,6 +93,17 @@ def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarra
     return out
 
 
+def check_temperatures(U: np.ndarray, t: float) -> None:
+    """InputError unless every temperature of the state ``U`` (°C) at ``t`` (s) is admissible
+    (:data:`~gatetherm.checks.CELSIUS`): a run that leaves the range has met heat inputs out of
+    all proportion, or a steady problem without a solution."""
+    lo, hi = float(U.min()), float(U.max())
+    if not (CELSIUS.holds(lo) and CELSIUS.holds(hi)):
+        raise InputError("temperature", f"the solution reaches {show(hi if CELSIUS.holds(lo) else lo)} °C at "
+                         f"t = {t:g} s, must be {CELSIUS}", "check the heat inputs (sources, fluxes: units and "
+                         "size) and, for a steady state, that a boundary holds a temperature or a film")
+
+
 def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
               U0: np.ndarray | None = None, solver: HeatSolver | None = None) -> RunResult:
@@ -96,24 +112,27 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     ``solver`` of ``model.heat`` carries its factorisations over from earlier runs.
     Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
-    inputs, Y, states = [], [], []
+    inputs, Y, states, envs = [], [], [], {}
     t0 = _time.perf_counter()
     scheme = model.problem.scheme if scheme is None else scheme
     if model.elastic is not None:  # outputs come from adjoint weights: room for the heat factors
         model.elastic.solve.release()
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
+        env = environment(drive, t)
+        check_temperatures(U, t)
         inputs.append({"time_s": t, **drive(t)})
-        Y.append(model.read(U))
+        Y.append(model.read(U, env))
         if t in keep:
             states.append((t, U.copy()))
+            envs[t] = env
         if on_step:
             on_step(i + 1, len(times))
     cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
     cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
     secs = _time.perf_counter() - t0
     log.info("marched %d steps in %.2f s", len(Y) - 1, secs)
-    return RunResult(cols, states, secs)
+    return RunResult(cols, states, secs, envs)
 
 
 def prominent_peaks(x: np.ndarray, prominence: float) -> list[int]:

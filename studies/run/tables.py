@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.checks import FINITE, Range
+from gatetherm.checks import CELSIUS, FINITE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
 
 
@@ -24,7 +24,7 @@ class Table:
                     raise InputError(f"{file}: {where}.{key}", "unknown key", f"known keys: {', '.join(known)}")
 
     def key(self, k: str) -> str:
-        return f"{self.file}: {self.where}.{k}"
+        return f"{self.file}: {self.where}.{k}" if self.where else f"{self.file}: {k}"
 
     def fail(self, k: str, problem: str, fix: str = ""):
         raise InputError(self.key(k), problem, fix)
@@ -54,12 +54,16 @@ class Table:
         return v
 
     def value(self, k: str, names, default=None, unit: str = "") -> Value:
+        """The value at ``k``: a number or an expression of ``names``, in the range of its
+        ``unit`` (°C: a temperature, else finite), checked now if it reads no input, else
+        wherever it is evaluated."""
+        rng = CELSIUS if unit == "°C" else FINITE
         if k not in self.data and default is not None:
-            return Value(default)
+            return Value(default, "", self.key(k), rng)
         if k not in self.data:
             self.fail(k, "missing", f"give a number{' in ' + unit if unit else ''} or an expression")
         try:
-            v = Value.of(self.data[k])
+            v = Value.of(self.data[k], self.key(k), rng)
         except ExpressionError as err:
             self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
         unknown = sorted(v.names() - set(names))

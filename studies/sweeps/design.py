@@ -126,13 +126,13 @@ def with_frame(cfg: Config, **changes) -> Config:
 
 def histories(designs: dict[str, Config], dim: int) -> dict[str, dict[int, tuple]]:
     """delta(t) (s, um) of each design (label -> model) for conditions 1-3."""
-    from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.studies.run.scenario import ScenarioCache
 
     out = {}
     for label, cfg in designs.items():
-        cache = ScenarioCache()
-        runs = (run_scenario(cfg, dim, condition_schedule(c, cfg), cache=cache).columns for c in CONDITIONS)
-        out[label] = {c: (r["time_s"], r["delta_um"]) for c, r in zip(CONDITIONS, runs)}
+        runs = condition_runs(cfg, dim, CONDITIONS, ScenarioCache())
+        out[label] = {c: (r.columns["time_s"], r.columns["delta_um"]) for c, r in runs.items()}
     return out
 
 

@@ -54,31 +54,61 @@ def _run(cols: dict) -> dict[str, float | None]:
             "theta_C_end_K": float(cols["theta_C_degC"][-1] - cols["theta_C_degC"][0])}
 
 
+def case_results(case, cols: dict) -> dict[str, float]:
+    """A case study's ``run`` results: the final, largest and smallest value of every relative
+    displacement (µm), δ's figures where the case has a δ, and the final temperature of every probe."""
+    from gatetherm.studies.run.simulate import column, delta_figures
+
+    p, out = case.problem, {}
+    for r in p.relative:
+        name, _ = column(p, ("relative", r.name))
+        stem = name.removesuffix("_um")
+        out.update({f"{stem}_final_um": float(cols[name][-1]), f"{stem}_max_um": float(cols[name].max()),
+                    f"{stem}_min_um": float(cols[name].min())})
+    if "delta_um" in cols and len(cols["time_s"]) > 1:
+        out.update(delta_figures(cols["time_s"], cols["delta_um"]))
+    for pr in p.probes:
+        name, _ = column(p, ("T", pr.name))
+        if name in cols:
+            out[f"{name.removesuffix('_degC')}_final_degC"] = float(cols[name][-1])
+    return out
+
+
 def evaluate(task: Task) -> dict[str, Any]:
     """The result record of one point: key, params, status, note, results, seconds."""
-    record = {"key": task.key, "params": dict(task.params), "status": "skipped", "note": task.skip,
-              "results": {}, "seconds": 0.0, "version": gatetherm.__version__,
-              "scheme": scheme_digest(task.config.model)}
-    if task.skip:
-        return record
-    from gatetherm.geometry.build import build_mesh
-    from gatetherm.studies.run.scenario import condition_schedule, prepare, run_scenario
+    from gatetherm.studies.run.scenario import prepare, run_scenario
 
+    record = {"key": task.key, "params": dict(task.params), "status": "skipped", "note": task.skip,
+              "results": {}, "seconds": 0.0, "version": gatetherm.__version__}
+    if task.skip:
+        return {**record, "scheme": scheme_digest(task.config.model)}
     t0 = time.perf_counter()
-    cfg, dim, effects = task.config, task.dim, dict(task.effects)
-    schedule = condition_schedule(task.condition or 1, cfg)
+    effects = dict(task.effects)
+    if task.case is not None:
+        from gatetherm.studies.run.case import load_case
+
+        with _GMSH:
+            case = load_case(task.case, overrides=dict(task.overrides))
+        run = run_scenario(case, effects=effects)
+        res = {**case_results(case, run.columns), "nodes": int(len(case.mesh.points))}
+        return {**record, "status": "ok", "results": res, "seconds": round(time.perf_counter() - t0, 3),
+                "scheme": scheme_digest(case.problem)}
+    from gatetherm.studies.run.frame_case import frame_case
+
+    cfg, dim = task.config, task.dim
     with _GMSH:
-        mesh = build_mesh(cfg.model.frame, dim, cfg.model.mesh)
+        case = frame_case(cfg, dim, task.condition or 1)
     res: dict[str, Any] = {}
     if "run" in task.compute:
-        run = run_scenario(cfg, dim, schedule, effects, mesh=mesh)
+        run = run_scenario(case, effects=effects)
         model, res = run.model, _run(run.columns)
     else:
-        model = prepare(cfg, dim, schedule.drive, effects, mesh=mesh).model
+        model = prepare(case, effects).model
     if "coefficients" in task.compute:
         res.update(_coefficients(model, dataclasses.replace(cfg, model=model.config)))
     res["nodes"] = int(len(model.fmesh.points))
-    record.update(status="ok", results=res, seconds=round(time.perf_counter() - t0, 3))
+    record.update(status="ok", results=res, seconds=round(time.perf_counter() - t0, 3),
+                  scheme=scheme_digest(task.config.model))
     return record
 
 

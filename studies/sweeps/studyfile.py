@@ -1,6 +1,6 @@
-"""The study file (STUDY.toml) of ``gatetherm sweep``: ``[study]`` (name, dim, config,
-compute, fit_frame), ``[set]``, ``[grid]`` and ``[[plot]]`` tables into a
-:class:`~gatetherm.studies.sweeps.sweep.Study`."""
+"""The study file (STUDY.toml) of ``gatetherm sweep``: ``[study]`` (name, and ``case`` for a case
+file, or ``dim``, ``config``, ``compute``, ``fit_frame`` for the paper's frame), ``[set]``,
+``[grid]`` and ``[[plot]]`` tables into a :class:`~gatetherm.studies.sweeps.sweep.Study`."""
 from __future__ import annotations
 
 import tomllib
@@ -32,8 +32,23 @@ def _scalar(key: str, value):
     raise InputError(key, f"expected a number, true/false or a string, got {value!r}")
 
 
-def parse_study(data: dict, source: str = "<study>", base: Config | None = None) -> Study:
-    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the model it overrides)."""
+def case_columns(case) -> tuple[str, ...]:
+    """The ``run`` result columns of a case study (:func:`~gatetherm.studies.sweeps.evaluate.case_results`)."""
+    from gatetherm.studies.run.simulate import column
+
+    p, out = case.problem, []
+    for r in p.relative:
+        stem = column(p, ("relative", r.name))[0].removesuffix("_um")
+        out += [f"{stem}_final_um", f"{stem}_max_um", f"{stem}_min_um"]
+    if p.signals.delta and case.time is not None:
+        out += ["first_peak_um", "first_peak_min", "second_peak_um", "swing_um"]
+    out += [f"{column(p, ('T', pr.name))[0].removesuffix('_degC')}_final_degC" for pr in p.probes if "T" in pr.quantities]
+    return tuple(out)
+
+
+def parse_study(data: dict, source: str = "<study>", base: Config | None = None, case: str | None = None) -> Study:
+    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the frame's model it overrides;
+    ``case``: a case file it overrides instead)."""
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.sweeps.sweep import COMPUTE, PlotSpec, Study
 
@@ -45,9 +60,11 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None)
             raise InputError(key, f"expected {'[[plot]] tables' if key == 'plot' else f'a [{key}] table'}")
     head = dict(data.get("study", {}))
     for key in head:
-        if key not in ("name", "dim", "config", "compute", "fit_frame"):
+        if key not in ("name", "dim", "config", "compute", "fit_frame", "case"):
             raise InputError(f"study.{key}", "unknown key",
-                             "known keys: name, dim, config, compute, fit_frame")
+                             "known keys: name, case (a case file), or dim, config, compute, fit_frame (the frame)")
+    if case is not None:
+        return _case_study(data, head, source, case)
     dim = head.get("dim", 2)
     if dim not in (2, 3) or isinstance(dim, bool):
         raise InputError("study.dim", f"must be 2 or 3, got {dim!r}")
@@ -90,8 +107,46 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None)
                  tuple(compute), tuple(plots), fit)
 
 
+def _case_study(data: dict, head: dict, source: str, path: str) -> Study:
+    from gatetherm.studies.run.case import load_case
+    from gatetherm.studies.sweeps.sweep import PlotSpec, Study
+
+    for key in ("dim", "config", "fit_frame"):
+        if key in head:
+            raise InputError(f"study.{key}", "applies to the paper's frame, not to a case", "remove it")
+    compute = head.get("compute", ["run"])
+    if compute not in (["run"], "run"):
+        raise InputError("study.compute", f"{compute!r}: a case study computes run only", 'use compute = ["run"]')
+    fixed = {k: _scalar(f"set.{k}", v) for k, v in _flatten(data.get("set", {})).items()}
+    grid = []
+    for key, values in _flatten(data.get("grid", {})).items():
+        if not isinstance(values, list) or not values:
+            raise InputError(f"grid.{key}", "expected a non-empty list of values", f'e.g. "{key}" = [1, 2]')
+        if key in fixed:
+            raise InputError(f"set.{key}", "is also swept in [grid]", "keep it in one of the two")
+        grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
+    if not grid:
+        raise InputError("grid", "no swept key", 'add e.g. "thermal.free.film" = [6.0, 10.0] under [grid]')
+    case = load_case(path)
+    results = case_columns(case)
+    columns = {k for k, _ in grid} | {"nodes"} | set(results)
+    plots = []
+    for i, spec in enumerate(data.get("plot", [])):
+        if not isinstance(spec, dict) or "x" not in spec or "y" not in spec:
+            raise InputError(f"plot[{i + 1}]", "needs x and y", "write [[plot]] with x, y and hue")
+        for key, value in spec.items():
+            if key not in ("x", "y", "hue"):
+                raise InputError(f"plot[{i + 1}].{key}", "unknown key", "known keys: x, y, hue")
+            if value not in columns:
+                raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",
+                                 f"choose from {', '.join(sorted(columns))}")
+        plots.append(PlotSpec(spec["x"], spec["y"], spec.get("hue")))
+    return Study(str(head.get("name", source)), case.dim, None, tuple(fixed.items()), tuple(grid), ("run",),
+                 tuple(plots), False, str(path), results)
+
+
 def load_study(path) -> Study:
-    """Read a STUDY.toml; a relative ``study.config`` is taken from the study file's folder."""
+    """Read a STUDY.toml; a relative ``study.config`` or ``study.case`` is taken from the study file's folder."""
     p = Path(path)
     try:
         data = tomllib.loads(read_text(p, "STUDY.toml", "give a study file"))
@@ -104,6 +159,11 @@ def load_study(path) -> Study:
         if not isinstance(head, dict):
             raise InputError("study", "expected a [study] table")
         head.setdefault("name", p.stem)
+        case = head.pop("case", None)
+        if case is not None:
+            if not isinstance(case, str):
+                raise InputError("study.case", f"expected a file name, got {case!r}")
+            return parse_study(data, str(p), case=str(p.parent / case))
         config = head.pop("config", None)
         if config is not None and not isinstance(config, str):
             raise InputError("study.config", f"expected a file name, got {config!r}")

@@ -2,7 +2,14 @@
 
 A study is data: a base model, fixed overrides (``set``), a grid whose cartesian
 product gives the points, the dimension, and what to compute at each point.
-Parameter keys are
+
+The base is a case file (``[study] case``) or the paper's frame (a model file). On a case,
+a key is any key of the case file by dotted path (``materials.column.k``,
+``thermal.free.film``, ``sources.spindle.power``, ``mesh.parameters.h``, ``time.schedule``)
+or ``effect.<key>`` (an effect, ``gatetherm diagnose --case … --list-effects``), and the
+point computes ``run``: the case run on its own schedule, the final, largest and smallest
+value of every relative displacement and the final temperature of every probe. On the
+frame, keys are
 
 * ``<section>.<field>`` for the model-file sections ``geometry``, ``mesh``, ``material``,
   ``material.tie_bar``, ``thermal``, ``supply`` and ``model`` (see studies/config.py);
@@ -70,7 +77,8 @@ class Study:
 
     name: str
     dim: int
-    base: Config
+    base: Config | None
+    """The paper frame's model (None: a study of :attr:`case`)."""
     fixed: tuple[tuple[str, Any], ...]
     """Overrides applied at every point, (key, value)."""
     grid: tuple[tuple[str, tuple], ...]
@@ -79,6 +87,10 @@ class Study:
     plots: tuple[PlotSpec, ...] = ()
     fit_frame: bool = True
     """Raise the column (and the 3-D tie-bar height t_C) so that every tie bar fits."""
+    case: str | None = None
+    """A case file whose keys the grid sets (instead of the frame's :attr:`base`)."""
+    columns: tuple[str, ...] = ()
+    """The result columns of a case study's ``run`` (its relative displacements and probes)."""
 
 
 @dataclass(frozen=True)
@@ -88,13 +100,17 @@ class Task:
     key: str
     params: tuple[tuple[str, Any], ...]
     """The grid values of this point (its table columns)."""
-    config: Config
+    config: Config | None
     dim: int
     compute: tuple[str, ...]
     condition: int | None
     effects: tuple[tuple[str, float], ...]
     skip: str = ""
     """Why the frame cannot be built ("" = buildable)."""
+    case: str | None = None
+    """A case study's case file."""
+    overrides: tuple[tuple[str, Any], ...] = ()
+    """A case study's keys of the case file at this point."""
 
 
 # --- derived parameters ---------------------------------------------------------------
@@ -166,7 +182,8 @@ def _nest(flat: dict[str, Any]) -> dict:
 
 def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = True):
     """``(config, condition, effects, skip)`` of one point; bad keys raise InputError."""
-    from gatetherm.solvers.effects import CATALOGUE
+    from gatetherm.solvers.effects import resolve
+    from gatetherm.solvers.frame import TARGETS
     from gatetherm.studies.run.conditions import CONDITIONS
 
     sections, geometry, derived, effects, condition = {}, {}, {}, {}, None
@@ -185,9 +202,9 @@ def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = Tru
             if name not in DERIVED:
                 raise InputError(key, "unknown derived parameter", f"known: {', '.join(DERIVED)}")
             derived[name] = _number(key, value, DERIVED[name][1])
-        elif head == "effect":
-            if name not in CATALOGUE:
-                raise InputError(key, "unknown effect", f"known: {', '.join(CATALOGUE)}")
+        elif key.startswith("effect."):
+            name = key[len("effect."):]
+            resolve(name, TARGETS, key)
             effects[name] = _number(key, value, float)
         elif head in SECTIONS:
             sections[key] = value
@@ -235,13 +252,57 @@ def point_key(cfg: Config, dim: int, compute, condition, effects) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
+def case_point(study: Study, base, overrides: dict[str, Any]) -> Task:
+    """A point of a case study on its ``base`` case: its keys checked by reading the case with
+    them (meshing again when a key of ``[mesh]`` changes), and its key: the digest of the case
+    file, the files it names, the overrides, effects, computations and the gatetherm version."""
+    from gatetherm.solvers.effects import resolve
+
+    effects, keys = {}, {}
+    for key, value in overrides.items():
+        if key.startswith("effect."):
+            effects[key[len("effect."):]] = _number(key, value, float)
+        else:
+            keys[key] = value
+    case = base.with_overrides(keys)
+    for k in effects:
+        resolve(k, case.targets, f"effect.{k}")
+    digest = hashlib.sha256()
+    for f in sorted(case_files(case)):
+        digest.update(f.read_bytes())
+    blob = json.dumps({"keys": keys, "effects": effects, "compute": sorted(study.compute), "files": digest.hexdigest(),
+                       "version": gatetherm.__version__, "scheme": scheme_digest(case.problem)}, sort_keys=True,
+                      default=repr)
+    return Task(hashlib.sha256(blob.encode()).hexdigest()[:20], (), None, case.dim, study.compute, None,
+                tuple(sorted(effects.items())), case=study.case, overrides=tuple(keys.items()))
+
+
+def case_files(case) -> list:
+    """The files a case reads: the case file, its mesh or geometry, its schedule."""
+    from pathlib import Path
+
+    doc = case.origin.document
+    base = Path(case.origin.path).parent
+    files = [Path(case.origin.path), base / doc["mesh"]["file"]]
+    if case.time is not None and case.time.schedule is not None:
+        files.append(Path(case.time.schedule))
+    return [f for f in files if f.is_file()]
+
+
 def plan(study: Study) -> list[Task]:
     """The points of ``study`` in grid order (last key varying fastest); bad keys raise."""
+    from gatetherm.studies.run.case import load_case
+
     keys = [k for k, _ in study.grid]
     tasks = []
+    base = load_case(study.case) if study.case is not None else None
     for values in itertools.product(*(v for _, v in study.grid)):
         params = tuple(zip(keys, values))
         overrides = {**dict(study.fixed), **dict(params)}
+        if base is not None:
+            task = case_point(study, base, overrides)
+            tasks.append(dataclasses.replace(task, params=params))
+            continue
         cfg, cond, eff, skip = configure(study.base, overrides, study.dim, study.fit_frame)
         if "run" in study.compute and cond is None:
             raise InputError("condition", "the 'run' computation needs a heating condition",
@@ -254,15 +315,17 @@ def plan(study: Study) -> list[Task]:
     return tasks
 
 
-def table(tasks: list[Task], records: dict[str, dict]) -> tuple[list[str], list[dict]]:
+def table(tasks: list[Task], records: dict[str, dict], results=()) -> tuple[list[str], list[dict]]:
     """Columns and rows (grid order) of the tidy table: parameters, status, note, then the
-    results in the order of :data:`COMPUTE`. Points without a record are "pending" rows."""
+    results in the order of :data:`COMPUTE` (a case study's: ``results``). Points without a record
+    are "pending" rows."""
     rows = []
     for t in tasks:
         rec = records.get(t.key, {"status": "pending", "note": "", "results": {}})
         made = {k: rec.get(k, "") for k in MADE_BY}
         rows.append({**dict(t.params), "status": rec["status"], "note": rec["note"], **rec["results"], **made})
     params = [k for k, _ in tasks[0].params] if tasks else []
-    results = ["nodes"] + [c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]]
+    results = ["nodes"] + ([c for k in (tasks[0].compute if tasks else ()) for c in COMPUTE[k]]
+                           if not (tasks and tasks[0].case) else list(results))
     extra = [k for r in rows for k in r if k not in params + results + ["status", "note", *MADE_BY]]
     return params + ["status", "note"] + results + list(dict.fromkeys(extra)) + list(MADE_BY), rows

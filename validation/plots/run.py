@@ -52,7 +52,8 @@ def plot_responses(runs: dict, path, title: str) -> None:
     t0 = first["time_s"] / 60.0
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.5), sharex=True)
     for ax in (a1, a2):
-        shade(ax, t0, first["pump"] > 0.5)
+        if "pump" in first:
+            shade(ax, t0, first["pump"] > 0.5)
     for k, (name, cols) in enumerate(runs.items()):
         t, ls, tag = cols["time_s"] / 60.0, ("-", "--", ":")[k % 3], f" {name}" if name else ""
         for i, (key, lab) in enumerate((("theta_A_degC", "θ_A"), ("theta_B_degC", "θ_B"), ("theta_C_degC", "θ_C"))):
@@ -73,7 +74,8 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     """Temperature on the frame deformed by ``scale`` × displacement, the undeformed outline
     in grey (pyvista, off screen), framed by matplotlib with a labelled colour bar.
 
-    ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components).
+    ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components);
+    without ``T`` (a purely mechanical case) the colours show the displacement's magnitude.
     """
     import pyvista as pv
     from matplotlib.cm import ScalarMappable
@@ -82,7 +84,11 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
 
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)  # no X display: VTK falls back quietly
     pv.OFF_SCREEN = True
-    T = np.asarray(grid["T"])
+    thermal = "T" in grid.point_data
+    if not thermal:
+        grid["|u| [µm]"] = 1e6 * np.linalg.norm(np.asarray(grid["u"]), axis=1)
+    name = "T" if thermal else "|u| [µm]"
+    T = np.asarray(grid[name])
     clim = (float(T.min()), float(T.max()) if T.max() > T.min() else float(T.min()) + 1.0)
     flat = grid.bounds[5] - grid.bounds[4] < 1e-12
     outline = grid.extract_surface(algorithm="dataset_surface").extract_feature_edges(feature_angle=30.0, boundary_edges=flat,
@@ -90,7 +96,7 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
                                                            non_manifold_edges=False)
     p = pv.Plotter(off_screen=True, window_size=(1600, 1200))
     p.set_background("white")
-    p.add_mesh(grid.warp_by_vector("u", factor=scale), scalars="T", cmap=CMAP, clim=clim, show_scalar_bar=False)
+    p.add_mesh(grid.warp_by_vector("u", factor=scale), scalars=name, cmap=CMAP, clim=clim, show_scalar_bar=False)
     p.add_mesh(outline, color="#8c8c8c", line_width=2)
     if flat:
         p.view_xy()
@@ -102,7 +108,7 @@ def render_deformed(grid, path, title: str, scale: float) -> None:
     ax.imshow(img, interpolation="lanczos")
     ax.set_axis_off()
     bar = fig.colorbar(ScalarMappable(Normalize(*clim), CMAP), ax=ax, fraction=0.04, pad=0.02, shrink=0.85)
-    bar.set_label("temperature T [°C]")
+    bar.set_label("temperature T [°C]" if thermal else "displacement |u| [µm]")
     ax.set_title(f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges", fontsize="medium")
     save(fig, path, tight=True)
 
@@ -168,6 +174,30 @@ def plot_channels(cols: dict, path, title: str) -> None:
     axes[0].set_title(title)
     axes[1].set(xlabel="time [h]")
     save(fig, path, tight=False)
+
+
+def write_pictures(run, out, title: str, picture_s: float | None, solved: dict | None = None) -> list[str]:
+    """The pictures of a run (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) into ``out``,
+    by what the case has: ``channels.png`` (every channel of a transient run), ``response.png``
+    (θ_A, θ_B, θ_C and δ: Figs. 11–13), ``oil_temperatures.png`` (a fluid's supply, volume and wall:
+    Fig. 10) and ``deformed.png`` (the state kept nearest ``picture_s``); returns the names written."""
+    from pathlib import Path
+
+    out, cols, written = Path(out), run.columns, []
+    transient = len(cols["time_s"]) > 1
+    if transient:
+        plot_channels(cols, out / "channels.png", title)
+        written.append("channels.png")
+    if transient and all(k in cols for k in ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")):
+        plot_response(cols, out / "response.png", title)
+        written.append("response.png")
+    if transient and "oil_degC" in cols and "pump" in cols:
+        plot_oil(cols, out / "oil_temperatures.png", title)
+        written.append("oil_temperatures.png")
+    if picture_s is not None and run.model.elastic is not None:
+        draw_deformed(run, picture_s, out / "deformed.png", lambda t: f"{title}, t = {t / 60:.0f} min", solved)
+        written.append("deformed.png")
+    return written
 
 
 def plot_case(run, out, title: str, solved: dict | None = None) -> None:

@@ -35,7 +35,7 @@ from gatetherm.validation.report.result import Result, dump, load
 log = logging.getLogger(__name__)
 
 PACKAGES = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.validation")
-PRESENTATION = ("gatetherm/studies/cli/", "gatetherm/validation/report/build.py", "gatetherm/validation/report/page.py",
+PRESENTATION = ("gatetherm/cli/", "gatetherm/validation/report/build.py", "gatetherm/validation/report/page.py",
                 "gatetherm/validation/report/readme.py", "gatetherm/validation/report/browser.py")
 """Source files left out of the code digest: they decide what to reuse and format results, they
 do not make them."""

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gatetherm import InputError
 from gatetherm.studies.run.timeseries import TimeSeries
 
 INPUTS = ("oil_degC", "pump", "ambient_degC", "u_piezo_um")
@@ -43,6 +44,20 @@ def channels(ts: TimeSeries) -> Channels:
     temp = [n for n in names if n.endswith("_degC") and n not in INPUTS]
     other = [n for n in names if n not in disp and n not in temp and not n.endswith("_MPa")]
     return Channels(tuple(disp), tuple(temp), tuple(other))
+
+
+def check_record(ts: TimeSeries, where: str) -> None:
+    """InputError naming ``where`` unless ``ts`` is a record a drift can be read from: two
+    samples or more, a displacement or temperature channel, and a value in each of those."""
+    if len(ts) < 2:
+        raise InputError(str(where), f"{len(ts)} data row: a drift needs two samples or more", "give the whole record")
+    ch = channels(ts)
+    if not ch.displacement + ch.temperature:
+        raise InputError(str(where), "no displacement (*_um) or temperature (*_degC) column besides the inputs",
+                         "give the channels whose drift is reported")
+    empty = next((n for n in ch.displacement + ch.temperature if not np.isfinite(ts[n]).any()), None)
+    if empty:
+        raise InputError(f"{where}, column {empty}", "has no values", "fill it or leave the column out")
 
 
 def phase_signal(ts: TimeSeries, ch: Channels) -> tuple[str, np.ndarray] | None:
@@ -106,6 +121,7 @@ def compute(ts: TimeSeries, work, name: str):
     from gatetherm.validation.plots.drift import plot_drift
     from gatetherm.validation.report.result import Figure, Result, from_dicts
 
+    check_record(ts, name)
     ch = channels(ts)
     shade = phase_signal(ts, ch)
     plot_drift(ts.time_s - ts.time_s[0], {n: drift(ts[n]) for n in ch.displacement},

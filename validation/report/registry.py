@@ -65,7 +65,8 @@ BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks" / "results"
 BENCHMARK_FILES = {"peer.json": "python benchmarks/peer.py --rounds 3",
                    "scaling.json": "python benchmarks/scaling.py",
                    "backends.json": "python benchmarks/backends.py --rounds 3",
-                   "blas_threads.json": "python benchmarks/blas_threads.py --rounds 3"}
+                   "blas_threads.json": "python benchmarks/blas_threads.py --rounds 3",
+                   "errormodel.json": "/tmp/venv_bench/bin/python benchmarks/errormodel.py --data FILE.csv"}
 """Result files of the benchmark scripts the speed section shows, with the command that measures
 each; each fills the README block ``speed-NAME`` (NAME: the file's stem)."""
 
@@ -76,9 +77,9 @@ SECTIONS: tuple[Section, ...] = (
             also="python -m pytest tests/test_verification_heat.py tests/test_verification_elastic.py -s "
                  "(-m slow adds the 3-D elastic orders)"),
     Section("nafems", "NAFEMS benchmarks through case files", "nafems:compute",
-            subset={"cases": ["t1", "t3", "t4", "le11"]}, inputs=("gatetherm.validation:nafems/*",),
+            subset={"cases": ["t1", "t3", "t4", "le11", "le1", "le10"]}, inputs=("gatetherm.validation:nafems/*",),
             readme=("nafems",),
-            also="gatetherm run validation/nafems/t1.toml --out D (and t3, t4, le11)"),
+            also="gatetherm run validation/nafems/t1.toml --out D (and t3, t4, le11, le1, le10)"),
     Section("paper", "Paper vs gatetherm, 2-D and 3-D (Figs. 10-13 analogues)", "paper:compute",
             subset={"dims": [2, 3], "size_3d": 0.015}, full={"dims": [2, 3], "size_3d": None},
             about="3-D on a coarser mesh (element size 15 mm instead of the model's 9 mm)",

@@ -19,12 +19,13 @@ TOLERANCE = 5e-3
 def compute(ctx) -> Result:
     from gatetherm import write_text_atomic
     from gatetherm.studies.run.ccx import export_state, relative_from_dat
-    from gatetherm.studies.run.scenario import condition_schedule
+    from gatetherm.studies.run.frame_case import frame_case
 
     s = ctx.scope
     cfg = paper_model(size_3d=s["size_3d"])
     t = 60.0 * s["time_min"]
-    inp, info = export_state(cfg, 3, condition_schedule(s["condition"], cfg), t,
+    case = frame_case(cfg, 3, s["condition"])
+    inp, info = export_state(case, case.schedule, t,
                              f"gatetherm condition {s['condition']}, t = {s['time_min']:g} min")
     write_text_atomic(ctx.work / "job.inp", inp)
     write_text_atomic(ctx.work / "gatetherm.json", json.dumps(info, indent=2) + "\n")

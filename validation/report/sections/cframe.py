@@ -13,15 +13,15 @@ def compute(ctx) -> Result:
     import gatetherm.validation
     from gatetherm.studies.run.case import load_case
     from gatetherm.studies.run.output import probe_summary
-    from gatetherm.studies.run.scenario import case_schedule, run_scenario
+    from gatetherm.studies.run.scenario import run_scenario
     from gatetherm.studies.run.simulate import column
     from gatetherm.studies.run.timeseries import TimeSeries
     from gatetherm.validation.plots.run import plot_case
     from gatetherm.validation.report import drift
 
     case = load_case(Path(gatetherm.validation.__path__[0]) / ctx.scope["case"])
-    schedule = case_schedule(case)
-    run = run_scenario(case, case.mesh.dim, schedule, keep_times=[float(schedule.times[-1])])
+    schedule = case.schedule
+    run = run_scenario(case, schedule, keep_times=[float(schedule.times[-1])])
     plot_case(run, ctx.work, case.name)
     summary = probe_summary(case.problem, run.columns)
     probes = [{"probe": k, **v} for k, v in summary["probes"].items()]

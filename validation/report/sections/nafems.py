@@ -1,4 +1,4 @@
-"""NAFEMS section: T1, T3, T4 and LE11 run as case files (validation/nafems/), each against
+"""NAFEMS section: T1, T3, T4, LE11, LE1 and LE10 run as case files (validation/nafems/), each against
 its published target (NAFEMS, The Standard NAFEMS Benchmarks, TNSB Rev. 3, 1990)."""
 from __future__ import annotations
 
@@ -12,6 +12,8 @@ BENCHMARKS = {
     "t3": ("T3 1-D transient, T at x = 0.08 m, t = 32 s", "T_degC", "36.60", "°C", ""),
     "t4": ("T4 2-D convection, T at E", "T_degC", "18.25", "°C", ""),
     "le11": ("LE11 cylinder/taper/sphere, σ_zz at A", "sigma_zz_MPa", "-105", "MPa", "quarter"),
+    "le1": ("LE1 elliptic membrane, σ_yy at D", "sigma_yy_MPa", "92.7", "MPa", "quarter"),
+    "le10": ("LE10 thick plate under pressure, σ_yy at D", "sigma_yy_MPa", "-5.38", "MPa", "quarter"),
 }
 """Case -> (label, probe quantity of the probe ``target``, published target as printed, unit, model note)."""
 
@@ -31,10 +33,10 @@ def run(path: Path) -> tuple[dict, object]:
     """The probes' summary and the case of one benchmark (as ``gatetherm run`` computes them)."""
     from gatetherm.studies.run.case import load_case
     from gatetherm.studies.run.output import probe_summary
-    from gatetherm.studies.run.scenario import case_schedule, run_scenario
+    from gatetherm.studies.run.scenario import run_scenario
 
     case = load_case(path)
-    res = run_scenario(case, case.mesh.dim, case_schedule(case))
+    res = run_scenario(case)
     return probe_summary(case.problem, res.columns), case
 
 

@@ -7,13 +7,13 @@ from gatetherm.validation import paper_model
 
 
 def compute(ctx) -> Result:
-    from gatetherm.solvers.effects import CATALOGUE
+    from gatetherm.solvers.frame import EFFECTS
     from gatetherm.validation import rom_study as rs
     from gatetherm.validation.plots.rom import plot_rom_bands, plot_rom_error
 
     effects = ctx.scope["effects"]
     st = rs.write_rom_study(ctx.work, paper_model(), ctx.scope["dims"], conditions=ctx.scope["conditions"],
-                            effects=tuple(CATALOGUE) if effects == "all" else effects)
+                            effects=EFFECTS if effects == "all" else effects)
     plot_rom_error(st.errors, ctx.work / "rom_error.png")
     plot_rom_bands(st.rows, ctx.work / "rom_bands.png")
     checks = table("The reduced model against full FE runs (1-min samples)", rs.CHECK_COLUMNS, rs.check_rows(st.checks),

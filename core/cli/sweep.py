@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.studies.cli.options import Progress, add_parallel_options
+from gatetherm.cli.options import Progress, add_parallel_options
 
 #: What a run writes into --out besides the point files (kept: a rerun resumes from them);
 #: a rerun replaces all of it.
@@ -51,10 +51,10 @@ def _sweep(args, study, tasks, out) -> list:
 
     (records,), failed = run_studies([(tasks, PointStore(out))], args.workers, args.scheduler,
                                      Progress(f"sweep {study.name}"))
-    columns, rows = table(tasks, records)
+    columns, rows = table(tasks, records, study.columns)
     write_table(out / "table.csv", columns, rows)
     write_text_atomic(out / "study.json", json.dumps(
-        {"name": study.name, "dim": study.dim, "config": study.base.source, "compute": list(study.compute),
+        {"name": study.name, "dim": study.dim, "config": study.case or study.base.source, "compute": list(study.compute),
          "set": dict(study.fixed), "grid": {k: list(v) for k, v in study.grid}}, indent=2) + "\n")
     n_skip = sum(r["status"] == "skipped" for r in rows)
     print(f"wrote {out / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} done, "

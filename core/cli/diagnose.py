@@ -5,9 +5,9 @@ it gets with them.
 Writes, once everything is computed: ``DIR/residuals.png``, ``DIR/scores.png``,
 ``DIR/before_after.png`` and ``DIR/model.toml`` (when pieces were found),
 ``DIR/report.md``, and last ``DIR/diagnosis.json``. ``--list-effects [--json]``
-prints the hypotheses instead. ``--case CASE.toml`` replays the run through a case file's
-frame (any frame) instead of the paper model; no ``model.toml`` is written then (the
-report lists the values to put into the case file).
+prints the hypotheses instead. ``--case CASE.toml`` replays the run through a case file (any
+machine) instead of the paper's frame; no ``model.toml`` is written then (the report lists the
+values to put into the case file).
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE
-from gatetherm.studies.cli.options import add_model_options, number
+from gatetherm.cli.options import add_model_options, number, refuse_model_options
 
 log = logging.getLogger(__name__)
 
@@ -93,19 +93,20 @@ def settings_from(args):
 
 
 def load_model(args):
-    """The paper model of --config, or the case of --case (checked against the other options)."""
-    from gatetherm.studies.run.case import load_case
-    from gatetherm.studies.run.config import load_config
+    """The case of --case, or the paper's frame of --config/--dim (checked against the other options)."""
+    import gatetherm as gt
 
     if args.case is None:
         if args.mesh_factor is not None:
             raise InputError("--mesh-factor", "goes with --case only", "give --mesh-size for the paper model")
-        return load_config(args.config)
-    if args.config is not None:
-        raise InputError("--case/--config", "give one model, a case file or a model file", "drop one of the two")
-    if args.dim != 2 or args.mesh_size is not None:
-        raise InputError("--dim/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
-    case = load_case(args.case, args.mesh_factor or 1.0)
+        case = gt.gate_frame(args.dim, args.config)
+        if args.mesh_size is not None:
+            case = case.with_overrides({"mesh.size" if args.dim == 2 else "mesh.size_3d": args.mesh_size})
+        return case
+    refuse_model_options(args)
+    if args.mesh_size is not None:
+        raise InputError("--case/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
+    case = gt.load_case(args.case, args.mesh_factor or 1.0)
     if case.time is None:
         raise InputError(f"{args.case}: time", "a diagnosed case needs [time] (a transient run)",
                          "add [time] with end and step; the run's times come from --data")
@@ -121,22 +122,17 @@ def run(args: argparse.Namespace) -> int:
     if not args.data or not args.out:
         raise InputError("--data/--out", "both are required", "e.g. gatetherm diagnose --data run.csv --out diag")
     from gatetherm.outdir import output_dir
-    from gatetherm.studies.diagnosis.discrepancy import adopted_config, diagnose
-    from gatetherm.studies.run.scenario import case_series_schedule
+    from gatetherm.studies.diagnosis.discrepancy import adopted_case, diagnose
+    from gatetherm.studies.run.scenario import measured_schedule
     from gatetherm.studies.run.timeseries import read_timeseries
 
     settings = settings_from(args)
-    cfg = load_model(args)
-    ts = read_timeseries(args.data, **({} if args.case is None else {"required": ("time_s",)}))
-    if args.case is not None:
-        mesh = None
-        case_series_schedule(cfg, ts, str(args.data))  # every input the case reads is in the file
-    else:
-        mesh = cfg.model.mesh if args.mesh_size is None else dataclasses.replace(
-            cfg.model.mesh, **{"size" if args.dim == 2 else "size_3d": args.mesh_size})
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, args.case)) as out:
-        diag = diagnose(cfg, ts, args.dim, mesh, settings)
-        _write(args, cfg, diag, adopted_config(cfg, diag), out)
+    case = load_model(args)
+    ts = read_timeseries(args.data, required=("time_s",))
+    measured_schedule(case, ts, str(args.data))  # every input the case reads is in the file
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *case.files)) as out:
+        diag = diagnose(case, ts, settings)
+        _write(args, case, diag, adopted_case(case, diag), out)
     s = diag.summary()
     print(f"verdict: {diag.verdict}")
     for r in diag.pieces:
@@ -154,10 +150,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _write(args, cfg, diag, adopted, out: Path) -> None:
+def _write(args, case, diag, adopted, out: Path) -> None:
     from gatetherm import write_text_atomic
     from gatetherm.studies.diagnosis.report import report_markdown
-    from gatetherm.studies.run.config import config_toml
     from gatetherm.studies.run.output import write_json
     from gatetherm.validation.plots.discrepancy import plot_before_after, plot_residuals, plot_scores
 
@@ -169,12 +164,13 @@ def _write(args, cfg, diag, adopted, out: Path) -> None:
     if adopted is not None:
         files["before_after"] = "before_after.png"
         plot_before_after(diag, out / files["before_after"])
-    if adopted is not None and args.case is None:
+    text = None if adopted is None else adopted.origin.model_file(adopted, (
+        f"gatetherm diagnose of {args.data}: verdict {diag.verdict}, pieces "
+        + ", ".join(r.piece.label for r in diag.pieces) + f"\nbase model: {case.source}"))
+    if text is not None:
         files["model"] = str(out / "model.toml")
-        head = (f"gatetherm diagnose of {args.data}: verdict {diag.verdict}, pieces "
-                + ", ".join(r.piece.label for r in diag.pieces) + f"\nbase model: {cfg.source}")
-        write_text_atomic(out / "model.toml", config_toml(adopted, head))
-    write_text_atomic(out / "report.md", report_markdown(diag, str(args.data), cfg.source, files))
-    write_json(out / "diagnosis.json", {**diag.summary(), "data": str(args.data), "config": cfg.source,
+        write_text_atomic(out / "model.toml", text)
+    write_text_atomic(out / "report.md", report_markdown(diag, str(args.data), case.source, files))
+    write_json(out / "diagnosis.json", {**diag.summary(), "data": str(args.data), "config": case.source,
                                         "case": args.case, "model_file": files.get("model"),
                                         "mesh_size": args.mesh_size, "mesh_factor": args.mesh_factor})

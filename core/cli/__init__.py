@@ -1,11 +1,12 @@
 """The ``gatetherm`` console command: argument parsing and error reporting only.
 
 Exit codes: 0 done; 1 an I/O failure (a full disk, an output directory that cannot be
-written or that another run is writing into) or failed sweep points; 2 bad input; 130
-Ctrl-C; 143 SIGTERM. Each failure is one line on stderr, never a traceback; argument
-errors too (the usage is printed by ``--help``). Only ``os``, ``signal``, ``sys`` and
-``threading`` are imported before :func:`main` runs, so that a Ctrl-C while the command
-modules are imported ends in that one line as well.
+written or that another run is writing into) or failed sweep points; 2 bad input (also
+equations made from it that no solver can solve); 130 Ctrl-C; 143 SIGTERM. Each failure is
+one line on stderr, never a traceback; argument errors too (the usage is printed by
+``--help``). Only ``os``, ``signal``, ``sys`` and ``threading`` are imported before
+:func:`main` runs, so that a Ctrl-C while the command modules are imported ends in that one
+line as well.
 """
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ import threading
 
 #: Sub-command modules of this package, in ``--help`` order.
 COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
-                   "export", "report")
+                   "errormodel", "export", "report")
 
 
 class Terminated(BaseException):
@@ -71,7 +72,7 @@ class _Signals:
 def build_parser():
     import importlib
 
-    from gatetherm.studies.cli.options import Parser
+    from gatetherm.cli.options import Parser
 
     parser = Parser(
         prog="gatetherm",
@@ -81,7 +82,7 @@ def build_parser():
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
-        importlib.import_module(f"gatetherm.studies.cli.{name}").register(sub)
+        importlib.import_module(f"gatetherm.cli.{name}").register(sub)
     return parser
 
 
@@ -98,7 +99,7 @@ def _run(argv: list[str] | None) -> int:
     import logging
 
     from gatetherm import InputError
-    from gatetherm.studies.cli.options import UsageError
+    from gatetherm.cli.options import UsageError
 
     parser = build_parser()
     try:
@@ -115,9 +116,11 @@ def _run(argv: list[str] | None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from gatetherm.studies.cli.process import configure
+    from gatetherm.process import configure
     from gatetherm.studies.sweeps.runner import PointsFailed
 
+    logging.captureWarnings(True)  # the numerical libraries' warnings: in the log, shown with -v
+    logging.getLogger("py.warnings").setLevel(logging.INFO if args.verbose else logging.ERROR)
     try:
         configure()
         return int(args.func(args) or 0)
@@ -125,8 +128,15 @@ def _run(argv: list[str] | None) -> int:
         return _say(f"error: {err}", 2)
     except PointsFailed as err:
         return _say(f"error: {err}", 1)
+    except RuntimeError as err:  # the equations of the input cannot be solved (a solver ran: it is imported)
+        linsolve = sys.modules.get("gatetherm.solvers.linsolve")
+        if linsolve is None or not isinstance(err, linsolve.SolverError):
+            raise
+        return _say(f"error: {err}", 2)
     except OSError as err:
         return _say(f"error: {_os_message(err)}", 1)
+    finally:
+        logging.captureWarnings(False)
 
 
 def main(argv: list[str] | None = None) -> int:

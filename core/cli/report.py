@@ -7,7 +7,8 @@ import time
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.studies.cli.options import WORKERS, number
+from gatetherm.files import read_text
+from gatetherm.cli.options import WORKERS, number
 
 PAGE = ("index.html",)
 """What a report run replaces in --out; the sections' folders (the cache) are kept."""
@@ -37,6 +38,10 @@ def register(sub) -> None:
 def run(args) -> int:
     t0 = time.perf_counter()
     if args.data:
+        given = [o for o, v in (("--full", args.full), ("--section", args.section), ("--readme", args.readme)) if v]
+        if given:
+            raise InputError(f"--data/{given[0]}", "applies to the validation report, not to a drift report",
+                             f"drop {given[0]}, or --data")
         return _drift(args)
     from gatetherm.outdir import output_dir
     from gatetherm.validation.report import readme as rd
@@ -48,7 +53,7 @@ def run(args) -> int:
     if args.readme:
         if not args.full:
             raise InputError("--readme", "the README quotes the full studies", "add --full")
-        text = Path(args.readme).read_text(encoding="utf-8")
+        text = read_text(args.readme, "--readme", "give the project's README.md")
         rd.check_names(rd.blocks(text), {n for s in SECTIONS for n in s.readme}, args.readme)
 
     def tell(key, status, seconds):
@@ -59,7 +64,8 @@ def run(args) -> int:
         write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code_digest()))
     print(f"wrote {out}/index.html in {time.perf_counter() - t0:.0f} s")
     if text is not None:
-        text = Path(args.readme).read_text(encoding="utf-8")  # as it is now: it may have been edited meanwhile
+        # as it is now: it may have been edited meanwhile
+        text = read_text(args.readme, "--readme", "give the project's README.md")
         tables, partial = rd.full_tables(results)
         new, done = rd.rewrite(text, tables)
         write_text_atomic(args.readme, new)
@@ -72,10 +78,11 @@ def run(args) -> int:
 def _drift(args) -> int:
     from gatetherm.outdir import output_dir
     from gatetherm.studies.run.timeseries import read_timeseries
-    from gatetherm.validation.report.drift import compute
+    from gatetherm.validation.report.drift import check_record, compute
     from gatetherm.validation.report.page import drift_html
 
     ts = read_timeseries(args.data, required=("time_s",))
+    check_record(ts, args.data)
     with output_dir(args.out, DRIFT, keep=(args.data,)) as out:
         result = compute(ts, out, Path(args.data).name)
         write_text_atomic(out / "index.html", drift_html(result, args.data, f"gatetherm report --data {args.data} "

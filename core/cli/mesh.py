@@ -3,9 +3,8 @@ case file (``case.toml`` with ``schedule.csv``: a paper condition) that ``gateth
 runs and a user can copy."""
 from __future__ import annotations
 
-from gatetherm.geometry.build import build_mesh
 from gatetherm.geometry.mesh import save_mesh
-from gatetherm.studies.cli.options import add_model_options
+from gatetherm.cli.options import add_model_options
 
 #: What a run writes into --out; a rerun replaces all of it.
 OUTPUTS = ("mesh.msh", "mesh.vtu", "case.toml", "schedule.csv")
@@ -21,17 +20,18 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    import gatetherm as gt
     from gatetherm.outdir import output_dir
-    from gatetherm.studies.run.config import load_config
     from gatetherm.studies.run.frame_case import write_frame_case
 
-    cfg = load_config(args.config)
+    gt.condition(args.condition)  # a bad number fails before the frame is meshed
     with output_dir(args.out, OUTPUTS, keep=(args.config,)) as out:
-        fm = build_mesh(cfg.model.frame, args.dim, cfg.model.mesh)
+        case = gt.gate_frame(args.dim, args.config, args.condition)
+        fm = case.mesh
         for name in OUTPUTS[:2]:
             save_mesh(fm, out / name)
             print(f"wrote {out / name}")
-        write_frame_case(cfg, fm, args.condition, out)
+        write_frame_case(case, args.condition, out)
     print(f"wrote {out / 'case.toml'} and {out / 'schedule.csv'} (the frame as a case: gatetherm run {out / 'case.toml'})")
     c = fm.counts()
     print(f"{args.dim}-D frame: {c['nodes']} nodes, {c['elements']} elements")

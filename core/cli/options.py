@@ -5,13 +5,26 @@ import argparse
 import os
 import sys
 
+from gatetherm import InputError
 from gatetherm.checks import Range
+
+
+class _Default(int):
+    """An option's default value, told apart from the same value given on the command line."""
 
 
 def add_model_options(p: argparse.ArgumentParser, dims=(2, 3), dim_help: str = "2-D section or 3-D solid (default 2)") -> None:
     """``--dim`` and ``--config``, shared by the commands that build a model."""
-    p.add_argument("--dim", type=int, choices=dims, default=2, help=dim_help)
+    p.add_argument("--dim", type=int, choices=dims, default=_Default(2), help=dim_help)
     p.add_argument("--config", metavar="FILE.toml", help="model file (default: the shipped paper model)")
+
+
+def refuse_model_options(args, case: str = "--case") -> None:
+    """InputError if ``--dim`` or ``--config`` was given with a case file (which gives its own model and mesh)."""
+    given = [o for o, v in (("--dim", args.dim), ("--config", args.config))
+             if v is not None and type(v) is not _Default]
+    if given:
+        raise InputError(f"{case}/{given[0]}", "a case file gives its own model and mesh", f"drop {given[0]}")
 
 
 def add_parallel_options(p: argparse.ArgumentParser) -> None:
@@ -69,3 +82,12 @@ FIELD_FILES = ("fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf",
 """The field files of a run in its --out (studies.run.output.write_fields)."""
 WORKERS = Range(1, whole=True)
 """Worker processes."""
+
+
+def picture_keep(schedule, every: float, picture_every: float = 300.0) -> list[float]:
+    """The sample times whose states a written run needs: the fields every ``every`` s, the
+    candidates of the deformed picture (every ``picture_every`` s: it shows δ's first peak) and
+    the end."""
+    times = [float(t) for t in schedule.times]
+    on = [t for t in times if any(abs(t / e - round(t / e)) < 1e-9 for e in (every, picture_every))]
+    return sorted(set(on) | {times[-1]})

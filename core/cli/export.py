@@ -6,7 +6,7 @@ import json
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.studies.cli.options import add_model_options
+from gatetherm.cli.options import add_model_options, refuse_model_options
 
 #: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
 OUTPUTS = ("job.inp", "gatetherm.json")
@@ -27,26 +27,25 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    import gatetherm as gt
     from gatetherm.outdir import output_dir
     from gatetherm.studies.run.ccx import check_time, export_state
-    from gatetherm.studies.run.scenario import case_schedule, condition_schedule
 
     if (args.case is None) == (args.condition is None):
         raise InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
     if args.case:
-        from gatetherm.studies.run.case import load_case
-
-        cfg = load_case(args.case)
-        schedule, dim, what = case_schedule(cfg), cfg.mesh.dim, str(args.case)
-    else:
-        from gatetherm.studies.run.config import load_config
-
-        cfg = load_config(args.config)
-        schedule, dim, what = condition_schedule(args.condition, cfg), args.dim, f"condition {args.condition}"
+        refuse_model_options(args, "CASE.toml")
+    gt.condition(args.condition or 1)
+    case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config, args.condition)
+    what = str(args.case) if args.case else f"condition {args.condition}"
+    if case.dim != 3:  # before the run
+        raise InputError(f"{args.case}: mesh" if args.case else "--dim", "CalculiX export is for 3-D models",
+                         "give a 3-D mesh" if args.case else "use --dim 3")
+    schedule = case.schedule
     t = float(schedule.times[-1]) if args.time is None else args.time * 60.0
-    check_time(schedule, t)
-    with output_dir(args.out, OUTPUTS, keep=(args.case, args.config)) as out:
-        inp, info = export_state(cfg, dim, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
+    t = check_time(schedule, t)
+    with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files)) as out:
+        inp, info = export_state(case, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
         write_text_atomic(out / "job.inp", inp)
         write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")
     print(f"wrote {args.out}/job.inp ({info['vertices']} vertices) and gatetherm.json; run: cd {args.out} && ccx job")

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE, Range
-from gatetherm.studies.cli.options import WORKERS, Progress, add_model_options, add_parallel_options, number
+from gatetherm.cli.options import WORKERS, Progress, add_model_options, add_parallel_options, number
 
 
 def register(sub) -> None:

@@ -1,0 +1,202 @@
+"""``gatetherm compensate``: predict delta from temperatures and compensate it with the piezo.
+
+Takes a time-series file (``--data``; delta_um = the uncompensated thermal displacement), runs a
+case file (``--case``) or simulates one of the paper's conditions on the frame (``--condition N``,
+with ``--dim`` and ``--config``), compensates it (``gatetherm.studies.control.methods``) and
+writes, once everything has been computed: ``DIR/compensated.csv`` (the input plus ``u_piezo_um`` =
+displacement achieved at the cutting area, ``delta_pred_um``, ``delta_comp_um``),
+``DIR/compensation.png``, ``DIR/piezo_loops.png`` (unless --no-actuator) and
+``DIR/summary.json`` (last).
+
+``--method`` paper (default) is that procedure. K_i, K_C (um/K): ``--Ki/--Kc``, or
+``--k-source`` theory (default: beam theory of the model given by --config, the paper's
+procedure), fe (FE load cases on that model at --dim, read at the tips F) or fit (least squares
+on the run itself).
+
+``--method mlr``: the industry baseline, a static regression of delta on theta_A, theta_B,
+theta_C fitted on condition 1 of the --config/--dim model, forecasting one sample ahead from the
+extrapolated temperatures (the paper's latency), updated every --interval-min.
+
+``--method rom``: a Kalman filter on the reduced model estimates the thermal state from the
+inputs, the --sensors columns and delta; the controller forecasts delta over the hold from the
+known schedule and commands the minimax value (studies/control/predictive.py), updating when the
+forecast residual would exceed a threshold planned for the --max-updates budget (``--updates
+event``, default) or every --interval-min (``--updates fixed``). For --data it takes the file's
+input columns (those the reduced model reads) as the schedule known in advance. The reduced model
+is --rom FILE (from ``gatetherm reduce``), or built from the case (or --config/--dim) with --states
+states and kept as DIR/rom.npz (reused by a later run with the same model and states, which
+DIR/rom.key records).
+
+The actuator is the case's ``[actuator]`` (the frame's: the paper's piezo), ideal without one or
+with ``--no-actuator``. The mlr regression is fitted on the model's own schedule (the frame's:
+condition 1).
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import logging
+import math
+from pathlib import Path
+
+from gatetherm import InputError, write_text_atomic
+from gatetherm.cli.options import add_model_options, refuse_model_options
+
+log = logging.getLogger(__name__)
+
+WRITTEN = ("u_piezo_um", "delta_pred_um", "delta_comp_um")
+"""Columns compensate adds to its input. Those of an earlier compensation (a file with its
+``compensation`` metadata) and ``u_piezo_um`` are replaced with a warning; in any other
+file a column of these names is refused, since it would be lost."""
+#: What a run writes into --out; a rerun replaces all of it.
+OUTPUTS = ("compensated.csv", "compensation.png", "piezo_loops.png", "summary.json")
+
+
+def register(subparsers) -> None:
+    from gatetherm.studies.control.methods import K_SOURCES, METHODS
+    from gatetherm.studies.control.predictive import THERMOCOUPLES
+
+    p = subparsers.add_parser(
+        "compensate",
+        help="predict and compensate the thermal displacement of a run (paper section 3.2)",
+        description="Predict delta one minute ahead from theta_A, theta_B, theta_C (paper), a regression (mlr) "
+        "or a reduced model with a Kalman filter (rom), and drive the actuator with the command.",
+    )
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--data", metavar="FILE.csv", help="time-series file (docs/data-format.md)")
+    src.add_argument("--condition", type=int, metavar="N",
+                     help="simulate the paper's condition 1, 2 or 3 on the frame and compensate it")
+    p.add_argument("--case", metavar="CASE.toml",
+                   help="the model: a case file whose [signals] map theta_A, theta_B, theta_C and delta; without "
+                   "--data its own run is compensated")
+    add_model_options(p)
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--Ki", type=float, metavar="UM_PER_K", help="K_i in um/K (with --Kc)")
+    p.add_argument("--Kc", type=float, metavar="UM_PER_K", help="K_C in um/K (with --Ki)")
+    p.add_argument("--k-source", choices=K_SOURCES,
+                   help="where K_i, K_C come from instead of --Ki/--Kc (default: theory, the frame's beam theory; "
+                   "fit for a case file)")
+    p.add_argument("--interval-min", type=float, default=5.0, metavar="MIN",
+                   help="actuator update interval in minutes (default 5, as in the paper)")
+    p.add_argument("--no-actuator", action="store_true",
+                   help="ideal actuator: the stroke equals the command")
+    p.add_argument("--method", choices=METHODS[:3], default="paper",
+                   help="paper (default): the paper's procedure; mlr: regression baseline; rom: Kalman filter "
+                   "and predictive control on the reduced model")
+    p.add_argument("--rom", metavar="ROM.npz", help="rom: reduced model from 'gatetherm reduce' (default: build "
+                   "one from the model and keep it in DIR)")
+    p.add_argument("--states", type=int, default=30, metavar="N", help="rom: states when building (default 30)")
+    p.add_argument("--updates", choices=("event", "fixed"), default="event",
+                   help="rom: event-triggered within the budget (default) or every --interval-min")
+    p.add_argument("--max-updates", type=int, default=60, metavar="N", help="rom: update budget (default 60)")
+    p.add_argument("--sensors", default=",".join(THERMOCOUPLES), metavar="COL,...",
+                   help="rom: temperature columns the observer reads (default the paper's three)")
+    p.add_argument("--model", metavar="MODEL.json", help="replay a model from 'gatetherm errormodel fit' instead of "
+                   "--method (the --data file needs only time_s, the model's columns and --target)")
+    p.add_argument("--target", metavar="COL", help="--model: the compensated channel (default: the model's only one)")
+    p.add_argument("--correction", action="store_true", help="--model of the paper's form: on-line R_i, R_C (eqs 30-38)")
+    p.set_defaults(func=run)
+
+
+def _settings(args):
+    from gatetherm.studies.control.compensator import CompensatorParams
+    from gatetherm.studies.control.methods import Settings
+    from gatetherm.studies.control.predictive import PredictiveParams
+
+    if not (math.isfinite(args.interval_min) and args.interval_min > 0):
+        raise InputError("--interval-min", f"must be > 0, got {args.interval_min}", "e.g. --interval-min 5")
+    params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
+    control = PredictiveParams(mode=args.updates, max_updates=args.max_updates, interval_s=params.update_interval_s)
+    sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
+    model = None
+    if args.model is not None:  # a bad model file or --target fails before --out is touched
+        from gatetherm.studies.errormodel.model import load_model
+        from gatetherm.studies.errormodel.replay import loop_target
+
+        model = load_model(args.model)
+        loop_target(model, args.target)
+    return Settings("errormodel" if model else args.method, params, args.Ki, args.Kc, args.k_source, args.states,
+                    control, sensors=sensors, model=model, target=args.target, correction=args.correction)
+
+
+def run(args: argparse.Namespace) -> int:
+    import gatetherm as gt
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.timeseries import FORMAT, read_timeseries
+
+    settings = _settings(args)
+    if args.model is not None and args.data is None:
+        raise InputError("--model", "replays a fitted model on recorded data", "give --data FILE.csv")
+    if args.data is None and args.condition is None and args.case is None:
+        raise InputError("--data/--condition/--case", "give what to compensate",
+                         "a time-series file, one of the paper's conditions, or a case file (its own run)")
+    if args.case is not None and args.condition is not None:
+        raise InputError("--case/--condition", "the paper's conditions drive the frame's oil supply",
+                         "compensate a case's own run (--case alone) or a recorded file (--data)")
+    if args.case is not None:
+        refuse_model_options(args)
+    if args.condition is not None:
+        gt.condition(args.condition)  # a bad number fails before the model is built
+        case = gt.gate_frame(args.dim, args.config)
+    else:
+        case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config)
+    if args.data is not None:
+        ts, what = read_timeseries(args.data, required=("time_s",)), str(args.data)
+        clash = [name for name in WRITTEN[1:] if name in ts]
+        if clash and "compensation" not in ts.metadata:
+            raise InputError(f"{args.data}, column {clash[0]}", "compensate writes a column of this name "
+                             "and the file is not from an earlier compensate", "rename the column so that it is kept")
+    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *case.files)) as out_dir:
+        if args.data is None:
+            if not case.problem.signals.complete or case.time is None:
+                raise InputError(f"{case.source}: signals", "a compensated case needs [time] and [signals] with "
+                                 "theta_A, theta_B, theta_C and delta", "map them to its probes and a relative "
+                                 "displacement")
+            schedule = gt.condition(args.condition, case) if args.condition is not None else case.schedule
+            res = gt.run(case, schedule, keep=())
+            meta = {"format": FORMAT, "source": "gatetherm compensate", "schedule": schedule.label,
+                    "dim": str(case.dim), "config": case.source}
+            ts = res.scenario.series({**meta, **({"condition": str(args.condition)} if args.condition else {})})
+            what = f"condition {args.condition}" if args.condition is not None else str(args.case)
+        return _compensate(args, case, ts, what, settings, out_dir)
+
+
+def _um(value) -> str:
+    return "n/a" if value is None else f"{value:.2f} um"
+
+
+def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
+    from gatetherm.studies.control.methods import compensate
+    from gatetherm.studies.run.reduce import load_rom
+    from gatetherm.studies.run.timeseries import write_timeseries
+
+    actuator = None if args.no_actuator else case.actuator
+    replaced = [name for name in WRITTEN if name in ts]
+    if replaced:
+        log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
+    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=out_dir,
+                      source=what, rom_source=args.rom)
+    summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
+               "config": case.source, "dim": case.dim, **({"model": args.model} if args.model else {})}
+    text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
+    loop = comp.loop
+    out = ts.with_columns(u_piezo_um=loop.stroke_um, delta_pred_um=loop.delta_pred_um,
+                          delta_comp_um=loop.delta_comp_um)
+    out = dataclasses.replace(out, metadata={
+        **out.metadata, "compensation": f"{'' if settings.method == 'paper' else settings.method + ': '}{comp.label}, "
+        f"{'actuator model' if actuator else 'ideal actuator'}"})
+
+    from gatetherm.validation.plots.compensation import plot_compensation, plot_piezo_loops  # outer layer
+    write_timeseries(out_dir / "compensated.csv", out)
+    plot_compensation(loop, out_dir / "compensation.png")
+    if actuator:
+        plot_piezo_loops(actuator, out_dir / "piezo_loops.png")
+    write_text_atomic(out_dir / "summary.json", text)
+    print(f"wrote {out_dir}/compensated.csv, compensation.png, "
+          f"{'piezo_loops.png, ' if actuator else ''}summary.json")
+    print(f"{what}: {comp.head}; swing {summary['swing_um']:.2f} um, "
+          f"prediction error band {_um(summary['prediction_error_band_um'])}, "
+          f"residual band {_um(summary['residual_band_um'])} "
+          f"({_um(summary['residual_at_updates_um'])} at the update instants), {summary['updates']} updates")
+    return 0

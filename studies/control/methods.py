@@ -1,0 +1,202 @@
+"""Compensation of a run by one of three methods, on any case: the one place that composes them.
+
+* ``paper``: the paper's adaptive predictor (:mod:`.compensator`) with K_i, K_C given, from the
+  beam theory (``theory``, a model with the paper frame's beam parameters), from FE load cases
+  (``fe``, ditto) or fitted on the run itself (``fit``);
+* ``mlr``: a static regression of δ on θ_A, θ_B, θ_C fitted on the case's own schedule, forecasting
+  one sample ahead from the extrapolated temperatures (the paper's latency);
+* ``rom``: a Kalman filter on the case's reduced model and predictive control (:mod:`.predictive`);
+* ``errormodel``: a thermal-error model fitted on measured data (``gatetherm errormodel fit``,
+  :mod:`gatetherm.studies.errormodel`), replayed on one of its targets.
+
+The actuator is the case's (``[actuator]``; the paper frame's piezo), or ideal (None): the
+correction sent to the machine's control as an offset.
+"""
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from gatetherm import InputError
+from gatetherm.solvers.expr import Value
+from gatetherm.studies.control.actuator import ActuatorParams
+from gatetherm.studies.control.compensator import (NEEDED, ClosedLoop, CompensatorParams, close_loop, compensate as
+                                                   paper_loop, external_prediction, summarize)
+from gatetherm.studies.control.observer import ObserverParams
+from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams, rom_prediction
+from gatetherm.studies.control.regression import THETAS, fit_coefficients, fit_regression, regression_forecast
+from gatetherm.studies.run.case import Case
+from gatetherm.studies.run.scenario import ScenarioCache, prepare, run_scenario
+from gatetherm.studies.run.timeseries import TimeSeries, validate_complete
+
+log = logging.getLogger(__name__)
+
+METHODS = ("paper", "mlr", "rom", "errormodel")
+K_SOURCES = ("theory", "fe", "fit")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How a run is compensated."""
+
+    method: str = "paper"
+    """"paper", "mlr" or "rom"."""
+    params: CompensatorParams = CompensatorParams()
+    Ki: float | None = None
+    """K_i, um/K (paper; with Kc), else from :attr:`k_source`."""
+    Kc: float | None = None
+    k_source: str | None = None
+    """"theory", "fe" or "fit" (default: theory where the case has beam parameters, else fit)."""
+    states: int = 30
+    """rom: states of the reduced model built."""
+    control: PredictiveParams = PredictiveParams()
+    observer: ObserverParams = ObserverParams()
+    sensors: tuple[str, ...] = THERMOCOUPLES
+    """rom: temperature columns the observer reads."""
+    model: object = None
+    """errormodel: the fitted :class:`~gatetherm.studies.errormodel.model.ErrorModel`."""
+    target: str | None = None
+    """errormodel: the compensated channel (default: the model's only one)."""
+    correction: bool = False
+    """errormodel of the paper's form: the on-line R_i, R_C of eqs 30–38."""
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """A compensated run."""
+
+    loop: ClosedLoop
+    summary: dict
+    label: str
+    """What was done, for metadata: method, K or model, update rule."""
+    head: str
+    """One line for the terminal."""
+    extra: dict = field(default_factory=dict)
+
+
+def coefficients(case: Case | None, ts: TimeSeries, s: Settings, cache: ScenarioCache | None = None
+                 ) -> tuple[float, float, str]:
+    """K_i, K_C (um/K) and their source (``explicit`` or a :data:`K_SOURCES` entry)."""
+    if s.Ki is not None or s.Kc is not None:
+        if s.Ki is None or s.Kc is None or s.k_source:
+            raise InputError("--Ki/--Kc", "give both, and not together with --k-source",
+                             "e.g. --Ki 2.1 --Kc 0.8, or --k-source fit")
+        if not (math.isfinite(s.Ki) and math.isfinite(s.Kc)):
+            raise InputError("--Ki/--Kc", "must be finite numbers", "e.g. --Ki 2.1 --Kc 0.8")
+        return s.Ki, s.Kc, "explicit"
+    beam = case is not None and case.parameters is not None
+    source = s.k_source or ("theory" if beam else "fit")
+    if source == "fit":
+        return (*fit_coefficients(ts), source)
+    if not beam:
+        raise InputError("--k-source", f"'{source}' needs the paper frame's beam model; this case has none",
+                         "use --k-source fit or --Ki/--Kc")
+    if source == "theory":
+        from gatetherm.solvers.beam import theory_coefficients
+
+        return (*theory_coefficients(case.parameters), source)
+    from gatetherm.solvers.reduced import tip_coefficients_um
+
+    return (*tip_coefficients_um(prepare(case, cache=cache).model), source)
+
+
+def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Settings(),
+               actuator: ActuatorParams | None = None, *, rom=None, rom_dir: Path | None = None,
+               cache: ScenarioCache | None = None, source: str = "--data", rom_source: str | None = None
+               ) -> Compensation:
+    """Compensate the series ``ts`` (δ the uncompensated thermal displacement).
+
+    Parameters
+    ----------
+    ts : TimeSeries
+        The run: θ_A, θ_B, θ_C and δ (and for ``rom`` the inputs the reduced model reads).
+    case : Case, optional
+        The model: the K sources ``theory``/``fe``, the ``mlr`` training run (its own schedule) and the
+        ``rom`` reduced model come from it.
+    settings : Settings
+    actuator : ActuatorParams, optional
+        None: ideal (the command is applied exactly).
+    rom : ReducedModel, optional
+        ``rom``: this reduced model (read from ``rom_source``) instead of one built from ``case``
+        (kept in ``rom_dir``).
+    source : str
+        What the series is, for messages (a file name).
+
+    Returns
+    -------
+    Compensation
+    """
+    s, params = settings, settings.params
+    if s.method not in METHODS:
+        raise InputError("--method", f"unknown method {s.method!r}", f"choose from {', '.join(METHODS)}")
+    every = f"update every {params.update_interval_s / 60:g} min"
+    if s.method == "errormodel":
+        from gatetherm.studies.errormodel.replay import loop_target, replay
+
+        if s.model is None:
+            raise InputError("--model", "the errormodel method needs a fitted model", "give --model MODEL.json")
+        target = loop_target(s.model, s.target)
+        loop = replay(s.model, ts, target, params, actuator, s.correction)
+        extra = {"target": target, "correction": s.correction}
+        label = head = f"error model, {target} ({s.model.target(target).form} form" \
+            f"{', on-line R' if s.correction else ''}), {every}"
+        return Compensation(loop, {**summarize(loop, params.settle_s), "method": s.method, **extra,
+                                   "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
+                                   "actuator": dataclasses.asdict(actuator) if actuator else None}, label, head, extra)
+    validate_complete(ts, NEEDED)
+    if s.method == "paper":
+        ki, kc, source = coefficients(case, ts, s, cache)
+        loop = paper_loop(ts, ki, kc, params, actuator)
+        extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source}
+        label = f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source}), {every}"
+        head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source})"
+    elif s.method == "mlr":
+        if case is None:
+            raise InputError("--method mlr", "needs a model to train on", "give --case, or the frame's --config/--dim")
+        train = run_scenario(case, cache=cache).series({})
+        mlr = fit_regression(train, THETAS)
+        loop = close_loop(ts, external_prediction(ts, regression_forecast(mlr, ts), params), params, actuator)
+        extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))}}
+        label = f"regression on theta_A, theta_B, theta_C ({case.schedule.label} of the model), 1-sample forecast, " \
+            + every
+        head = f"mlr ({label})"
+    else:
+        loop, extra, label = _rom_loop(ts, case, s, actuator, rom, rom_dir, cache, source, rom_source)
+        head = f"rom ({label})"
+    summary = {**summarize(loop, params.settle_s), "method": s.method, **extra,
+               "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
+               "actuator": dataclasses.asdict(actuator) if actuator else None}
+    return Compensation(loop, summary, label, head, extra)
+
+
+def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache, source: str, where: str | None):
+    """The rom method's closed loop, its summary entries and a label."""
+    from gatetherm.studies.run.reduce import build_rom, cached_rom
+
+    if not 2 <= s.states <= 200:
+        raise InputError("--states", f"{s.states} is outside 2..200", "e.g. --states 30")
+    if not s.sensors:
+        raise InputError("--sensors", "no column named", "e.g. --sensors theta_A_degC,theta_B_degC")
+    control = dataclasses.replace(s.control, interval_s=s.params.update_interval_s)
+    if rom is None:
+        if case is None:
+            raise InputError("--method rom", "needs a reduced model", "give --rom FILE or a model (--case)")
+        if rom_dir is not None:
+            rom, where = cached_rom(case, s.states, rom_dir, cache), str(Path(rom_dir) / "rom.npz")
+        else:
+            rom = build_rom(case, s.states, cache).rom
+    read = set().union(*(Value.of(u.text).names() for u in rom.inputs), *(Value.of(p).names() for p in rom.pumps))
+    lacking = sorted(read - {"t"} - set(ts.names) - set(rom.defaults))
+    if lacking:
+        raise InputError(f"{source}, column {lacking[0]}", f"missing: the reduced model {where or ''} reads it",
+                         "record it, or give a reduced model of the inputs recorded")
+    pr, cmds = rom_prediction(ts, rom, s.params, control, s.observer, s.sensors)
+    loop = close_loop(ts, pr, s.params, actuator)
+    extra = {"rom": where, "rom_states": rom.states, "sensors": list(s.sensors), "threshold_um": cmds.threshold_um,
+             "predictive": dataclasses.asdict(control), "observer": dataclasses.asdict(s.observer)}
+    how = f"threshold {cmds.threshold_um:.2f} um" if cmds.threshold_um is not None else \
+        f"every {s.params.update_interval_s / 60:g} min"
+    return loop, extra, f"reduced model ({rom.states} states), Kalman filter on {', '.join(s.sensors)}, {how}"

@@ -1,0 +1,7 @@
+"""Thermal-error models fitted to a machine's measurements (docs/errormodel.md).
+
+:mod:`.terms` the regressors (temperature rises, differences, lagged inputs), :mod:`.select` the
+held-out error and the sensor selection, :mod:`.fit` :func:`~.fit.fit_error_model`, :mod:`.paper` the paper's form,
+:mod:`.model` the fitted model, its ``model.json`` and :func:`~.model.predict`, :mod:`.replay`
+the model in the compensation loop.
+"""

@@ -1,0 +1,286 @@
+"""Fitting thermal-error models to measured displacements (:func:`fit_error_model`).
+
+Per target, inside the fitting span and by the held-out error of :mod:`.select` (forward selection
+to the budget, then the smallest model on the path within ``min_gain`` of the best):
+
+* ``static``: ``delta = c0 + sum_k K_k theta_k`` over at most ``max_sensors`` temperature rises
+  (and, with ``differences``, differences ``theta_a - theta_b``);
+* ``dynamic``: the same candidates plus each operating input as ``lag_tau[(|u|/u_max)^p]`` for
+  ``p`` in ``exponents`` and ``tau`` on the grid ``input_taus_s`` (at most ``max_inputs`` such
+  terms), and, with ``sensor_taus_s``, lagged rises ``lag_tau[theta_k]``;
+* then (``refine``) the time constants are refined continuously (least squares on the fitting
+  span, within the grid's range) and each term is dropped whose removal raises the held-out error
+  by less than ``min_gain`` (two grid lags bracketing one time constant become one lag);
+* ``paper``: ``delta = K_i (theta_a - theta_b) - K_C theta_c`` (eq 21, no intercept), every
+  triple a, b, c of the candidates tried.
+
+``form="auto"`` fits ``static`` and ``dynamic`` and keeps ``dynamic`` only if its held-out error is
+lower by at least ``min_gain``. The fit is deterministic: no random numbers; ties go to the
+candidate listed first. The coefficients come from least squares on all valid rows of the span.
+"""
+from __future__ import annotations
+
+import dataclasses
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize
+
+from gatetherm import InputError
+from gatetherm.studies.errormodel import select
+from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, residual_stats
+from gatetherm.studies.errormodel.paper import fit_paper_form
+from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps
+
+log = logging.getLogger(__name__)
+
+FIT_FORMS = ("auto", "static", "dynamic", "paper")
+SQRT2 = float(np.sqrt(2.0))
+
+
+@dataclass(frozen=True)
+class FitParams:
+    """Settings of :func:`fit_error_model`."""
+
+    max_sensors: int = 4
+    """Most temperature columns one target's model may read."""
+    max_inputs: int = 2
+    """Most operating-input terms in one target's model."""
+    exponents: tuple[float, ...] = (1.0, 2.0)
+    """Exponents p of the input terms (|u|/u_max)^p tried, dimensionless."""
+    input_taus_s: tuple[float, ...] = (60.0, 120.0, 240.0, 480.0, 960.0, 1920.0, 3840.0)
+    """Time constants of the input lags tried, s (the fast part; slow heating is what the temperatures see)."""
+    sensor_taus_s: tuple[float, ...] = ()
+    """Time constants of lagged temperature rises tried, s; empty = none."""
+    differences: bool = False
+    """Also offer every difference theta_a - theta_b as one regressor (two sensors, one coefficient)."""
+    folds: tuple[int, ...] = (4, 5, 6, 7, 8)
+    """Block counts of the blocked cross-validation; its error is averaged over them."""
+    min_gain: float = 0.03
+    """Relative drop of the held-out error a further term must bring, dimensionless."""
+    form: str = "auto"
+    """``auto``, ``static``, ``dynamic`` or ``paper`` (module docstring)."""
+    refine: bool = True
+    """Refine the selected time constants continuously and drop terms that do not earn ``min_gain``."""
+    resolution_K: float = 0.01
+    """Temperature resolution, K: a rise or difference that spans less than 10 x this in the fitting
+    span is not offered (it carries no information, and its coefficient would amplify noise)."""
+    max_gap_s: float = 300.0
+    """Longest gap in a used column that is bridged by linear interpolation, s; rows in longer gaps
+    are left out of the fit and not predicted."""
+
+    def __post_init__(self):
+        if self.form not in FIT_FORMS:
+            raise InputError("form", f"{self.form!r} is not one of {', '.join(FIT_FORMS)}", "e.g. form auto")
+        if self.max_sensors < 1 or self.max_inputs < 0:
+            raise InputError("max_sensors", "must be >= 1 (and max_inputs >= 0)", "e.g. 4")
+        if not self.folds or min(self.folds) < 2:
+            raise InputError("folds", "need block counts >= 2", "e.g. (4, 5, 6, 7, 8)")
+        bad = [v for v in (*self.exponents, *self.input_taus_s, *self.sensor_taus_s, self.max_gap_s)
+               if not (np.isfinite(v) and v > 0)]
+        if bad:
+            raise InputError("exponents, time constants, max_gap_s", f"{bad[0]} is not > 0", "use positive values")
+        if not 0 <= self.min_gain < 1:
+            raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
+
+
+def fraction_span(t_s: np.ndarray, lo: float, hi: float) -> tuple[float, float]:
+    """The span from fraction ``lo`` to ``hi`` of the time from the first to the last sample, s."""
+    if not 0 <= lo < hi <= 1:
+        raise InputError("fit span", f"{lo:g}:{hi:g} is not 0 <= start < end <= 1", "e.g. 0:0.6")
+    return t_s[0] + lo * (t_s[-1] - t_s[0]), t_s[0] + hi * (t_s[-1] - t_s[0])
+
+
+def default_candidates(names, targets) -> tuple[str, ...]:
+    """Every temperature column (``*_degC``) that is not a target."""
+    return tuple(n for n in names if n.endswith("_degC") and n not in targets)
+
+
+def fit_error_model(series, targets, candidates=None, inputs=(), params: FitParams = FitParams(),
+                    span: tuple[float, float] | None = None, source: str = "") -> ErrorModel:
+    """Fit a thermal-error model of each target column.
+
+    Parameters
+    ----------
+    series : mapping or TimeSeries
+        ``time_s`` (s, increasing), the targets (um; NaN = not measured), the candidate temperature
+        columns (degC) and the inputs (e.g. ``spindle_rpm``, 1/min).
+    targets : sequence of str
+        Displacement columns to model, um.
+    candidates : sequence of str, optional
+        Temperature columns to choose sensors from; default every ``*_degC`` column.
+    inputs : sequence of str
+        Operating inputs for the dynamic terms; none = static and paper forms only.
+    params : FitParams
+        Budgets, grids, cross-validation and form.
+    span : (float, float), optional
+        Fitting span ``(start_s, end_s)`` of ``time_s``, s, both included; default the whole series.
+    source : str
+        Where the data came from (recorded in the model).
+
+    Returns
+    -------
+    ErrorModel
+        Models of the targets, the reference temperatures (first valid sample in the span, degC)
+        and the span; see :mod:`gatetherm.studies.errormodel.model`.
+    """
+    names = tuple(series.names if hasattr(series, "names") else series)
+    targets = tuple(targets)
+    candidates = tuple(candidates) if candidates is not None else default_candidates(names, targets)
+    for name in ("time_s", *targets, *candidates, *inputs):
+        if name not in names:
+            raise InputError(f"{source or 'data'}: column {name}", "missing", f"columns are {', '.join(names)}")
+    if not targets or not candidates:
+        raise InputError("targets/candidates", "none given", "name at least one target and one temperature column")
+    t = np.asarray(series["time_s"], float)
+    lo, hi = span if span is not None else (t[0], t[-1])
+    in_span = (t >= lo) & (t <= hi)
+    cols, long = {}, np.zeros(t.size, bool)
+    for name in (*candidates, *inputs):
+        v = np.asarray(series[name], float)
+        if not np.isfinite(v[in_span]).any():
+            raise InputError(f"column {name}", "no valid sample in the fitting span", "give measured values")
+        cols[name], gap, report = fill_gaps(t, v, params.max_gap_s)
+        long |= gap
+        if report.filled:
+            log.info("%s: %d missing samples filled (longest gap %.0f s)", name, report.filled, report.longest_s)
+    reference = {c: float(cols[c][np.flatnonzero(in_span & np.isfinite(series[c]))[0]]) for c in candidates}
+    base = _base_terms(candidates, inputs, cols, in_span, params)
+    B = np.column_stack([np.ones(t.size)] + [evaluate(b, t, cols, reference) for b in base])
+    models = [_fit_target(series[y], y, t, base, B, in_span & ~long, cols, reference, params)
+              for y in targets]
+    used = {s for m in models for s in m.sensors}
+    return ErrorModel(tuple(models), {c: reference[c] for c in candidates if c in used},
+                      {"start_s": float(lo), "end_s": float(hi), "samples": int(in_span.sum()), "source": str(source)},
+                      params.max_gap_s, _settings(params, candidates, inputs))
+
+
+def _settings(params: FitParams, candidates, inputs) -> dict:
+    return {**dataclasses.asdict(params), "candidates": list(candidates), "inputs": list(inputs)}
+
+
+def _base_terms(candidates, inputs, cols, in_span, params: FitParams) -> list[Term]:
+    base = [Term("sensor", c, tau_s=tau) for c in candidates for tau in (None, *params.sensor_taus_s)]
+    if params.form in ("auto", "dynamic"):
+        for u in inputs:
+            scale = float(np.max(np.abs(cols[u][in_span])))
+            if scale == 0:
+                log.warning("input %s is 0 throughout the fitting span: not used", u)
+                continue
+            base += [Term("input", u, tau_s=tau, exponent=p, scale=scale)
+                     for p in params.exponents for tau in params.input_taus_s]
+    if params.form == "static":
+        base = [b for b in base if b.tau_s is None]
+    return base
+
+
+def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:
+    """Terms offered to the forward selection and their combination vectors (column 0 = ones);
+    ``B`` are the base columns on the fitting rows."""
+    terms, cands, p = [], [], len(base) + 1
+    for j, b in enumerate(base):
+        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B[:, j + 1], params.resolution_K)):
+            w = np.zeros(p)
+            w[j + 1] = 1.0
+            terms.append(b)
+            cands.append(select.Candidate(len(cands), w, frozenset(() if b.kind == "input" else (b.column,)),
+                                          b.kind == "input"))
+    if params.differences:
+        plain = [j for j, b in enumerate(base) if b.kind == "sensor" and b.tau_s is None]
+        for i, k in [(i, k) for n, i in enumerate(plain) for k in plain[n + 1:]]:
+            w = np.zeros(p)
+            w[i + 1], w[k + 1] = 1.0, -1.0
+            if not select.informative(B @ w, params.resolution_K):
+                continue
+            terms.append(Term("difference", base[i].column, other=base[k].column))
+            cands.append(select.Candidate(len(cands), w, frozenset((base[i].column, base[k].column)), False))
+    return terms, cands
+
+
+def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams) -> TargetModel:
+    y_all = np.asarray(y_all, float)
+    rows = ok & np.isfinite(y_all)
+    if rows.sum() < 4 * max(params.folds):
+        raise InputError(f"target {name}", f"only {rows.sum()} valid samples in the fitting span",
+                         f"give at least {4 * max(params.folds)}")
+    cv = select.CrossValidation(B[rows], y_all[rows], params.folds)
+    if params.form == "paper":
+        return fit_paper_form(cv, name, base, B, y_all, rows, params.resolution_K)
+    forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
+    has_dynamic = any(b.tau_s is not None for b in base)
+    fits, selection = {}, []
+    intercept = np.eye(len(base) + 1)[:, :1]
+    for form in forms:
+        if form == "dynamic" and not has_dynamic:
+            continue
+        terms, cands = _candidates(base, B[rows], params, form == "dynamic")
+        path = select.forward(cv, cands, intercept, params.max_sensors, params.max_inputs)
+        pick = select.choose(path, params.min_gain)
+        fits[form] = _refine([terms[k] for k in pick.chosen], pick.cv_mae, t, cols, reference, y_all, rows, params) \
+            if params.refine else ([terms[k] for k in pick.chosen], pick.cv_mae)
+        selection += [{"form": form, "terms": [terms[k].label for k in s.chosen], "sensors": s.sensors,
+                       "cv_mae_um": s.cv_mae} for s in path]
+    form = "dynamic" if "dynamic" in fits and ("static" not in fits or
+                                               fits["dynamic"][1] < fits["static"][1] * (1 - params.min_gain)) \
+        else "static"
+    terms, cv_mae = fits[form]
+    X = np.column_stack([np.ones(t.size)] + [evaluate(term, t, cols, reference) for term in terms])
+    c = np.linalg.lstsq(X[rows], y_all[rows], rcond=None)[0]
+    return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
+                       residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection))
+
+
+def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
+    """The terms with their lag time constants refined by least squares on the span (each within the
+    grid's range widened by sqrt(2)) and their held-out error; inf if two lags of one signal end up
+    within a factor sqrt(2) of each other (one of them is redundant)."""
+    lagged = [j for j, term in enumerate(terms) if term.tau_s is not None]
+    fixed = [evaluate(term, t, cols, reference)[rows] for term in terms]
+    y = y_all[rows]
+
+    def design(log_tau):
+        cs = list(fixed)
+        for j, lt in zip(lagged, log_tau):
+            cs[j] = evaluate(dataclasses.replace(terms[j], tau_s=float(np.exp(lt))), t, cols, reference)[rows]
+        return np.column_stack([np.ones(y.size)] + cs)
+
+    def sse(log_tau):
+        X = design(log_tau)
+        r = X @ np.linalg.lstsq(X, y, rcond=None)[0] - y
+        return float(r @ r)
+
+    out = list(terms)
+    if lagged:
+        grid = {j: params.input_taus_s if terms[j].kind == "input" else params.sensor_taus_s for j in lagged}
+        bounds = [(np.log(min(grid[j]) / SQRT2), np.log(max(grid[j]) * SQRT2)) for j in lagged]
+        res = minimize(sse, np.log([terms[j].tau_s for j in lagged]), method="L-BFGS-B", bounds=bounds)
+        for j, lt in zip(lagged, res.x):
+            out[j] = dataclasses.replace(terms[j], tau_s=float(np.exp(lt)))
+        if any(a.columns == b.columns and a.kind == b.kind and a.exponent == b.exponent
+               and max(a.tau_s, b.tau_s) < SQRT2 * min(a.tau_s, b.tau_s)
+               for i, a in enumerate(out) for b in out[i + 1:] if a.tau_s and b.tau_s):
+            return out, np.inf
+    X = np.column_stack([np.ones(y.size)] + [evaluate(term, t, cols, reference)[rows] for term in out])
+    return out, select.CrossValidation(X, y, params.folds).error(np.eye(X.shape[1]))
+
+
+def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):
+    """Refine the selected terms' time constants (:func:`_tuned`), then drop, one at a time, any
+    term whose removal (time constants refined again) raises the held-out error by less than
+    ``min_gain``: two grid lags that bracket one true time constant become one. Returns the terms
+    and their held-out error; the grid's (``terms``, ``cv_mae``) if refining does not lower it."""
+    best, best_cv = terms, cv_mae
+    tuned, tuned_cv = _tuned(terms, t, cols, reference, y_all, rows, params)
+    if tuned_cv <= best_cv:
+        best, best_cv = tuned, tuned_cv
+    dropped = True
+    while dropped and len(best) > 1:
+        dropped = False
+        for j in reversed(range(len(best))):
+            fewer, fewer_cv = _tuned(best[:j] + best[j + 1:], t, cols, reference, y_all, rows, params)
+            if fewer_cv < best_cv * (1 + params.min_gain):
+                log.info("%s dropped: held-out error %.4g without it, %.4g with", best[j].label, fewer_cv, best_cv)
+                best, best_cv, dropped = fewer, min(fewer_cv, best_cv), True
+                break
+    return best, best_cv

@@ -1,0 +1,116 @@
+"""Choosing the regressors by held-out error inside the fitting span.
+
+Held-out error: blocked cross-validation. The fitting span's rows are cut into ``K`` contiguous
+blocks of equal length; each block in turn is predicted by the least-squares fit on the others,
+and the mean absolute error over all rows is averaged over several ``K`` (default 4 … 8), so that
+the estimate does not hang on where one set of block edges falls. Blocks are hours long, so the
+held-out rows are not near-copies of neighbouring fitting rows, as they would be with a shuffled
+split of a slow signal.
+
+Every candidate regressor is a linear combination ``w`` of *base columns* (temperature rises,
+lagged rises, lagged inputs, a column of ones): a sensor is a unit vector, a difference
+``theta_a - theta_b`` the vector ``e_a - e_b``. Per block the Gram matrices of the base columns are
+formed once; any model's are ``W^T G W``, so a cross-validated error costs a few small solves.
+
+* :func:`forward`: greedy forward selection. Each step adds the candidate with the lowest held-out
+  error, within the budget of sensors and input terms, until the budget is spent (a step may
+  raise the error: a greedy path can need a detour); :func:`choose` then takes the smallest model
+  on the path whose error is within ``min_gain`` (relative) of the path's lowest: fewer
+  parameters unless more predict measurably better.
+* :func:`exhaustive`: every model of a fixed shape (the paper's ``K_i (theta_a - theta_b) -
+  K_C theta_c``: all pairs a, b and third sensors c).
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class CrossValidation:
+    """Blocked cross-validation of least squares on combinations of the base columns ``Z`` (n x p)."""
+
+    def __init__(self, Z: np.ndarray, y: np.ndarray, folds=(4, 5, 6, 7, 8)):
+        self.Z, self.y, n = Z, y, len(y)
+        if n < 2 * max(folds):
+            raise ValueError(f"{n} samples are too few for {max(folds)} blocks")
+        self.blocks = [(lo, hi) for k in folds for lo, hi in itertools.pairwise(np.linspace(0, n, k + 1).astype(int))]
+        self.partitions = len(folds)
+        self.G = Z.T @ Z
+        self.r = Z.T @ y
+        self.Gb = [Z[lo:hi].T @ Z[lo:hi] for lo, hi in self.blocks]
+        self.rb = [Z[lo:hi].T @ y[lo:hi] for lo, hi in self.blocks]
+
+    def error(self, W: np.ndarray) -> float:
+        """Held-out mean absolute error (unit of y) of the model with regressors ``Z @ W``; inf if singular."""
+        A, b = W.T @ self.G @ W, W.T @ self.r
+        total = 0.0
+        try:
+            for (lo, hi), Gb, rb in zip(self.blocks, self.Gb, self.rb):
+                c = np.linalg.solve(A - W.T @ Gb @ W, b - W.T @ rb)
+                total += np.abs(self.Z[lo:hi] @ (W @ c) - self.y[lo:hi]).sum()
+        except np.linalg.LinAlgError:
+            return np.inf
+        return total / (len(self.y) * self.partitions)
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """A regressor that selection may add."""
+
+    index: int
+    """Its position in the caller's list of terms."""
+    w: np.ndarray
+    """Combination of the base columns."""
+    sensors: frozenset
+    """The temperature columns it reads (what the sensor budget counts)."""
+    is_input: bool
+    """True for an operating-input term (what the input budget counts)."""
+
+
+@dataclass(frozen=True)
+class Step:
+    """One model on the selection path."""
+
+    chosen: tuple[int, ...]
+    """Candidate indices, in the order added."""
+    cv_mae: float
+    """Held-out mean absolute error, unit of the target."""
+    sensors: int
+    """Distinct temperature columns read."""
+
+
+def forward(cv: CrossValidation, candidates: list[Candidate], fixed: np.ndarray, max_sensors: int,
+            max_inputs: int) -> list[Step]:
+    """Greedy forward selection (module docstring). ``fixed`` (p x m, m may be 0) are the columns
+    always in the model (the intercept). Returns the path, the first step being ``fixed`` alone."""
+    chosen: list[Candidate] = []
+    path = [Step((), cv.error(fixed) if fixed.shape[1] else np.inf, 0)]
+    while True:
+        used = frozenset().union(*(c.sensors for c in chosen))
+        inputs = sum(c.is_input for c in chosen)
+        pool = [c for c in candidates if c not in chosen and len(used | c.sensors) <= max_sensors
+                and (not c.is_input or inputs < max_inputs)]
+        scored = [(cv.error(np.column_stack([fixed] + [d.w for d in chosen] + [c.w])), k) for k, c in enumerate(pool)]
+        if not scored:
+            return path
+        err, k = min(scored)
+        chosen.append(pool[k])
+        path.append(Step(tuple(c.index for c in chosen), err, len(used | pool[k].sensors)))
+
+
+def choose(path: list[Step], min_gain: float) -> Step:
+    """The first step whose held-out error is within ``min_gain`` (relative) of the path's lowest."""
+    best = min(s.cv_mae for s in path)
+    return next(s for s in path if s.cv_mae <= best * (1.0 + min_gain))
+
+
+def exhaustive(cv: CrossValidation, models) -> list[tuple[float, tuple]]:
+    """Held-out error of every ``(key, W)`` in ``models``, best first: ``[(cv_mae, key), ...]``."""
+    return sorted((cv.error(W), key) for key, W in models)
+
+
+def informative(values: np.ndarray, resolution: float) -> bool:
+    """True if ``values`` span at least 10 ``resolution`` (a signal below that carries no information)."""
+    return bool(np.ptp(values) >= 10 * resolution)
