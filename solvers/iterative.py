@@ -115,7 +115,10 @@ class PCG:
     def __call__(self, b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)
         if b.ndim == 2:
-            return np.column_stack([self(col) for col in b.T]) if b.shape[1] else np.zeros(b.shape)
+            before = self.iterations
+            x = np.column_stack([self._solve(col) for col in b.T]) if b.shape[1] else np.zeros(b.shape)
+            log.debug("AMG-CG: %d right-hand sides in %d iterations", b.shape[1], self.iterations - before)
+            return x
         return self._solve(b)
 
     def _start(self, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
