@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import signal
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -16,7 +17,7 @@ from gatetherm import InputError
 from gatetherm.geometry.build import _extract
 from gatetherm.geometry.geoscan import scan
 from gatetherm.geometry.groups import GroupRule, fragment, interfaces, physical, regions
-from gatetherm.geometry.isolate import run_isolated
+from gatetherm.geometry.isolate import READ_LIMIT_S, run_isolated
 from gatetherm.geometry.mesh import FrameMesh, check_mesh, from_arrays, to_arrays
 from gatetherm.geometry.sizing import check_estimate, model_estimate
 
@@ -108,7 +109,10 @@ def _size_key(spec: MeshSpec, tag: int | None, size: float, mine: dict[int, int]
     if spec.factor != 1.0:
         return "--mesh-factor", spec.factor
     if tag is None:
-        return ("mesh.size", spec.size) if spec.size else (f"{spec.path.name}: element size", size)
+        if spec.size:
+            return "mesh.size", spec.size
+        given = [k for k, v in spec.parameters.items() if abs(float(v) - size) <= 1e-9 * size]  # the script's size
+        return (f"mesh.parameters.{given[0]}", size) if given else (f"{spec.path.name}: element size", size)
     return (f"mesh.refine[{mine[tag]}].size" if tag in mine else f"{spec.path.name}: Field[{tag}].SizeMin"), size
 
 
@@ -117,12 +121,15 @@ def _read(gmsh, spec: MeshSpec) -> int:
         gmsh.parser.setNumber(k, [float(v)])
     try:
         if spec.path.suffix.lower() == SCRIPT:
+            signal.alarm(READ_LIMIT_S)  # an endless loop: the child ends on SIGALRM (isolate._result)
             gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)
         else:
             gmsh.model.occ.importShapes(str(spec.path))
             gmsh.model.occ.synchronize()
     except Exception as err:  # gmsh reports a bad file as a plain Exception
         raise InputError(str(spec.path), f"gmsh cannot read it ({err})", "check the file in gmsh") from None
+    finally:
+        signal.alarm(0)
     dim = max((d for d, _ in gmsh.model.getEntities()), default=0)
     if dim < 2:
         raise InputError(str(spec.path), "has no surfaces or volumes", "give a 2-D or 3-D geometry")

@@ -76,6 +76,11 @@ def gmsh_session(name: str = "frame", verbosity: int = 0):
         THREADS_STARTED["here"] |= sandbox.threads() > threads
 
 
+READ_LIMIT_S = 30
+"""Longest a geometry script may take to run, before meshing, s: a script that runs longer (an
+endless loop) is refused (the child ends on SIGALRM). Meshing itself has no time limit."""
+
+
 def _record(kind: bytes, payload: bytes) -> bytes:
     return kind + struct.pack("<Q", len(payload)) + payload
 
@@ -271,6 +276,9 @@ def _result(data: bytes, status: int, label: str, lines) -> tuple[dict, dict[str
     errors = [x for x in lines if x.startswith("Error")]
     said = f": {errors[-1]}" if errors else ""
     if not data:
+        if os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGALRM:
+            raise InputError(label, f"gmsh was still reading it after {READ_LIMIT_S} s (an endless loop in the "
+                             "script?)", "end every loop of the script, or simplify the geometry")
         if os.WIFSIGNALED(status):
             sig = os.WTERMSIG(status)
             raise InputError(label, f"gmsh crashed on it ({signal.Signals(sig).name}){said}",

@@ -22,7 +22,7 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.material import Material
-from gatetherm.solvers.problem import Film, Problem, Source
+from gatetherm.solvers.problem import Contact, Film, Problem, Source
 
 
 @dataclass(frozen=True)
@@ -113,6 +113,9 @@ class Targets:
 
     joints: Mapping[str, tuple[JointLayer, ...]] = field(default_factory=dict)
     """Joints by name: the layer regions whose material a joint effect changes."""
+    interfaces: tuple[str, ...] = ()
+    """Boundaries ``A/B`` between two regions: a joint effect there is a contact of the problem
+    (its own ``[contacts]`` entry changed, or a new one on a bonded interface)."""
     defaults: Mapping[str, str] = field(default_factory=dict)
     """Kind → the target meant when a key names the kind alone."""
     named: Mapping[str, Named] = field(default_factory=dict)
@@ -289,6 +292,8 @@ def apply_effects(problem: Problem, eff: ActiveEffects, volume) -> Problem:
         kind, target = r.effect.name, r.target
         if kind == "ambient_drift":
             p = _drifting(p, v)
+        elif kind in ("joint_resistance", "joint_compliance") and target not in eff.targets.joints:
+            p = _contact(p, r, eff.targets, kind, v)
         elif kind in ("joint_resistance", "joint_compliance"):
             mats = dict(p.materials)
             for layer in _layers(r, eff.targets):
@@ -305,6 +310,28 @@ def apply_effects(problem: Problem, eff: ActiveEffects, volume) -> Problem:
             _named(r, p.materials, "region")
             p = dataclasses.replace(p, sources=(*p.sources, Source(target, Value(v / volume(target)))))
     return p
+
+
+PERFECT_CONTACT = 1e9
+"""Conductance of a bonded interface, W/(m² K), where a compliance effect makes it a contact."""
+
+
+def _contact(p: Problem, r: Resolved, targets: Targets, kind: str, v: float) -> Problem:
+    """A joint effect on a contact (by its name or its interface ``A/B``): its conductance or its
+    normal stiffness set; a bonded interface becomes a contact."""
+    old = next((c for c in p.contacts if r.target in (c.name, c.boundary)), None)
+    if old is None:
+        if r.target not in targets.interfaces:
+            names = [*targets.joints, *(c.name for c in p.contacts), *targets.interfaces]
+            raise InputError(f"effect {r.key}", f"no joint, contact or interface '{r.target}'",
+                             f"joints of this case: {', '.join(names) or 'none'}")
+        old = Contact(r.target, tuple(r.target.split("/")), PERFECT_CONTACT if p.heat else None, None)
+    if kind == "joint_resistance":
+        new = dataclasses.replace(old, conductance=v)
+    else:
+        new = dataclasses.replace(old, stiffness=(v, old.stiffness[1] if old.stiffness else v))
+    return dataclasses.replace(p, contacts=(*(c for c in p.contacts if c is not old and c.boundary != new.boundary),
+                                            new))
 
 
 def _named(r: Resolved, names, what: str) -> None:

@@ -156,3 +156,17 @@ def test_a_case_study_on_a_dask_cluster_gives_the_same_table(tmp_path):
                                   protocol="tcp://", dashboard_address=None) as cluster:
         dask, _ = _case_sweep(tmp_path, "--scheduler", cluster.scheduler_address)
     assert (dask / "table.csv").read_text() == (local / "table.csv").read_text()
+
+
+def test_simulate_and_the_api_give_the_same_run(tmp_path):
+    """``gatetherm simulate --condition 1`` and ``gt.run(gt.gate_frame(dim=2), schedule=gt.condition(1))``."""
+    from gatetherm.cli import main
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    assert main(["simulate", "--condition", "1", "--out", str(tmp_path), "--no-pictures", "--fields-every", "300"]) == 0
+    ts = read_timeseries(tmp_path / "timeseries.csv")
+    run = gt.run(gt.gate_frame(dim=2), schedule=gt.condition(1), keep=())
+    assert set(ts.names) == set(run.columns)
+    for name in ("delta_um", "theta_A_degC", "theta_C_degC", "T_tank_oil_degC"):
+        np.testing.assert_allclose(run[name], ts[name], rtol=1e-15, atol=1e-12)
+    assert run.summary()["first_peak_um"] == pytest.approx(48.25, abs=5e-3)  # README: 48.25 µm at 13.0 min

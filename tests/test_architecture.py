@@ -90,3 +90,50 @@ def test_the_facade_offers_the_api_and_the_cli_calls_only_it_and_below():
     assert not {m for m in root if m.startswith("gatetherm.")}  # the root imports no layer at import time
     above = [m for m in MODULES if layer(m) > LAYERS.index("gatetherm.api")]
     assert above and all(m.startswith("gatetherm.cli") for m in above)
+
+
+def backend_choices(path: Path) -> list[str]:
+    """Where the module at ``path`` would choose a matplotlib backend: calls of ``matplotlib.use`` or
+    ``pyplot.switch_backend`` (through any alias), ``from matplotlib import use``, and assignments
+    to ``rcParams["backend"]``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    alias = {}  # local name -> module
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            alias |= {(a.asname or a.name.split(".")[0]): (a.name if a.asname else a.name.split(".")[0])
+                      for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "matplotlib":
+            alias |= {(a.asname or a.name): f"{node.module}.{a.name}" for a in node.names}
+    found = []
+    for node in ast.walk(tree):
+        where = (getattr(node, "lineno", 0), f"{path.name}:{getattr(node, 'lineno', 0)}")
+        if isinstance(node, ast.Call):
+            f = node.func
+            name = (f"{alias.get(f.value.id, f.value.id)}.{f.attr}" if isinstance(f, ast.Attribute)
+                    and isinstance(f.value, ast.Name) else alias.get(f.id, f.id) if isinstance(f, ast.Name) else "")
+            if name in ("matplotlib.use", "matplotlib.pyplot.switch_backend"):
+                found.append((*where, name))
+        elif isinstance(node, (ast.Assign, ast.AugAssign)):
+            for target in getattr(node, "targets", [getattr(node, "target", None)]):
+                if isinstance(target, ast.Subscript) and isinstance(target.slice, ast.Constant) \
+                        and target.slice.value == "backend":
+                    found.append((*where, "rcParams['backend']"))
+    return [f"{w} {what}" for _, w, what in sorted(found)]
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_no_module_chooses_a_matplotlib_backend(name):
+    assert not backend_choices(MODULES[name])
+
+
+def test_the_backend_check_sees_every_form(tmp_path):
+    path = tmp_path / "bad.py"
+    path.write_text("import matplotlib\nimport matplotlib as mpl\nimport matplotlib.pyplot as plt\n"
+                    "from matplotlib import use, rcParams\n"
+                    "matplotlib.use('Agg')\nmpl.use('Agg')\nplt.switch_backend('Agg')\nuse('Agg')\n"
+                    "rcParams['backend'] = 'Agg'\n\ndef f():\n    import matplotlib\n    matplotlib.use('svg')\n")
+    assert [f.split(" ", 1)[1] for f in backend_choices(path)] == [
+        "matplotlib.use", "matplotlib.use", "matplotlib.pyplot.switch_backend", "matplotlib.use",
+        "rcParams['backend']", "matplotlib.use"]
+    path.write_text("import matplotlib\nmatplotlib.get_backend()\nx = {}\nx['backend'] = 1\n")
+    assert backend_choices(path) == ["bad.py:4 rcParams['backend']"]  # any 'backend' key: on the safe side

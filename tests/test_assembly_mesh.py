@@ -206,3 +206,24 @@ def test_the_mesh_factor_scales_the_scripts_own_sizes():
     ratio = len(load_case(t4, 0.5).mesh.cells) / len(load_case(t4).mesh.cells)
     assert ratio == pytest.approx(3.92, abs=0.05)  # achieved 5241 / 1337 = 3.920; band: 4 ± 10 %
     assert 3.6 < ratio < 4.4
+
+
+def test_a_composite_wall_from_one_step_with_a_contact_conductance(tmp_path, capsys):
+    """The same two solids with a thermal contact of 500 W/(m² K) between them: q = ΔT / (L/k1 +
+    1/h + L/k2), the column's face of the interface at 100 − q L/k1, the jump q/h (1-D, exact at P1)."""
+    _step(tmp_path / "two.step", TWO, ("column", "sleeve"))
+    (tmp_path / "case.toml").write_text(
+        '[mesh]\nfile = "two.step"\nsize = 0.25\n'
+        '[mesh.groups.hot]\ndim = 2\nnormal = [-1, 0, 0]\n[mesh.groups.cold]\ndim = 2\nnormal = [1, 0, 0]\n'
+        '[materials.column]\nk = 50.0\n[materials.sleeve]\nk = 25.0\n'
+        '[thermal.hot]\ntemperature = 100.0\n[thermal.cold]\ntemperature = 0.0\n'
+        '[contacts.fit]\nbetween = ["column", "sleeve"]\nconductance = 500.0\n'
+        '[means]\ninterface = "column/sleeve"\n[probes.a]\npoint = [0.5, 0.5, 0.5]\n[probes.b]\npoint = [1.5, 0.5, 0.5]\n')
+    assert main(["run", str(tmp_path / "case.toml"), "--out", str(tmp_path / "out"), "--no-pictures"]) == 0, \
+        capsys.readouterr().err
+    probes = json.loads((tmp_path / "out" / "summary.json").read_text())["probes"]
+    q = 100.0 / (1 / 50 + 1 / 500 + 1 / 25)
+    a, b = probes["a"]["T_degC"], probes["b"]["T_degC"]
+    assert a == pytest.approx(100 - q * 0.5 / 50, rel=1e-9) and b == pytest.approx(q * 0.5 / 25, rel=1e-9)
+    jump = (a - q * 0.5 / 50) - (b + q * 0.5 / 25)  # both sides extrapolated to the interface
+    assert abs(jump / (q / 500) - 1) < 0.005 and jump / (q / 500) - 1 == pytest.approx(0.0, abs=1e-9)

@@ -269,6 +269,7 @@ def test_cli_bad_input(cli, capsys, args, option):
 
 
 def test_plots_written(tmp_path):
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.beam import plot_ki_kc
 
     a = np.linspace(0.5, 5.0, 200)
@@ -277,7 +278,12 @@ def test_plots_written(tmp_path):
     fe = {b: (fa, *(v * 1.03 for v in normalised(fa, b))) for b in (0.01, 0.1)}
     for tag, fe_data in (("theory", None), ("fe", fe)):
         pk, pc = tmp_path / f"{tag}_ki.png", tmp_path / f"{tag}_kc.png"
-        plot_ki_kc(a, theory, fe_data, pk, pc)
+        ki, kc = plot_ki_kc(a, theory, fe_data)
+        # a theory line per beta, FE markers per beta with FE data, the zero line and the legend's keys
+        assert len(ki.lines) == len(BETAS) + len(fe_data or {}) + 1 + (2 if fe_data else 1)
+        assert ki.lines[0].get_ydata() == pytest.approx(theory[min(BETAS)][0])
+        save(ki, pk)
+        save(kc, pc)
         for p in (pk, pc):
             assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fe_kc.png", "fe_ki.png", "theory_kc.png",

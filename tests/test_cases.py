@@ -198,3 +198,15 @@ def test_c_frame_example_runs_end_to_end(tmp_path, capsys):
     assert main(["compensate", "--case", str(EXAMPLE / "case.toml"), "--out", str(tmp_path / "t"),
                  "--k-source", "theory"]) == 2
     assert "needs the paper frame's beam model; this case has none" in capsys.readouterr().err
+
+
+def test_two_tables_on_overlapping_facets_are_refused_naming_both(tmp_path, capsys):
+    """``free`` holds every edge, ``hot`` one of them: a film and a temperature on the same facets."""
+    (tmp_path / "sq.geo").write_text('SetFactory("OpenCASCADE");\nRectangle(1) = {0, 0, 0, 1, 1};\n'
+                                     'Physical Surface("plate") = {1};\nPhysical Curve("free") = {1, 2, 3, 4};\n'
+                                     'Physical Curve("hot") = {1};\nMesh.MeshSizeMax = 0.25;\n')
+    (tmp_path / "c.toml").write_text('[mesh]\nfile = "sq.geo"\n[materials.plate]\nk = 1.0\n'
+                                     '[thermal.free]\nfilm = 5.0\nambient = 20.0\n[thermal.hot]\ntemperature = 80.0\n')
+    assert main(["run", str(tmp_path / "c.toml"), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "thermal.hot: shares facets with thermal.free" in err and "rest = true" in err

@@ -28,7 +28,8 @@ from gatetherm.studies.run.config import load_config
 from gatetherm.studies.run.simulate import run_model, sample_times
 from gatetherm.studies.run.timeseries import read_timeseries, write_timeseries
 from gatetherm.validation import compensation_study
-from gatetherm.validation.plots.compensation import plot_piezo_loops
+from gatetherm.validation.plots import save
+from gatetherm.validation.plots.compensation import loop_widths, plot_piezo_loops
 
 
 PINNED = """
@@ -186,8 +187,11 @@ def test_cli_needs_exactly_one_source(tmp_path, gatetherm):
 
 def test_piezo_loop_plot_closes_with_reset_and_is_open_without(tmp_path):
     p = ActuatorParams()
-    widths = plot_piezo_loops(p, tmp_path / "loops.png")
+    axes = plot_piezo_loops(p)
+    save(axes, tmp_path / "loops.png")
     assert (tmp_path / "loops.png").stat().st_size > 10_000
+    widths = loop_widths(p)
+    assert [len(ax.lines) for ax in axes] == [3, 3]  # direct, reset and the bias voltage's line
     for preload in (0.0, p.preload_N):
         reset = widths[f"preload {preload:g} N, reset"]
         assert reset <= dead_band_um(dataclasses.replace(p, preload_N=preload)) and reset == 0.0

@@ -10,7 +10,7 @@ import pytest
 
 from gatetherm import InputError
 from gatetherm.geometry.frame import MeshParams
-from gatetherm.solvers.effects import (KINDS, ActiveEffects, Targets, apply_effects, catalogue_json, effects_from_table,
+from gatetherm.solvers.effects import (KINDS, ActiveEffects, apply_effects, catalogue_json, effects_from_table,
                                        effects_table, first_order_lag, parse_effect, resolve)
 from gatetherm.solvers.fem import to_skfem
 from gatetherm.solvers.frame import EFFECTS, TARGETS, frame_problem, region_volume

@@ -453,3 +453,25 @@ def test_split_interface_cuts_between_two_regions_only():
     assert not np.isin(pairs[:, 0], right).any() and np.isin(pairs[:, 1], right).all()
     assert np.isin(pairs[:, 1], cut.boundaries["bottom"]).sum() == 1  # the bottom corner node, on the right's side
     assert cut.sensors == fm.sensors and to_skfem(cut).nvertices == len(fm.points) + len(pairs)
+
+
+def test_a_joint_resistance_effect_on_a_bonded_interface_is_its_contact(tmp_path):
+    """``joint_resistance@left/right`` on the wall bonded at its interface runs as the wall with
+    ``[contacts]`` of that conductance; on the contact itself it replaces its conductance."""
+    import gatetherm as gt
+
+    shutil.copy(DATA / "two_blocks.geo", tmp_path)
+    bonded = COMPOSITE.replace("[contacts.joint]\nbetween = [\"right\", \"left\"]\nconductance = 2000.0\n", "")
+    (tmp_path / "bonded.toml").write_text(bonded)
+    (tmp_path / "contact.toml").write_text(COMPOSITE)
+    case = gt.load_case(tmp_path / "bonded.toml")
+    assert case.targets.interfaces == ("left/right",)
+    with_effect = gt.run(case, effects={"joint_resistance@left/right": 2000.0})["T_face_degC"]
+    assert with_effect[-1] == pytest.approx(gt.run(gt.load_case(tmp_path / "contact.toml"))["T_face_degC"][-1],
+                                            rel=1e-12)
+    half = gt.run(gt.load_case(tmp_path / "contact.toml"), effects={"joint_resistance@joint": 1000.0})
+    L, k1, k2 = 0.1, 50.0, 15.0
+    assert half["T_face_degC"][-1] == pytest.approx(100.0 - 100.0 / (L / k1 + 1 / 1000.0 + L / k2) * L / k1, rel=1e-9)
+    from gatetherm.studies.diagnosis.hypotheses import effect_keys
+
+    assert "joint_resistance@left/right" in effect_keys(case)

@@ -262,3 +262,18 @@ def test_a_spawned_child_makes_the_same_mesh(monkeypatch):
     monkeypatch.setitem(isolate.THREADS_STARTED, "here", True)
     spawned = build_mesh(FIXED, 2, COARSE)
     assert np.array_equal(forked.points, spawned.points) and np.array_equal(forked.cells, spawned.cells)
+
+
+def test_an_endless_loop_in_a_script_is_refused_after_the_read_limit(tmp_path, monkeypatch, capsys):
+    from gatetherm.geometry import gmshfile, isolate
+
+    monkeypatch.setattr(gmshfile, "READ_LIMIT_S", 2)
+    monkeypatch.setattr(isolate, "READ_LIMIT_S", 2)
+    (tmp_path / "l.geo").write_text('SetFactory("OpenCASCADE");\nRectangle(1) = {0, 0, 0, 1, 1};\n'
+                                    'Physical Surface("p") = {1};\nPhysical Curve("e") = {1, 2, 3, 4};\n'
+                                    "For k In {1:1e15}\n  x = k;\nEndFor\n")
+    (tmp_path / "c.toml").write_text('[mesh]\nfile = "l.geo"\n[materials.p]\nk = 1.0\n[thermal.e]\ntemperature = 20.0\n')
+    assert main(["run", str(tmp_path / "c.toml"), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "gmsh was still reading it after 2 s (an endless loop in the script?)" in err
+    assert not (tmp_path / "o").exists()

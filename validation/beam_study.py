@@ -46,6 +46,7 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
     from gatetherm.solvers.beam import normalised
     from gatetherm.validation import beam_vs_fe as bv
     from gatetherm.validation import beam_vs_fe_report as bv_report
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.beam import plot_ki_kc
     from gatetherm.validation.effective import effective_coefficients, table_rows
     from gatetherm.validation.plots.sweep import plot_xy
@@ -60,7 +61,9 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
     theory = {b: normalised(a, b) for b in bv.BETAS}
     for rs, sfx in ((main, ""), (no_tank, "_no_tank")):
         write_table(out / f"beam_vs_fe{sfx}.csv", *columns_of(bv.csv_rows(rs)))
-        plot_ki_kc(a, theory, _fe_curves(bv.csv_rows(rs)), out / f"fig7_Ki{sfx}.png", out / f"fig8_Kc{sfx}.png")
+        ki, kc = plot_ki_kc(a, theory, _fe_curves(bv.csv_rows(rs)))
+        save(ki, out / f"fig7_Ki{sfx}.png")
+        save(kc, out / f"fig8_Kc{sfx}.png")
     errors, errors_nt = bv.error_rows(main, no_tank), bv.error_rows(no_tank, no_tank)
     write_table(out / "errors.csv", *columns_of(errors))
     gaps = [e for e in errors if e["gap"] or not e["within_tolerance"]]
@@ -74,8 +77,8 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
             continue
         write_table(out / f"{name}.csv", *columns_of(srows))
         for k in ("Ki", "Kc"):
-            plot_xy(srows, x, f"{k}_fe_rel_error", "point", out / f"{name}_{k}.png",
-                    f"{k}: (FE - theory)/theory, no tank cavity", logx=(name == "slenderness"), hline=0.0)
+            save(plot_xy(srows, x, f"{k}_fe_rel_error", "point", f"{k}: (FE - theory)/theory, no tank cavity",
+                         logx=(name == "slenderness"), hline=0.0), out / f"{name}_{k}.png")
     conv = bv.convergence(rows["mesh"], dim)
     write_table(out / "mesh.csv", *columns_of(conv))
     effective = table_rows(effective_coefficients(base, dim))

@@ -242,6 +242,7 @@ def summary_rows(st: Study) -> tuple[list[str], list[list[str]]]:
 
 def write_compensation_study(out: Path, cfg, dim: int = 2) -> Study:
     """Run the study, write the figures, ``compensation_table.md`` and ``.csv``; returns the study."""
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.compensation import plot_condition_study, plot_piezo_loops
 
     quiet = logging.getLogger("gatetherm.studies.control.actuator")
@@ -253,9 +254,9 @@ def write_compensation_study(out: Path, cfg, dim: int = 2) -> Study:
         quiet.setLevel(level)
     out = Path(out)
     for n, loops in st.loops.items():
-        plot_condition_study(f"condition {n} ({cfg.source}, {dim}-D)", loops,
-                             out / FIGURES.get(n, f"condition{n}.png"), PAPER_BAND_UM)
-    plot_piezo_loops(piezo.ActuatorParams(), out / "piezo_loops.png")
+        save(plot_condition_study(f"condition {n} ({cfg.source}, {dim}-D)", loops, PAPER_BAND_UM),
+             out / FIGURES.get(n, f"condition{n}.png"))
+    save(plot_piezo_loops(piezo.ActuatorParams()), out / "piezo_loops.png")
     write_text_atomic(out / "compensation_table.csv", table_csv(st))
     write_text_atomic(out / "compensation_table.md", markdown(st))
     return st

@@ -21,6 +21,7 @@ def write_design_study(out: Path, base: Config, dim: int, workers: int = 1, sche
     heights as fractions of l)."""
     from gatetherm.studies.sweeps import design as ds
     from gatetherm.studies.sweeps.sweep import table
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.sweep import plot_histories, plot_positions, plot_second
 
     t0, c0 = time.perf_counter(), cpu_seconds()
@@ -44,16 +45,16 @@ def write_design_study(out: Path, base: Config, dim: int, workers: int = 1, sche
     columns = list(dict.fromkeys(k for r in rows for k in r))
     write_table(out / "positions.csv", columns, sorted(rows, key=lambda r: (r["geometry.l4"], r["condition"])))
     write_table(out / "second_tie_bar.csv", *columns_of(second))
-    plot_positions(rows, {f"model l4 = {first[0]:.3g}": first[0], f"optimum {best['l4']:.3g}": best["l4"]},
-                   out / "design_position.png", f"one tie bar, {dim}-D")
-    plot_second(second, out / "design_second.png", f"second tie bar above the cutting area, {dim}-D")
+    save(plot_positions(rows, {f"model l4 = {first[0]:.3g}": first[0], f"optimum {best['l4']:.3g}": best["l4"]},
+                        f"one tie bar, {dim}-D"), out / "design_position.png")
+    save(plot_second(second, f"second tie bar above the cutting area, {dim}-D"), out / "design_second.png")
     top = min(second, key=lambda r: r["worst_swing_um"])
     column = plans["s"][0][0].config.model.frame.column_height
     designs = {f"model, l4 = {first[0]:.3g} m": base,
                f"optimal l4 = {best['l4']:.3g} m": ds.with_frame(base, l4=best["l4"]),
                f"l4 = {top['l4']:.3g} m + second bar at {top['l4_2']:.3g} m":
                    ds.with_frame(base, l4=top["l4"], l4_2=top["l4_2"], column_height=column)}
-    plot_histories(ds.histories(designs, dim), out / "design_histories.png")
+    save(plot_histories(ds.histories(designs, dim)), out / "design_histories.png")
     paper_swing = ds.swings(paper_rows)[round(first[0], 6)]
     timing = {"wall s": round(time.perf_counter() - t0, 1), "CPU s": round(cpu_seconds() - c0, 1),
               "workers": scheduler or workers}

@@ -37,7 +37,7 @@ from gatetherm.solvers.frame import EFFECTS, TARGETS
 from gatetherm.studies.run.config import Config, load_config
 from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
-from gatetherm.studies.diagnosis.replay import DELTA, resolution
+from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times

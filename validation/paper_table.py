@@ -43,6 +43,7 @@ def run_condition(cfg: Config, dim: int, c: int, cache=None, keep_times=()):
 
 
 def run_all(out: Path, cfg: Config, dims, reuse: bool) -> dict:
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.run import plot_response
 
     res = {}
@@ -52,7 +53,7 @@ def run_all(out: Path, cfg: Config, dims, reuse: bool) -> dict:
             if not (reuse and (d / "summary.json").exists()):
                 run, summary = run_condition(cfg, dim, c)
                 write_text_atomic(d / "summary.json", json.dumps(summary, indent=2, sort_keys=True) + "\n")
-                plot_response(run.columns, d / "response.png", f"gatetherm {dim}-D, condition {c}")
+                save(plot_response(run.columns, f"gatetherm {dim}-D, condition {c}"), d / "response.png")
             res[(c, dim)] = json.loads((d / "summary.json").read_text())
     return res
 

@@ -38,9 +38,8 @@ from gatetherm.solvers.beam import theory_coefficients
 from gatetherm.solvers.effects import resolve
 from gatetherm.solvers.frame import EFFECTS, TARGETS
 from gatetherm.studies.control.actuator import ActuatorParams
-from gatetherm.studies.control.compensator import CompensatorParams, close_loop, compensate, external_prediction, summarize
-from gatetherm.studies.control.observer import ObserverParams
-from gatetherm.studies.control.predictive import PredictiveParams, rom_prediction
+from gatetherm.studies.control.compensator import CompensatorParams, close_loop, external_prediction, summarize
+from gatetherm.studies.control.predictive import PredictiveParams
 from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
 from gatetherm.studies.run.frame_case import frame_case
 from gatetherm.studies.run.reduce import cached_rom, check_run, rom_outputs
@@ -86,21 +85,26 @@ class Row:
 
 def compare(ts, rom, mlr, K, params: CompensatorParams = CompensatorParams(),
             actuator: ActuatorParams = ActuatorParams()) -> dict:
-    """The four compensators on one series: residual bands, updates, threshold, rom forecast error."""
-    band = lambda loop: summarize(loop, params.settle_s)  # noqa: E731
-    paper = band(compensate(ts, *K, params, actuator))
+    """The four compensators on one series (the library's methods, :mod:`gatetherm.studies.control.methods`):
+    residual bands, updates, threshold, rom forecast error."""
+    from gatetherm.studies.control.methods import Settings, compensate as method
+
+    paper = method(ts, None, Settings("paper", params, *K), actuator).summary
     out = {"swing_um": paper["swing_um"], "paper_um": paper["residual_band_um"],
            "mlr_um": band(close_loop(ts, external_prediction(ts, regression_forecast(mlr, ts), params), params,
-                                     actuator))["residual_band_um"]}
+                                     actuator), params)["residual_band_um"]}
     for mode in ("fixed", "event"):
-        pr, cmds = rom_prediction(ts, rom, params, PredictiveParams(mode=mode, max_updates=BUDGET), ObserverParams(),
-                                  THETAS)
-        s = band(close_loop(ts, pr, params, actuator))
+        s = method(ts, None, Settings("rom", params, control=PredictiveParams(mode=mode, max_updates=BUDGET),
+                                      sensors=THETAS), actuator, rom=rom).summary
         out["rom_5min_um" if mode == "fixed" else "rom_event_um"] = s["residual_band_um"]
         if mode == "event":
-            out.update(rom_updates=s["updates"], threshold_um=cmds.threshold_um,
+            out.update(rom_updates=s["updates"], threshold_um=s["threshold_um"],
                        rom_prediction_error_um=s["prediction_error_band_um"])
     return out
+
+
+def band(loop, params: CompensatorParams) -> dict:
+    return summarize(loop, params.settle_s)
 
 
 def study(cfg, out: Path, dims=(2, 3), conditions=(1, 2, 3), effects=EFFECTS, on_row=None,

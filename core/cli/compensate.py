@@ -187,11 +187,12 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
         **out.metadata, "compensation": f"{'' if settings.method == 'paper' else settings.method + ': '}{comp.label}, "
         f"{'actuator model' if actuator else 'ideal actuator'}"})
 
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.compensation import plot_compensation, plot_piezo_loops  # outer layer
     write_timeseries(out_dir / "compensated.csv", out)
-    plot_compensation(loop, out_dir / "compensation.png")
+    save(plot_compensation(loop), out_dir / "compensation.png")
     if actuator:
-        plot_piezo_loops(actuator, out_dir / "piezo_loops.png")
+        save(plot_piezo_loops(actuator), out_dir / "piezo_loops.png")
     write_text_atomic(out_dir / "summary.json", text)
     print(f"wrote {out_dir}/compensated.csv, compensation.png, "
           f"{'piezo_loops.png, ' if actuator else ''}summary.json")

@@ -12,7 +12,6 @@ values to put into the case file).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import logging
 from pathlib import Path
@@ -154,16 +153,17 @@ def _write(args, case, diag, adopted, out: Path) -> None:
     from gatetherm import write_text_atomic
     from gatetherm.studies.diagnosis.report import report_markdown
     from gatetherm.studies.run.output import write_json
-    from gatetherm.validation.plots.discrepancy import plot_before_after, plot_residuals, plot_scores
+    from gatetherm.validation.plots import save
+    from gatetherm.validation.plots.discrepancy import DPI, plot_before_after, plot_residuals, plot_scores
 
     files = {"residuals": "residuals.png"}
-    plot_residuals(diag, out / files["residuals"])
+    save(plot_residuals(diag), out / files["residuals"], DPI)
     if diag.rounds:
         files["scores"] = "scores.png"
-        plot_scores(diag, out / files["scores"])
+        save(plot_scores(diag), out / files["scores"], DPI)
     if adopted is not None:
         files["before_after"] = "before_after.png"
-        plot_before_after(diag, out / files["before_after"])
+        save(plot_before_after(diag), out / files["before_after"], DPI)
     text = None if adopted is None else adopted.origin.model_file(adopted, (
         f"gatetherm diagnose of {args.data}: verdict {diag.verdict}, pieces "
         + ", ".join(r.piece.label for r in diag.pieces) + f"\nbase model: {case.source}"))

@@ -103,7 +103,7 @@ def run_fit(args) -> int:
 def run_predict(args) -> int:
     from gatetherm.outdir import output_dir
     from gatetherm.validation.plots import save
-    from gatetherm.validation.plots.errormodel import prediction_figure
+    from gatetherm.validation.plots.errormodel import plot_model_prediction
 
     model = load_model(args.model)
     ts = read_timeseries(args.data, required=("time_s",))
@@ -120,9 +120,7 @@ def run_predict(args) -> int:
     with output_dir(args.out, PREDICT_OUTPUTS, keep=(args.data, args.model)) as out:
         source = {"source": f"gatetherm errormodel predict {args.model}"}
         write_timeseries(out / "prediction.csv", TimeSeries(cols, source))
-        span = (model.fit_span.get("start_s"), model.fit_span.get("end_s"))
-        save(prediction_figure(ts.time_s, pred, {n: ts[n] for n in pred if n in ts},
-                               span if None not in span else None), out / "prediction.png")
+        save(plot_model_prediction(model, ts), out / "prediction.png")
         write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
     print(f"wrote {out}/prediction.csv, prediction.png, summary.json")
     for name, g in gaps.items():

@@ -3,7 +3,6 @@ gatetherm against an independent FE code."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.cli.options import add_model_options, refuse_model_options

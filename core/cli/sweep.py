@@ -60,11 +60,12 @@ def _sweep(args, study, tasks, out) -> list:
     print(f"wrote {out / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} done, "
           f"{n_skip} skipped (frame cannot be built), {len(failed)} failed")
     if not args.no_plots and study.plots:
+        from gatetherm.validation.plots import save
         from gatetherm.validation.plots.sweep import plot_xy
 
         for spec in study.plots:
             path = out / f"{spec.y}_vs_{spec.x}{'_by_' + spec.hue if spec.hue else ''}.png".replace("/", "_")
             others = [k for k, _ in study.grid if k not in (spec.x, spec.hue)]
-            plot_xy(rows, spec.x, spec.y, spec.hue, path, study.name, lines_by=others)
+            save(plot_xy(rows, spec.x, spec.y, spec.hue, study.name, lines_by=others), path)
             print(f"wrote {path}")
     return failed

@@ -188,6 +188,10 @@ def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache, source: str,
             rom, where = cached_rom(case, s.states, rom_dir, cache), str(Path(rom_dir) / "rom.npz")
         else:
             rom = build_rom(case, s.states, cache).rom
+    missing = [n for n in ("delta_um", *s.sensors) if n not in rom.outputs]
+    if missing:
+        raise InputError(f"{where or 'reduced model'}: outputs", f"no {missing[0]!r}",
+                         f"its outputs: {', '.join(rom.outputs[:12])}{' …' if len(rom.outputs) > 12 else ''}")
     read = set().union(*(Value.of(u.text).names() for u in rom.inputs), *(Value.of(p).names() for p in rom.pumps))
     lacking = sorted(read - {"t"} - set(ts.names) - set(rom.defaults))
     if lacking:

@@ -80,7 +80,10 @@ def effect_keys(case: Case) -> list[str]:
     conditioned = {c.boundary for c in (*p.films, *p.fixed, *p.fluxes, *p.fluids)}
     keys = ["ambient_drift"] if p.films or p.faces else []
     keys += [f"heat_source@{r}" for r in p.materials if r not in heated] if p.heat else []
-    keys += [f"{k}@{j}" for j in case.targets.joints for k in ("joint_resistance", "joint_compliance")]
+    joints = [*case.targets.joints, *(c.name for c in p.contacts),
+              *(b for b in case.targets.interfaces if b not in {c.boundary for c in p.contacts})]
+    kinds = ("joint_resistance",) * p.heat + ("joint_compliance",) * p.elastic
+    keys += [f"{k}@{j}" for j in joints for k in kinds]
     keys += [f"compliant_base@{s.boundary}" for s in p.supports if s.stiffness is None]
     keys += [f"base_conduction@{s.boundary}" for s in p.supports if s.boundary not in conditioned and p.heat]
     keys += ["thermocouple_lag"] + (["stand_drift"] if case.targets.base_mean in dict(p.means) else [])

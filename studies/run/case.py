@@ -26,7 +26,6 @@ from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_
 from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
 from gatetherm.solvers.effects import Targets
-from gatetherm.solvers.expr import Value
 from gatetherm.solvers.frame import enclosed_volume, region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
@@ -415,7 +414,7 @@ def _time(top: Table, base: Path):
     """The time settings, the scheme and the schedule file's series (None: no schedule)."""
     if "time" not in top.data:
         return None, TimeScheme(), None
-    from gatetherm.studies.run.timeseries import check_steps, read_timeseries
+    from gatetherm.studies.run.timeseries import check_steps
 
     t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
     end = t.number("end", SECONDS)
@@ -529,9 +528,18 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     twice = _twice(kw)
     if twice:
         top.fail("thermal", f"boundary '{twice}' is given two conditions", "give each boundary one condition")
+    both = _overlapping(fm, [c.boundary for c in (*kw.get("films", ()), *kw.get("fixed", ()), *kw.get("fluxes", ()),
+                                                  *kw.get("fluids", ()))])
+    if both:
+        top.fail(f"thermal.{both[1]}", f"shares facets with thermal.{both[0]}: two conditions on those facets",
+                 "give every part of the boundary one condition (split the groups, or use rest = true)")
     supports = _supports(top, fm, names) if elastic else ()
     if elastic:
         kw.update(case_mech.read_loads(top, fm, names))
+        both = _overlapping(fm, [ld.boundary for ld in kw.get("loads", ())])
+        if both:
+            top.fail(f"loads.{both[1]}", f"shares facets with loads.{both[0]}: the loads would add up unseen",
+                     "give every part of the boundary one load table")
     elif "gravity" in data or "loads" in data:
         top.fail("gravity" if "gravity" in data else "loads", "a mechanical load needs [supports]",
                  "hold the body with [supports.BOUNDARY] tables")
@@ -557,7 +565,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         schedule = timed_schedule(time.end, time.step, time.output, drive,
                                   f"schedule {time.schedule}" if time.schedule else "no schedule")
     return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
-                case_targets(problem), actuator=_actuator(top), path=path, source=str(path),
+                case_targets(problem, fm), actuator=_actuator(top), path=path, source=str(path),
                 files=(path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else [])))
 
 
@@ -598,10 +606,23 @@ def _actuator(top: Table):
         a.fail("stroke", err.problem, err.fix)
 
 
-def case_targets(problem: Problem) -> Targets:
-    """What a case file's effects act on by default: its one support, if it has only one."""
+def case_targets(problem: Problem, fm: FrameMesh) -> Targets:
+    """What a case file's effects act on: its one support by default, if it has only one; its
+    contacts and the interfaces ``A/B`` of its regions as joints."""
     rigid = [s.boundary for s in problem.supports if s.stiffness is None]
-    return Targets(defaults={"compliant_base": rigid[0], "base_conduction": rigid[0]} if len(rigid) == 1 else {})
+    interfaces = tuple(b for b in fm.boundaries if b.count("/") == 1 and all(r in fm.regions for r in b.split("/")))
+    return Targets(defaults={"compliant_base": rigid[0], "base_conduction": rigid[0]} if len(rigid) == 1 else {},
+                   interfaces=interfaces)
+
+
+def _overlapping(fm: FrameMesh, boundaries: list[str]) -> tuple[str, str] | None:
+    """Two different ``boundaries`` of the mesh that share a facet (the first such pair), if any."""
+    owner: dict = {}
+    for b in dict.fromkeys(boundaries):
+        for f in map(tuple, np.sort(fm.boundaries[b], axis=1)):
+            if owner.setdefault(f, b) != b:
+                return owner[f], b
+    return None
 
 
 def _twice(kw: dict) -> str | None:

@@ -122,13 +122,16 @@ def write_xdmf(model: Model, steps, path: Path) -> None:
 def pyvista_grid(model: Model, U: np.ndarray, u_dofs: np.ndarray | None = None, env=None):
     """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``
     (``u_dofs``: the displacement of ``U``, if solved already)."""
+    return volume_grid(model.fmesh, nodal_fields(model, U, stress=False, u_dofs=u_dofs, env=env))
+
+
+def volume_grid(fmesh, point_data: dict[str, np.ndarray]):
+    """A pyvista grid of the volume cells of ``fmesh`` (triangles in 2-D, tetrahedra in 3-D)
+    with the nodal arrays ``point_data``."""
     import pyvista as pv
 
-    mm = to_meshio(model.fmesh, nodal_fields(model, U, stress=False, u_dofs=u_dofs, env=env))
-    cell_type = "tetra" if model.dim == 3 else "triangle"
-    grid = pv.from_meshio(mm)
-    keep = np.flatnonzero(grid.celltypes == {"tetra": 10, "triangle": 5}[cell_type])
-    return grid.extract_cells(keep)
+    grid = pv.from_meshio(to_meshio(fmesh, point_data))
+    return grid.extract_cells(np.flatnonzero(grid.celltypes == (10 if fmesh.dim == 3 else 5)))
 
 
 def write_json(path: Path, data: dict) -> None:

@@ -59,7 +59,8 @@ class _Pool(ProcessPoolExecutor):
 @contextlib.contextmanager
 def worker_pool(workers: int, mp_context=None):
     """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes as above;
-    on an exception (Ctrl-C included) its workers are terminated at once, not awaited."""
+    on an exception (Ctrl-C included) its workers are killed at once (SIGKILL: a worker still
+    starting has SIGTERM blocked; workers write no files, the parent does), not awaited."""
     ctx = mp_context or multiprocessing.get_context()
     parent = os.getpid() if ctx.get_start_method() in ("fork", "spawn") else None  # else a server forks them
     pool = _Pool(workers, mp_context=ctx, initializer=_die_with, initargs=(parent,))
@@ -68,9 +69,9 @@ def worker_pool(workers: int, mp_context=None):
     except BaseException:
         procs = list((getattr(pool, "_processes", None) or {}).values())
         for proc in procs:
-            proc.terminate()
+            proc.kill()
         for proc in procs:  # gone before the caller cleans up after them
-            proc.join(timeout=5)
+            proc.join(timeout=2)
         pool.shutdown(wait=False, cancel_futures=True)
         raise
     pool.shutdown(wait=True)

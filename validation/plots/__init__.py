@@ -1,4 +1,12 @@
-"""Figures of runs and studies (matplotlib, off screen); every file is written atomically."""
+"""Figures of runs and studies (matplotlib): library plots.
+
+Every plot function draws on the Axes it is given (``ax=``, or ``axes=`` for a figure of
+several panels) and returns them; given none, it draws on a new :func:`figure`: a bare
+:class:`matplotlib.figure.Figure`, outside pyplot's state, that needs no backend. No plot
+chooses a backend or writes a file: :func:`save` is the one writer (the CLI, ``Run.write``
+and the report call it). ``gt.plot`` (:mod:`gatetherm.validation.plots.api`) is the curated
+set for notebooks.
+"""
 from __future__ import annotations
 
 import os
@@ -10,13 +18,25 @@ DPI = 200
 """Resolution of every PNG, dots per inch (print quality)."""
 
 
+def figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, fig=None, **subplots):
+    """The subplots of a new bare Figure of size ``figsize`` (inches), or of ``fig`` (resized to
+    it) if given: a single Axes, or an array as :meth:`matplotlib.figure.Figure.subplots` gives."""
+    from matplotlib.figure import Figure
+
+    if fig is None:
+        fig = Figure(figsize=figsize)
+    else:
+        fig.set_size_inches(*figsize)
+    return fig.subplots(nrows, ncols, **subplots)
+
+
 def save(fig, path: str | os.PathLike, dpi: int = DPI, tight: bool = True) -> None:
-    """Write ``fig`` as a PNG at ``path`` atomically and release it (pyplot figures are closed)."""
+    """Write ``fig`` (a Figure, or what a plot returns: an Axes or an array of them) as a PNG
+    at ``path`` atomically."""
+    import numpy as np
+
+    fig = np.asarray(fig, dtype=object).flat[0].figure
     if tight:
         fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=dpi)
-    import matplotlib.pyplot as plt
-
-    if plt.fignum_exists(fig.number if hasattr(fig, "number") else -1):
-        plt.close(fig)

@@ -1,21 +1,69 @@
-"""Plots of the public API (``gt.plot``): each takes ``ax=`` (a matplotlib Axes; a new figure's
-when None), draws on it and returns it; none chooses a backend or writes a file."""
+"""Plots of the public API (``gt.plot``), for notebooks and scripts::
+
+    run = gt.run(gt.load_case("validation/examples/c_frame/case.toml"))
+    ax = gt.plot.series(run, "delta_um")          # a new figure's Axes
+    gt.plot.field(run, "T", t=run.time[-1], ax=ax2)  # or the Axes you give
+    gt.plot.save(ax, "delta.png")
+
+Each takes what the API gives (a :class:`~gatetherm.api.Run`, a compensation, a diagnosis …) and
+``ax=`` (``axes=`` for a figure of several panels), draws on it and returns it. None chooses a
+backend or writes a file (:func:`save` writes a PNG). Given no Axes, a plot draws on a new
+*pyplot* figure, so that it shows in a notebook or with ``plt.show()`` as your own figures do:
+pyplot uses the backend matplotlib would anyway (``MPLBACKEND``, ``matplotlibrc``, the
+notebook's) and leaves it so. The pictures the command line and the report write come from the
+same functions on bare figures (:mod:`gatetherm.validation.plots`).
+"""
 from __future__ import annotations
+
+import os
+
+from gatetherm.validation.plots import save
+
+__all__ = ["channels", "compensation", "deformed", "field", "fluids", "prediction", "residuals", "response", "save",
+           "series", "sweep"]
 
 LABELS = {"_um": "displacement [µm]", "_degC": "temperature [°C]", "_MPa": "stress [MPa]"}
 
 
-def _axes(ax):
-    if ax is None:
-        import matplotlib.pyplot as plt
+def _figure():
+    import matplotlib.pyplot as plt
 
-        _, ax = plt.subplots()
-    return ax
+    return plt.figure()
+
+
+def _axes(ax):
+    return _figure().subplots() if ax is None else ax
+
+
+def _panels(axes):
+    """The ``fig`` for a plot of several panels: a new pyplot figure unless ``axes`` are given."""
+    return _figure() if axes is None else None
+
+
+def _title(run, t: float | None = None) -> str:
+    name = getattr(getattr(run, "case", None), "name", "")
+    return name if t is None else f"{name}, t = {t / 3600:.3g} h"
 
 
 def series(run, *columns: str, ax=None, hours: bool = True):
-    """The ``columns`` of a run (a :class:`gatetherm.api.Run`, or a mapping of columns with ``time_s``)
-    against time; returns the Axes."""
+    """Columns of a run against time.
+
+    Parameters
+    ----------
+    run : Run or mapping
+        A :class:`gatetherm.api.Run`, a time series, or a mapping of columns with ``time_s``.
+    *columns : str
+        The columns drawn (``"delta_um"``, ``"theta_A_degC"`` …).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure).
+    hours : bool
+        Time in h (else min).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        One line per column, labelled with its name.
+    """
     ax = _axes(ax)
     cols = run.columns if hasattr(run, "columns") else run
     t = cols["time_s"] / (3600.0 if hours else 60.0)
@@ -27,3 +75,204 @@ def series(run, *columns: str, ax=None, hours: bool = True):
         ax.legend(fontsize="small")
     ax.grid(alpha=0.3)
     return ax
+
+
+def channels(run, axes=None):
+    """Every channel of a run against time: temperatures (°C) above, displacements (µm) below.
+
+    Parameters
+    ----------
+    run : Run
+    axes : pair of matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure of two panels).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+        The two panels, one line per ``*_degC`` and per ``*_um`` column.
+    """
+    from gatetherm.validation.plots.run import plot_channels
+
+    return plot_channels(run.columns, _title(run), axes, _panels(axes))
+
+
+def response(run, axes=None):
+    """The response of the paper's Figs. 11–13: the rises of θ_A, θ_B, θ_C (top) and δ (bottom)
+    against time, the pump phases shaded where the run has a ``pump`` column.
+
+    Parameters
+    ----------
+    run : Run
+        A run with the signals ``theta_A_degC``, ``theta_B_degC``, ``theta_C_degC`` and ``delta_um``.
+    axes : pair of matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure of two panels).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+        The two panels.
+    """
+    from gatetherm.validation.plots.run import plot_response
+
+    return plot_response(run.columns, _title(run), axes, _panels(axes))
+
+
+def fluids(run, ax=None):
+    """The fluid temperatures of the paper's Fig. 10: each fluid volume of the case
+    (``T_<name>_degC``), its supply where a column gives it and the mean of its wetted wall where
+    the case reports one, the phases its pump runs shaded.
+
+    Parameters
+    ----------
+    run : Run
+        A run of a case with ``[fluids]`` (the paper's frame: its oil tank).
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from gatetherm.validation.plots.run import plot_fluids
+
+    return plot_fluids(run.columns, run.scenario.model.problem, _title(run), _axes(ax))
+
+
+def field(run, name: str = "T", t: float | None = None, ax=None):
+    """A nodal field on the mesh at a kept time: a tripcolor in 2-D, a picture of the body's
+    surface (pyvista, off screen) in 3-D, with a colour bar.
+
+    Parameters
+    ----------
+    run : Run
+    name : str
+        ``"T"`` (drawn in °C), ``"u"`` (its magnitude, µm), ``"sigma_xx"`` … or ``"von_mises"`` (MPa).
+    t : float, optional
+        Time, s (default: the last sample); a state must be kept there (``gt.run(..., keep=...)``).
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        2-D: the tripcolor's values are the field's at the mesh nodes.
+    """
+    from gatetherm.validation.plots.field import plot_field
+
+    t = float(run.time[-1]) if t is None else float(t)
+    kept, _ = run.state(t)
+    return plot_field(run.scenario.model.fmesh, name, run.field(name, kept), _title(run, kept), _axes(ax))
+
+
+def deformed(run, t: float | None = None, ax=None):
+    """Temperature on the deformed body (pyvista, off screen; the displacement magnified by a
+    power of ten so that it shows), the undeformed edges in grey, with a colour bar.
+
+    Parameters
+    ----------
+    run : Run
+        A run of a case with elasticity.
+    t : float, optional
+        Time, s (default: the last sample); a state must be kept there.
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+    """
+    from gatetherm.validation.plots.field import draw_deformed
+
+    kept, _ = run.state(float(run.time[-1]) if t is None else float(t))
+    return draw_deformed(run.scenario, kept, lambda s: _title(run, s), ax=_axes(ax))
+
+
+def compensation(result, axes=None):
+    """A compensation (:func:`gatetherm.compensate`): δ and its prediction, the prediction error,
+    the compensated δ with the actuator's stroke, and the correction factors, against time.
+
+    Parameters
+    ----------
+    result : Compensation
+        What :func:`gatetherm.compensate` returns.
+    axes : four matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure of four panels).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+    """
+    from gatetherm.validation.plots.compensation import plot_compensation
+
+    return plot_compensation(result.loop, axes, _panels(axes))
+
+
+def prediction(model, data, axes=None):
+    """What a thermal-error model predicts for a run, against the measured targets the run has,
+    and the residual, one row per target; the model's fitting span shaded.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        From ``gatetherm.studies.errormodel`` (``fit_error_model``, ``load_model``).
+    data : Run, TimeSeries or mapping
+        The run: the columns the model reads (and the targets, to compare).
+    axes : array of matplotlib.axes.Axes, optional
+        Targets × 2 (default: a new figure).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+        Targets × 2: displacement, residual.
+    """
+    from gatetherm.validation.plots.errormodel import plot_model_prediction
+
+    return plot_model_prediction(model, getattr(data, "columns", data), axes, _panels(axes))
+
+
+def residuals(diagnosis, axes=None):
+    """A diagnosis' residuals (:func:`gatetherm.diagnose`): measured minus the baseline model per
+    channel, its systematic part, the resolution band and the significant stretches, the phases
+    shaded and the end of the training window dashed.
+
+    Parameters
+    ----------
+    diagnosis : Diagnosis
+        What :func:`gatetherm.diagnose` returns.
+    axes : array of matplotlib.axes.Axes, optional
+        One per channel (default: a new figure).
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib.axes.Axes
+        Channels × 1.
+    """
+    from gatetherm.validation.plots.discrepancy import plot_residuals
+
+    return plot_residuals(diagnosis, axes, _panels(axes))
+
+
+def sweep(rows, x: str, y: str, hue: str | None = None, ax=None, **options):
+    """A sweep's ``y`` against ``x``: lines with markers, one colour per value of ``hue``.
+
+    Parameters
+    ----------
+    rows : sequence of mappings, or path
+        The sweep's table: its rows, or its ``table.csv`` (``gatetherm sweep``).
+    x, y, hue : str
+        Columns of the table (``hue``: one line per value).
+    ax : matplotlib.axes.Axes, optional
+    **options
+        ``title``, ``logx``, ``hline``, ``lines_by`` of
+        :func:`gatetherm.validation.plots.sweep.plot_xy`.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        Rows without a number in ``x`` or ``y`` are left out.
+    """
+    from gatetherm.validation.plots.sweep import plot_xy
+
+    if isinstance(rows, (str, os.PathLike)):
+        import csv
+
+        with open(rows, newline="", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+    return plot_xy(rows, x, y, hue, ax=_axes(ax), **options)

@@ -1,14 +1,11 @@
 """Fig. 7 / Fig. 8 analogues: normalised K_i and K_C against l/l4, theory curves and FE markers."""
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
-from gatetherm.validation.plots import save
+from gatetherm.validation.plots import figure
 
 KI_LABEL = r"$K_i\,/\,(3\alpha l^2/8h)$  ($l_1 = l/2$)"
 KC_LABEL = r"$K_C\,/\,(\alpha l_C)$  ($l_1 = l/2$)"
@@ -16,12 +13,9 @@ A_LABEL = r"$l/l_4$"
 A_RANGE = (0.5, 5.0)
 
 
-def _plot_one(theory_a, curves: Mapping, fe_points: Mapping | None, ylabel: str,
-              zero_line: bool, path: str | os.PathLike) -> None:
-    """One figure: a theory line per beta and FE markers of the same colour; atomic PNG."""
-    fig = Figure(figsize=(6.0, 4.2))
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
+def _plot_one(theory_a, curves: Mapping, fe_points: Mapping | None, ylabel: str, zero_line: bool, ax=None):
+    """A theory line per beta and FE markers of the same colour; returns the Axes."""
+    ax = figure((6.0, 4.2)) if ax is None else ax
     a = np.asarray(theory_a, dtype=float)
     for i, (b, y) in enumerate(sorted(curves.items())):
         colour = f"C{i}"
@@ -39,18 +33,18 @@ def _plot_one(theory_a, curves: Mapping, fe_points: Mapping | None, ylabel: str,
     if fe_points:
         ax.plot([], [], "o", color="0.3", mfc="none", label="FE")
     ax.legend(fontsize="small", ncol=2)
-    save(fig, path)
+    return ax
 
 
-def plot_ki_kc(theory_a, theory: Mapping, fe: Mapping | None,
-               path_ki: str | os.PathLike, path_kc: str | os.PathLike) -> None:
-    """Draw the Fig. 7 (``K_i``) and Fig. 8 (``K_C``) analogues to two PNG files.
+def plot_ki_kc(theory_a, theory: Mapping, fe: Mapping | None, axes=(None, None)):
+    """The Fig. 7 (``K_i``) and Fig. 8 (``K_C``) analogues on the two Axes ``axes`` (each None:
+    a figure of its own); returns them.
 
     ``theory_a``: the l/l4 values of the theory curves; ``theory``: beta -> (Ki_norm, Kc_norm)
     arrays over ``theory_a``; ``fe``: beta -> (a, Ki_norm, Kc_norm) FE results or None.
     """
     fe = fe or {}
-    _plot_one(theory_a, {b: v[0] for b, v in theory.items()},
-              {b: (v[0], v[1]) for b, v in fe.items()}, KI_LABEL, True, path_ki)
-    _plot_one(theory_a, {b: v[1] for b, v in theory.items()},
-              {b: (v[0], v[2]) for b, v in fe.items()}, KC_LABEL, False, path_kc)
+    return (_plot_one(theory_a, {b: v[0] for b, v in theory.items()},
+                      {b: (v[0], v[1]) for b, v in fe.items()}, KI_LABEL, True, axes[0]),
+            _plot_one(theory_a, {b: v[1] for b, v in theory.items()},
+                      {b: (v[0], v[2]) for b, v in fe.items()}, KC_LABEL, False, axes[1]))

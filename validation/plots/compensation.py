@@ -2,23 +2,19 @@
 compensation study and the Fig. 5 analogue (piezo loops)."""
 from __future__ import annotations
 
-import os
 from dataclasses import replace
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from gatetherm.studies.control import actuator as piezo
 from gatetherm.studies.control.compensator import ClosedLoop
-from gatetherm.validation.plots import save
+from gatetherm.validation.plots import figure
 
 
-def plot_compensation(loop: ClosedLoop, path: str | os.PathLike) -> None:
-    """Four panels against time: delta and prediction, prediction error, compensated delta, R."""
-    fig = Figure(figsize=(7.5, 9.0))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(4, 1, sharex=True)
+def plot_compensation(loop: ClosedLoop, axes=None, fig=None):
+    """Four panels against time: delta and prediction, prediction error, compensated delta, R;
+    on ``axes`` (four), or four panels of ``fig`` or of a new figure. Returns the Axes."""
+    axes = figure((7.5, 9.0), 4, 1, fig, sharex=True) if axes is None else axes
     t_h = loop.t_s / 3600.0
     pr = loop.prediction
     axes[0].plot(t_h, loop.delta_um, label=r"measured $\delta$ (uncompensated)")
@@ -40,25 +36,30 @@ def plot_compensation(loop: ClosedLoop, path: str | os.PathLike) -> None:
         ax.grid(True, lw=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize="small")
-    save(fig, path)
+    return axes
 
 
-def plot_piezo_loops(params: piezo.ActuatorParams, path: str | os.PathLike, steps: int = 30) -> dict:
-    """Fig. 5 analogue: 0 -> max -> 0 V loops unloaded / preloaded, direct / reset drive.
+def piezo_drives(params: piezo.ActuatorParams) -> list[list[piezo.ActuatorParams]]:
+    """The drives of the Fig. 5 analogue: [direct, reset] unloaded, then preloaded."""
+    return [[replace(params, preload_N=preload, strategy=s) for s in ("direct", "reset")]
+            for preload in (0.0, params.preload_N)]
 
-    Returns {panel label: open-loop width in um} for the four cases drawn.
-    """
-    fig = Figure(figsize=(9.0, 4.2))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 2, sharey=True)
-    widths = {}
-    for ax, preload in zip(axes, (0.0, params.preload_N)):
-        for strategy, style in (("direct", "-o"), ("reset", "--s")):
-            p = replace(params, preload_N=preload, strategy=strategy)
+
+def loop_widths(params: piezo.ActuatorParams, steps: int = 30) -> dict:
+    """{"preload P N, STRATEGY": open-loop width in um} of the loops :func:`plot_piezo_loops` draws."""
+    return {f"preload {p.preload_N:g} N, {p.strategy}": piezo.loop_width_um(p, steps)
+            for pair in piezo_drives(params) for p in pair}
+
+
+def plot_piezo_loops(params: piezo.ActuatorParams, axes=None, steps: int = 30):
+    """Fig. 5 analogue: 0 -> max -> 0 V loops unloaded (left) / preloaded (right), direct /
+    reset drive, on ``axes`` (two) or a new figure's. Returns the Axes."""
+    axes = figure((9.0, 4.2), 1, 2, sharey=True) if axes is None else axes
+    for ax, pair in zip(axes, piezo_drives(params)):
+        for p, style in zip(pair, ("-o", "--s")):
+            strategy, preload = p.strategy, p.preload_N
             volts, stroke = piezo.hysteresis_loop(p, steps)
             width = piezo.loop_width_um(p, steps)
-            label = f"preload {preload:g} N, {strategy}"
-            widths[label] = width
             ax.plot(volts, stroke, style, ms=3, mfc="none",
                     label=f"{strategy}: open loop {width:.2f} µm\n"
                     f"({p.transmission * width:.2f} µm at the cutting area)")
@@ -70,17 +71,15 @@ def plot_piezo_loops(params: piezo.ActuatorParams, path: str | os.PathLike, step
     axes[0].set_ylabel("stroke / µm")
     axes[0].set_xlim(0, params.max_voltage_V * 1.02)
     axes[0].set_ylim(bottom=min(0.0, float(np.min(stroke))) - 0.5)
-    save(fig, path)
-    return widths
+    return axes
 
 
-def plot_condition_study(title: str, loops: dict[str, ClosedLoop], path: str | os.PathLike,
-                         band_um: float = 7.0, settle_s: float = 600.0) -> None:
+def plot_condition_study(title: str, loops: dict[str, ClosedLoop], band_um: float = 7.0,
+                         settle_s: float = 600.0, axes=None):
     """Figs. 14-16 analogue: uncompensated delta, prediction error delta - delta_et, and the
-    compensated delta with the actuator in the loop, one line per predictor in ``loops``."""
-    fig = Figure(figsize=(7.5, 8.0))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(3, 1, sharex=True)
+    compensated delta with the actuator in the loop, one line per predictor in ``loops``, on
+    ``axes`` (three) or a new figure's. Returns the Axes."""
+    axes = figure((7.5, 8.0), 3, 1, sharex=True) if axes is None else axes
     first = next(iter(loops.values()))
     axes[0].plot(first.t_s / 3600.0, first.delta_um, color="k")
     axes[0].set_ylabel(r"uncompensated $\delta$ / µm")
@@ -99,4 +98,4 @@ def plot_condition_study(title: str, loops: dict[str, ClosedLoop], path: str | o
         ax.legend(fontsize="x-small", ncol=2)
     for ax in axes:
         ax.grid(True, lw=0.3)
-    save(fig, path)
+    return axes

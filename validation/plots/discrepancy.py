@@ -3,17 +3,14 @@ residual is significant, how the additions scored round by round, and the held-o
 residual before and after the chosen pieces."""
 from __future__ import annotations
 
-from pathlib import Path
+import numpy as np
 
-import matplotlib
+from gatetherm.studies.diagnosis.locate import significant, smooth, threshold
+from gatetherm.studies.diagnosis.replay import label, resolution, unit
+from gatetherm.validation.plots import figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from gatetherm.studies.diagnosis.locate import significant, smooth, threshold  # noqa: E402
-from gatetherm.studies.diagnosis.replay import label, resolution, unit  # noqa: E402
-from gatetherm.validation.plots import save  # noqa: E402
+DPI = 110
+"""Resolution of the diagnosis' pictures, dots per inch (``gatetherm diagnose`` writes them at it)."""
 
 PHASE_COLOURS = {"pump off": "#dddddd", "heating": "#f6d5c8", "forced cooling": "#cfe0f3"}
 
@@ -30,12 +27,14 @@ def _phases(ax, diag, names: bool) -> None:
     ax.set_xlim(h[0], h[-1])
 
 
-def plot_residuals(diag, path: Path) -> None:
+def plot_residuals(diag, axes=None, fig=None):
     """Baseline residual per channel over the whole run: samples, systematic part,
-    ±resolution band, significant stretches in red, phases shaded, training/held-out split dashed."""
+    ±resolution band, significant stretches in red, phases shaded, training/held-out split dashed;
+    on ``axes`` (one per channel), or panels of ``fig`` or of a new figure. Returns the Axes."""
     t = diag.time_s
     n = len(diag.channels)
-    fig, axes = plt.subplots(n, 1, figsize=(9, 1.9 * n + 0.8), sharex=True, squeeze=False)
+    axes = (figure((9, 1.9 * n + 0.8), n, 1, fig, sharex=True, squeeze=False) if axes is None
+            else np.reshape(axes, (n, 1)))
     for k, (ax, c) in enumerate(zip(axes[:, 0], diag.channels)):
         r, res = diag.residual_before[c], resolution(c)
         s = smooth(t, r)
@@ -51,17 +50,17 @@ def plot_residuals(diag, path: Path) -> None:
         ax.set_ylabel(f"{label(c)} ({unit(c)})")
     axes[0, 0].legend(fontsize=7, loc="lower left", ncol=5)
     axes[-1, 0].set_xlabel("time (h)   — dashed: end of the training window")
-    fig.suptitle("Residual of the baseline model", y=0.995)
-    fig.tight_layout()
-    save(fig, path, dpi=110, tight=False)
+    axes[0, 0].figure.suptitle("Residual of the baseline model", y=0.995)
+    return axes
 
 
-def plot_before_after(diag, path: Path) -> None:
-    """Held-out residual per channel with the baseline and with the chosen pieces."""
+def plot_before_after(diag, axes=None):
+    """Held-out residual per channel with the baseline and with the chosen pieces, on ``axes``
+    (one per channel) or a new figure's. Returns the Axes."""
     t = diag.time_s
     held = t > diag.train_end_s
     n = len(diag.channels)
-    fig, axes = plt.subplots(n, 1, figsize=(8, 1.9 * n + 0.8), sharex=True, squeeze=False)
+    axes = figure((8, 1.9 * n + 0.8), n, 1, sharex=True, squeeze=False) if axes is None else np.reshape(axes, (n, 1))
     name = " + ".join(r.piece.label for r in diag.pieces) or "—"
     for ax, c in zip(axes[:, 0], diag.channels):
         res = resolution(c)
@@ -75,15 +74,16 @@ def plot_before_after(diag, path: Path) -> None:
         ax.set_ylabel(f"{label(c)} ({unit(c)})")
         ax.legend(fontsize=7, loc="best")
     axes[-1, 0].set_xlabel("time (h), held-out window")
-    fig.suptitle(f"Held-out residual before and after: {name}", y=0.995)
-    fig.tight_layout()
-    save(fig, path, dpi=110, tight=False)
+    axes[0, 0].figure.suptitle(f"Held-out residual before and after: {name}", y=0.995)
+    return axes
 
 
-def plot_scores(diag, path: Path, shown: int = 12) -> None:
-    """Score gain of the best additions tried in each selection round (log scale)."""
+def plot_scores(diag, shown: int = 12, axes=None):
+    """Score gain of the best additions tried in each selection round (log scale), on ``axes``
+    (one per round) or a new figure's. Returns the Axes."""
     n = len(diag.rounds)
-    fig, axes = plt.subplots(1, n, figsize=(4.2 * n + 1.5, 0.3 * shown + 1.4), squeeze=False)
+    axes = (figure((4.2 * n + 1.5, 0.3 * shown + 1.4), 1, n, squeeze=False) if axes is None
+            else np.reshape(axes, (1, n)))
     for ax, k, rnd in zip(axes[0], range(1, n + 1), diag.rounds):
         trials = rnd.trials[:shown]
         y = np.arange(len(trials))[::-1]
@@ -96,18 +96,17 @@ def plot_scores(diag, path: Path, shown: int = 12) -> None:
         added = f"+ {' + '.join(p.label for p in rnd.added)}" if rnd.added else "nothing added"
         ax.set_title(f"round {k}: {added}", fontsize=9)
         ax.set_xlabel("1 + score gain", fontsize=8)
-    fig.suptitle(f"Additions by round (green: explains the held-out data, orange: screened only; "
-                 f"dotted: margin {diag.margin_min:g})", fontsize=9)
-    fig.tight_layout()
-    save(fig, path, dpi=110, tight=False)
+    axes[0, 0].figure.suptitle(f"Additions by round (green: explains the held-out data, orange: screened only; "
+                               f"dotted: margin {diag.margin_min:g})", fontsize=9)
+    return axes
 
 
-def plot_hidden_study(rows: list[dict], path) -> None:
+def plot_hidden_study(rows: list[dict], ax=None):
     """Held-out RMS of δ before (the baseline model) and after the diagnosis, one pair of bars
-    per case of the hidden-effect study, labelled with the true effect and the verdict."""
+    per case of the hidden-effect study, labelled with the true effect and the verdict. Returns the Axes."""
     labels = [f"{r['effect']} (c{r['condition']}) → {r['named'] or r['verdict']}" for r in rows]
     y = np.arange(len(rows))
-    fig, ax = plt.subplots(figsize=(7.5, 1.2 + 0.32 * len(rows)))
+    ax = figure((7.5, 1.2 + 0.32 * len(rows))) if ax is None else ax
     before = [r["rms_before_um"] for r in rows]
     after = [r["rms_after_um"] if r["rms_after_um"] is not None else np.nan for r in rows]
     ax.barh(y - 0.2, before, 0.4, color="0.7", label="baseline model")
@@ -119,4 +118,4 @@ def plot_hidden_study(rows: list[dict], path) -> None:
     ax.set_xlabel("held-out RMS of δ [µm]")
     ax.legend(fontsize="small", loc="lower right")
     ax.grid(axis="x", which="both", lw=0.3)
-    save(fig, path)
+    return ax

@@ -2,23 +2,18 @@
 inputs against time, the input phases shaded."""
 from __future__ import annotations
 
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-
-from gatetherm.validation.plots import save
+from gatetherm.validation.plots import figure
 from gatetherm.validation.plots.run import shade as shade_phases
 
 
-def plot_drift(t_s, displacement: dict, temperature: dict, inputs: dict, shade, path, title: str) -> None:
+def plot_drift(t_s, displacement: dict, temperature: dict, inputs: dict, shade, title: str = "", axes=None):
     """Three panels against time ``t_s`` (s from the start): the drift of each displacement
     (µm; ``delta_um`` bold), of each temperature (K), and the inputs (temperatures on the left
     axis, others on the right); each dict maps a column name to its values. ``shade``:
-    (label, on per sample) or None."""
+    (label, on per sample) or None. On ``axes`` (three) or a new figure's; returns the Axes."""
     hours = t_s[-1] > 3 * 3600.0
     t = t_s / (3600.0 if hours else 60.0)
-    fig = Figure(figsize=(8.0, 9.0))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(3, 1, sharex=True)
+    axes = figure((8.0, 9.0), 3, 1, sharex=True) if axes is None else axes
     for ax in axes:
         if shade:
             shade_phases(ax, t, shade[1], shade[0])
@@ -46,4 +41,4 @@ def plot_drift(t_s, displacement: dict, temperature: dict, inputs: dict, shade, 
         if handles:
             ax.legend(fontsize="x-small", ncol=3 if len(handles) > 6 else 1, loc="upper left")
     axes[0].set_title(title)
-    save(fig, path)
+    return axes

@@ -3,22 +3,18 @@ against the FE runs, and the residual band of each compensator per case."""
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 from matplotlib.ticker import ScalarFormatter
 
-from gatetherm.validation.plots import save
+from gatetherm.validation.plots import figure
 
 COMPENSATORS = (("paper_um", "paper (K theory, 5 min)"), ("mlr_um", "MLR (5 min)"),
                 ("rom_5min_um", "rom, 5 min"), ("rom_event_um", "rom, event-triggered"))
 """Columns of the study's rows drawn as bars, with their legend."""
 
 
-def plot_rom_error(errors: dict, path) -> None:
-    """δ_rom − δ_FE (µm) against time, one curve per (dimension, condition)."""
-    fig = Figure(figsize=(7, 3.6))
-    FigureCanvasAgg(fig)
-    ax = fig.subplots()
+def plot_rom_error(errors: dict, ax=None):
+    """δ_rom − δ_FE (µm) against time, one curve per (dimension, condition). Returns the Axes."""
+    ax = figure((7, 3.6)) if ax is None else ax
     for (dim, n), (t, err) in sorted(errors.items()):
         ax.plot(np.asarray(t) / 3600.0, err, ls="-" if dim == 2 else "--", color=f"C{n - 1}",
                 label=f"{dim}-D, condition {n}")
@@ -26,14 +22,12 @@ def plot_rom_error(errors: dict, path) -> None:
     ax.set(xlabel="time [h]", ylabel="δ_rom − δ_FE [µm]", title="Reduced model (30 states) against the FE runs")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small", ncol=2)
-    save(fig, path)
+    return ax
 
 
-def plot_rom_bands(rows, path) -> None:
-    """Residual band (µm, log scale) of each compensator per case of the study."""
-    fig = Figure(figsize=(max(7.0, 0.45 * len(rows) + 2.0), 4.2))
-    FigureCanvasAgg(fig)
-    ax = fig.subplots()
+def plot_rom_bands(rows, ax=None):
+    """Residual band (µm, log scale) of each compensator per case of the study. Returns the Axes."""
+    ax = figure((max(7.0, 0.45 * len(rows) + 2.0), 4.2)) if ax is None else ax
     x, w = np.arange(len(rows)), 0.8 / len(COMPENSATORS)
     for k, (field, label) in enumerate(COMPENSATORS):
         ax.bar(x + (k - 1.5) * w, [getattr(r, field) for r in rows], w, label=label, color=f"C{k}")
@@ -45,4 +39,4 @@ def plot_rom_bands(rows, path) -> None:
     ax.set(ylabel="residual band [µm]", title="Compensated δ: residual band after the first 10 min")
     ax.grid(axis="y", alpha=0.3, which="both")
     ax.legend(fontsize="small", ncol=2)
-    save(fig, path)
+    return ax

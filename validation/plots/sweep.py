@@ -1,20 +1,13 @@
 """Plots of sweep tables: y against x, one line per value of a hue column."""
 from __future__ import annotations
 
-import os
-
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter, ScalarFormatter
-from gatetherm.validation.plots import save
 
+from gatetherm.validation.plots import figure
 
-
-def new_axes(figsize=(6.0, 4.2)):
-    fig = Figure(figsize=figsize)
-    FigureCanvasAgg(fig)
-    return fig, fig.add_subplot()
+SIZE = (6.0, 4.2)
+"""Size of a one-panel sweep plot, inches."""
 
 
 def _num(v) -> float:
@@ -24,12 +17,12 @@ def _num(v) -> float:
         return np.nan
 
 
-def plot_xy(rows: list[dict], x: str, y: str, hue: str | None, path: str | os.PathLike,
-            title: str = "", logx: bool = False, hline: float | None = None, lines_by=()) -> None:
+def plot_xy(rows: list[dict], x: str, y: str, hue: str | None = None, title: str = "", logx: bool = False,
+            hline: float | None = None, lines_by=(), ax=None):
     """Lines with markers of ``y`` over ``x`` (rows without a number left out): one colour per
     ``hue`` value, one line per combination of the ``lines_by`` columns (other swept
-    parameters; line styles tell them apart, the legend names them)."""
-    fig, ax = new_axes()
+    parameters; line styles tell them apart, the legend names them). Returns the Axes."""
+    ax = figure(SIZE) if ax is None else ax
     hues = list(dict.fromkeys(r.get(hue) for r in rows)) if hue else [None]
     others = list(dict.fromkeys(tuple(r.get(k) for k in lines_by) for r in rows))
     styles = ["-", "--", ":", "-."]
@@ -54,17 +47,17 @@ def plot_xy(rows: list[dict], x: str, y: str, hue: str | None, path: str | os.Pa
     ax.grid(True, lw=0.3)
     if hue or lines_by:
         ax.legend(fontsize="x-small", ncol=2 if len(hues) * len(others) > 6 else 1)
-    save(fig, path)
+    return ax
 
 
 # --- the design study (studies/design.py) ---------------------------------------------------
 
-def plot_positions(rows: list[dict], marks: dict[str, float], path: str | os.PathLike, title: str = "") -> None:
+def plot_positions(rows: list[dict], marks: dict[str, float], title: str = "", axes=None):
     """Swing of delta per condition (and the worst) over the tie-bar height, with the FE
-    K_i, K_C at the tips below; vertical lines at ``marks`` (label -> l4)."""
-    fig = Figure(figsize=(6.4, 6.4))
-    FigureCanvasAgg(fig)
-    ax, bx = fig.subplots(2, 1, sharex=True)
+    K_i, K_C at the tips below; vertical lines at ``marks`` (label -> l4). On ``axes`` (two)
+    or a new figure's; returns the Axes."""
+    axes = figure((6.4, 6.4), 2, 1, sharex=True) if axes is None else axes
+    ax, bx = axes
     ok = [r for r in rows if r.get("status") == "ok"]
     conds = sorted({r["condition"] for r in ok})
     worst: dict = {}
@@ -88,13 +81,13 @@ def plot_positions(rows: list[dict], marks: dict[str, float], path: str | os.Pat
         a.grid(True, lw=0.3)
         a.legend(fontsize="small")
     ax.set_title(title, fontsize="medium")
-    save(fig, path)
+    return axes
 
 
-def plot_second(summary: list[dict], path: str | os.PathLike, title: str = "") -> None:
+def plot_second(summary: list[dict], title: str = "", ax=None):
     """Worst swing over conditions 1-3 against the second tie bar's height, one line per
-    first-bar height; the level without a second bar dashed."""
-    fig, ax = new_axes()
+    first-bar height; the level without a second bar dashed. Returns the Axes."""
+    ax = figure(SIZE) if ax is None else ax
     for i, l4 in enumerate(sorted({r["l4"] for r in summary})):
         rs = [r for r in summary if r["l4"] == l4]
         ref = [r["worst_swing_um"] for r in rs if r["l4_2"] == 0.0]
@@ -108,22 +101,21 @@ def plot_second(summary: list[dict], path: str | os.PathLike, title: str = "") -
     ax.grid(True, lw=0.3)
     ax.legend(fontsize="small")
     ax.set_title(title, fontsize="medium")
-    save(fig, path)
+    return ax
 
 
-def plot_histories(histories: dict[str, dict[int, tuple]], path: str | os.PathLike) -> None:
-    """delta(t) per condition (one panel each), one line per design (label -> condition -> (t_s, delta_um))."""
+def plot_histories(histories: dict[str, dict[int, tuple]], axes=None):
+    """delta(t) per condition (one panel each), one line per design (label -> condition -> (t_s, delta_um)),
+    on ``axes`` (one per condition) or a new figure's. Returns the Axes."""
     conds = sorted(next(iter(histories.values())))
-    fig = Figure(figsize=(6.4, 2.3 * len(conds)))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(len(conds), 1, sharex=True)
-    for ax, c in zip(np.atleast_1d(axes), conds):
+    axes = np.atleast_1d(figure((6.4, 2.3 * len(conds)), len(conds), 1, sharex=True) if axes is None else axes)
+    for ax, c in zip(axes, conds):
         for i, (label, runs) in enumerate(histories.items()):
             t, d = runs[c]
             ax.plot(np.asarray(t) / 3600.0, d, color=f"C{i}", label=label)
         ax.axhline(0.0, color="0.5", lw=0.6)
         ax.set_ylabel(rf"$\delta$ (µm), cond. {c}")
         ax.grid(True, lw=0.3)
-    np.atleast_1d(axes)[0].legend(fontsize="x-small")
-    np.atleast_1d(axes)[-1].set_xlabel("time (h)")
-    save(fig, path)
+    axes[0].legend(fontsize="x-small")
+    axes[-1].set_xlabel("time (h)")
+    return axes

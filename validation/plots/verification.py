@@ -1,20 +1,14 @@
 """Observed convergence: errors against mesh size and time step, log-log, with fitted orders."""
 from __future__ import annotations
 
-import os
-
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-
-from gatetherm.validation.plots import save
+from gatetherm.validation.plots import figure
 
 
-def plot_orders(spatial: dict, temporal: dict, path: str | os.PathLike) -> None:
+def plot_orders(spatial: dict, temporal: dict, axes=None):
     """Two panels: ``spatial`` {label: (h, L2 error, order)} and ``temporal`` {label: (dt, error, order)};
-    each study's errors with markers, its observed order in the legend."""
-    fig = Figure(figsize=(10.0, 4.4))
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 2)
+    each study's errors with markers, its observed order in the legend; on ``axes`` (two) or a
+    new figure's. Returns the Axes."""
+    axes = figure((10.0, 4.4), 1, 2) if axes is None else axes
     for ax, studies, xlabel, ylabel in ((axes[0], spatial, "element size h", "L2 error [K or m]"),
                                          (axes[1], temporal, "time step dt", "max nodal error [K]")):
         for i, (label, (x, err, p)) in enumerate(studies.items()):
@@ -25,4 +19,4 @@ def plot_orders(spatial: dict, temporal: dict, path: str | os.PathLike) -> None:
         ax.legend(fontsize="x-small", title="observed order", title_fontsize="x-small")
     axes[0].set_title("manufactured solutions (space)", fontsize="medium")
     axes[1].set_title("exact modal solution (time)", fontsize="medium")
-    save(fig, path)
+    return axes

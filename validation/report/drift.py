@@ -118,14 +118,16 @@ def sampling(ts: TimeSeries) -> dict:
 def compute(ts: TimeSeries, work, name: str):
     """The drift report of ``ts`` as a report Result: the figure (``drift.png`` in ``work``), the
     per-channel and per-phase tables and the test's duration and sampling."""
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.drift import plot_drift
     from gatetherm.validation.report.result import Figure, Result, from_dicts
 
     check_record(ts, name)
     ch = channels(ts)
     shade = phase_signal(ts, ch)
-    plot_drift(ts.time_s - ts.time_s[0], {n: drift(ts[n]) for n in ch.displacement},
-               {n: drift(ts[n]) for n in ch.temperature}, {n: ts[n] for n in ch.inputs}, shade, work / "drift.png", name)
+    save(plot_drift(ts.time_s - ts.time_s[0], {n: drift(ts[n]) for n in ch.displacement},
+                    {n: drift(ts[n]) for n in ch.temperature}, {n: ts[n] for n in ch.inputs}, shade, name),
+         work / "drift.png")
     s = sampling(ts)
     rows = {kind: [channel_row(ts, n) for n in names] for kind, names in
             (("µm", ch.displacement), ("°C", ch.temperature), ("input", ch.inputs))}

@@ -16,13 +16,17 @@ def compute(ctx) -> Result:
     from gatetherm.studies.run.scenario import run_scenario
     from gatetherm.studies.run.simulate import column
     from gatetherm.studies.run.timeseries import TimeSeries
-    from gatetherm.validation.plots.run import plot_case
+    from gatetherm.validation.plots import save
+    from gatetherm.validation.plots.field import draw_deformed
+    from gatetherm.validation.plots.run import plot_channels
     from gatetherm.validation.report import drift
 
     case = load_case(Path(gatetherm.validation.__path__[0]) / ctx.scope["case"])
     schedule = case.schedule
     run = run_scenario(case, schedule, keep_times=[float(schedule.times[-1])])
-    plot_case(run, ctx.work, case.name)
+    save(plot_channels(run.columns, case.name), ctx.work / "channels.png", tight=False)
+    save(draw_deformed(run, float(run.columns["time_s"][-1]), lambda t: f"{case.name}, t = {t / 3600:.3g} h"),
+         ctx.work / "deformed.png")
     summary = probe_summary(case.problem, run.columns)
     probes = [{"probe": k, **v} for k, v in summary["probes"].items()]
     cols, t = run.columns, run.columns["time_s"]

@@ -7,13 +7,14 @@ from gatetherm.validation.report.result import Figure, Result, from_dicts, table
 
 def compute(ctx) -> Result:
     from gatetherm.validation.hidden_effects import ALL_CASES, COLUMNS, write_hidden_effects
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.discrepancy import plot_hidden_study
 
     s = ctx.scope
     wanted = ALL_CASES if s["effects"] == "all" else tuple(s["effects"])
     acc, rows = write_hidden_effects(ctx.work, max(ctx.workers, 1), s["seed"], tuple(s["conditions"]), wanted,
                                per_kind=s.get("per_kind"))
-    plot_hidden_study(rows, ctx.work / "hidden_effects.png")
+    save(plot_hidden_study(rows), ctx.work / "hidden_effects.png")
     cases = from_dicts("Every case: true effect, verdict, named effect and the held-out RMS", rows,
                        [c for c in COLUMNS if c != "reason"],
                        note="Held-out window: the last 40 % of each 5-h run; weighted RMS: all channels in units of "

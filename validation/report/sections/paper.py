@@ -15,7 +15,9 @@ CONDITIONS = (1, 2, 3)
 def compute(ctx) -> Result:
     from gatetherm.studies.run.scenario import ScenarioCache
     from gatetherm.validation.paper_table import run_condition, table_rows
-    from gatetherm.validation.plots.run import draw_deformed, plot_oil, plot_responses
+    from gatetherm.validation.plots import save
+    from gatetherm.validation.plots.field import draw_deformed
+    from gatetherm.validation.plots.run import plot_fluids, plot_responses
 
     dims, load = ctx.scope["dims"], os.getloadavg()[0]
     keep = [60.0 * k for k in range(61)]  # every minute of the first hour: the first peak of δ is in it
@@ -26,17 +28,21 @@ def compute(ctx) -> Result:
             runs[(c, dim)], res[(c, dim)] = run_condition(cfg, dim, c, cache, keep_times=keep if c == 1 else ())
     figures = []
     for c in CONDITIONS:
-        plot_oil(runs[(c, 2)].columns, ctx.work / f"fig10_oil_c{c}.png", f"condition {c}: oil and tank (2-D)")
+        run = runs[(c, 2)]
+        save(plot_fluids(run.columns, run.model.problem, f"condition {c}: oil and tank (2-D)"),
+             ctx.work / f"fig10_oil_c{c}.png")
         figures.append(Figure(f"fig10_oil_c{c}.png", f"Fig. 10 analogue, condition {c}: supply oil, oil in the "
                               "tank and tank wall; grey: pump on"))
-        plot_responses({f"{d}-D": runs[(c, d)].columns for d in dims}, ctx.work / f"response_c{c}.png",
-                       f"condition {c}: θ rises and δ" + (" (solid 2-D, dashed 3-D)" if len(dims) > 1 else ""))
+        save(plot_responses({f"{d}-D": runs[(c, d)].columns for d in dims},
+                            f"condition {c}: θ rises and δ" + (" (solid 2-D, dashed 3-D)" if len(dims) > 1 else "")),
+             ctx.work / f"response_c{c}.png")
         figures.append(Figure(f"response_c{c}.png", f"Figs. 11–13 analogue, condition {c}: θ_A, θ_B, θ_C rises "
                               "and δ against time, pump phases shaded"))
     for dim in dims:
         peak = res[(1, dim)]["first_peak_min"] or 60.0
-        draw_deformed(runs[(1, dim)], peak * 60.0, ctx.work / f"deformed_c1_d{dim}.png",
-                      lambda t: f"condition 1, {dim}-D, t = {t / 60:.0f} min (first peak of δ)")
+        save(draw_deformed(runs[(1, dim)], peak * 60.0,
+                           lambda t: f"condition 1, {dim}-D, t = {t / 60:.0f} min (first peak of δ)"),
+             ctx.work / f"deformed_c1_d{dim}.png")
         figures.append(Figure(f"deformed_c1_d{dim}.png", f"Temperature on the deformed {dim}-D frame at the first "
                               "peak of δ, condition 1"))
     columns, rows = table_rows(res, dims, load)

@@ -9,13 +9,14 @@ from gatetherm.validation import paper_model
 def compute(ctx) -> Result:
     from gatetherm.solvers.frame import EFFECTS
     from gatetherm.validation import rom_study as rs
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.rom import plot_rom_bands, plot_rom_error
 
     effects = ctx.scope["effects"]
     st = rs.write_rom_study(ctx.work, paper_model(), ctx.scope["dims"], conditions=ctx.scope["conditions"],
                             effects=EFFECTS if effects == "all" else effects)
-    plot_rom_error(st.errors, ctx.work / "rom_error.png")
-    plot_rom_bands(st.rows, ctx.work / "rom_bands.png")
+    save(plot_rom_error(st.errors), ctx.work / "rom_error.png")
+    save(plot_rom_bands(st.rows), ctx.work / "rom_bands.png")
     checks = table("The reduced model against full FE runs (1-min samples)", rs.CHECK_COLUMNS, rs.check_rows(st.checks),
                    readme="rom-check", note="Built in: assembly and reduction, wall time on this machine (load average "
                                             "at the top of the section); 5-h run: the reduced march alone.")

@@ -56,10 +56,11 @@ def _exact() -> list[tuple[str, str, str]]:
 
 
 def compute(ctx) -> Result:
+    from gatetherm.validation.plots import save
     from gatetherm.validation.plots.verification import plot_orders
 
     spatial, temporal, rows = _orders(ctx.scope)
-    plot_orders(spatial, temporal, ctx.work / "orders.png")
+    save(plot_orders(spatial, temporal), ctx.work / "orders.png")
     orders = table("Observed convergence orders (least-squares slope of log error against log h or log dt)",
                    ("check", "observed", "expected"), rows, readme="verification",
                    note="Space: unit square refined n times (h = 2^-n) or unit cube of n³ cubes of six tetrahedra "

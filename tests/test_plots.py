@@ -1,0 +1,181 @@
+"""Library plots: ``gt.plot`` draws what the run holds on the Axes it is given (or a new pyplot
+figure's) and returns them; the README snippet leaves a notebook's matplotlib backend as it
+was; pyvista's global off-screen switch is not touched; the pictures are written by one writer."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import gatetherm as gt
+from gatetherm import InputError
+from gatetherm.validation.plots import save
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE = ROOT / "validation" / "examples" / "c_frame" / "case.toml"
+
+
+def axes(n: int = 1, **kw):
+    """Axes of a bare figure: what a test hands to a plot."""
+    return Figure().subplots(n, 1, **kw)
+
+
+@pytest.fixture(scope="module")
+def cframe():
+    return gt.run(gt.load_case(CASE))
+
+
+def test_the_readme_snippet_keeps_the_svg_backend(tmp_path):
+    """The snippet in a fresh interpreter with ``MPLBACKEND=svg``: the plots made without ``ax=``
+    are pyplot figures (they show in a notebook), and the backend is still svg afterwards."""
+    snippet = textwrap.dedent(f"""
+        import io
+        import gatetherm as gt
+        case = gt.load_case({str(CASE)!r})
+        run = gt.run(case)
+        ax = gt.plot.series(run, "delta_um")
+        bx = gt.plot.field(run, "T", t=run.time[-1])
+        gt.plot.response(run)
+        import matplotlib, matplotlib.pyplot as plt
+        ax.figure.savefig(io.BytesIO(), format="svg")
+        print(matplotlib.get_backend(), plt.get_fignums(), ax.figure is plt.figure(1), bx.figure is plt.figure(2))
+    """)
+    env = {**os.environ, "MPLBACKEND": "svg"}
+    out = subprocess.run([sys.executable, "-c", snippet], env=env, cwd=tmp_path, capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split("\n")[-2] == "svg [1, 2, 3] True True"
+
+
+def test_series_draws_the_columns(cframe):
+    ax = gt.plot.series(cframe, "delta_um", "drift_x_um", ax=axes())
+    assert [line.get_label() for line in ax.lines] == ["delta_um", "drift_x_um"]
+    assert np.array_equal(ax.lines[0].get_ydata(), cframe["delta_um"])
+    assert np.array_equal(ax.lines[1].get_xdata(), cframe.time / 3600.0)
+    assert ax.get_ylabel() == "displacement [µm]"
+
+
+def test_channels_and_response(cframe):
+    top, bottom = gt.plot.channels(cframe, axes=axes(2))
+    temps = [k for k in cframe.columns if k.endswith("_degC")]
+    assert [line.get_label() for line in top.lines] == temps
+    assert [line.get_label() for line in bottom.lines] == [k for k in cframe.columns if k.endswith("_um")]
+    assert np.array_equal(top.lines[-1].get_ydata(), cframe[temps[-1]])
+    a1, a2 = gt.plot.response(cframe, axes=axes(2))
+    theta = cframe["theta_B_degC"]
+    assert np.array_equal(a1.lines[1].get_ydata(), theta - theta[0])  # the rise of θ_B
+    assert np.array_equal(a2.lines[0].get_ydata(), cframe["delta_um"]) and not a1.patches  # no pump: no shading
+
+
+def test_fluids_of_the_frame():
+    """The paper frame's tank: supply, oil and wall (mean), one grey band per pump phase."""
+    from conftest import fixed_condition
+
+    case, schedule = fixed_condition(150)  # pump on for the first hour, off, on again at 2 h
+    run = gt.run(case, schedule, keep=())
+    ax = gt.plot.fluids(run, ax=axes())
+    assert [line.get_label() for line in ax.lines] == ["supply", "tank oil", "tank wall (mean)"]
+    assert np.array_equal(ax.lines[1].get_ydata(), run["T_tank_oil_degC"])
+    assert len(ax.patches) == 2 and ax.patches[0].get_label() == "pump on"
+
+
+def test_field_in_2d_is_the_nodal_field(cframe):
+    ax = gt.plot.field(cframe, "T", ax=axes())
+    mesh = ax.collections[0]
+    assert np.array_equal(mesh.get_array(), cframe.field("T"))
+    assert ax.get_title() == "C-frame machining centre, t = 6 h"
+    u = gt.plot.field(cframe, "u", t=3600.0, ax=axes()).collections[0].get_array()
+    assert np.allclose(u, 1e6 * np.linalg.norm(cframe.field("u", 3600.0), axis=1), rtol=1e-15, atol=0)
+    with pytest.raises(InputError, match="no state kept at 30 s"):
+        gt.plot.field(cframe, "T", t=30.0)
+
+
+def test_field_in_3d_is_a_surface_picture_and_leaves_pyvista_on_screen(tmp_path):
+    import pyvista as pv
+
+    from test_assembly_mesh import BOX, CASE_GROUPS  # a 1 x 2 x 3 m box, one face at 100 °C, a film elsewhere
+
+    (tmp_path / "box.geo").write_text(BOX)
+    (tmp_path / "case.toml").write_text(CASE_GROUPS)
+    run = gt.run(gt.load_case(tmp_path / "case.toml"))
+    before = pv.OFF_SCREEN
+    ax = gt.plot.field(run, "T", ax=axes())
+    assert pv.OFF_SCREEN is before
+    T = run.field("T")
+    image, = ax.images
+    assert image.get_array().shape[2] in (3, 4) and min(image.get_array().shape[:2]) > 300
+    bar = ax.figure.axes[-1]  # the colour bar over the field's range
+    assert bar.get_ylim() == pytest.approx((T.min(), T.max()), rel=1e-12)
+    assert T.max() == pytest.approx(100.0, abs=1e-9)  # the hot face
+
+
+def test_deformed_picture(cframe, tmp_path):
+    ax = gt.plot.deformed(cframe, ax=axes())
+    assert len(ax.images) == 1 and "magnified ×" in ax.get_title() and "t = 6 h" in ax.get_title()
+    save(ax, tmp_path / "d.png")
+    assert (tmp_path / "d.png").stat().st_size > 10_000
+
+
+def test_compensation(cframe):
+    comp = gt.compensate(cframe, method="paper")
+    ax = gt.plot.compensation(comp, axes=axes(4))
+    assert np.array_equal(ax[0].lines[0].get_ydata(), cframe["delta_um"])
+    assert np.array_equal(ax[2].lines[0].get_ydata(), comp.loop.delta_comp_um)
+    assert np.array_equal(ax[2].lines[1].get_ydata(), comp.loop.stroke_um)
+
+
+def test_prediction(cframe):
+    from gatetherm.studies.errormodel.fit import FitParams, fit_error_model
+    from gatetherm.studies.errormodel.model import predict
+
+    model = fit_error_model(cframe.columns, ["delta_um"], ["theta_A_degC", "theta_B_degC", "theta_C_degC"],
+                            params=FitParams(form="static"))
+    (left, right), = gt.plot.prediction(model, cframe, axes=Figure().subplots(1, 2))
+    measured, predicted = left.lines
+    assert np.array_equal(measured.get_ydata(), cframe["delta_um"])
+    assert np.array_equal(predicted.get_ydata(), predict(model, cframe.columns)["delta_um"])
+    assert np.array_equal(right.lines[0].get_ydata(), cframe["delta_um"] - predicted.get_ydata())
+    assert len(left.patches) == 1  # the fitting span
+
+
+def test_residuals():
+    """A diagnosis' residuals (a stand-in with the fields the plot reads; ``gatetherm diagnose``
+    draws a real one in tests/test_discrepancy.py)."""
+    from gatetherm.studies.diagnosis.locate import Phase
+
+    t = np.arange(0.0, 5 * 3600.0 + 1, 60.0)
+    r = {"delta_um": np.where(t > 3 * 3600.0, 1.0, 0.0) + 0.01 * np.sin(t), "theta_A_degC": 0.01 * np.cos(t)}
+    diag = SimpleNamespace(time_s=t, channels=tuple(r), residual_before=r, train_end_s=3 * 3600.0,
+                           phases=(Phase("heating", 0.0, 3600.0), Phase("pump off", 3600.0, t[-1], True)))
+    ax = gt.plot.residuals(diag, axes=axes(2))
+    assert ax.shape == (2, 1)
+    lines = {line.get_label(): line.get_ydata() for line in ax[0, 0].lines}
+    assert np.array_equal(lines["measured − model"], r["delta_um"])
+    assert ax[0, 0].get_ylabel() == "δ (µm)" and ax[1, 0].get_ylabel() == "θ_A (K)"
+    significant = lines["significant"]  # the step of 1 µm after 3 h stands out, the noise does not
+    assert np.isfinite(significant[t > 3.5 * 3600.0]).all() and np.isnan(significant[t < 2.5 * 3600.0]).all()
+
+
+def test_sweep_from_rows_and_from_the_table(tmp_path):
+    from gatetherm.studies.sweeps.runner import write_table
+
+    rows = [{"film": f, "h": h, "delta_um": 10 * f + h} for h in (1, 2) for f in (3.0, 1.0, 2.0)]
+    ax = gt.plot.sweep(rows, "film", "delta_um", hue="h", ax=axes())
+    assert [line.get_label() for line in ax.lines] == ["h = 1", "h = 2"]
+    assert list(ax.lines[1].get_xdata()) == [1.0, 2.0, 3.0] and list(ax.lines[1].get_ydata()) == [12.0, 22.0, 32.0]
+    write_table(tmp_path / "table.csv", ["film", "h", "delta_um"], rows)
+    again = gt.plot.sweep(tmp_path / "table.csv", "film", "delta_um", hue="h", ax=axes())
+    assert [list(line.get_ydata()) for line in again.lines] == [list(line.get_ydata()) for line in ax.lines]
+
+
+def test_every_plot_of_gt_plot_is_tested():
+    tested = {n.removeprefix("test_") for n in globals() if n.startswith("test_")}
+    names = set(gt.plot.__all__) - {"save"}
+    assert all(any(n in t for t in tested) for n in names), names

@@ -1,0 +1,123 @@
+"""Pictures on the mesh: a nodal field (a tripcolor in 2-D, a pyvista surface picture in 3-D)
+and the deformed frame. pyvista renders off screen into an image (its own plotter's setting:
+``pyvista.OFF_SCREEN`` is left as it was), which matplotlib frames with a labelled colour bar."""
+from __future__ import annotations
+
+import numpy as np
+
+from gatetherm.validation.plots import figure
+
+CMAP = "coolwarm"
+"""Colour map of temperature on the frame (no black end: every part of the frame stays visible)."""
+
+
+def scalar(name: str, values) -> tuple[np.ndarray, str]:
+    """(values drawn, colour-bar label) of the nodal field ``name`` as
+    :meth:`gatetherm.api.Run.field` gives it: T in °C, |u| in µm, stresses in MPa."""
+    values = np.asarray(values, dtype=float)
+    if name == "T":
+        return values, "temperature T [°C]"
+    if name == "u":
+        return 1e6 * np.linalg.norm(values, axis=1), "displacement |u| [µm]"
+    return 1e-6 * values, f"{name} [MPa]"
+
+
+def _limits(v) -> tuple[float, float]:
+    return float(v.min()), float(v.max()) if v.max() > v.min() else float(v.min()) + 1.0
+
+
+def plot_field(fmesh, name: str, values, title: str = "", ax=None):
+    """The nodal field ``name`` (``values`` at the nodes of ``fmesh``, a
+    :class:`~gatetherm.geometry.mesh.FrameMesh`): in 2-D a tripcolor on the mesh (x, y in m),
+    in 3-D a picture of the body's surface (pyvista). Returns the Axes."""
+    v, label = scalar(name, values)
+    if fmesh.dim == 3:
+        from gatetherm.studies.run.output import volume_grid
+
+        grid = volume_grid(fmesh, {name: v})
+        return frame_image(screenshot(grid, name, _limits(v), grid), _limits(v), label, title, ax)
+    ax = figure((7.5, 6.0)) if ax is None else ax
+    x, y = np.asarray(fmesh.points, dtype=float)[:, :2].T
+    art = ax.tripcolor(x, y, np.asarray(fmesh.cells)[:, :3], v, shading="gouraud", cmap=CMAP)
+    ax.figure.colorbar(art, ax=ax, fraction=0.04, pad=0.02, shrink=0.85).set_label(label)
+    ax.set_aspect("equal")
+    ax.set(xlabel="x [m]", ylabel="y [m]", title=title)
+    return ax
+
+
+def screenshot(shown, name: str, clim, outline_of) -> np.ndarray:
+    """An off-screen pyvista image of the point array ``name`` on ``shown`` (colours over ``clim``)
+    with the feature edges of ``outline_of`` in grey, cropped to its content."""
+    import pyvista as pv
+    from vtkmodules.vtkCommonCore import vtkLogger
+
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)  # no X display: VTK falls back quietly
+    flat = outline_of.bounds[5] - outline_of.bounds[4] < 1e-12
+    outline = outline_of.extract_surface(algorithm="dataset_surface").extract_feature_edges(
+        feature_angle=30.0, boundary_edges=flat, feature_edges=not flat, manifold_edges=False, non_manifold_edges=False)
+    p = pv.Plotter(off_screen=True, window_size=(1600, 1200))
+    try:
+        p.set_background("white")
+        p.add_mesh(shown, scalars=name, cmap=CMAP, clim=clim, show_scalar_bar=False)
+        p.add_mesh(outline, color="#8c8c8c", line_width=2)
+        if flat:
+            p.view_xy()
+        else:  # y is up; seen from behind and above, so the tool side stays on the left
+            p.view_vector((0.35, 0.45, 1.0), viewup=(0.0, 1.0, 0.0))
+        return _trim(p.screenshot(return_img=True))
+    finally:
+        p.close()
+
+
+def frame_image(img: np.ndarray, clim, label: str, title: str, ax=None):
+    """``img`` on ``ax`` (axes off) with a colour bar of :data:`CMAP` over ``clim`` labelled
+    ``label``. Returns the Axes."""
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    ax = figure((7.5, 6.0)) if ax is None else ax
+    ax.imshow(img, interpolation="lanczos")
+    ax.set_axis_off()
+    bar = ax.figure.colorbar(ScalarMappable(Normalize(*clim), CMAP), ax=ax, fraction=0.04, pad=0.02, shrink=0.85)
+    bar.set_label(label)
+    ax.set_title(title, fontsize="medium")
+    return ax
+
+
+def render_deformed(grid, title: str, scale: float, ax=None):
+    """Temperature on the frame deformed by ``scale`` × displacement, the undeformed outline
+    in grey (pyvista, off screen), framed on ``ax`` with a labelled colour bar; returns the Axes.
+
+    ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components);
+    without ``T`` (a purely mechanical case) the colours show the displacement's magnitude.
+    """
+    thermal = "T" in grid.point_data
+    if not thermal:
+        grid["|u| [µm]"] = scalar("u", grid["u"])[0]
+    name = "T" if thermal else "|u| [µm]"
+    clim = _limits(np.asarray(grid[name]))
+    img = screenshot(grid.warp_by_vector("u", factor=scale), name, clim, grid)
+    return frame_image(img, clim, "temperature T [°C]" if thermal else "displacement |u| [µm]",
+                       f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges", ax)
+
+
+def _trim(img: np.ndarray, pad: int = 12) -> np.ndarray:
+    """The image cropped to its non-white content plus ``pad`` pixels."""
+    ink = np.flatnonzero(img.min(axis=2).min(axis=1) < 250), np.flatnonzero(img.min(axis=2).min(axis=0) < 250)
+    if not len(ink[0]):
+        return img
+    (r0, r1), (c0, c1) = (ink[0][[0, -1]], ink[1][[0, -1]])
+    return img[max(r0 - pad, 0):r1 + pad + 1, max(c0 - pad, 0):c1 + pad + 1]
+
+
+def draw_deformed(run, t: float, title, solved: dict | None = None, ax=None):
+    """The kept state of ``run`` (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) nearest
+    ``t`` (s) drawn by :func:`render_deformed`, magnified so that the largest displacement shows
+    as about 8 % of the frame's width (a power of ten); ``title``: text or a function of the time
+    drawn; ``solved``: displacements of kept states, by time, if solved already. Returns the Axes."""
+    from gatetherm.studies.run.output import deformed_grid
+
+    t, grid = deformed_grid(run, t, solved)
+    umax = float(np.abs(grid["u"]).max()) or 1.0
+    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
+    return render_deformed(grid, title(t) if callable(title) else title, scale, ax)
