@@ -4,7 +4,7 @@ one and with two BLAS threads (``GATETHERM_BLAS_THREADS``), interleaved.
     python benchmarks/blas_threads.py [--rounds 3] [--threads 1 2] [--json FILE]
 
 Prints the medians of wall time, CPU time and peak memory per thread count; the default of
-``gatetherm.process.BLAS_THREADS`` is chosen from this table (README, Speed).
+``gatetherm.process.BLAS_THREADS`` is chosen from this table (docs/performance.md).
 """
 from __future__ import annotations
 

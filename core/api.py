@@ -37,20 +37,73 @@ log = logging.getLogger(__name__)
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
-__all__ = ["Case", "Run", "Schedule", "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose",
-           "gate_frame", "load_case", "reduce", "run", "schedule_file", "write_reduction"]
+__all__ = ["Case", "Run", "Schedule", "beam_coefficients", "check_placement", "check_rom", "check_schedules",
+           "compensate", "condition", "configure", "diagnose", "gate_frame", "load_case", "place_sensors", "reduce",
+           "run", "schedule_file", "write_placement", "write_reduction"]
 
 
 def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:
-    """The paper's condition ``number`` (1, 2 or 3): the oil supply unit's set points and pump
-    states, sampled every ``step_s`` (s). ``case``: a frame case whose supply unit drives it
-    (default: the shipped paper model's)."""
+    """The paper's condition ``number``: the oil supply unit's set points and pump states.
+
+    Parameters
+    ----------
+    number : int
+        1, 2 or 3 (``docs/paper.md``).
+    case : Case, optional
+        A frame case whose supply unit drives it (default: the shipped paper model's).
+    step_s : float
+        Sample interval, s.
+
+    Returns
+    -------
+    Schedule
+        5 h of ``oil_degC`` (°C), ``pump`` (0/1) and ``ambient_degC`` (°C) samples.
+    """
     supply = getattr(getattr(case, "origin", None), "config", None)
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
 
 
+def beam_coefficients(case: Case, source: str = "theory") -> tuple[float, float]:
+    """The paper's predictor coefficients, δ = K_i (θ_A − θ_B) − K_C θ_C, of the paper's frame.
+
+    Parameters
+    ----------
+    case : Case
+        A frame from :func:`gate_frame` (a case file has no beam model).
+    source : str
+        ``"theory"``: the beam theory (eqs. 22–29) on the frame's dimensions; ``"fe"``: the FE
+        frame under the theory's two load cases (θ_A − θ_B = 1 K over the heated height, +1 K on
+        the tie bar), δ at the tips.
+
+    Returns
+    -------
+    tuple of float
+        K_i, K_C in µm/K.
+    """
+    from gatetherm.studies.control.methods import Settings, coefficients
+
+    if source not in ("theory", "fe"):
+        raise InputError("source", f"unknown source {source!r}", "choose 'theory' or 'fe'")
+    ki, kc, _ = coefficients(case, None, Settings(k_source=source))
+    return float(ki), float(kc)
+
+
 def schedule_file(path: str | os.PathLike, case: Case, step_s: float = 60.0) -> Schedule:
-    """A schedule file (the data format) of the inputs ``case`` reads, sampled every ``step_s``."""
+    """A schedule file of the inputs ``case`` reads.
+
+    Parameters
+    ----------
+    path : str or path
+        A time-series file (``docs/data-format.md``) with a column for every input the case reads.
+    case : Case
+        The case it drives.
+    step_s : float
+        Sample interval, s (linear between the file's samples; a pump keeps its last one).
+
+    Returns
+    -------
+    Schedule
+    """
     return file_schedule(path, sorted(case.inputs()), case.held(), case.defaults, step_s)
 
 
@@ -71,10 +124,12 @@ class Run:
 
     @property
     def time(self) -> np.ndarray:
+        """Sample times, s from the start."""
         return self.scenario.columns["time_s"]
 
     @property
     def columns(self) -> dict[str, np.ndarray]:
+        """Every column of the run in the data format (``docs/data-format.md``), name → array."""
         return self.scenario.columns
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -99,8 +154,20 @@ class Run:
         return kept, U
 
     def field(self, name: str, t: float | None = None) -> np.ndarray:
-        """The nodal field ``name`` at time ``t`` (default: the last sample): ``"T"`` (°C), ``"u"``
-        (m, nodes × 3), ``"sigma_xx"`` … and ``"von_mises"`` (Pa)."""
+        """A nodal field at a kept time.
+
+        Parameters
+        ----------
+        name : str
+            ``"T"`` (°C), ``"u"`` (m, nodes × 3), ``"sigma_xx"`` … and ``"von_mises"`` (Pa).
+        t : float, optional
+            Time, s (default: the last sample); one of :attr:`kept`.
+
+        Returns
+        -------
+        numpy.ndarray
+            One value (a row for ``"u"``) per mesh node.
+        """
         from gatetherm.studies.run.output import nodal_fields
 
         t = float(self.time[-1]) if t is None else float(t)
@@ -130,9 +197,22 @@ class Run:
         return out
 
     def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None) -> dict:
-        """Write the run directory ``out``: ``timeseries.csv``, ``summary.json``, the fields at
-        every ``fields_every`` s (default: the case's field interval) and the last sample
-        (``fields/``, ParaView), and the pictures; returns the summary."""
+        """Write the run directory that ``gatetherm run`` writes.
+
+        Parameters
+        ----------
+        out : str or path
+            The folder: ``timeseries.csv``, ``summary.json``, ``fields/`` (ParaView) and the pictures.
+        pictures : bool
+            Write ``channels.png`` and ``deformed.png``.
+        fields_every : float, optional
+            Interval of the fields, s (default: the case's field interval); the last sample always.
+
+        Returns
+        -------
+        dict
+            The summary (:meth:`summary`).
+        """
         from gatetherm.studies.run.output import write_json, write_run
 
         out = Path(out)
@@ -210,7 +290,14 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
 
 
 def reduce(case: Case, states: int = 30):
-    """The reduced heat model of ``case`` (its effects on): balanced truncation to ``states`` states.
+    """The reduced heat model of ``case`` (its effects on): balanced truncation.
+
+    Parameters
+    ----------
+    case : Case
+        Any case with a transient heat solve.
+    states : int
+        States of the reduced model.
 
     Returns
     -------
@@ -224,8 +311,18 @@ def reduce(case: Case, states: int = 30):
 
 
 def check_schedules(case: Case) -> list[Schedule]:
-    """What a reduced model of ``case`` is checked on: its own schedule and, where the case reads
-    only the inputs they drive (the oil supply, the pump, the room), the paper's conditions 1-3."""
+    """What a reduced model of ``case`` is checked on (:func:`check_rom`'s default).
+
+    Parameters
+    ----------
+    case : Case
+
+    Returns
+    -------
+    list of Schedule
+        Its own schedule and, where the case reads only the inputs they drive (the oil supply,
+        the pump, the room), the paper's conditions 1-3.
+    """
     from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
 
     out = [case.schedule] if len(case.schedule.times) > 1 else []
@@ -235,8 +332,22 @@ def check_schedules(case: Case) -> list[Schedule]:
 
 
 def check_rom(case: Case, rom, schedules=None) -> list:
-    """The reduced model ``rom`` of ``case`` against full FE runs of ``schedules`` (default
-    :func:`check_schedules`): the largest error of every output per schedule."""
+    """The reduced model ``rom`` of ``case`` against full FE runs.
+
+    Parameters
+    ----------
+    case : Case
+        The case it was reduced from.
+    rom : ReducedModel
+        ``reduce(case).rom``, or one read with ``gatetherm.studies.run.reduce.load_rom``.
+    schedules : list of Schedule, optional
+        What to run (default :func:`check_schedules`).
+
+    Returns
+    -------
+    list
+        Per schedule, the largest error of every output (δ in µm, temperatures in K).
+    """
     from gatetherm.studies.run.reduce import check
     from gatetherm.studies.run.scenario import ScenarioCache
 
@@ -244,7 +355,28 @@ def check_rom(case: Case, rom, schedules=None) -> list:
 
 
 def write_reduction(out: str | os.PathLike, red, checks, case: Case, states: int, seconds: float) -> dict:
-    """``out/rom.npz``, ``out/rom.key`` and, last, ``out/summary.json``; returns the summary."""
+    """Write a reduction: ``out/rom.npz``, ``out/rom.key`` and, last, ``out/summary.json``.
+
+    Parameters
+    ----------
+    out : str or path
+        The folder.
+    red : Reduction
+        :func:`reduce`'s result.
+    checks : list
+        :func:`check_rom`'s result (may be empty).
+    case : Case
+        The case it was reduced from.
+    states : int
+        Its states (in the key that later runs reuse it by).
+    seconds : float
+        Wall time of the reduction, s.
+
+    Returns
+    -------
+    dict
+        The summary: states, bounds (µm), the static-gain error, timings and checks.
+    """
     from gatetherm.studies.run.output import write_json
     from gatetherm.studies.run.reduce import rom_key, save_rom
 
@@ -325,3 +457,127 @@ def diagnose(case: Case, measured, **settings):
 
     ts = measured if isinstance(measured, TimeSeries) else read_timeseries(measured, required=("time_s",))
     return run_diagnosis(case, ts, Settings(**settings))
+
+
+def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, **settings):
+    """Where to put ``count`` thermocouples on ``case``: the surface points whose temperatures
+    predict every relative displacement best on held-out duty cycles (docs/sensors.md).
+
+    The case is reduced once (``states`` states); every training and held-out load is marched
+    through the reduced model; the candidates are screened by column-pivoted QR of their
+    output-weighted temperature snapshots; 1 ... ``count`` sensors and the error-model family
+    (static, or with input lags) are chosen greedily, with exchanges, by leave-one-load-out error
+    on the training loads, and each size is scored on the held-out loads.
+
+    Parameters
+    ----------
+    case : Case
+        Any case with a heat solve and relative displacements: a case file's, or the paper's frame.
+    count : int
+        Sensors to place; the held-out error is reported for 1 ... ``count``.
+    schedules : sequence of Schedule, optional
+        Training duty cycles (:func:`schedule_file`) instead of the generated family; the case's
+        own schedule is added unless it is held out.
+    held_out : sequence of Schedule, optional
+        Loads to judge on (default: the paper's conditions 1-3 for a case driven by the frame's
+        inputs, else ``held_out_loads`` generated ones of their own seed).
+    **settings
+        ``boundaries`` (names whose nodes are the candidates; default the outer surface),
+        ``spacing_m`` (thin the candidates to this spacing, m), ``exclude`` (boxes no sensor may
+        lie in: ``(low corner, high corner)`` pairs, m), ``min_distance_m`` (least distance between
+        two sensors, m), ``noise_K`` (standard deviation of each sensor's noise, K; default 0.05),
+        ``loads`` (generated training loads, default 20), ``held_out_loads``, ``ranges``
+        ({input: (lo, hi)} in the input's unit, e.g. °C, W), ``duration_s``, ``step_s``, ``seed``,
+        ``states``, ``neighbours`` (of each screening pivot; None: no screening): the fields of
+        :class:`gatetherm.studies.sensors.place.PlacementSettings`; and ``form`` (``auto``,
+        ``static``, ``dynamic``), ``max_inputs``, ``min_gain`` of the error-model family.
+
+    Returns
+    -------
+    Placement
+        ``.sensors`` (name, node, coordinates in m, boundary), ``.model`` (the errormodel
+        ``ErrorModel``), ``.curve`` (per count: form, leave-one-load-out and held-out MAE per target,
+        µm), ``.failed`` (held-out MAE with one sensor lost, µm), ``.signals`` (the same family given
+        the case's θ_A, θ_B, θ_C mean, if it has them), ``.stopped`` (why the curve stops short).
+
+    Raises
+    ------
+    InputError
+        A setting out of range, an unknown boundary or input, no candidate left, a case without
+        relative displacements.
+    """
+    from gatetherm.studies.errormodel.fit import FitParams
+    from gatetherm.studies.sensors.candidates import Box
+    from gatetherm.studies.sensors.place import PlacementSettings, place_sensors as place
+
+    fit = {k: settings.pop(k) for k in ("form", "max_inputs", "min_gain") if k in settings}
+    if isinstance(settings.get("ranges"), Mapping):
+        settings["ranges"] = tuple((k, float(lo), float(hi)) for k, (lo, hi) in settings["ranges"].items())
+    if "exclude" in settings:
+        settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
+    if "boundaries" in settings:
+        b = settings["boundaries"]
+        settings["boundaries"] = (b,) if isinstance(b, str) else tuple(b)
+    return place(case, PlacementSettings(count=count, fit=FitParams(**fit), **settings), schedules, held_out)
+
+
+def check_placement(case: Case, placement):
+    """The independent check of a :func:`place_sensors` result by full FE runs (no reduced model):
+    the case made again with the chosen points as ``[probes]``, every training and held-out load
+    run in full, the placement model's terms refitted by least squares on the training runs and
+    scored on the held-out ones.
+
+    Parameters
+    ----------
+    case : Case
+        The case the placement was made for.
+    placement : Placement
+        What :func:`place_sensors` returns.
+
+    Returns
+    -------
+    FECheck
+        ``.held_out_mae_um`` against ``.placement_mae_um`` per target (µm) and their ``.ratio``,
+        the largest temperature error of the reduced model at the chosen points over the held-out
+        loads (``.temperature_error_K``, K), ``.runs``, ``.seconds``.
+    """
+    from gatetherm.studies.sensors.check import fe_check
+
+    return fe_check(case, placement)
+
+
+def write_placement(out: str | os.PathLike, placement, case: Case, check=None, extra: Mapping | None = None) -> dict:
+    """Write what ``gatetherm sensors`` writes into ``out``: ``sensors.toml`` (the chosen points as
+    ``[probes]``), ``model.json`` (the fitted error model, as ``gatetherm errormodel fit``
+    writes it), ``curve.csv``, ``curve.png`` (held-out error against the number of sensors),
+    ``machine.png`` (the machine with the chosen points and the case's thermocouples) and, last,
+    ``summary.json`` (with the mesh's node count, the FE check's figures if ``check`` is given,
+    and ``extra``).
+
+    Parameters
+    ----------
+    out : path
+        The directory (made if missing).
+    placement : Placement
+        What :func:`place_sensors` returns.
+    case : Case
+        The case it was made for.
+    check : FECheck, optional
+        What :func:`check_placement` returns.
+    extra : mapping, optional
+        More entries of ``summary.json``.
+
+    Returns
+    -------
+    dict
+        The summary.
+    """
+    from gatetherm.validation.plots import figure, save
+    from gatetherm.validation.plots.api import sensor_curve, sensors
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    save(sensor_curve(placement, ax=figure((6.0, 3.6))), out / "curve.png")
+    save(sensors(placement, case, ax=figure((6.0, 5.0))), out / "machine.png")
+    more = {"mesh_nodes": len(case.mesh.points), **(extra or {}), **({"fe_check": check.summary()} if check else {})}
+    return placement.write(out, extra=more)

@@ -1,5 +1,5 @@
 """Process-wide settings a command makes before its numerics, each measured on the 3-D
-frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; README, Speed):
+frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.md):
 
 * BLAS threads: :data:`BLAS_THREADS` (``GATETHERM_BLAS_THREADS`` overrides), through
   threadpoolctl;
@@ -20,13 +20,22 @@ from gatetherm import InputError
 log = logging.getLogger(__name__)
 
 BLAS_THREADS = 1
-"""BLAS threads of a command; see README, Speed, for the measurement."""
+"""BLAS threads of a command; see docs/performance.md for the measurement."""
 THREADS_ENV = "GATETHERM_BLAS_THREADS"
 _M_MMAP_THRESHOLD = -3
 
 
 def configure() -> None:
-    """Apply the settings of this module to the running process."""
+    """Set up the running process for gatetherm's numerics, as every command does first.
+
+    One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
+    sweeps and studies do not oversubscribe the cores, and glibc's mmap threshold at 4 MiB, so
+    that freed large arrays go back to the system at once. Optional in a script.
+
+    Returns
+    -------
+    None
+    """
     try:
         ctypes.CDLL("libc.so.6").mallopt(_M_MMAP_THRESHOLD, 4 << 20)
     except (OSError, AttributeError):  # not glibc

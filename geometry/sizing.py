@@ -11,11 +11,38 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.geometry.frame import Box, FrameParams, MeshParams, part_boxes, tank_box
 
-BYTES_PER_ELEMENT = {2: 10_000, 3: 5_000}
-"""Peak memory of a P1 condition per *estimated* element (:func:`element_estimate`), bytes, by
-dimension: measured 6.8 kB per triangle (2-D, 14k to 207k elements), rounded up; in 3-D
-3.3-3.4 kB per estimated tetrahedron from 53k to 177k nodes (``benchmarks/scaling.py``: 1.47 GB
-at 52 812 nodes, 6.18 GB at 177 283), with room for the factor's faster growth on finer meshes."""
+REFERENCE_NODES = 52_812
+"""Nodes of the default 3-D frame mesh, at which the constants below were measured."""
+NODES_PER_ELEMENT = {2: 0.6, 3: 0.12}
+"""Nodes per *estimated* element (:func:`element_estimate`, :func:`model_estimate`): the frame's
+2-D meshes 0.60-0.53 (7 509 to 53 592 nodes), 3-D 0.116-0.086 (52 812 to 779 457 nodes); the
+larger, so that memory is not underestimated."""
+NONZEROS_PER_NODE = {2: 7.0, 3: 13.6}
+"""Entries per row of a scalar P1 matrix (the node graph plus the diagonal); the elastic
+matrix has ``block²`` times as many per node."""
+FACTOR = {2: (7_509, 1.66e5, 1.19, 6.1e6, 1.58), 3: (REFERENCE_NODES, 8.3e6, 1.46, 3.1e9, 2.05)}
+"""Sparse Cholesky factors of P1 matrices in a METIS order, by dimension: (reference nodes,
+factor entries there per block², their growth exponent, flops per block³, their exponent),
+``block`` the DOFs per node. Measured with PARDISO on the frame's heat (1 DOF per node) and
+elastic matrices: 3-D at 1, 2 and 4 × the default nodes, 8.45, 20.2 and 49.2 million entries
+for heat, 73.2, 177 and 429 million for elasticity, 3.2 and 82 GFlop at the default; 2-D at 1
+and 8 × the default section (7 509 and 53 592 nodes), 0.167 and 1.74 million for heat."""
+BYTES_PER_ENTRY = (11.5, 300.0)
+"""PARDISO's memory per factor entry and per unknown, numeric and symbolic (0.81 GB for 73
+million entries and 155 664 unknowns; 5.9 MB for 0.17 million and 7 509)."""
+AMG_BYTES_PER_NONZERO = 36.0
+"""AMG-CG's memory per matrix nonzero: the matrix (12) and the hierarchy (21-23 measured, heat
+and elasticity)."""
+BASE_BYTES = 0.15e9
+"""The libraries and the interpreter, bytes (a 2-D condition of 7 509 nodes peaks at 0.16 GB)."""
+BASE_BYTES_PER_NODE = {2: 6_500.0, 3: 8_000.0}
+"""What a P1 condition holds besides its solvers' memory, per node: mesh, bases, matrices, load
+and weight vectors, kept states and the transients of assembly and of the AMG set-up; fitted to
+``benchmarks/scaling.py``'s peaks (3-D iterative: 2.58, 4.63 and 13.2 GB at 0.18, 0.33 and 0.96
+million nodes; 2-D: 0.46 GB at 53 592 nodes)."""
+HEAT_FACTORS = 4
+"""Heat step matrices of a condition (a paper condition's: 60-s and 15-s steps, pump on and
+off), each with a factor of its own on the direct path."""
 FALLBACK_MEMORY = 8e9
 """Memory assumed where the operating system does not report it, bytes."""
 CELL = {2: math.sqrt(3) / 4, 3: 1 / (6 * math.sqrt(2))}
@@ -98,17 +125,55 @@ def memory_bytes() -> float:
         return FALLBACK_MEMORY
 
 
-def check_estimate(elements: float, dim: int, key: str, size: float) -> None:
+def factor_entries(nodes: float, dim: int, block: int = 1) -> float:
+    """Predicted entries of the Cholesky factor of a P1 matrix on ``nodes`` nodes with
+    ``block`` DOFs per node."""
+    ref, c, p, _, _ = FACTOR[dim]
+    return c * block ** 2 * (nodes / ref) ** p
+
+
+def factor_flops(nodes: float, dim: int, block: int = 1) -> float:
+    """Predicted flops of that factorisation."""
+    ref, _, _, c, p = FACTOR[dim]
+    return c * block ** 3 * (nodes / ref) ** p
+
+
+def factor_bytes(nodes: float, dim: int, block: int = 1) -> float:
+    """Predicted memory of that factor, bytes."""
+    return BYTES_PER_ENTRY[0] * factor_entries(nodes, dim, block) + BYTES_PER_ENTRY[1] * block * nodes
+
+
+def amg_bytes(n: int, nnz: float) -> float:
+    """Predicted memory of AMG-CG on a matrix of ``n`` unknowns and ``nnz`` nonzeros, bytes:
+    the matrix, the hierarchy and the kept solutions of the Galerkin start."""
+    return AMG_BYTES_PER_NONZERO * nnz + 2 * 6 * 8 * n
+
+
+def path_memory(nodes: float, dim: int) -> dict[str, float]:
+    """Predicted peak memory of a P1 condition on ``nodes`` nodes, bytes, by solver path: the
+    larger of the heat factors and the elastic factor ("direct"), or AMG-CG for both
+    ("iterative"), over what the condition holds besides (:data:`BASE_BYTES_PER_NODE`)."""
+    base = BASE_BYTES + BASE_BYTES_PER_NODE[dim] * nodes
+    nnz1 = NONZEROS_PER_NODE[dim] * nodes
+    direct = max(HEAT_FACTORS * factor_bytes(nodes, dim, 1) + amg_bytes(nodes, nnz1), factor_bytes(nodes, dim, dim))
+    iterative = amg_bytes(nodes, nnz1) + amg_bytes(dim * nodes, dim ** 2 * nnz1)
+    return {"direct": base + direct, "iterative": base + iterative}
+
+
+def check_estimate(elements: float, dim: int, key: str, size: float) -> dict[str, float]:
     """Raise InputError naming ``key`` (an element size of ``size`` m, or a factor on the
     sizes) if a mesh of about ``elements`` elements of dimension ``dim`` needs more memory
-    than the machine has; the fix gives the smallest admissible value (elements ∝ size^-dim)."""
-    need, have = elements * BYTES_PER_ELEMENT[dim], memory_bytes()
+    than the machine has on both solver paths (:func:`path_memory`); the fix gives the
+    smallest admissible value (elements ∝ size^-dim). Else the predicted peak of each path."""
+    need, have = path_memory(elements * NODES_PER_ELEMENT[dim], dim), memory_bytes()
+    low = min(need.values())
     unit = "" if "factor" in key else " m"
-    if need > have:
+    if low > have:
         raise InputError(key, f"{size:g}{unit} gives about {elements:.2g} "
-                         f"{'triangles' if dim == 2 else 'tetrahedra'} needing ~{need / 1e9:.3g} GB, more than the "
+                         f"{'triangles' if dim == 2 else 'tetrahedra'} needing ~{low / 1e9:.3g} GB, more than the "
                          f"{have / 1e9:.3g} GB of memory of this machine",
-                         f"raise it to at least {size * (need / have) ** (1 / dim):.2g}{unit}")
+                         f"raise it to at least {size * (low / have) ** (1 / dim):.2g}{unit}")
+    return need
 
 
 def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:

@@ -20,8 +20,7 @@ from skfem.helpers import ddot, div, sym_grad
 from gatetherm import InputError
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element
-from gatetherm.solvers.linsolve import (Factor, expand_order, nd_order, restrict_order, rigid_body_modes,
-                                       spd_solver)
+from gatetherm.solvers.linsolve import SPDSolver, expand_order, nd_order, restrict_order, rigid_body_modes
 from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
 
 log = logging.getLogger(__name__)
@@ -73,7 +72,7 @@ class ElasticSystem:
     B: sp.csr_matrix
     """Thermal load per unit temperature rise (all DOFs × heat DOFs)."""
     free: np.ndarray
-    solve: Factor
+    solve: SPDSolver
     """Solves with the stiffness on the free DOFs (one or more right-hand sides)."""
     plane: str = "stress"
     """2-D: "stress", "strain" or "axisymmetric"."""
@@ -186,15 +185,17 @@ def _refuse_loose(vb: CellBasis, mesh, loose, pieces) -> None:
                      "foundation, or join the part to a held one (a contact stiffness in both directions)")
 
 
-def _factor(K, dim: int, rbm, perm):
-    """:func:`spd_solver`, a singular matrix (zero pivot) refused as bad input."""
-    try:
-        return spd_solver(K, dim, rbm, order=perm)
-    except (RuntimeError, ArithmeticError) as err:
-        if not re.search("pivot|singular|definite", str(err), re.I):
-            raise
-        raise InputError("supports", f"the elastic system is singular ({err})",
-                         "a part is not held: hold every part, or join it to a held one") from None
+class _Solver(SPDSolver):
+    """:class:`~gatetherm.solvers.linsolve.SPDSolver`, a singular matrix (zero pivot) refused as bad input."""
+
+    def _make(self, rhs: int):
+        try:
+            return super()._make(rhs)
+        except (RuntimeError, ArithmeticError) as err:
+            if not re.search("pivot|singular|definite", str(err), re.I):
+                raise
+            raise InputError("supports", f"the elastic system is singular ({err})",
+                             "a part is not held: hold every part, or join it to a held one") from None
 
 
 def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, alpha: Field,
@@ -241,9 +242,11 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     K_fixed = K[:, fixed] if any(s.values for s in supports) else None
     dof_order = nd_order(K, dim) if node_order is None else expand_order(node_order, dim)
     perm = restrict_order(dof_order, free, vb.N)
-    K = K[free][:, free]
+    K = K[free]  # in two steps: the full matrix goes before the columns are taken
+    K = K[:, free]
     rbm = rigid_body_modes(vb.doflocs, vb.split_indices())[free]
     log.info("elastic system: %d free DOFs (P%d, %d-D%s)", len(free), order, dim,
              f" plane {plane}" if dim == 2 else "")
-    solve = Factor(lambda: _factor(K, dim, rbm, perm))
-    return ElasticSystem(vb, K, B.tocsr(), free, solve, plane, K_fixed)
+    nodal = len(free) % dim == 0 and bool(np.all(free.reshape(-1, dim) == (free[::dim] // dim * dim)[:, None]
+                                                   + np.arange(dim)))
+    return ElasticSystem(vb, K, B.tocsr(), free, _Solver(K, dim, rbm, perm, nodal), plane, K_fixed)

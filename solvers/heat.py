@@ -21,6 +21,7 @@ from __future__ import annotations
 import functools
 import logging
 import time
+from collections import Counter
 from dataclasses import dataclass
 from typing import Callable, Iterator, Mapping
 
@@ -33,7 +34,7 @@ from gatetherm.checks import Range, admissible
 from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.fem import Field, dof_basis, element
-from gatetherm.solvers.linsolve import Bordered, nd_order, restrict_order
+from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
 
 log = logging.getLogger(__name__)
 
@@ -180,10 +181,18 @@ class HeatSystem:
         return np.full(self.n, self.T0 if T0 is None else T0)
 
 
+HEAT_RTOL = 1e-8
+"""Relative residual of a heat step solved iteratively (δ within 3e-6 µm of the factor's over
+condition 1 on the 3-D frame)."""
+
+
 class HeatSolver:
-    """Step solves of one :class:`HeatSystem`: the conductance matrix of each mode and the
-    factor of each distinct (θ dt, mode) step matrix on the free unknowns, made on first
-    use and kept (four per paper condition: 60-s and 15-s steps, pump on and off)."""
+    """Step solves of one :class:`HeatSystem`: the conductance matrix of each mode and a
+    solver of each distinct (θ dt, mode) step matrix on the free unknowns, made on first
+    use and kept (four per paper condition: 60-s and 15-s steps, pump on and off). Each
+    is a sparse Cholesky factor or AMG-CG warm-started from the previous steps, as
+    :func:`~gatetherm.solvers.linsolve.planned_solver` picks for the steps :meth:`expect` said
+    it would take beside the memory held already."""
 
     def __init__(self, system: HeatSystem):
         self.system = system
@@ -194,8 +203,9 @@ class HeatSolver:
         self._K: dict[Mode, sp.csr_matrix] = {}
         self._lu: dict[tuple[float, Mode], tuple[Bordered, sp.csr_matrix | None]] = {}
         self._order: list = []
+        self._expected: dict[tuple[float, Mode], int] = {}
         self.factor_seconds = 0.0
-        """Seconds spent factorising so far."""
+        """Seconds spent setting the step solvers up so far."""
 
     def K(self, mode: Mode) -> sp.csr_matrix:
         if mode not in self._K:
@@ -204,31 +214,44 @@ class HeatSolver:
 
     @property
     def factorisations(self) -> int:
-        """How many step matrices were factorised so far."""
+        """How many step matrices were set up so far."""
         return len(self._lu)
 
+    def expect(self, steps: Mapping[tuple[float, Mode], int]) -> None:
+        """The number of steps of each ``(θ dt, mode)`` of the coming march (see :func:`step_keys`)."""
+        self._expected = dict(steps)
+
+    def _inner(self, S: sp.csr_matrix, rhs: int, what: str):
+        """A solver of the solid block ``S`` for ``rhs`` solves (one METIS order for all the
+        factors: the step matrices share a pattern)."""
+        sys = self.system
+        if not self._order:
+            self._order.append(nd_order(S) if sys.order is None else
+                               restrict_order(sys.order, self.free[:self.n_inner], sys.n_solid))
+        return planned_solver(S, sys.basis.mesh.dim(), rhs, what, order=self._order[0], rtol=HEAT_RTOL,
+                              warm=rhs > 1)[0]
+
+    def _system(self, A: sp.csr_matrix, rhs: int, what: str):
+        """``(Bordered solver, coupling to the fixed unknowns)`` of a matrix on all unknowns."""
+        fixed = self.system.fixed_dofs
+        coupling = None
+        if fixed.size:
+            coupling, A = A[self.free][:, fixed], A[self.free][:, self.free]
+        return Bordered(A, self.n_inner, self._inner(A[:self.n_inner, :self.n_inner], rhs, what)), coupling
+
     def solve(self, dt: float, theta: float, mode: Mode, rhs: np.ndarray, held: np.ndarray) -> np.ndarray:
-        """Solve ``(M/dt + θ K) U = rhs`` with ``U[fixed] = held``, by the factor of
+        """Solve ``(M/dt + θ K) U = rhs`` with ``U[fixed] = held``, by the solver of
         ``M/(θ dt) + K`` on the free unknowns, which backward Euler over dt/2 and
-        Crank–Nicolson over dt share: a sparse Cholesky of its SPD solid block (one METIS
-        order for all, the matrices share a pattern) bordered by the lumped unknowns."""
+        Crank–Nicolson over dt share: of its SPD solid block, bordered by the lumped unknowns."""
         key = (round(theta * dt, 9), mode)
         fixed = self.system.fixed_dofs
         if key not in self._lu:
             t0 = time.perf_counter()
             A = (self.system.M / (theta * dt) + self.K(mode)).tocsr()
-            coupling = None
-            if fixed.size:
-                coupling, A = A[self.free][:, fixed], A[self.free][:, self.free]
-            if not self._order:
-                inner = A[:self.n_inner, :self.n_inner]
-                self._order.append(nd_order(inner) if self.system.order is None else
-                                   restrict_order(self.system.order, self.free[:self.n_inner], self.system.n_solid))
-            self._lu[key] = (Bordered(A, self.n_inner, self._order[0]), coupling)
+            self._lu[key] = self._system(A, self._expected.get(key, 1), f"heat step θdt={theta * dt:g} s, mode {mode}")
             seconds = time.perf_counter() - t0
             self.factor_seconds += seconds
-            log.debug("factorised heat matrix for θdt=%g s, mode=%s in %.2f s (%s)", theta * dt, mode, seconds,
-                      self._lu[key][0].backend)
+            log.debug("set up the heat step solver for θdt=%g s, mode=%s in %.2f s", theta * dt, mode, seconds)
         solve, coupling = self._lu[key]
         if coupling is None:
             return solve(rhs / theta)
@@ -239,16 +262,13 @@ class HeatSolver:
 
     def steady(self, env) -> np.ndarray:
         """The state in equilibrium with the inputs ``env``."""
-        from scipy.sparse.linalg import spsolve
-
         sys = self.system
         mode = sys.mode(env)
         K, f, held = self.K(mode), sys.f(env, mode), sys.boundary_values(env)
+        solve, coupling = self._system(K, 1, f"steady heat, mode {mode}")
         U = np.empty(sys.n)
-        D = sys.fixed_dofs
-        U[D] = held
-        rhs = f[self.free] - (K[self.free][:, D] @ held if D.size else 0.0)
-        U[self.free] = spsolve(K[self.free][:, self.free].tocsc(), rhs)
+        U[sys.fixed_dofs] = held
+        U[self.free] = solve(f[self.free] - (coupling @ held if coupling is not None else 0.0))
         return U
 
 
@@ -277,17 +297,33 @@ def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple
     return [(float(a), float(b), th) for a, b, th in steps]
 
 
+def steps(system: HeatSystem, drive: Drive, times: np.ndarray,
+          scheme: TimeScheme = TimeScheme()) -> list[tuple[float, float, float, Mode, bool]]:
+    """The steps ``(start, end, θ, mode, last of its interval)`` of a march over ``times``:
+    the mode of an interval is read at its midpoint, and the first interval after a switch
+    (and the first of all) is refined as :class:`TimeScheme` says."""
+    out, last, since = [], None, 0
+    for t0, t1 in zip(times[:-1], times[1:]):
+        mode = system.mode(environment(drive, 0.5 * (t0 + t1)))
+        since = 0 if mode != last else since + 1
+        sub = substeps(float(t0), float(t1), scheme, since)
+        out += [(a, b, theta, mode, i == len(sub) - 1) for i, (a, b, theta) in enumerate(sub)]
+        last = mode
+    return out
+
+
+def step_keys(plan: list[tuple[float, float, float, Mode, bool]]) -> dict[tuple[float, Mode], int]:
+    """How many of the :func:`steps` each step matrix ``(θ dt, mode)`` takes."""
+    return dict(Counter((round(theta * (b - a), 9), mode) for a, b, theta, mode, _ in plan))
+
+
 def march(system: HeatSystem | HeatSolver, drive: Drive, times: np.ndarray, scheme: TimeScheme = TimeScheme(),
           U0: np.ndarray | None = None) -> Iterator[tuple[float, np.ndarray]]:
     """Yield ``(t, U)`` at every entry of ``times``, starting with the initial state
-    (fixed temperatures applied).
+    (fixed temperatures applied), stepping as :func:`steps` says.
 
-    Pass a :class:`HeatSolver` to reuse its factorisations across runs; a bare
+    Pass a :class:`HeatSolver` to reuse its step solvers across runs; a bare
     :class:`HeatSystem` gets a solver of its own for this run.
-
-    The mode of an interval is read at its midpoint, so a pump switch at a sample
-    time takes effect for the whole following interval; that interval (and the
-    first) is refined as :class:`TimeScheme` says.
     """
     solver = system if isinstance(system, HeatSolver) else HeatSolver(system)
     sys = solver.system
@@ -295,18 +331,26 @@ def march(system: HeatSystem | HeatSolver, drive: Drive, times: np.ndarray, sche
     if sys.fixed:
         U[sys.fixed_dofs] = sys.boundary_values(environment(drive, float(times[0])))
     yield float(times[0]), U
-    last, since = None, 0
-    for t0, t1 in zip(times[:-1], times[1:]):
-        mode = sys.mode(environment(drive, 0.5 * (t0 + t1)))
-        since = 0 if mode != last else since + 1
-        for a, b, theta in substeps(float(t0), float(t1), scheme, since):
-            U = theta_step(solver, drive, U, a, b, theta, mode)
-        last = mode
-        yield float(t1), U
+    todo = steps(sys, drive, np.asarray(times, dtype=float), scheme)
+    solver.expect(step_keys(todo))
+    for a, b, theta, mode, last in todo:
+        U = theta_step(solver, drive, U, a, b, theta, mode)
+        if last:
+            yield b, U
 
 
-def _facets(mesh, name: str, e, q: int):
-    return FacetBasis(mesh, e, facets=mesh.boundaries[name], intorder=q)
+def boundary_terms(mesh, name: str, e, q: int, thickness: Field) -> tuple[sp.csr_matrix, np.ndarray]:
+    """``(∫ t u v, ∫ t v)`` over the named boundary (``t`` the 2-D thickness of the element
+    beside each facet): a film of unit coefficient and its load. Linear elements in numpy
+    (:func:`~gatetherm.solvers.p1.facet_terms`), others by scikit-fem's facet basis."""
+    facets = mesh.boundaries[name]
+    if e.maxdeg == 1:
+        t = thickness.values[mesh.f2t[0, facets]] if np.ptp(thickness.values) else np.full(len(facets),
+                                                                                           thickness.values[0])
+        return p1.facet_terms(mesh.p.T, mesh.facets[:, facets].T, t, mesh.nvertices)
+    fb = FacetBasis(mesh, e, facets=facets, intorder=q)
+    tf = thickness.at(fb)
+    return asm(film, fb, h=1.0, t=tf), asm(film_load, fb, h=1.0, t=tf)
 
 
 def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None,
@@ -341,13 +385,11 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
 
     loads: list[tuple[np.ndarray, Value, str]] = []
     for fl in problem.films:
-        fb = _facets(mesh, fl.boundary, e, q)
-        tf = th.at(fb)
-        K = K + asm(film, fb, h=fl.h, t=tf)
-        loads.append((asm(film_load, fb, h=fl.h, t=tf), fl.ambient, "film"))
+        A_f, a_f = boundary_terms(mesh, fl.boundary, e, q, th)
+        K = K + fl.h * A_f
+        loads.append((fl.h * a_f, fl.ambient, "film"))
     for fx in problem.fluxes:
-        fb = _facets(mesh, fx.boundary, e, q)
-        loads.append((asm(film_load, fb, h=1.0, t=th.at(fb)), fx.value, "flux"))
+        loads.append((boundary_terms(mesh, fx.boundary, e, q, th)[1], fx.value, "flux"))
     if problem.faces is not None and mesh.dim() == 2:
         cb = cells()
         K = K + asm(film, cb, h=problem.faces.h, t=2.0)
@@ -360,12 +402,10 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
     for fluid in problem.fluids:
-        wb = _facets(mesh, fluid.boundary, e, q)
-        tw = th.at(wb)
         lumped[fluid.name] = n_solid + len(caps)
         caps.append(fluid.capacity)
         losses.append((0.0, None))
-        couplings.append((asm(film, wb, h=1.0, t=tw), asm(film_load, wb, h=1.0, t=tw)))
+        couplings.append(boundary_terms(mesh, fluid.boundary, e, q, th))
         if fluid.hose_capacity > 0:
             lumped[fluid.hose_name or f"{fluid.name}_hose"] = n_solid + len(caps)
             caps.append(fluid.hose_capacity)

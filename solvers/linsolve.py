@@ -12,12 +12,10 @@ workhorse. The backend is the first of :data:`BACKENDS` that is installed and wo
   reordering), or its minimum degree without pymetis. Always there.
 
 Which backend runs, and why a better one was skipped, is logged once (with the pip command);
-``GATETHERM_SPD_BACKEND`` forces one (``amg``: the iterative elastic solve below). For
-elasticity without pardiso or cholmod the 3-D systems use conjugate gradients preconditioned by smoothed-aggregation AMG (pyamg) on the
-rigid-body modes instead of SuperLU: an iterative solve that does not converge raises
-:class:`SolverError`. ``benchmarks/backends.py`` measures the backends on the 3-D frame
-(medians of 3, s): heat factor 0.37 (PARDISO) against 1.1 (SuperLU); 300 heat steps 7.7
-against 13.6; elastic set-up 5.7 (PARDISO) against 8.4 (AMG); the elastic solve 0.2 against 2.9.
+``GATETHERM_SPD_BACKEND`` forces one (``amg``: the iterative path for elasticity). Where a
+factor would not fit in memory or would cost more than AMG-preconditioned conjugate gradients
+(:mod:`.iterative`) for the right-hand sides expected, :class:`SPDSolver` takes the iterative
+path instead (:mod:`.plan` predicts both); so does 3-D elasticity without pardiso or cholmod.
 """
 from __future__ import annotations
 
@@ -29,6 +27,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from gatetherm.solvers.iterative import PCG, SolverError
+from gatetherm.solvers.plan import plan
+
 log = logging.getLogger(__name__)
 
 Solve = Callable[[np.ndarray], np.ndarray]
@@ -36,18 +37,12 @@ Solve = Callable[[np.ndarray], np.ndarray]
 DIRECT_LIMIT_3D = 30_000
 """Largest 3-D elastic system (DOFs) solved by SuperLU when no Cholesky backend is installed."""
 RTOL = 1e-9
-"""Relative residual at which AMG-preconditioned CG stops."""
-MAXITER = 500
-"""Iterations after which AMG-preconditioned CG gives up (and raises)."""
-SETTINGS = {"direct_limit_3d": DIRECT_LIMIT_3D, "rtol": RTOL, "maxiter": MAXITER}
+"""Relative residual at which AMG-preconditioned CG stops on an elastic system."""
+SETTINGS = {"direct_limit_3d": DIRECT_LIMIT_3D, "rtol": RTOL}
 """What the solution depends on, for digests of the numerical scheme."""
 BACKEND_ENV = "GATETHERM_SPD_BACKEND"
 HINTS = {"pardiso": "pip install py-mkl-pardiso (Linux x86_64, Windows)", "cholmod": "pip install cvxopt (GPL-3)",
          "metis": "pip install pymetis"}
-
-
-class SolverError(RuntimeError):
-    """An iterative solve did not converge, or a matrix cannot be factorised."""
 
 
 class NoBackend(SolverError):
@@ -181,14 +176,13 @@ def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACK
 
 class Bordered:
     """Solves with ``[[S, U], [V, D]]``: ``S`` SPD (the solid), a few unknowns last (lumped
-    fluids, which make the whole matrix nonsymmetric). ``S`` is factored once, ``Z = S⁻¹U``
-    and the small Schur complement ``D − V Z`` are formed, and a solve costs one solve with
-    ``S`` and one with the Schur complement."""
+    fluids, which make the whole matrix nonsymmetric). ``inner`` solves with ``S`` (a factor
+    or AMG-CG, set up once), ``Z = S⁻¹U`` and the small Schur complement ``D − V Z`` are
+    formed, and a solve costs one solve with ``S`` and one with the Schur complement."""
 
-    def __init__(self, A: sp.spmatrix, n_inner: int, order: np.ndarray | None = None):
+    def __init__(self, A: sp.spmatrix, n_inner: int, inner: Solve):
         A = A.tocsr()
-        self.n = n_inner
-        self.inner, self.backend = spd_factor(A[:n_inner, :n_inner], order)
+        self.n, self.inner = n_inner, inner
         U = A[:n_inner, n_inner:].toarray()
         self.V = A[n_inner:, :n_inner].toarray()
         self.Z = self.inner(U).reshape(n_inner, -1) if U.size else np.zeros((n_inner, 0))
@@ -202,23 +196,61 @@ class Bordered:
         return np.concatenate([y - self.Z @ last, last])
 
 
-class Factor:
-    """A solver set up by ``make`` now, which :meth:`release` frees (the 3-D frame's
-    elastic factor holds 0.86 GB) and the next solve sets up again: a run keeps the heat
-    factors, not this one, while it marches."""
+def planned_solver(A: sp.spmatrix, dim: int, rhs: int, what: str, block: int = 1, near_null=None,
+                   order: np.ndarray | None = None, rtol: float = RTOL, held: float | None = None,
+                   allow=("pardiso", "cholmod", "superlu"), amg_block: int = 1,
+                   warm: bool = False) -> tuple[Solve, str]:
+    """A solver of the SPD matrix ``A`` (``block`` DOFs per node of a ``dim``-D mesh) for
+    ``rhs`` right-hand sides by the path :func:`.plan.plan` chooses (logged in one line as
+    ``what``; ``held``: bytes held already, default this process's): a Cholesky factor of the first
+    backend of ``allow`` that installs (``order``: a fill-reducing order), else AMG-CG to
+    ``rtol`` (``near_null``: the rigid-body modes, aggregated by nodes of ``amg_block`` DOFs;
+    ``warm``: the right-hand sides are a sequence, each close to the last). ``(solve, path)``."""
+    A = A.tocsr()
+    p = plan(A.shape[0], A.nnz, block, dim, rhs, held, warm=warm)
+    log.info("%s", p.describe(f"{what} ({A.shape[0]} unknowns)", rhs))
+    if p.path == "direct":
+        try:
+            return spd_factor(A, order, allow)[0], "direct"
+        except NoBackend:
+            _say_once(f"amg {what}", logging.INFO, "no Cholesky backend for the %s: AMG-CG; %s", what, HINTS["pardiso"])
+    return PCG(A, near_null, amg_block, rtol), "iterative"
 
-    def __init__(self, make: Callable[[], Solve]):
-        self._make = make
-        self._solve: Solve | None = make()
+
+class SPDSolver:
+    """Solves with one SPD elastic matrix, one batch of right-hand sides at a time, by the
+    path :func:`planned_solver` picks for the first batch: a factor or AMG-CG (its Galerkin
+    start recycling the earlier solutions). :meth:`release` frees a factor (the 3-D frame's
+    holds 0.81 GB): a run keeps the heat solvers, not this one, while it marches, and the
+    next batch is planned again. AMG-CG is kept: its memory is a fraction of the matrix's and
+    its set-up costs as much as ten solves."""
+
+    def __init__(self, A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
+                 order: np.ndarray | None = None, nodal: bool = False, what: str = "elastic system"):
+        """``near_null``: the rigid-body modes; ``nodal``: the unknowns are whole nodes' ``dim``
+        DOFs in turn (then AMG aggregates nodes)."""
+        self.A, self.dim, self.near_null, self.order, self.what = A.tocsr(), dim, near_null, order, what
+        self.block = dim if nodal else 1
+        self._solve: Solve | None = None
+        self.path: str | None = None
+        """The path of the live solver (None: released)."""
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
         if self._solve is None:
-            log.debug("setting the released solver up again")
-            self._solve = self._make()
+            self._solve, self.path = self._make(1 if np.ndim(b) == 1 else np.shape(b)[1])
         return self._solve(b)
 
+    def _make(self, rhs: int) -> tuple[Solve, str]:
+        small = self.dim == 2 or self.A.shape[0] <= DIRECT_LIMIT_3D or self.near_null is None
+        allow = ("pardiso", "cholmod") + (("superlu",) if small else ())
+        if os.environ.get(BACKEND_ENV) == "amg" and self.near_null is not None:
+            return PCG(self.A, self.near_null, self.block, RTOL), "iterative"
+        return planned_solver(self.A, self.dim, rhs, self.what, self.dim, self.near_null, self.order, allow=allow,
+                              amg_block=self.block)
+
     def release(self) -> None:
-        self._solve = None
+        if self.path == "direct":
+            self._solve, self.path = None, None
 
 
 def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.ndarray:
@@ -234,38 +266,3 @@ def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.nd
         m[components[a]] = -x[b, components[a]]
         m[components[b]] = x[a, components[b]]
     return np.column_stack(modes)
-
-
-def spd_solver(A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None, rtol: float = RTOL,
-               order: np.ndarray | None = None) -> Solve:
-    """Return ``solve(b)`` for the SPD elastic matrix ``A``, set up once: a Cholesky factor
-    (pardiso or cholmod; ``order`` a fill-reducing order of A, as :func:`restrict_order` gives);
-    else SuperLU for 2-D and small 3-D systems; else AMG-CG on the rigid-body modes ``near_null``."""
-    A = A.tocsr()
-    small = dim == 2 or A.shape[0] <= DIRECT_LIMIT_3D or near_null is None
-    if os.environ.get(BACKEND_ENV) != "amg" or near_null is None:
-        try:
-            return spd_factor(A, order, ("pardiso", "cholmod") + (("superlu",) if small else ()))[0]
-        except NoBackend:
-            _say_once("amg", logging.INFO, "no Cholesky backend: elasticity by AMG-CG; %s", HINTS["pardiso"])
-    import pyamg
-
-    # energy-minimising prolongation smoothing halves the CG iterations on the frame
-    # (28 against 53 at 53k DOFs) for about the same set-up time
-    ml = pyamg.smoothed_aggregation_solver(A, B=near_null, symmetry="symmetric", smooth="energy",
-                                           strength=("symmetric", {"theta": 0.0}), max_coarse=500)
-    log.info("AMG hierarchy: %d levels, operator complexity %.2f", len(ml.levels), ml.operator_complexity())
-
-    def solve(b: np.ndarray) -> np.ndarray:
-        if np.ndim(b) == 2:
-            return np.column_stack([solve(col) for col in b.T])
-        res: list[float] = []
-        x = ml.solve(b, tol=rtol, accel="cg", maxiter=MAXITER, residuals=res)
-        rel = float(np.linalg.norm(b - A @ x) / max(np.linalg.norm(b), 1e-300))
-        log.debug("AMG-CG: %d iterations, relative residual %.2e", len(res) - 1, rel)
-        if not rel <= 10 * rtol:
-            raise SolverError(f"AMG-CG did not converge: relative residual {rel:.2e} after {len(res) - 1} "
-                              f"iterations (tolerance {rtol:g})")
-        return x
-
-    return solve

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import CellBasis, FacetBasis, asm
+from skfem import CellBasis, asm
 
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.axisym import Revolution
@@ -26,7 +26,7 @@ from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, moduli
 from gatetherm.solvers.loads import Terms, mechanical_terms, unit_responses
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
-from gatetherm.solvers.heat import HeatSystem, assemble_heat, film_load
+from gatetherm.solvers.heat import HeatSystem, assemble_heat, boundary_terms
 from gatetherm.solvers.problem import AXES, Problem
 from gatetherm.solvers.stress import Recovery, recovery, von_mises
 
@@ -52,8 +52,7 @@ def region_fields(problem: Problem, mesh) -> dict[str, Field]:
 
 def boundary_mean(mesh, basis: CellBasis, name: str, thickness: Field) -> np.ndarray:
     """Weights giving the area-mean of a nodal field over a named boundary."""
-    fb = FacetBasis(mesh, basis.elem, facets=mesh.boundaries[name])
-    a = asm(film_load, fb, h=1.0, t=thickness.at(fb))
+    a = boundary_terms(mesh, name, basis.elem, 2 * basis.elem.maxdeg, thickness)[1]
     return a / a.sum()
 
 

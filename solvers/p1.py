@@ -22,14 +22,21 @@ from gatetherm.solvers.linsolve import nd_order
 
 def gradients(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Barycentric gradients (E, d+1, d) and measures (E,) of the simplices ``cells``
-    (E, d+1) of ``points`` (N, d)."""
+    (E, d+1) of ``points`` (N, d): the rows of the inverse Jacobian by cofactors (cross
+    products in 3-D), a third of the time of a batched ``np.linalg.inv``."""
     X = points[cells]
     J = X[:, 1:] - X[:, :1]  # (E, d, d): rows x_i − x_0
-    inv = np.linalg.inv(J)  # columns: gradients of λ_1..λ_d
+    if points.shape[1] == 3:
+        a, b, c = J[:, 0], J[:, 1], J[:, 2]
+        cof = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
+        det = np.einsum("ij,ij->i", a, cof[:, 0])
+    else:
+        det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
+        cof = np.stack([np.stack([J[:, 1, 1], -J[:, 1, 0]], -1), np.stack([-J[:, 0, 1], J[:, 0, 0]], -1)], axis=1)
     G = np.empty(cells.shape + (points.shape[1],))
-    G[:, 1:] = inv.transpose(0, 2, 1)
+    G[:, 1:] = cof / det[:, None, None]  # row i: the gradient of λ_i
     G[:, 0] = -G[:, 1:].sum(axis=1)
-    return G, np.abs(np.linalg.det(J)) / factorial(points.shape[1])
+    return G, np.abs(det) / factorial(points.shape[1])
 
 
 class Pattern:
@@ -37,12 +44,15 @@ class Pattern:
 
     def __init__(self, cells: np.ndarray, n_nodes: int):
         k = cells.shape[1]
-        i = np.repeat(cells, k, axis=1).ravel().astype(np.int64)
-        j = np.tile(cells, (1, k)).ravel().astype(np.int64)
-        keys, self.inv = np.unique(i * n_nodes + j, return_inverse=True)
-        self.indices = (keys % n_nodes).astype(np.int32)
-        self.indptr = np.searchsorted(keys // n_nodes, np.arange(n_nodes + 1)).astype(np.int32)
-        self.n, self.nnz, self.k = n_nodes, len(keys), k
+        i = np.repeat(cells, k, axis=1).ravel()
+        j = np.tile(cells, (1, k)).ravel()
+        A = sp.csr_matrix((np.ones(len(i), dtype=np.int8), (i, j)), shape=(n_nodes, n_nodes))  # sorted, summed
+        self.indices, self.indptr = A.indices.astype(np.int32), A.indptr.astype(np.int32)
+        rows = np.repeat(np.arange(n_nodes, dtype=np.int64) * n_nodes, np.diff(A.indptr))
+        inv = np.searchsorted(rows + A.indices, i.astype(np.int64) * n_nodes + j)
+        self.inv = inv.astype(np.int32) if A.nnz < 2 ** 31 else inv
+        """Position of every element entry (element-major, row-major within) in the pattern."""
+        self.n, self.nnz, self.k = n_nodes, A.nnz, k
 
     def graph(self) -> sp.csr_matrix:
         """The node adjacency (the pattern as a matrix of ones)."""
@@ -81,11 +91,14 @@ def stiffness(pattern: Pattern, G: np.ndarray, vol: np.ndarray, lam: np.ndarray,
     ``K[d i + a, d j + b] = vol (λ G_ia G_jb + μ G_ib G_ja + μ δ_ab G_i·G_j)``, v test (i), u trial (j)."""
     dim = G.shape[2]
     dot = conduction(G, vol, mu)
+    Gl, Gm = (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
 
     def entry(a, b):
-        out = (lam * vol)[:, None, None] * (G[:, :, a][:, :, None] * G[:, :, b][:, None, :])
-        out += (mu * vol)[:, None, None] * (G[:, :, b][:, :, None] * G[:, :, a][:, None, :])
-        return out + dot if a == b else out
+        out = Gl[:, :, a][:, :, None] * G[:, :, b][:, None, :]
+        out += Gm[:, :, b][:, :, None] * G[:, :, a][:, None, :]
+        if a == b:
+            out += dot
+        return out
 
     return pattern.blocks(entry, dim, dim)
 
@@ -96,6 +109,22 @@ def thermal_load(pattern: Pattern, G: np.ndarray, vol: np.ndarray, b: np.ndarray
     w = (b * vol / k)[:, None, None]
     return pattern.blocks(lambda a, _: np.broadcast_to(w * G[:, :, a][:, :, None], G.shape[:2] + (k,)),
                           G.shape[2], 1)
+
+
+def facet_terms(points: np.ndarray, facets: np.ndarray, w: np.ndarray, n: int) -> tuple[sp.csr_matrix, np.ndarray]:
+    """``(∫_F w u v, ∫_F w v)`` over the boundary facets ``facets`` (F, d) of P1 simplices
+    in ``points`` (N, d), ``w`` per facet: the facet's mass matrix ``w |F| (1 + δ_ij) / (d (d+1))``
+    and load ``w |F| / d``, on ``n`` unknowns (as scikit-fem's ``FacetBasis`` forms give them)."""
+    X = points[facets]
+    if points.shape[1] == 3:
+        area = 0.5 * np.linalg.norm(np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), axis=1)
+    else:
+        area = np.linalg.norm(X[:, 1] - X[:, 0], axis=1)
+    k = facets.shape[1]
+    Ke = mass(np.empty((len(facets), k, 0)), area, w)
+    i = np.repeat(facets, k, axis=1).ravel()
+    A = sp.csr_matrix((Ke.ravel(), (i, np.tile(facets, (1, k)).ravel())), shape=(n, n))
+    return A, np.bincount(facets.ravel(), weights=np.repeat(w * area / k, k), minlength=n)
 
 
 @dataclass(frozen=True)

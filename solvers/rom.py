@@ -35,10 +35,14 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from gatetherm import InputError
+from gatetherm.solvers import krylov
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 
 log = logging.getLogger(__name__)
 
+KRYLOV_ABOVE = 100_000
+"""Unknowns above which :func:`reduce` builds its basis by :func:`gatetherm.solvers.krylov.basis`
+(a cost linear in the unknowns) instead of balanced truncation of the full model."""
 UM_PER_K = 10.0
 """Output weight of a temperature against a displacement in the balancing: 0.1 K ~ 1 µm (the
 sensors' resolutions)."""
@@ -262,6 +266,12 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
     Cw = _weights(lhm.key_outputs)[:, None] * lhm.C[key]
     modes = lhm.modes
     B = {m: lhm.B[m][:, np.abs(lhm.B[m]).sum(axis=0) > 0] for m in modes}  # no dead supply column
+    if lhm.M.shape[0] > KRYLOV_ABOVE:  # large: rational Krylov, then balanced truncation of its projection
+        V, info = krylov.basis(lhm.M, {m: (lhm.K[m], lhm.B[m]) for m in modes}, Cw, states, 3, handover, horizon_s)
+        rom = project(lhm, V)
+        dc = {m: float(np.max(np.abs(lhm.C[key[0]] @ info["static"][m] - rom.C[key[0]] @ np.linalg.solve(
+            -rom.A[m], V.T @ B[m])))) if B[m].shape[1] else 0.0 for m in modes}
+        return Reduction(rom, V, info["bound"], info["hankel"], dc, info["seconds"])
     secs, t0 = {}, time.perf_counter()
     slowest = _slowest(lhm)
     solves = {m: ShiftedSolves(lhm.K[m], lhm.M, slowest=slowest) for m in modes}

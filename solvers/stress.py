@@ -137,7 +137,7 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
     else:
         Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=b, T=T_at(sb))[:, None]) for c in normal}
     full = sb if elements is None else CellBasis(mesh, element(dim, order), intorder=q)
-    return Recovery(sb, full, active, _factor(M[active][:, active]), S, Q, comps)
+    return Recovery(sb, full, active, _factor(M[active][:, active], dim=dim), S, Q, comps)
 
 
 def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simplices) -> Recovery:
@@ -176,14 +176,17 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
         sb = CellBasis(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))
         Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=Field(b_all).at(sb), T=T_at(sb))[:, None]) for c in normal}
     full = dof_basis(mesh, element(dim, 1))
-    return Recovery(full, full, active, _factor(M, order), S, Q, comps)
+    return Recovery(full, full, active, _factor(M, order, dim), S, Q, comps)
 
 
-def _factor(M: sp.spmatrix, order: np.ndarray | None = None):
-    """The mass matrix's factor as an object with ``solve`` (sparse Cholesky, METIS order)."""
+def _factor(M: sp.spmatrix, order: np.ndarray | None = None, dim: int = 3):
+    """A solver of the mass matrix as an object with ``solve``: a sparse Cholesky factor in a
+    METIS order, or AMG-CG where that would not fit (:func:`~gatetherm.solvers.linsolve.planned_solver`,
+    planned for the six components of a few fields)."""
     from types import SimpleNamespace
 
-    from gatetherm.solvers.linsolve import nd_order, spd_factor
+    from gatetherm.solvers.linsolve import nd_order, planned_solver
 
-    return SimpleNamespace(solve=spd_factor(M, nd_order(M) if order is None else order)[0])
-
+    solve = planned_solver(M, dim, 6 * 8, "stress projection", order=nd_order(M) if order is None else order,
+                           rtol=1e-12)[0]
+    return SimpleNamespace(solve=solve)

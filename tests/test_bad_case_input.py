@@ -250,16 +250,17 @@ def test_a_reduced_model_whose_input_the_data_lacks_is_refused(tmp_path, capsys)
     (["export", "ccx", "c.toml", "--config", "m.toml"], "CASE.toml/--config"),
     (["report", "--data", "d.csv", "--section", "nafems"], "--data/--section: applies to the validation report"),
     (["report", "--data", "d.csv", "--full"], "--data/--full"),
+    (["report", "--data", "d.csv", "--docs", "docs"], "--data/--docs"),
 ])
 def test_options_that_do_not_apply_are_refused(tmp_path, capsys, argv, needle):
     refused(capsys, 2, [*argv, "--out", tmp_path / "o"], needle)
     assert not (tmp_path / "o").exists()
 
 
-def test_report_readme_of_a_binary_file(tmp_path, capsys):
-    (tmp_path / "README.md").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x01")
-    refused(capsys, 2, ["report", "--full", "--readme", tmp_path / "README.md", "--out", tmp_path / "o"],
-            f"{tmp_path / 'README.md'}, line 3: holds a NUL byte")
+def test_report_docs_that_is_no_folder(tmp_path, capsys):
+    (tmp_path / "README.md").write_text("x")
+    refused(capsys, 2, ["report", "--docs", tmp_path / "README.md", "--out", tmp_path / "o"],
+            f"--docs: '{tmp_path / 'README.md'}' is not a folder")
 
 
 @pytest.mark.parametrize("columns, needle", [

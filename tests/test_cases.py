@@ -20,7 +20,7 @@ DATA = Path(__file__).resolve().parent / "data"
 TARGETS = {"t1": ("sigma_yy_MPa", 50.0), "t3": ("T_degC", 36.60), "t4": ("T_degC", 18.25),
            "le11": ("sigma_zz_MPa", -105.0), "le1": ("sigma_yy_MPa", 92.7), "le10": ("sigma_yy_MPa", -5.38)}
 ACHIEVED = {"t1": 50.336, "t3": 36.595, "t4": 18.254, "le11": -105.23, "le1": 92.815, "le10": -5.4203}
-"""What the shipped meshes give (the README's NAFEMS table): a regression shows before the 1 % band."""
+"""What the shipped meshes give (the NAFEMS table of docs/validation.md, written by `gatetherm report`): a regression shows before the 1 % band."""
 SLOW = ("le11", "le10")
 
 
@@ -180,7 +180,7 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_f
 
 
 def test_c_frame_example_runs_end_to_end(tmp_path, capsys):
-    """The second machine (README "A second machine"): regression values of its 6-h run,
+    """The second machine (docs/model.md "Benchmarks through the case path", docs/case-file.md): regression values of its 6-h run,
     its fields and pictures, and the paper's compensator on it through its signals."""
     s = run_case(EXAMPLE / "case.toml", tmp_path / "run")
     assert s["nodes"] == 2036 and s["analysis"] == "transient"

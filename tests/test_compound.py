@@ -199,7 +199,7 @@ def test_visibility_of_the_weakest_drawn_strengths(coarse):
 
 
 def test_the_by_kinds_table_counts_each_group_and_all():
-    """compound.md's table by kinds (the README's): one wrong pair of two sensor pieces."""
+    """compound.md's table by kinds (docs/diagnosis.md's): one wrong pair of two sensor pieces."""
     def row(kinds, ok, strict=False):
         return {"kinds": kinds, "verdict": "explained", "both_named": ok, "both_named_or_equivalent": True,
                 "wrong_piece": not ok, "missed": [], "wrong_effect": False, "wrong_piece_strict": not ok or strict}

@@ -68,7 +68,7 @@ def test_bad_parameter_is_one_line_exit_2(tmp_path, capsys):
 
 
 def test_simulate_condition_1_coarse(tmp_path, capsys):
-    """Regression values of a coarse 2-D condition-1 run (the default mesh is in the README table)."""
+    """Regression values of a coarse 2-D condition-1 run (the default mesh is in docs/validation.md's paper table)."""
     cfg = tmp_path / "coarse.toml"
     cfg.write_text(COARSE)
     out = tmp_path / "c1"

@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 from skfem import Basis, ElementTetP1, ElementVector, MeshTet, asm
 
-from gatetherm.solvers import linsolve
+from gatetherm.solvers import iterative, linsolve
 from gatetherm.solvers.elasticity import stiffness
 from gatetherm.solvers.material import lame
 
@@ -63,7 +63,7 @@ def test_bordered_solve_equals_lu_of_the_whole_matrix():
     D = np.array([[3.0, 0.0], [-1.0, 2.5]])
     A = sp.bmat([[S, U], [V, D]]).tocsr()
     b = rng.normal(size=n + 2)
-    bordered = linsolve.Bordered(A, n, linsolve.nd_order(S))
+    bordered = linsolve.Bordered(A, n, linsolve.spd_factor(S, linsolve.nd_order(S))[0])
     reference = spsolve(A.tocsc(), b)
     assert np.abs(bordered(b) - reference).max() < 1e-12 * np.abs(reference).max()
 
@@ -71,17 +71,17 @@ def test_bordered_solve_equals_lu_of_the_whole_matrix():
 def test_amg_cg_matches_the_direct_solve(elastic_3d, monkeypatch):
     Kff, rbm, *_ = elastic_3d
     b = np.random.default_rng(0).normal(size=(Kff.shape[0], 2))
-    direct = linsolve.spd_solver(Kff, 3, rbm)(b)
+    direct = linsolve.SPDSolver(Kff, 3, rbm)(b)
     monkeypatch.setenv(linsolve.BACKEND_ENV, "amg")
-    amg = linsolve.spd_solver(Kff, 3, rbm)(b)
+    amg = linsolve.SPDSolver(Kff, 3, rbm, nodal=True)(b)
     assert np.linalg.norm(amg - direct) <= 1e-7 * np.linalg.norm(direct)
 
 
 def test_amg_cg_that_does_not_converge_raises(elastic_3d, monkeypatch):
     Kff, rbm, *_ = elastic_3d
     monkeypatch.setenv(linsolve.BACKEND_ENV, "amg")
-    monkeypatch.setattr(linsolve, "MAXITER", 2)
-    solve = linsolve.spd_solver(Kff, 3, rbm)
+    monkeypatch.setattr(iterative, "MAXITER", 2)
+    solve = linsolve.SPDSolver(Kff, 3, rbm)
     with pytest.raises(linsolve.SolverError, match="did not converge: relative residual"):
         solve(np.ones(Kff.shape[0]))
 
@@ -96,5 +96,7 @@ def test_without_a_cholesky_backend_large_3d_elasticity_uses_amg(elastic_3d, mon
     monkeypatch.setattr(linsolve, "_say_once", lambda key, level, msg, *a: linsolve.log.log(level, msg, *a))
     b = np.ones(Kff.shape[0])
     with caplog.at_level("INFO", logger="gatetherm.solvers.linsolve"):
-        x = linsolve.spd_solver(Kff, 3, rbm)(b)
-    assert "elasticity by AMG-CG" in caplog.text and _residual(Kff, x, b) < 1e-8
+        solve = linsolve.SPDSolver(Kff, 3, rbm)
+        x = solve(b)
+    assert "no Cholesky backend for the elastic system: AMG-CG" in caplog.text and _residual(Kff, x, b) < 1e-8
+    assert solve.path == "iterative"

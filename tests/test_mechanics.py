@@ -1,5 +1,5 @@
 """Mechanical loads, joints of an assembly and axisymmetric sections, through case files
-written as a user writes them from README "Case files": closed forms with the achieved
+written as a user writes them from docs/case-file.md: closed forms with the achieved
 values pinned beside the bands, and the refusals of a part held by nothing."""
 from __future__ import annotations
 
@@ -405,14 +405,14 @@ def test_a_zero_pivot_is_bad_input_not_a_traceback(monkeypatch, backend):
     import scipy.sparse as sp
 
     from gatetherm import InputError
-    from gatetherm.solvers.elasticity import _factor
+    from gatetherm.solvers.elasticity import _Solver
 
     if backend == "pardiso":
         pytest.importorskip("pymklpardiso")
     monkeypatch.setenv("GATETHERM_SPD_BACKEND", backend)
     K = sp.csr_matrix(np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
     with pytest.raises(InputError, match="the elastic system is singular .*a part is not held"):
-        _factor(K, 2, None, None)
+        _Solver(K, 2)(np.ones(3))
 
 
 THREE = """SetFactory("OpenCASCADE");

@@ -84,3 +84,33 @@ def test_p1_fixed_dofs_equal_scikit_fem_facet_dofs(dim, frame_2d, frame_3d):
         want = np.unique(vb.get_dofs(mesh.boundaries["mounting_face"]).all([names[c] for c in comps]))
         got = fixed_dofs(vb, mesh, [Support("mounting_face", comps)])
         assert len(want) > 0 and np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_facets_by_integer_keys_equal_scikit_fem_entities(dim, frame_2d, frame_3d):
+    """``to_skfem`` finds the facets and the element-to-facet map by integer keys: exactly
+    scikit-fem's ``build_entities`` (same facets, same order, same map)."""
+    from skfem import MeshTet, MeshTri
+
+    fm = frame_2d if dim == 2 else frame_3d
+    mesh = to_skfem(fm)
+    ref = (MeshTri if dim == 2 else MeshTet)(np.ascontiguousarray(fm.points.T), np.ascontiguousarray(fm.cells.T))
+    facets, t2f = ref.build_entities(ref.t, ref.elem.refdom.facets)
+    assert np.array_equal(mesh.facets, facets) and np.array_equal(mesh.t2f, t2f)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_boundary_films_in_numpy_equal_the_facet_forms(dim, frame_2d, frame_3d):
+    """The P1 facet mass and load of :func:`~gatetherm.solvers.heat.boundary_terms` equal
+    scikit-fem's ``film`` and ``film_load`` over a facet basis, with an element-wise thickness."""
+    from skfem import FacetBasis
+
+    from gatetherm.solvers.heat import boundary_terms, film, film_load
+
+    mesh = to_skfem(frame_2d if dim == 2 else frame_3d)
+    t = Field(np.random.default_rng(3).uniform(0.05, 0.2, mesh.nelements) if dim == 2 else np.ones(mesh.nelements))
+    for name in ("tank_wall", "free_surface"):
+        A, a = boundary_terms(mesh, name, element(dim, 1), 2, t)
+        fb = FacetBasis(mesh, element(dim, 1), facets=mesh.boundaries[name], intorder=2)
+        assert _close(A, asm(film, fb, h=1.0, t=t.at(fb))) < 1e-13
+        assert np.abs(a - asm(film_load, fb, h=1.0, t=t.at(fb))).max() < 1e-13 * np.abs(a).max()

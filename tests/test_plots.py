@@ -1,6 +1,7 @@
 """Library plots: ``gt.plot`` draws what the run holds on the Axes it is given (or a new pyplot
-figure's) and returns them; the README snippet leaves a notebook's matplotlib backend as it
-was; pyvista's global off-screen switch is not touched; the pictures are written by one writer."""
+figure's) and returns them; the snippet of gt.plot's docstring leaves a notebook's matplotlib
+backend as it was; pyvista's global off-screen switch is not touched; the pictures are written by
+one writer."""
 from __future__ import annotations
 
 import os
@@ -32,7 +33,7 @@ def cframe():
     return gt.run(gt.load_case(CASE))
 
 
-def test_the_readme_snippet_keeps_the_svg_backend(tmp_path):
+def test_the_documented_snippet_keeps_the_svg_backend(tmp_path):
     """The snippet in a fresh interpreter with ``MPLBACKEND=svg``: the plots made without ``ax=``
     are pyplot figures (they show in a notebook), and the backend is still svg afterwards."""
     snippet = textwrap.dedent(f"""
@@ -179,3 +180,20 @@ def test_every_plot_of_gt_plot_is_tested():
     tested = {n.removeprefix("test_") for n in globals() if n.startswith("test_")}
     names = set(gt.plot.__all__) - {"save"}
     assert all(any(n in t for t in tested) for n in names), names
+
+
+def test_sensor_curve_and_sensors_draw_a_placement():
+    """The C-frame meshed coarse, 2 sensors from 3 loads: the curve has a held-out and a
+    leave-one-load-out line per target (and the case's TF, TB, TS star); the machine picture marks
+    the chosen points and the case's thermocouples."""
+    case = gt.load_case(CASE, mesh_factor=3.0)
+    p = gt.place_sensors(case, 2, loads=3, held_out_loads=1, states=8)
+    ax = gt.plot.sensor_curve(p, ax=axes())
+    targets = list(p.curve[0].held_out_mae_um)
+    assert [line.get_label() for line in ax.lines][:2] == [f"{targets[0]}, held-out loads",
+                                                           f"{targets[0]}, leave one training load out"]
+    assert list(ax.lines[0].get_ydata()) == [c.held_out_mae_um[targets[0]] for c in p.curve]
+    bx = gt.plot.sensors(p, case, ax=axes())
+    marked = {t.get_text(): t.xy for t in bx.texts}
+    assert {s.name: s.xyz for s in p.sensors}.items() <= marked.items()
+    assert {"TF", "TB", "TS"} <= set(marked)

@@ -1,6 +1,6 @@
 """The validation report: the section cache (a rerun recomputes nothing, a changed input
 recomputes its section only, a default run reuses a full result but not the other way),
-the page and its links, the README blocks, the thermal drift report and the XDMF time
+the page and its links, the Markdown results page, the thermal drift report and the XDMF time
 series of a run. The browser check is a slow test."""
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from gatetherm import InputError
 from gatetherm.cli import main
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.report import build as b
-from gatetherm.validation.report import drift, readme
+from gatetherm.validation.report import drift
 from gatetherm.validation.report.browser import static_check
 from gatetherm.validation.report.page import report_html
 from gatetherm.validation.report.registry import SECTIONS, Section
@@ -42,7 +42,7 @@ def registry(tmp_path):
         def compute(ctx):
             calls.append(key)
             _png(ctx.work / f"{key}.png")
-            return Result(tables=(table(f"table {key}", ("n",), [(str(ctx.scope["n"]),)], readme=key),),
+            return Result(tables=(table(f"table {key}", ("n",), [(str(ctx.scope["n"]),)]),),
                           figures=(Figure(f"{key}.png", f"figure {key}"),))
         return compute
 
@@ -130,37 +130,21 @@ def test_the_page_links_resolve_and_captions_name_the_command(tmp_path, registry
     assert "subset: n = 2 instead of 3" in text and "<script" not in text
 
 
-README = """# x
+def test_the_markdown_page_has_every_table_and_says_what_it_shows(tmp_path, registry):
+    """The results page: each section's scope (subset or full), tables with their captions,
+    the command that regenerates it; figures linked in R, named in a docs copy."""
+    from gatetherm.validation.report.markdown import results_markdown
 
-<!-- report:a -->
-old a
-<!-- /report -->
-text
-<!-- report:b -->
-| old |
-<!-- /report -->
-"""
-
-
-def test_readme_blocks_take_the_full_tables_only(tmp_path, registry):
     sections, _, _ = registry
     res = b.build(tmp_path / "R", sections)
-    tables, partial = readme.full_tables(res)
-    assert set(tables) == {"a"} and partial == {"b"}    # a has no separate full scope; b is a subset
-    new, done = readme.rewrite(README, tables)
-    assert done == ["a"] and "| n |\n| --- |\n| 1 |\n<!-- /report -->" in new and "| old |" in new
-    assert readme.blocks(new) == ["a", "b"]
-    with pytest.raises(InputError, match="report:zz"):
-        readme.check_names(["a", "zz"], {"a", "b"}, "README.md")
-    with pytest.raises(InputError, match="without its"):
-        readme.blocks("<!-- report:a -->\nno end\n")
-
-
-def test_shipped_readme_blocks_are_known_tables():
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
-    names = readme.blocks(text)
-    assert {"verification", "nafems", "paper", "compensation", "rom-check", "rom"} <= set(names)
-    readme.check_names(names, {n for s in SECTIONS for n in s.readme}, "README.md")
+    text = results_markdown(sections, res, "R", False, b.code_digest())
+    assert "| n |\n| --- |\n| 1 |\n\n*Table 1.* table a." in text and "*Table 2.* table b." in text
+    assert "- [B](#b) (subset)" in text and "- [A](#a) (full study)" in text and "(not in this build)" in text
+    assert "a subset (n = 2 instead of 3; `--full` runs the whole study)" in text
+    assert "Regenerate: `gatetherm report --out R --section b`" in text and "Not in this build: a later issue." in text
+    assert "![figure a](sections/a/a.png)" in text
+    docs = results_markdown(sections, res, "R", False, b.code_digest(), figures=False)
+    assert "](sections/" not in docs and "Figures (on the HTML page): figure a." in docs
 
 
 def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypatch):
@@ -184,8 +168,7 @@ def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypat
     assert t.columns == ("case", "gatetherm s", "ratio") and t.rows == (("3-D heat", "1.235", "0.5"),
                                                                         ("3-D elastic", "2", "—"))
     assert t.title == "peer.json: measured by `python benchmarks/peer.py --rounds 3` on 2 cores, 2026-11-26"
-    assert t.note == "median of 3 rounds" and len(notes) == 4 and t.readme == "speed-peer"
-    assert t.markdown().splitlines()[0] == t.title + ":" and t.markdown().endswith("\n\nmedian of 3 rounds")
+    assert t.note == "median of 3 rounds" and len(notes) == 4
     assert notes[0].startswith("`benchmarks/results/scaling.json` is not a benchmark table (AttributeError: ")
     assert notes[0].endswith("rerun `python benchmarks/scaling.py`.")
     monkeypatch.setattr(b, "input_files", lambda patterns: {p: tmp_path / Path(p).name for p in patterns})
@@ -295,24 +278,22 @@ def test_rom_section_is_the_rom_study(tmp_path):
     assert float(checks.rows[0][2]) < 0.1 and all((tmp_path / f.file).stat().st_size > 1e4 for f in res.figures)
 
 
-def test_readme_edits_made_during_a_run_are_kept(tmp_path, monkeypatch, capsys):
-    """``report --full --readme`` rewrites its blocks in the README as it is when the run ends."""
+def test_report_writes_the_results_page_into_out_and_docs(tmp_path, monkeypatch, capsys):
+    """``report`` writes ``R/validation.md`` beside ``R/index.html``; ``--docs DIR`` also
+    ``DIR/validation.md`` (commands naming ``R``, no figure links); nothing else is touched."""
     from gatetherm.cli import main
     from gatetherm.validation.report.sections import speed
 
     monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)
     (tmp_path / "peer.json").write_text(json.dumps({"date": "2026-11-26", "machine": "m", "command": "c",
                                                     "columns": ["job", "s"], "rows": [["x", 1.5]], "notes": []}))
-    doc = tmp_path / "README.md"
-    doc.write_text("intro\n<!-- report:speed-peer -->\nold\n<!-- /report -->\n")
-    shown = speed.compute
-
-    def compute_while_edited(ctx):
-        doc.write_text(doc.read_text() + "added during the run\n")
-        return shown(ctx)
-
-    monkeypatch.setattr(speed, "compute", compute_while_edited)
-    assert main(["report", "--full", "--section", "speed", "--out", str(tmp_path / "R"), "--readme", str(doc)]) == 0
-    text = doc.read_text()
-    assert "added during the run" in text and "| x | 1.5 |" in text and "old" not in text
-    assert "rewrote speed-peer" in capsys.readouterr().out
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    (docs / "other.md").write_text("kept")
+    out = tmp_path / "R"
+    assert main(["report", "--section", "speed", "--out", str(out), "--docs", str(docs)]) == 0
+    page, copy = (out / "validation.md").read_text(), (docs / "validation.md").read_text()
+    assert "| x | 1.5 |" in page and "| x | 1.5 |" in copy and "peer.json: measured by `c` on m, 2026-11-26." in copy
+    assert f"gatetherm report --out {out} --section speed" in page and "gatetherm report --out R --section speed" in copy
+    assert sorted(p.name for p in docs.iterdir()) == ["other.md", "validation.md"]
+    assert f"and {docs / 'validation.md'}" in capsys.readouterr().out

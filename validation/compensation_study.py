@@ -224,7 +224,7 @@ def table_csv(st: Study) -> str:
 
 
 def summary_rows(st: Study) -> tuple[list[str], list[list[str]]]:
-    """(columns, rows) of the README's compensation table: per condition the swing, the
+    """(columns, rows) of the compensation table (docs/validation.md): per condition the swing, the
     prediction-error bands of the paper's procedure with K from theory, FE and the fit, and
     the residual bands of the K-theory loop (5-min updates, at the update instants, 1-min)."""
     paper = [p for p in dict.fromkeys(r.predictor for r in st.rows) if p.startswith("paper")]

@@ -189,7 +189,7 @@ def _fmt(v) -> str:
 
 
 def kinds_markdown(rows: list[dict]) -> str:
-    """The pairs by the kinds of their hidden pieces (README, "Compound diagnosis")."""
+    """The pairs by the kinds of their hidden pieces (docs/diagnosis.md, "Compound diagnosis")."""
     L = ["| hidden kinds | cases | verdict `explained` | both pieces named | both named, or in a named piece's group "
          "| a wrong piece named (groups as right) | a piece missed | a wrong catalogue effect "
          "| a piece other than the hidden (groups as wrong) |", "|---|---|---|---|---|---|---|---|---|"]

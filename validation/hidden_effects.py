@@ -50,7 +50,7 @@ log = logging.getLogger(__name__)
 
 SETTINGS = Settings(p2_check=False)
 """The diagnosis of the study (the frame's own discretisation is below the resolution at its mesh:
-README, Verification; the P2 run would only cost time)."""
+docs/model.md, Verification; the P2 run would only cost time)."""
 
 
 def draw_strengths(name: str, rng: np.random.Generator) -> tuple[float, float]:

@@ -1,4 +1,4 @@
-"""The README's paper-vs-gatetherm table (``gatetherm validate paper --out runs``).
+"""The paper-vs-gatetherm table (docs/paper.md) (``gatetherm validate paper --out runs``).
 
 Runs every condition in every dimension through the scenario path that ``gatetherm
 simulate`` takes, writes ``runs/cN_dD/summary.json`` and ``response.png`` (``reuse``

@@ -27,10 +27,9 @@ OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "rep
 
 DIM_HELP = ("2-D section (default) or 3-D solid. A 3-D diagnosis replays the 3-D model for every hypothesis "
             "(about 100 runs, each up to a 3-D condition's build and march, about 25 s at the default 3-D mesh by the "
-            "scaling table in README 'Speed': tens of minutes, not timed). A 2-D diagnosis of a 3-D "
+            "scaling table in docs/performance.md: tens of minutes, not timed). A 2-D diagnosis of a 3-D "
             "measurement also sees the 2-D/3-D model-form difference as a significant residual; the pieces it "
-            "names then make the section model fit, they are not faults of the machine (README, 'Discrepancy "
-            "diagnosis')")
+            "names then make the section model fit, they are not faults of the machine (docs/diagnosis.md)")
 
 
 def register(sub) -> None:

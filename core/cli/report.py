@@ -7,10 +7,9 @@ import time
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.files import read_text
 from gatetherm.cli.options import WORKERS, number
 
-PAGE = ("index.html",)
+PAGE = ("index.html", "validation.md")
 """What a report run replaces in --out; the sections' folders (the cache) are kept."""
 DRIFT = ("index.html", "drift.png")
 """What a drift report writes into --out."""
@@ -19,9 +18,10 @@ DRIFT = ("index.html", "drift.png")
 def register(sub) -> None:
     from gatetherm.validation.report.registry import SECTIONS
 
-    p = sub.add_parser("report", help="every validation result on one page (DIR/index.html); --data: a drift report",
+    p = sub.add_parser("report", help="every validation result on one page (DIR/index.html, DIR/validation.md); --data: a drift report",
                        description="Compute (or reuse from DIR) every section of the validation report and write "
-                       "DIR/index.html with its figures beside it. The long studies run a stated subset unless "
+                       "DIR/index.html with its figures beside it, and the same results as Markdown, DIR/validation.md "
+                       "(--docs: also into a repository's docs folder). The long studies run a stated subset unless "
                        "--full. With --data FILE.csv: the thermal drift report of one time series instead.")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory (also the cache of the results)")
     p.add_argument("--full", action="store_true", help="run every study in full (default: the stated subsets)")
@@ -29,8 +29,7 @@ def register(sub) -> None:
                    help="compute only these sections (others are shown if cached): " + ", ".join(s.key for s in SECTIONS))
     p.add_argument("--workers", type=number(WORKERS), default=os.cpu_count() or 1, metavar="N",
                    help="worker processes for the sweeps (default: the CPU count)")
-    p.add_argument("--readme", metavar="README.md",
-                   help="rewrite the README's <!-- report:NAME --> blocks from the full results (needs --full)")
+    p.add_argument("--docs", metavar="DIR", help="also write the results page DIR/validation.md (docs/ of a checkout)")
     p.add_argument("--data", metavar="FILE.csv", help="thermal drift report of this time series (data format)")
     p.set_defaults(func=run)
 
@@ -38,40 +37,32 @@ def register(sub) -> None:
 def run(args) -> int:
     t0 = time.perf_counter()
     if args.data:
-        given = [o for o, v in (("--full", args.full), ("--section", args.section), ("--readme", args.readme)) if v]
+        given = [o for o, v in (("--full", args.full), ("--section", args.section), ("--docs", args.docs)) if v]
         if given:
             raise InputError(f"--data/{given[0]}", "applies to the validation report, not to a drift report",
                              f"drop {given[0]}, or --data")
         return _drift(args)
     from gatetherm.outdir import output_dir
-    from gatetherm.validation.report import readme as rd
     from gatetherm.validation.report.build import build, code_digest
+    from gatetherm.validation.report.markdown import results_markdown
     from gatetherm.validation.report.page import report_html
     from gatetherm.validation.report.registry import SECTIONS
 
-    text = None
-    if args.readme:
-        if not args.full:
-            raise InputError("--readme", "the README quotes the full studies", "add --full")
-        text = read_text(args.readme, "--readme", "give the project's README.md")
-        rd.check_names(rd.blocks(text), {n for s in SECTIONS for n in s.readme}, args.readme)
-
+    docs = Path(args.docs) if args.docs else None
+    if docs is not None and not docs.is_dir():
+        raise InputError("--docs", f"'{docs}' is not a folder", "give the docs folder of a checkout (docs)")
     def tell(key, status, seconds):
         print(f"{key:<16} {status}" + (f" ({seconds:.0f} s)" if status in ("computed", "cached") else ""), flush=True)
 
     with output_dir(args.out, PAGE) as out:  # the sections' folders are the cache: kept
         results = build(out, SECTIONS, args.full, args.workers, set(args.section) if args.section else None, tell)
-        write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code_digest()))
-    print(f"wrote {out}/index.html in {time.perf_counter() - t0:.0f} s")
-    if text is not None:
-        # as it is now: it may have been edited meanwhile
-        text = read_text(args.readme, "--readme", "give the project's README.md")
-        tables, partial = rd.full_tables(results)
-        new, done = rd.rewrite(text, tables)
-        write_text_atomic(args.readme, new)
-        kept = [n for n in rd.blocks(text) if n not in done]
-        print(f"{args.readme}: rewrote {', '.join(done) or 'no block'}"
-              + (f"; kept {', '.join(kept)} (no full result in {out}: compute it with --full)" if kept else ""))
+        code = code_digest()
+        write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code))
+        write_text_atomic(out / "validation.md", results_markdown(SECTIONS, results, args.out, args.full, code))
+    if docs is not None:
+        write_text_atomic(docs / "validation.md", results_markdown(SECTIONS, results, "R", args.full, code, figures=False))
+    print(f"wrote {out}/index.html and validation.md" + (f" and {docs / 'validation.md'}" if docs else "")
+          + f" in {time.perf_counter() - t0:.0f} s")
     return 0
 
 

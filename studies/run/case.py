@@ -7,7 +7,7 @@ lumped fluid volumes, supports, probes, relative displacements and the time sett
 Every key is checked where it is read: an unknown key, a name that is not a group of
 the mesh, a region without a material or a boundary with two conditions is one
 :class:`~gatetherm.InputError` line naming the file and the key and listing what is
-valid. README "Case files" is the reference of every key.
+valid. ``docs/case-file.md`` is the reference of every key.
 """
 from __future__ import annotations
 
@@ -50,6 +50,34 @@ THICKNESS = Range(1e-6, 1e3, unit="m")
 matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
 C-frame example, whose other regions are 0.25–0.6 m thick)."""
 FILM = Range(0.0, unit="W/(m² K)")
+KEYS = {
+    "case": ("name", "order", "plane", "uncertain"),
+    "mesh": ("file", "size", "parameters", "refine", "groups", "include"),
+    "mesh.refine": ("near", "size", "distance"),
+    "mesh.groups.NAME": ("dim", "box", "rest", "normal", "tolerance"),
+    "materials.REGION": tuple(MATERIAL_KEYS),
+    "initial": ("temperature", "reference"),
+    "temperature": ("field", "regions"),
+    "thermal.BOUNDARY": ("film", "ambient", "temperature", "flux"),
+    "faces": ("film", "ambient"),
+    "sources.REGION": ("density", "power"),
+    "fluids.NAME": ("boundary", "volume", "rho_c", "flow_rate", "capacity", "conductance", "film_on", "film_off",
+                    "supply", "pump", "hose_capacity", "hose_loss", "hose_name", "ambient"),
+    "supports.BOUNDARY": ("type", "components", "stiffness", "value"),
+    "probes.NAME": ("point", "quantities", "region"),
+    "relative.NAME": ("a", "b", "axis"),
+    "signals": ("theta_A", "theta_B", "theta_C", "delta"),
+    "time": ("end", "step", "output", "schedule", "fields", "scheme"),
+    "time.scheme": ("theta", "restart", "restart_intervals"),
+    "actuator": ("type", "stroke", "stack_stiffness", "spring_stiffness", "preload", "dead_band", "hysteresis",
+                 "reset"),
+    **case_mech.KEYS,
+}
+"""The keys of every table of a case file (NAME, REGION, BOUNDARY, POINT: a name of the case or a
+group of its mesh); ``docs/case-file.md`` documents each one (``tests/test_docs.py``).
+Tables of names the user chooses: :data:`FREE`."""
+FREE = {"mesh.parameters": "NAME", "temperature.regions": "REGION", "means": "NAME"}
+"""Tables whose keys are names: a .geo parameter, a region, a mean's name."""
 
 
 @dataclass(frozen=True)
@@ -186,7 +214,7 @@ class CaseFile:
 
 
 def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
-    m = top.sub("mesh", ("file", "size", "parameters", "refine", "groups", "include"))
+    m = top.sub("mesh", KEYS["mesh"])
     path = base / m.string("file")
     if not path.is_file():
         m.fail("file", f"no such file '{path}'", "give a .msh, .geo or CAD file beside the case")
@@ -204,7 +232,7 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
     params = m.sub("parameters")
     refine = []
     for i, r in enumerate(m.data.get("refine", [])):
-        rt = Table(top.file, f"mesh.refine[{i + 1}]", r, ("near", "size", "distance"))
+        rt = Table(top.file, f"mesh.refine[{i + 1}]", r, KEYS["mesh.refine"])
         refine.append(Refinement(rt.string("near"), factor * rt.number("size", METRES),
                                  rt.number("distance", METRES)))
     include = m.data.get("include", [])
@@ -214,7 +242,7 @@ def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
         if not (base / f).is_file():
             m.fail("include", f"no such file '{base / f}'",
                    "name files the geometry script reads, relative to the case")
-    groups = tuple(_group(m.sub("groups").sub(name, ("dim", "box", "rest", "normal", "tolerance")), name)
+    groups = tuple(_group(m.sub("groups").sub(name, KEYS["mesh.groups.NAME"]), name)
                    for name in m.data.get("groups", {}))
     size = factor * m.number("size", METRES, 0.0) or None
     return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
@@ -265,7 +293,7 @@ def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
                   f"{', '.join(fm.regions)})")
     materials, thickness = {}, {}
     for region in fm.regions:
-        t = mats.sub(region, tuple(MATERIAL_KEYS))
+        t = mats.sub(region, KEYS["materials.REGION"])
         for k in need - set(t.data):
             t.fail(k, "missing", f"give {k} in {MATERIAL_KEYS[k]} (needed for "
                    f"{'elasticity' if k in ('E', 'nu', 'alpha') else 'the heat solve'})")
@@ -282,7 +310,7 @@ def _boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
     th = top.sub("thermal", tuple(fm.boundaries))
     out = {"films": [], "fixed": [], "fluxes": []}
     for b in th.data:
-        t = th.sub(b, ("film", "ambient", "temperature", "flux"))
+        t = th.sub(b, KEYS["thermal.BOUNDARY"])
         kinds = [k for k in ("film", "temperature", "flux") if k in t.data]
         if len(kinds) != 1:
             t.fail("/".join(kinds) or "film", "give exactly one condition: film (with ambient), temperature or flux",
@@ -302,8 +330,7 @@ def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
     out = []
     fl = top.sub("fluids")
     for name in fl.data:
-        t = fl.sub(name, ("boundary", "volume", "rho_c", "flow_rate", "capacity", "conductance", "film_on", "film_off",
-                          "supply", "pump", "hose_capacity", "hose_loss", "hose_name", "ambient"))
+        t = fl.sub(name, KEYS["fluids.NAME"])
         wall = t.name("boundary", fm.boundaries, "boundary")
         hose = t.number("hose_capacity", Range(0.0, unit="J/K"), 0.0)
         if "capacity" in t.data:  # the lump's own figures
@@ -329,7 +356,7 @@ def _supports(top: Table, fm: FrameMesh, names) -> tuple:
     sup = top.sub("supports", case_mech.support_names(fm))
     out = []
     for b in sup.data:
-        t = sup.sub(b, ("type", "components", "stiffness", "value"))
+        t = sup.sub(b, KEYS["supports.BOUNDARY"])
         kind = t.string("type", choices=("clamped", "normal", "fixed", "foundation", "displacement"))
         case_mech.check_support(t, fm, b, kind)
         if kind == "displacement":
@@ -367,7 +394,7 @@ def _probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
     out = []
     finder = None
     for name in pr.data:
-        t = pr.sub(name, ("point", "quantities", "region"))
+        t = pr.sub(name, KEYS["probes.NAME"])
         point = t.data.get("point")
         if isinstance(point, str):
             if point not in fm.sensors:
@@ -400,14 +427,14 @@ def _relative(top: Table, probes, dim: int) -> tuple:
     names = [p.name for p in probes if "u" in p.quantities] + [p.name for p in probes if "u" not in p.quantities]
     out = []
     for name in rel.data:
-        t = rel.sub(name, ("a", "b", "axis"))
+        t = rel.sub(name, KEYS["relative.NAME"])
         out.append(Relative(name, t.name("a", names, "probe"), t.name("b", names, "probe"),
                             AXES.index(t.string("axis", choices=tuple(AXES[:dim])))))
     return tuple(out)
 
 
 def _signals(top: Table, probes, relative) -> Signals:
-    s = top.sub("signals", ("theta_A", "theta_B", "theta_C", "delta"))
+    s = top.sub("signals", KEYS["signals"])
     temps = [p.name for p in probes if "T" in p.quantities]
     c = s.data.get("theta_C", [])
     c = [c] if isinstance(c, str) else c
@@ -423,7 +450,7 @@ def _time(top: Table, base: Path):
         return None, TimeScheme(), None
     from gatetherm.studies.run.timeseries import check_steps
 
-    t = top.sub("time", ("end", "step", "output", "schedule", "fields", "scheme"))
+    t = top.sub("time", KEYS["time"])
     end = t.number("end", SECONDS)
     within = Range(0.0, end, lo_open=True, unit="s")  # an interval longer than the run is refused
     output = t.number("output", within, min(60.0, end))
@@ -431,7 +458,7 @@ def _time(top: Table, base: Path):
     check_steps(end, step, t.key("step"))
     if abs(output / step - round(output / step)) > 1e-9:
         t.fail("output", f"{output:g} s is not a whole multiple of the step {step:g} s", "change output or step")
-    sch = t.sub("scheme", ("theta", "restart", "restart_intervals"))
+    sch = t.sub("scheme", KEYS["time.scheme"])
     scheme = TimeScheme(sch.number("theta", SCHEME["theta"], 0.5), int(sch.number("restart", SCHEME["restart"], 4)),
                         int(sch.number("restart_intervals", SCHEME["restart_intervals"], 3)))
     schedule, ts = None, None
@@ -463,9 +490,24 @@ def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
 
 
 def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
-    """Read and check a case file (paths inside it are relative to its folder); with
-    ``mesh_factor``, a geometry is meshed with its element sizes times that factor;
-    ``overrides`` ({dotted key: value}) change keys of the file as it is read."""
+    """Read and check a case file (``docs/case-file.md``); paths inside it are relative to its folder.
+
+    Parameters
+    ----------
+    path : str or path
+        The ``.toml`` case file.
+    mesh_factor : float
+        A geometry (``.geo``, CAD) is meshed with its element sizes times this factor (a ``.msh``
+        is read as it is).
+    overrides : dict, optional
+        ``{dotted key: value}`` changing keys of the file as it is read, e.g.
+        ``{"thermal.free.film": 8.0}``.
+
+    Returns
+    -------
+    Case
+        Bad input raises :class:`gatetherm.InputError` naming the file, the key and the fix.
+    """
     path = Path(path)
     text = read_text(path, "CASE.toml", "give the path of a .toml case file")
     try:
@@ -478,7 +520,7 @@ def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> 
 def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: FrameMesh | None = None) -> Case:
     """The case of a parsed case file ``data`` read from ``path`` (``mesh``: its mesh, already made)."""
     top = Table(path, "", data, SECTIONS)
-    head = top.sub("case", ("name", "order", "plane", "uncertain"))
+    head = top.sub("case", KEYS["case"])
     uncertain = head.data.get("uncertain", [])
     bad = [k for k in uncertain if mesh_parameter(data, k) is None] if isinstance(uncertain, list) else [uncertain]
     if bad:
@@ -500,14 +542,14 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     need = ({"E", "nu"} if mechanical else need) | ({"rho"} if "gravity" in data else set())
     materials, thickness = _materials(top, fm, need)
     names = ("t", *columns)
-    init = top.sub("initial", ("temperature", "reference"))
+    init = top.sub("initial", KEYS["initial"])
     T0 = init.number("temperature", CELSIUS, 20.0)
     kw: dict = {}
     if prescribed:
         for s in ("thermal", "faces", "sources", "fluids", "time"):
             if s in data:
                 top.fail(s, "cannot go with a prescribed [temperature]", "remove one of the two")
-        tt = top.sub("temperature", ("field", "regions"))
+        tt = top.sub("temperature", KEYS["temperature"])
         if ("field" in tt.data) == ("regions" in tt.data):
             tt.fail("field", "give either field (an expression of x, y, z) or a [temperature.regions] table")
         if "field" in tt.data:
@@ -520,7 +562,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         src = top.sub("sources", tuple(fm.regions))
         sources = []
         for r in src.data:
-            s = src.sub(r, ("density", "power"))
+            s = src.sub(r, KEYS["sources.REGION"])
             if ("density" in s.data) == ("power" in s.data):
                 s.fail("density", "give either density (W/m³) or power (W)")
             if "density" in s.data:
@@ -533,7 +575,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         if "faces" in data:
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")
-            f = top.sub("faces", ("film", "ambient"))
+            f = top.sub("faces", KEYS["faces"])
             kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C"))
         kw["fluids"] = _fluids(top, fm, names, thickness)
     twice = _twice(kw)
@@ -587,8 +629,7 @@ def _actuator(top: Table):
 
     if "actuator" not in top.data:
         return None
-    a = top.sub("actuator", ("type", "stroke", "stack_stiffness", "spring_stiffness", "preload", "dead_band",
-                             "hysteresis", "reset"))
+    a = top.sub("actuator", KEYS["actuator"])
     if a.string("type", "piezo", ("piezo", "none")) == "none":
         if len(a.data) > 1:
             a.fail(next(k for k in a.data if k != "type"), "goes with type = \"piezo\" only", "remove it")

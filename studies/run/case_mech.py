@@ -1,7 +1,7 @@
 """The mechanical tables of a case file and the checks of an assembly: ``[gravity]``,
 ``[loads.NAME]``, ``[contacts.NAME]``, supports of ``type = "displacement"``, the
 axisymmetric section, parts connected to nothing. Each refusal is one
-:class:`~gatetherm.InputError` line naming the file and the key (README "Case files").
+:class:`~gatetherm.InputError` line naming the file and the key (``docs/case-file.md``).
 """
 from __future__ import annotations
 
@@ -16,6 +16,9 @@ from gatetherm.solvers.expr import Value
 from gatetherm.solvers.problem import BoundaryLoad, Contact, PointLoad, Support
 from gatetherm.studies.run.tables import Table
 
+KEYS = {"gravity": ("acceleration",), "loads.BOUNDARY": ("pressure", "traction", "force"), "loads.POINT": ("force",),
+        "contacts.NAME": ("between", "conductance", "stiffness")}
+"""The keys of each mechanical table (as :data:`gatetherm.studies.run.case.KEYS`)."""
 SECTIONS = ("gravity", "loads", "contacts")
 THERMAL = ("thermal", "sources", "faces", "fluids", "temperature")
 """Tables that make a case thermal (without any, a case with loads is purely mechanical)."""
@@ -53,17 +56,17 @@ def read_loads(top: Table, fm: FrameMesh, names) -> dict:
     """``gravity``, ``loads`` and ``point_loads`` of the Problem."""
     out: dict = {}
     if "gravity" in top.data:
-        g = top.sub("gravity", ("acceleration",))
+        g = top.sub("gravity", KEYS["gravity"])
         out["gravity"] = tuple(vector(g, "acceleration", names, fm.dim, unit="m/s²"))
     lt = top.sub("loads", tuple(fm.boundaries) + tuple(fm.sensors))
     loads, points = [], []
     for name in lt.data:
         if name not in fm.boundaries:
-            t = lt.sub(name, ("force",))
+            t = lt.sub(name, KEYS["loads.POINT"])
             points.append(PointLoad(name, tuple(vector(t, "force", names, fm.dim, unit="N"))))
             continue
-        t = lt.sub(name, ("pressure", "traction", "force"))
-        kinds = [k for k in ("pressure", "traction", "force") if k in t.data]
+        t = lt.sub(name, KEYS["loads.BOUNDARY"])
+        kinds = [k for k in KEYS["loads.BOUNDARY"] if k in t.data]
         if len(kinds) != 1:
             t.fail("/".join(kinds) or "pressure", "give exactly one load: pressure, traction or force",
                    "pressure in Pa (positive into the body), traction [tx, ty(, tz)] in Pa or force [Fx, Fy(, Fz)] "
@@ -92,7 +95,7 @@ def read_contacts(top: Table, fm: FrameMesh, heat: bool, elastic: bool) -> tuple
     ct = top.sub("contacts")
     out, seen = [], {}
     for name in ct.data:
-        t = ct.sub(name, ("between", "conductance", "stiffness"))
+        t = ct.sub(name, KEYS["contacts.NAME"])
         pair = t.data.get("between")
         if not (isinstance(pair, list) and len(pair) == 2 and all(p in fm.regions for p in pair)
                 and pair[0] != pair[1]):

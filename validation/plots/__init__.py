@@ -31,8 +31,23 @@ def figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, fig=Non
 
 
 def save(fig, path: str | os.PathLike, dpi: int = DPI, tight: bool = True) -> None:
-    """Write ``fig`` (a Figure, or what a plot returns: an Axes or an array of them) as a PNG
-    at ``path`` atomically."""
+    """Write a figure as a PNG, atomically (a temporary file renamed onto ``path``).
+
+    Parameters
+    ----------
+    fig : Figure, Axes or array of Axes
+        A figure, or what a plot returns.
+    path : str or path
+        The PNG file.
+    dpi : int
+        Resolution, dots per inch.
+    tight : bool
+        Apply ``tight_layout`` first.
+
+    Returns
+    -------
+    None
+    """
     import numpy as np
 
     fig = np.asarray(fig, dtype=object).flat[0].figure

@@ -20,7 +20,7 @@ import os
 from gatetherm.validation.plots import save
 
 __all__ = ["channels", "compensation", "deformed", "field", "fluids", "prediction", "residuals", "response", "save",
-           "series", "sweep"]
+           "sensor_curve", "sensors", "series", "sweep"]
 
 LABELS = {"_um": "displacement [µm]", "_degC": "temperature [°C]", "_MPa": "stress [MPa]"}
 
@@ -276,3 +276,51 @@ def sweep(rows, x: str, y: str, hue: str | None = None, ax=None, **options):
         with open(rows, newline="", encoding="utf-8") as f:
             rows = list(csv.DictReader(f))
     return plot_xy(rows, x, y, hue, ax=_axes(ax), **options)
+
+
+def sensors(placement, case, ax=None, probes=None):
+    """A sensor placement (:func:`gatetherm.place_sensors`) on the machine: the outline (3-D: the
+    surface nodes, seen along the axis of least extent), the candidates (grey), the screened ones
+    (open circles), the chosen points (red stars, named) and the case's own thermocouples (blue).
+
+    Parameters
+    ----------
+    placement : Placement
+        What :func:`gatetherm.place_sensors` returns.
+    case : Case
+        The case it was made for (its mesh is drawn).
+    ax : matplotlib.axes.Axes, optional
+    probes : mapping of str to coordinates, optional
+        Points to mark, m (default: the case's temperature probes).
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        Coordinates in m.
+    """
+    from gatetherm.validation.plots.sensors import plot_machine
+
+    if probes is None:
+        probes = {p.name: p.xyz for p in case.problem.probes if "T" in p.quantities}
+    return plot_machine(case.mesh, placement, _axes(ax), probes)
+
+
+def sensor_curve(placement, ax=None):
+    """A sensor placement's held-out error against the number of sensors: per target the MAE on
+    the held-out loads (solid) and leave one training load out (dashed), and the same model family
+    given the case's θ_A, θ_B, θ_C (stars at 3), where it has them.
+
+    Parameters
+    ----------
+    placement : Placement
+        What :func:`gatetherm.place_sensors` returns.
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        MAE in µm against the sensor count.
+    """
+    from gatetherm.validation.plots.sensors import plot_curve
+
+    return plot_curve(placement, _axes(ax))

@@ -4,7 +4,7 @@ A section's result is kept in ``DIR/sections/KEY/result.json`` beside its figure
 with a digest of everything it was made from: the section's key and scope, gatetherm's
 version, the *code digest* (SHA-256 of every source file of the installed package, except
 the modules that only reuse and present results: the CLI, this module and the report's page,
-README and browser modules), the bytes of the data files the section names and the version line of the
+Markdown and browser modules), the bytes of the data files the section names and the version line of the
 external programs it runs. A result whose digest matches is reused; anything else is
 recomputed. A default run also accepts a ``--full`` result of the same code and inputs, and a
 section left out by ``--section`` is shown from either.
@@ -36,7 +36,7 @@ log = logging.getLogger(__name__)
 
 PACKAGES = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.validation")
 PRESENTATION = ("gatetherm/cli/", "gatetherm/validation/report/build.py", "gatetherm/validation/report/page.py",
-                "gatetherm/validation/report/readme.py", "gatetherm/validation/report/browser.py")
+                "gatetherm/validation/report/markdown.py", "gatetherm/validation/report/browser.py")
 """Source files left out of the code digest: they decide what to reuse and format results, they
 do not make them."""
 

@@ -104,7 +104,7 @@ def report_html(sections, results: dict, out: str, full: bool, code: str) -> str
             f"{' --full' if full else ''}</code> (the default run computes a stated subset of the long studies; "
             "<code>--full</code> runs them all). Each section is cached under <code>sections/</code> by a digest of "
             "its scope, gatetherm's version, the package's source files (all but the CLI and the report's builder, "
-            "page, README and browser modules) and its data files and external programs: a rerun with nothing "
+            "page, Markdown and browser modules) and its data files and external programs: a rerun with nothing "
             "changed recomputes nothing."]
     nav = "<nav><ol>" + "".join(f"<li><a href=\"#{s.key}\">{html.escape(s.title)}</a> {_status(s, results.get(s.key))}"
                                 "</li>" for s in sections) + "</ol></nav>"

@@ -34,8 +34,6 @@ class Section:
     """External programs it runs (their version line is in the digest)."""
     also: str = ""
     """The command outside the report that makes the same study."""
-    readme: tuple[str, ...] = ()
-    """README blocks its tables fill (``<!-- report:NAME -->``)."""
     pending: str = ""
     """For a section not in this build: what brings it."""
 
@@ -68,22 +66,21 @@ BENCHMARK_FILES = {"peer.json": "python benchmarks/peer.py --rounds 3",
                    "blas_threads.json": "python benchmarks/blas_threads.py --rounds 3",
                    "errormodel.json": "/tmp/venv_bench/bin/python benchmarks/errormodel.py --data FILE.csv"}
 """Result files of the benchmark scripts the speed section shows, with the command that measures
-each; each fills the README block ``speed-NAME`` (NAME: the file's stem)."""
+each."""
 
 SECTIONS: tuple[Section, ...] = (
     Section("verification", "Verification: convergence orders and exact cases", "verification:compute",
             subset={"elastic_3d": ["3-D P2"]}, full={"elastic_3d": ["3-D P1", "3-D P2"]},
-            about="the 3-D P1 elastic order (70 s) is left out", readme=("verification",),
+            about="the 3-D P1 elastic order (70 s) is left out",
             also="python -m pytest tests/test_verification_heat.py tests/test_verification_elastic.py -s "
                  "(-m slow adds the 3-D elastic orders)"),
     Section("nafems", "NAFEMS benchmarks through case files", "nafems:compute",
             subset={"cases": ["t1", "t3", "t4", "le11", "le1", "le10"]}, inputs=("gatetherm.validation:nafems/*",),
-            readme=("nafems",),
             also="gatetherm run validation/nafems/t1.toml --out D (and t3, t4, le11, le1, le10)"),
     Section("paper", "Paper vs gatetherm, 2-D and 3-D (Figs. 10-13 analogues)", "paper:compute",
             subset={"dims": [2, 3], "size_3d": 0.015}, full={"dims": [2, 3], "size_3d": None},
             about="3-D on a coarser mesh (element size 15 mm instead of the model's 9 mm)",
-            inputs=(PAPER_MODEL,), also="gatetherm validate paper --out runs", readme=("paper",)),
+            inputs=(PAPER_MODEL,), also="gatetherm validate paper --out runs"),
     Section("beam", "Beam theory against FE (Figs. 7-8 analogues)", "beam:compute",
             subset={"dim": 2, "a_every": 4, "series": False}, full={"dim": 2, "a_every": 1, "series": True},
             about="every fourth l/l4 value and no slenderness, tie-bar height or mesh series",
@@ -95,8 +92,7 @@ SECTIONS: tuple[Section, ...] = (
                   "elements of 12 mm instead of 8 mm",
             inputs=(PAPER_MODEL,), also="gatetherm validate design --out d"),
     Section("compensation", "Compensation (Figs. 14-16 analogues)", "compensation:compute",
-            subset={"dim": 2}, inputs=(PAPER_MODEL,), also="gatetherm validate compensation --out comp",
-            readme=("compensation",)),
+            subset={"dim": 2}, inputs=(PAPER_MODEL,), also="gatetherm validate compensation --out comp"),
     Section("hidden-effects", "Discrepancy diagnosis: hidden effects found blind", "hidden:compute",
             subset={"conditions": [1], "effects": ["joint_resistance", "none"], "seed": 6, "per_kind": 1},
             full={"conditions": [1, 2, 3], "effects": "all", "seed": 6, "per_kind": None},
@@ -113,8 +109,7 @@ SECTIONS: tuple[Section, ...] = (
             full={"case": "examples/c_frame/case.toml", "seed": 10, "scenarios": None},
             about="two of the seven scenarios (a film and a thermocouple offset hidden; noise only on the case's "
                   "own mesh)",
-            inputs=("gatetherm.validation:examples/c_frame/*",), also="gatetherm validate case-diagnosis --out DIR",
-            readme=("case-diagnosis",)),
+            inputs=("gatetherm.validation:examples/c_frame/*",), also="gatetherm validate case-diagnosis --out DIR"),
     Section("calculix", "CalculiX cross-check of the 3-D frame", "calculix:compute",
             subset={"condition": 1, "time_min": 15, "size_3d": 0.015},
             full={"condition": 1, "time_min": 15, "size_3d": None},
@@ -126,7 +121,15 @@ SECTIONS: tuple[Section, ...] = (
             full={"dims": [2, 3], "conditions": [1, 2, 3], "effects": "all"},
             about="2-D only: no 3-D reduced model and no 3-D data on the 2-D model (the 3-D reduction took "
                   "25 min and 13 GB)",
-            inputs=(PAPER_MODEL,), also="gatetherm validate rom --out DIR", readme=("rom-check", "rom")),
+            inputs=(PAPER_MODEL,), also="gatetherm validate rom --out DIR"),
+    Section("sensors", "Sensor placement: where to put the thermocouples", "sensors:compute",
+            subset={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml", "seeds": [0]},
+            full={"frame_count": 3, "case_count": 4, "loads": 20, "case": "examples/c_frame/case.toml",
+                  "seeds": [0, 1, 2, 3, 4]},
+            about="the paper frame for seed 0 only (--full: seeds 0-4 of the generated loads and the noise)",
+            inputs=(PAPER_MODEL, "gatetherm.validation:examples/c_frame/*"),
+            also="gatetherm sensors --dim 2 --count 3 --check --out s; "
+                 "gatetherm sensors --case validation/examples/c_frame/case.toml --count 4 --out cs"),
     Section("compound", "Compound diagnosis: several missing pieces at once", "compound:compute",
             subset={"seed": 14, "pairs": 2, "single": False, "mesh_size": 0.012},
             full={"seed": 14, "pairs": 48, "single": True, "mesh_size": None},
@@ -134,7 +137,7 @@ SECTIONS: tuple[Section, ...] = (
                   "diagnosis takes 1-2 min)",
             inputs=(PAPER_MODEL,), also="gatetherm validate compound --out DIR"),
     Section("speed", "Speed and scaling", "speed:compute", inputs=tuple(str(BENCHMARKS / f) for f in BENCHMARK_FILES),
-            also="; ".join(BENCHMARK_FILES.values()), readme=tuple(f"speed-{Path(f).stem}" for f in BENCHMARK_FILES)),
+            also="; ".join(BENCHMARK_FILES.values())),
 )
 
 

@@ -19,21 +19,8 @@ class Table:
     """Column headings."""
     rows: tuple[tuple[str, ...], ...]
     """Cells, formatted (numbers with their units where the heading has none)."""
-    readme: str = ""
-    """Name of the README block (``<!-- report:NAME -->``) this table fills, if any."""
     note: str = ""
     """A sentence under the table (units, tolerances, what a mark means)."""
-    captioned: bool = False
-    """Its README block carries the title above and the note below the table too (a table
-    whose provenance, such as the machine and date of a measurement, only it knows)."""
-
-    def markdown(self) -> str:
-        def line(cells):
-            return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"
-        body = [line(self.columns), "|" + " --- |" * len(self.columns), *map(line, self.rows)]
-        if self.captioned:
-            body = [self.title + ":", "", *body, *(["", self.note] if self.note else [])]
-        return "\n".join(body)
 
 
 @dataclass(frozen=True)
@@ -96,7 +83,7 @@ def dump(result: Result, path: Path) -> None:
 def load(path: Path) -> Result:
     d = json.loads(Path(path).read_text(encoding="utf-8"))
     return Result(tables=tuple(Table(t["title"], tuple(t["columns"]), tuple(tuple(r) for r in t["rows"]),
-                                     t.get("readme", ""), t.get("note", ""), t.get("captioned", False))
+                                     t.get("note", ""))
                         for t in d["tables"]),
                   figures=tuple(Figure(**f) for f in d["figures"]), notes=tuple(d["notes"]),
                   files=tuple(tuple(f) for f in d["files"]), stamp=d["stamp"])

@@ -15,7 +15,6 @@ def compute(ctx) -> Result:
     line, rows = write_case_diagnosis(ctx.work, case, ctx.scope["seed"], ctx.scope.get("scenarios") or tuple(SCENARIOS))
     shown = [{**r, "fitted": cell(r["fitted"])} for r in rows]
     return Result(tables=(from_dicts("Every scenario: hidden pieces, verdict, pieces named", shown, COLUMNS,
-                                     readme="case-diagnosis",
                                      note=f"{line}. Truth: P2 elements; diagnosis: the case's P1 elements; both on "
                                           "the case's geometry with its element sizes times mesh_factor. "
                                           "p2_minus_p1_delta: the diagnosis' discretisation check on δ, in units "

@@ -14,7 +14,6 @@ def compute(ctx) -> Result:
 
     st = write_compensation_study(ctx.work, paper_model(), ctx.scope["dim"])
     summary = table("Compensation on conditions 1-3: the paper's procedure against its ±6–7 µm", *summary_rows(st),
-                    readme="compensation",
                     note="Bands counted after the first 10 min; the residual columns are the K-theory loop with the "
                          "piezo (reset strategy).")
     every = from_dicts("Every predictor (µm unless stated)", [asdict(r) for r in st.rows],

@@ -64,7 +64,7 @@ def compute(ctx) -> Result:
                      signed(f"{100 * (got / float(target) - 1):+.3f} %"),
                      _mesh_note(path, case), _element(case, extra)))
     t = table("NAFEMS benchmarks: gatetherm against the published targets",
-              ("benchmark", "target", "gatetherm", "rel. error", "mesh", "element"), rows, readme="nafems",
+              ("benchmark", "target", "gatetherm", "rel. error", "mesh", "element"), rows,
               note="Each case is `validation/nafems/NAME.toml` run as `gatetherm run` runs it; the value is the "
                    "probe `target` in its summary.json.")
     return Result(tables=(t,))

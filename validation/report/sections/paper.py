@@ -47,7 +47,7 @@ def compute(ctx) -> Result:
                               "peak of δ, condition 1"))
     columns, rows = table_rows(res, dims, load)
     size = ctx.scope.get("size_3d")
-    t = table("The paper's figures against gatetherm's", columns, rows, readme="paper",
+    t = table("The paper's figures against gatetherm's", columns, rows,
               note="✓: within the acceptance band (±25 % in 2-D, ±35 % in 3-D, peak time ±8 min). "
                    + (f"3-D on {size * 1e3:g}-mm elements (the model's are "
                       f"{paper_model().model.mesh.size_3d * 1e3:g} mm). " if size else "")

@@ -18,10 +18,10 @@ def compute(ctx) -> Result:
     save(plot_rom_error(st.errors), ctx.work / "rom_error.png")
     save(plot_rom_bands(st.rows), ctx.work / "rom_bands.png")
     checks = table("The reduced model against full FE runs (1-min samples)", rs.CHECK_COLUMNS, rs.check_rows(st.checks),
-                   readme="rom-check", note="Built in: assembly and reduction, wall time on this machine (load average "
+                   note="Built in: assembly and reduction, wall time on this machine (load average "
                                             "at the top of the section); 5-h run: the reduced march alone.")
     study = table("Compensation: the paper's procedure, the regression (MLR) and the reduced model (µm)", rs.COLUMNS,
-                  rs.rows_text(st.rows), readme="rom", note=rs.LEGEND)
+                  rs.rows_text(st.rows), note=rs.LEGEND)
     figures = (Figure("rom_error.png", "δ of the 30-state reduced model minus δ of the FE run, conditions 1-3"),
                Figure("rom_bands.png", "Residual band of each compensator per case (log scale); the targets are "
                                        "3 µm on the default models and 5 µm on the hidden-effect runs"))

@@ -5,7 +5,6 @@ they take long and want a quiet machine."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 from gatetherm.validation.report.registry import BENCHMARK_FILES, BENCHMARKS
 from gatetherm.validation.report.result import Result, cell, table
@@ -13,12 +12,11 @@ from gatetherm.validation.report.result import Result, cell, table
 
 def benchmark_table(name: str, data: dict, command: str):
     """The table of one benchmark result file: its columns and rows as they are, captioned with the
-    command, date and machine it records; it fills the README block ``speed-<stem of name>``."""
+    command, date and machine it records."""
     cmd = (data.get("command") or command).strip()
     return table(f"{name}: measured by `{cmd}` on {data.get('machine', 'an unrecorded machine')}, "
                  f"{data.get('date', 'undated')}", data["columns"], [[cell(v) for v in r] for r in data["rows"]],
-                 note="; ".join(str(n) for n in data.get("notes", ())), readme=f"speed-{Path(name).stem}",
-                 captioned=True)
+                 note="; ".join(str(n) for n in data.get("notes", ())))
 
 
 def compute(ctx) -> Result:

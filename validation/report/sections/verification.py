@@ -62,7 +62,7 @@ def compute(ctx) -> Result:
     spatial, temporal, rows = _orders(ctx.scope)
     save(plot_orders(spatial, temporal), ctx.work / "orders.png")
     orders = table("Observed convergence orders (least-squares slope of log error against log h or log dt)",
-                   ("check", "observed", "expected"), rows, readme="verification",
+                   ("check", "observed", "expected"), rows,
                    note="Space: unit square refined n times (h = 2^-n) or unit cube of n³ cubes of six tetrahedra "
                         "(h = 1/n), manufactured solutions with every term of the weak forms. Time: the unit-square "
                         "heat system with the oil loop and a supply hose against its exact modal solution over "

@@ -1,0 +1,135 @@
+"""``gatetherm sensors``: where to put the thermocouples of any case (or the paper's frame), from its
+reduced model: the surface points whose temperatures predict every relative displacement best on
+held-out duty cycles (docs/sensors.md; the library: gatetherm.place_sensors).
+
+Writes ``DIR/sensors.toml`` (the chosen points as ``[probes]`` to paste into a case),
+``DIR/model.json``, ``DIR/curve.csv``, ``DIR/curve.png``, ``DIR/machine.png`` and, last,
+``DIR/summary.json`` (:func:`gatetherm.api.write_placement`).
+"""
+from __future__ import annotations
+
+import time
+
+from gatetherm import InputError
+from gatetherm.checks import POSITIVE, Range
+from gatetherm.cli.options import add_model_options, number, refuse_model_options
+
+OUTPUTS = ("sensors.toml", "model.json", "curve.csv", "curve.png", "machine.png", "summary.json")
+COUNT, LOADS, STATES = Range(1, 50, whole=True), Range(0, 500, whole=True), Range(2, 200, whole=True)
+NOISE, LENGTH = Range(0.0, unit="K"), Range(0.0, unit="m")
+
+
+def _floats(text: str, option: str, example: str) -> list[float]:
+    try:
+        return [float(v) for v in text.replace(":", ",").split(",")]
+    except ValueError:
+        raise InputError(option, f"{text!r} is not a list of numbers", f"e.g. {option} {example}") from None
+
+
+def register(sub) -> None:
+    p = sub.add_parser("sensors", help="where to put the thermocouples: sensor placement from the FE model",
+                       description=__doc__.split("\n\n")[0])
+    p.add_argument("--case", metavar="CASE.toml", help="a case file (default: the paper's frame, --dim/--config)")
+    add_model_options(p)
+    p.add_argument("--mesh-factor", type=number(POSITIVE), metavar="F",
+                   help="with --case: mesh its geometry with the element sizes times F")
+    p.add_argument("--count", type=number(COUNT), default=3, metavar="K", help="sensors to place (default 3)")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--candidates", metavar="NAME,...", help="boundaries whose nodes are candidates "
+                   "(default: the outer surface)")
+    p.add_argument("--spacing", type=number(LENGTH), default=0.0, metavar="M", help="thin the candidates to this "
+                   "spacing, m")
+    p.add_argument("--exclude", action="append", default=[], metavar="X0,Y0[,Z0],X1,Y1[,Z1]",
+                   help="a box (low corner, high corner, m) no sensor may lie in; repeatable")
+    p.add_argument("--min-distance", type=number(LENGTH), default=0.0, metavar="M",
+                   help="least distance between two chosen sensors, m")
+    p.add_argument("--noise-K", type=number(NOISE), default=0.05, metavar="K", help="sensor noise, K (default 0.05)")
+    p.add_argument("--schedules", nargs="+", metavar="FILE.csv", help="training duty cycles instead of the "
+                   "generated ones (the data format; the case's own schedule is added)")
+    p.add_argument("--held-out", nargs="+", metavar="FILE.csv", help="duty cycles to judge on (default: the paper's "
+                   "conditions 1-3 for the frame's inputs, else generated)")
+    p.add_argument("--loads", type=number(LOADS), default=20, metavar="N", help="generated training loads (default 20)")
+    p.add_argument("--range", action="append", default=[], metavar="NAME=LO:HI",
+                   help="range of an input in the generated loads (default: its span over the case's schedules); "
+                   "repeatable")
+    p.add_argument("--seed", type=int, default=0, metavar="N", help="seed of the generated loads and the noise")
+    p.add_argument("--states", type=number(STATES), default=30, metavar="N", help="states of the reduced model (default 30)")
+    p.add_argument("--form", choices=("auto", "static", "dynamic"), default="auto",
+                   help="error-model family (default auto: dynamic only if 3%% better)")
+    p.add_argument("--check", action="store_true",
+                   help="also check by full FE runs of every load with probes at the chosen points")
+    p.set_defaults(func=run)
+
+
+def _settings(args, dim: int) -> dict:
+    boxes = []
+    for text in args.exclude:
+        v = _floats(text, "--exclude", "0,0,0.2,0.1" if dim == 2 else "0,0,0,0.2,0.1,0.1")
+        if len(v) != 2 * dim or any(a > b for a, b in zip(v[:dim], v[dim:])):
+            raise InputError(f"--exclude {text}", f"is not a {dim}-D box", f"give {2 * dim} numbers: the low "
+                             "corner, then the high one")
+        boxes.append((v[:dim], v[dim:]))
+    ranges = {}
+    for text in args.range:
+        name, _, span = text.partition("=")
+        v = _floats(span, f"--range {name}", f"{name or 'spindle_W'}=0:200")
+        if not name or len(v) != 2:
+            raise InputError(f"--range {text}", "is not NAME=LO:HI", "e.g. --range spindle_W=0:200")
+        ranges[name] = (v[0], v[1])
+    names = tuple(n.strip() for n in (args.candidates or "").split(",") if n.strip())
+    return {"boundaries": names, "spacing_m": args.spacing, "exclude": boxes, "min_distance_m": args.min_distance,
+            "noise_K": args.noise_K, "loads": args.loads, "ranges": ranges, "seed": args.seed, "states": args.states,
+            "form": args.form}
+
+
+def run(args) -> int:
+    import gatetherm as gt
+    from gatetherm.outdir import output_dir
+
+    if args.case is not None:
+        refuse_model_options(args)
+        case = gt.load_case(args.case, args.mesh_factor or 1.0)
+    elif args.mesh_factor is not None:
+        raise InputError("--mesh-factor", "goes with --case only", "give --config with a finer mesh for the frame")
+    else:
+        case = gt.gate_frame(args.dim, args.config)
+    settings = _settings(args, case.dim)
+    schedules = [gt.schedule_file(f, case) for f in args.schedules or ()]
+    held = [gt.schedule_file(f, case) for f in args.held_out or ()]
+    files = (args.config, *case.files, *(args.schedules or ()), *(args.held_out or ()))
+    with output_dir(args.out, OUTPUTS, keep=files) as out:
+        t0 = time.perf_counter()
+        placement = gt.place_sensors(case, args.count, schedules=schedules or None, held_out=held or None, **settings)
+        seconds = time.perf_counter() - t0
+        check = gt.check_placement(case, placement) if args.check else None
+        summary = gt.write_placement(out, placement, case, check, {"seconds_total": round(seconds, 2)})
+    _report(placement, summary, check, out, seconds)
+    return 0
+
+
+def _report(placement, summary, check, out, seconds) -> None:
+    print(f"{len(placement.sensors)} sensors of {len(placement.candidates)} candidates ({len(placement.shortlist)} "
+          f"screened) on a mesh of {summary['mesh_nodes']} nodes, placed in {seconds:.1f} s from "
+          f"{len(placement.training)} training loads, judged on {len(placement.held_out)} held-out loads; wrote {out}/"
+          "sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json")
+    for c in placement.curve:
+        errs = ", ".join(f"{k} {v:.3g}" for k, v in c.held_out_mae_um.items())
+        where = "; ".join(f"{s.name} ({', '.join(f'{v:.3f}' for v in s.xyz)}) on {s.boundary}" for s in c.sensors)
+        print(f"K={c.count} {c.form}: held-out MAE {errs} um (leave-one-load-out {c.cv_mean_um:.3g} um); {where}")
+    if placement.stopped:
+        print(f"stopped: {placement.stopped}")
+    for note in placement.notes:
+        print(f"note: {note}")
+    for name, errs in placement.failed.items():
+        print(f"{name} failed (model refitted without it): held-out MAE "
+              + ", ".join(f"{k} {v:.3g}" for k, v in errs.items()) + " um")
+    if placement.signals:
+        sig = placement.signals
+        print(f"the case's thermocouples θ_A, θ_B, θ_C ({sig['form']}): held-out MAE "
+              + ", ".join(f"{k} {v:.3g}" for k, v in sig["held_out_mae_um"].items()) + " um")
+    if check:
+        print(f"FE check ({check.runs} runs, {check.seconds:.1f} s): held-out MAE "
+              + ", ".join(f"{k} {v:.3g} um ({check.ratio[k]:.3f} of the reduced model's)"
+                          for k, v in check.held_out_mae_um.items())
+              + f"; sensor temperatures within {check.temperature_error_K:.2g} K of FE")
+
