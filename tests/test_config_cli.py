@@ -114,3 +114,20 @@ def test_simulate_applies_effects_of_the_model_file(tmp_path):
     s = json.loads((tmp_path / "e" / "summary.json").read_text())
     assert s["effects"] == {"stand_drift": 2.0}
     assert s["first_peak_um"] > REGRESSION["first_peak_um"] + 1.0
+
+
+def test_a_command_imports_only_its_own_command_module():
+    """`gatetherm simulate` builds the parser of simulate alone: the other commands' libraries
+    (the error models' scipy.signal, 1.3 s) are not imported; `gatetherm --help` lists all."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from gatetherm.cli import _command, build_parser; "
+            "p = build_parser(_command(['-v', 'simulate', '--condition', '1'])); "
+            "print(sorted(m for m in sys.modules if m.startswith('gatetherm.cli.')), 'scipy.signal' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out == "['gatetherm.cli.options', 'gatetherm.cli.simulate'] False\n"
+    from gatetherm.cli import COMMAND_MODULES, build_parser
+
+    listed = build_parser()._subparsers._group_actions[0].choices
+    assert list(listed) == list(COMMAND_MODULES)

@@ -69,19 +69,27 @@ class _Signals:
             signal.signal(sig, handler)
 
 
-def build_parser():
+def _command(argv: list[str]) -> str | None:
+    """The command named in ``argv`` (its first word that is no option), if it is one."""
+    word = next((a for a in argv if not a.startswith("-")), None)
+    return word if word in COMMAND_MODULES else None
+
+
+def build_parser(only: str | None = None):
+    """The argument parser of every command, or of the command ``only`` alone (a run imports
+    just its own command's module: the others' libraries cost a second or more to import)."""
     import importlib
 
     from gatetherm.cli.options import Parser
 
     parser = Parser(
         prog="gatetherm",
-        description="Thermal deformation of gate-type machine-tool frames: "
-        "FE, beam theory and compensation.",
+        description="Thermal deformation of machine tools and its compensation: FE on the paper's frame or any "
+        "machine in a case file, beam theory, reduced models, compensation, sensor placement, diagnosis.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in COMMAND_MODULES:
+    for name in (only,) if only else COMMAND_MODULES:
         importlib.import_module(f"gatetherm.cli.{name}").register(sub)
     return parser
 
@@ -101,7 +109,7 @@ def _run(argv: list[str] | None) -> int:
     from gatetherm import InputError
     from gatetherm.cli.options import UsageError
 
-    parser = build_parser()
+    parser = build_parser(_command(sys.argv[1:] if argv is None else argv))
     try:
         args = parser.parse_args(argv)
     except UsageError as err:
