@@ -50,7 +50,7 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None,
     """Build a :class:`Study` from a parsed STUDY.toml (``base``: the frame's model it overrides;
     ``case``: a case file it overrides instead)."""
     from gatetherm.studies.run.config import load_config
-    from gatetherm.studies.sweeps.sweep import COMPUTE, PlotSpec, Study
+    from gatetherm.studies.sweeps.sweep import COMPUTE, Study
 
     known = {"study": dict, "set": dict, "grid": dict, "plot": list}
     for key, value in data.items():
@@ -79,37 +79,16 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None,
         raise InputError("study.fit_frame", f"expected true/false, got {fit!r}")
     if base is None:
         base = load_config(head.get("config"))
-    fixed = {k: _scalar(f"set.{k}", v) for k, v in _flatten(data.get("set", {})).items()}
-    grid = []
-    for key, values in _flatten(data.get("grid", {})).items():
-        if not isinstance(values, list) or not values:
-            raise InputError(f"grid.{key}", "expected a non-empty list of values", f'e.g. "{key}" = [1, 2]')
-        if key in fixed:
-            raise InputError(f"set.{key}", "is also swept in [grid]", "keep it in one of the two")
-        grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
-    if not grid:
-        raise InputError("grid", "no swept parameter", 'add e.g. "geometry.l4" = [0.2, 0.3] under [grid]')
+    fixed, grid = _set_and_grid(data, '"geometry.l4" = [0.2, 0.3]')
     columns = {k for k, _ in grid} | {"nodes"} | {c for k in compute for c in COMPUTE[k]}
-    plots = []
-    for i, spec in enumerate(data.get("plot", [])):
-        if not isinstance(spec, dict):
-            raise InputError(f"plot[{i + 1}]", "expected a table", "write [[plot]] with x, y and hue")
-        for key, value in spec.items():
-            if key not in ("x", "y", "hue"):
-                raise InputError(f"plot[{i + 1}].{key}", "unknown key", "known keys: x, y, hue")
-            if value not in columns:
-                raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",
-                                 f"choose from {', '.join(sorted(columns))}")
-        if "x" not in spec or "y" not in spec:
-            raise InputError(f"plot[{i + 1}]", "needs x and y")
-        plots.append(PlotSpec(spec["x"], spec["y"], spec.get("hue")))
+    plots = _plots(data, columns)
     return Study(str(head.get("name", source)), dim, base, tuple(fixed.items()), tuple(grid),
                  tuple(compute), tuple(plots), fit)
 
 
 def _case_study(data: dict, head: dict, source: str, path: str) -> Study:
     from gatetherm.studies.run.case import load_case
-    from gatetherm.studies.sweeps.sweep import PlotSpec, Study
+    from gatetherm.studies.sweeps.sweep import Study
 
     for key in ("dim", "config", "fit_frame"):
         if key in head:
@@ -117,6 +96,17 @@ def _case_study(data: dict, head: dict, source: str, path: str) -> Study:
     compute = head.get("compute", ["run"])
     if compute not in (["run"], "run"):
         raise InputError("study.compute", f"{compute!r}: a case study computes run only", 'use compute = ["run"]')
+    fixed, grid = _set_and_grid(data, '"thermal.free.film" = [6.0, 10.0]')
+    case = load_case(path)
+    results = case_columns(case)
+    columns = {k for k, _ in grid} | {"nodes"} | set(results)
+    plots = _plots(data, columns)
+    return Study(str(head.get("name", source)), case.dim, None, tuple(fixed.items()), tuple(grid), ("run",),
+                 tuple(plots), False, str(path), results)
+
+
+def _set_and_grid(data: dict, example: str) -> tuple[dict, list]:
+    """The fixed values of ``[set]`` and the swept ``(key, values)`` of ``[grid]``, checked."""
     fixed = {k: _scalar(f"set.{k}", v) for k, v in _flatten(data.get("set", {})).items()}
     grid = []
     for key, values in _flatten(data.get("grid", {})).items():
@@ -126,10 +116,14 @@ def _case_study(data: dict, head: dict, source: str, path: str) -> Study:
             raise InputError(f"set.{key}", "is also swept in [grid]", "keep it in one of the two")
         grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
     if not grid:
-        raise InputError("grid", "no swept key", 'add e.g. "thermal.free.film" = [6.0, 10.0] under [grid]')
-    case = load_case(path)
-    results = case_columns(case)
-    columns = {k for k, _ in grid} | {"nodes"} | set(results)
+        raise InputError("grid", "no swept key", f"add e.g. {example} under [grid]")
+    return fixed, grid
+
+
+def _plots(data: dict, columns: set) -> list:
+    """The ``[[plot]]`` specs, each naming table columns as x, y and (optionally) hue."""
+    from gatetherm.studies.sweeps.sweep import PlotSpec
+
     plots = []
     for i, spec in enumerate(data.get("plot", [])):
         if not isinstance(spec, dict) or "x" not in spec or "y" not in spec:
@@ -141,8 +135,7 @@ def _case_study(data: dict, head: dict, source: str, path: str) -> Study:
                 raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",
                                  f"choose from {', '.join(sorted(columns))}")
         plots.append(PlotSpec(spec["x"], spec["y"], spec.get("hue")))
-    return Study(str(head.get("name", source)), case.dim, None, tuple(fixed.items()), tuple(grid), ("run",),
-                 tuple(plots), False, str(path), results)
+    return plots
 
 
 def load_study(path) -> Study:
