@@ -253,10 +253,10 @@ def close_loop(ts: TimeSeries, pr: Prediction, params: CompensatorParams,
         volts, stroke = piezo.apply_commands(actuator, pr.u_um[updates])
         saturated = int(np.sum(piezo.saturated_commands(actuator, pr.u_um[updates])))
     t = ts.time_s
-    held = np.searchsorted(pr.t_s[updates], t + 1e-9 * params.sample_interval_s, side="right") - 1
-    rest = held < 0  # before the first update the actuator is at rest (0 V, no stroke)
-    command, volts, stroke = (np.where(rest, at_rest, a[np.maximum(held, 0)]) for a, at_rest in
-                              ((pr.u_um[updates], 0.0), (volts, np.nan if actuator is None else 0.0), (stroke, 0.0)))
+    # entry 0: the actuator at rest (0 V, no stroke) before the first update
+    held = np.searchsorted(pr.t_s[updates], t + 1e-9 * params.sample_interval_s, side="right")
+    command, stroke = np.r_[0.0, pr.u_um[updates]][held], np.r_[0.0, stroke][held]
+    volts = np.r_[np.nan if actuator is None else 0.0, volts][held]
     pred = np.interp(t, pr.t_s, pr.delta_pred_um) if pr.resampled else pr.delta_pred_um
     delta = ts["delta_um"]
     return ClosedLoop(pr, t, delta, pred, command, volts, stroke, delta + stroke, pr.t_s[updates], saturated)
