@@ -26,7 +26,7 @@ from gatetherm.studies.sensors.candidates import UNNAMED, Box, candidates, outer
 from gatetherm.studies.sensors.loads import InputRange, duty_cycles, input_ranges
 from gatetherm.studies.sensors.screen import mode_weights, noise
 
-C_FRAME = Path(gt.__file__).parents[1] / "validation" / "examples" / "c_frame" / "case.toml"
+C_FRAME = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame" / "case.toml"  # the checkout
 
 
 def grid(n: int = 4) -> FrameMesh:
