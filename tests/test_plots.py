@@ -5,6 +5,7 @@ one writer."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -118,8 +119,17 @@ def test_field_in_3d_is_a_surface_picture_and_leaves_pyvista_on_screen(tmp_path)
 
 
 def test_deformed_picture(cframe, tmp_path):
+    """In 2-D a tripcolor of T on the nodes moved by scale × u, the undeformed outline in grey."""
     ax = gt.plot.deformed(cframe, ax=axes())
-    assert len(ax.images) == 1 and "magnified ×" in ax.get_title() and "t = 6 h" in ax.get_title()
+    assert "t = 6 h" in ax.get_title()
+    scale = float(re.search(r"magnified ×(\d+)", ax.get_title())[1])
+    colours, outline = ax.collections
+    xy, u = cframe.case.mesh.points[:, :2], cframe.field("u")[:, :2]
+    moved = colours._triangulation
+    assert np.allclose(np.c_[moved.x, moved.y], xy + scale * u, rtol=0, atol=1e-12)
+    assert np.array_equal(colours.get_array(), cframe.field("T"))
+    boundary = cframe.scenario.model.heat.basis.mesh.boundary_facets()  # scikit-fem's own count
+    assert len(outline.get_segments()) == len(boundary) == 313
     save(ax, tmp_path / "d.png")
     assert (tmp_path / "d.png").stat().st_size > 10_000
 

@@ -119,12 +119,6 @@ def write_xdmf(model: Model, steps, path: Path) -> None:
                       + "\n".join(grids) + "\n</Grid></Domain></Xdmf>\n")
 
 
-def pyvista_grid(model: Model, U: np.ndarray, u_dofs: np.ndarray | None = None, env=None):
-    """A pyvista grid of the frame volume cells with point arrays ``T`` and ``u``
-    (``u_dofs``: the displacement of ``U``, if solved already)."""
-    return volume_grid(model.fmesh, nodal_fields(model, U, stress=False, u_dofs=u_dofs, env=env))
-
-
 def volume_grid(fmesh, point_data: dict[str, np.ndarray]):
     """A pyvista grid of the volume cells of ``fmesh`` (triangles in 2-D, tetrahedra in 3-D)
     with the nodal arrays ``point_data``."""
@@ -156,13 +150,6 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_tim
     solved = displacements(run.model, states + list(extra.items()), envs)
     write_fields(run.model, states, out / "fields", solved, envs)
     return solved
-
-
-def deformed_grid(run, t_pic: float, solved: dict[float, np.ndarray] | None = None):
-    """(time, pyvista grid with the point arrays of :func:`nodal_fields`) of the kept state
-    nearest ``t_pic`` (s); ``solved``: :func:`displacements` that may include it."""
-    t, U = nearest_state(run, t_pic)
-    return t, pyvista_grid(run.model, U, (solved or {}).get(t), run.result.envs.get(t))
 
 
 def probe_summary(problem, cols: dict[str, np.ndarray]) -> dict:

@@ -1,5 +1,5 @@
-"""Pictures on the mesh: a nodal field (a tripcolor in 2-D, a pyvista surface picture in 3-D)
-and the deformed frame. pyvista renders off screen into an image (its own plotter's setting:
+"""Pictures on the mesh: a nodal field and the deformed frame (a tripcolor in 2-D, a pyvista
+surface picture in 3-D). pyvista renders off screen into an image (its own plotter's setting:
 ``pyvista.OFF_SCREEN`` is left as it was), which matplotlib frames with a labelled colour bar."""
 from __future__ import annotations
 
@@ -84,21 +84,44 @@ def frame_image(img: np.ndarray, clim, label: str, title: str, ax=None):
     return ax
 
 
-def render_deformed(grid, title: str, scale: float, ax=None):
+def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
     """Temperature on the frame deformed by ``scale`` × displacement, the undeformed outline
-    in grey (pyvista, off screen), framed on ``ax`` with a labelled colour bar; returns the Axes.
+    in grey, with a labelled colour bar; returns the Axes. A 2-D mesh is drawn by matplotlib
+    (a tripcolor), a 3-D body by pyvista off screen and framed on ``ax``.
 
-    ``grid`` is a pyvista mesh with point arrays ``T`` (°C) and ``u`` (m, 3 components);
-    without ``T`` (a purely mechanical case) the colours show the displacement's magnitude.
+    ``fields`` are nodal arrays of ``fmesh`` (a :class:`~gatetherm.geometry.mesh.FrameMesh`):
+    ``T`` (°C) and ``u`` (m, 3 components); without ``T`` (a purely mechanical case) the
+    colours show the displacement's magnitude.
     """
-    thermal = "T" in grid.point_data
-    if not thermal:
-        grid["|u| [µm]"] = scalar("u", grid["u"])[0]
-    name = "T" if thermal else "|u| [µm]"
-    clim = _limits(np.asarray(grid[name]))
-    img = screenshot(grid.warp_by_vector("u", factor=scale), name, clim, grid)
-    return frame_image(img, clim, "temperature T [°C]" if thermal else "displacement |u| [µm]",
-                       f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges", ax)
+    name, label = ("T", "temperature T [°C]") if "T" in fields else ("|u| [µm]", "displacement |u| [µm]")
+    values = fields["T"] if "T" in fields else scalar("u", fields["u"])[0]
+    clim = _limits(np.asarray(values))
+    title = f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges"
+    if fmesh.dim == 3:
+        from gatetherm.studies.run.output import volume_grid
+
+        grid = volume_grid(fmesh, {name: values, "u": fields["u"]})
+        return frame_image(screenshot(grid.warp_by_vector("u", factor=scale), name, clim, grid), clim, label, title, ax)
+    from matplotlib.collections import LineCollection
+
+    ax = figure((7.5, 6.0)) if ax is None else ax
+    tri = np.asarray(fmesh.cells)[:, :3]
+    xy = np.asarray(fmesh.points, dtype=float)[:, :2]
+    art = ax.tripcolor(*(xy + scale * fields["u"][:, :2]).T, tri, values, shading="gouraud", cmap=CMAP,
+                       vmin=clim[0], vmax=clim[1])
+    ax.add_collection(LineCollection(xy[boundary_edges(tri)], colors="#8c8c8c", linewidths=1.2))
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    ax.figure.colorbar(art, ax=ax, fraction=0.04, pad=0.02, shrink=0.85).set_label(label)
+    ax.set_title(title, fontsize="medium")
+    return ax
+
+
+def boundary_edges(tri: np.ndarray) -> np.ndarray:
+    """The edges (pairs of node indices) that belong to one triangle of ``tri`` only."""
+    edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    uniq, count = np.unique(edges, axis=0, return_counts=True)
+    return uniq[count == 1]
 
 
 def _trim(img: np.ndarray, pad: int = 12) -> np.ndarray:
@@ -115,9 +138,12 @@ def draw_deformed(run, t: float, title, solved: dict | None = None, ax=None):
     ``t`` (s) drawn by :func:`render_deformed`, magnified so that the largest displacement shows
     as about 8 % of the frame's width (a power of ten); ``title``: text or a function of the time
     drawn; ``solved``: displacements of kept states, by time, if solved already. Returns the Axes."""
-    from gatetherm.studies.run.output import deformed_grid
+    from gatetherm.studies.run.output import nearest_state, nodal_fields
 
-    t, grid = deformed_grid(run, t, solved)
-    umax = float(np.abs(grid["u"]).max()) or 1.0
-    scale = float(10 ** np.floor(np.log10(0.08 * max(grid.bounds[1] - grid.bounds[0], 1e-9) / umax)))
-    return render_deformed(grid, title(t) if callable(title) else title, scale, ax)
+    t, U = nearest_state(run, t)
+    fmesh = run.model.fmesh
+    fields = nodal_fields(run.model, U, stress=False, u_dofs=(solved or {}).get(t), env=run.result.envs.get(t))
+    x = np.asarray(fmesh.points)[:, 0]
+    umax = float(np.abs(fields["u"]).max()) or 1.0
+    scale = float(10 ** np.floor(np.log10(0.08 * max(x.max() - x.min(), 1e-9) / umax)))
+    return render_deformed(fmesh, fields, title(t) if callable(title) else title, scale, ax)
