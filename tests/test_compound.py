@@ -208,3 +208,14 @@ def test_the_by_kinds_table_counts_each_group_and_all():
     assert lines[2] == "| effect + effect | 1 | 1 | 1 | 1 | 0 | 0 | 0 | 1 |"  # a group member named: right
     assert lines[7] == "| sensor + sensor | 1 | 1 | 0 | 1 | 1 | 0 | 0 | 1 |"
     assert lines[8] == "| all | 2 | 2 | 1 (50.0 %) | 2 | 1 (50.0 %) | 0 | 0 | 2 (100.0 %) |"
+
+
+def test_the_pairs_table_has_a_heading_for_each_column():
+    """compound.md's table of pairs: a heading above each of the CSV's columns (it had three fewer)."""
+    from gatetherm.validation.compound_study import COLUMNS, table_markdown
+
+    row = {k: "x" for k in COLUMNS} | {"kinds": "effect+effect", "both_named": True, "both_named_or_equivalent": True,
+                                       "wrong_piece": False, "missed": [], "wrong_effect": False,
+                                       "wrong_piece_strict": False}
+    head, rule, line = table_markdown([row], {}, [], None).split("## Two pieces at once\n\n")[1].splitlines()[:3]
+    assert head.count("|") == rule.count("|") == line.count("|") == len(COLUMNS) + 1 == 18

@@ -312,7 +312,7 @@ def test_run_warns_when_p1_is_too_coarse_for_bending(tmp_path, caplog):
     """The cantilever under gravity at P1 with two elements through its depth: ``run`` solves
     it once more at P2 on the same mesh and names the output in one warning line with the
     fix; P2 itself is not checked."""
-    case = f"""
+    case = """
 [mesh]
 file = "body.geo"
 [materials.body]

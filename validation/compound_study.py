@@ -209,7 +209,8 @@ def kinds_markdown(rows: list[dict]) -> str:
 
 def table_markdown(rows: list[dict], acc: dict, single_rows: list[dict], single_acc: dict | None) -> str:
     head = ["hidden pieces", "strengths", "cond.", "noise seed", "verdict", "pieces named", "or equally", "both named",
-            "wrong piece", "best rejected", "δ RMS before (µm)", "δ RMS after (µm)", "model runs", "time (s)"]
+            "wrong piece", "wrong names", "missed", "stand-ins", "best rejected", "δ RMS before (µm)",
+            "δ RMS after (µm)", "model runs", "time (s)"]
     L = ["# Compound-diagnosis study", "",
          "Held-out window: last 40 % of each 5-h, 1-min run; sensor noise at the resolution (0.1 µm, 0.05 K). "
          "Strengths in the hypothesis' unit (`gatetherm diagnose --list-effects`).", "",
