@@ -7,12 +7,15 @@ lumped fluid volumes, supports, probes, relative displacements and the time sett
 Every key is checked where it is read: an unknown key, a name that is not a group of
 the mesh, a region without a material or a boundary with two conditions is one
 :class:`~gatetherm.InputError` line naming the file and the key and listing what is
-valid. ``docs/case-file.md`` is the reference of every key.
+valid. ``docs/case-file.md`` is the reference of every key. The tables are read by
+:mod:`~gatetherm.studies.run.case_mesh` (``[mesh]``), :mod:`~gatetherm.studies.run.case_tables`
+(materials, thermal conditions, fluids, supports, probes, signals, actuator) and
+:mod:`~gatetherm.studies.run.case_mech` (loads, contacts); this module reads the rest and
+puts the case together.
 """
 from __future__ import annotations
 
 import dataclasses
-import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,55 +25,31 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, ranges
 from gatetherm.files import read_text
-from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_geometry
-from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
-from gatetherm.geometry.mesh import FrameMesh, load_mesh
+from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.effects import Targets
-from gatetherm.solvers.frame import enclosed_volume, region_volume
+from gatetherm.solvers.frame import region_volume
 from gatetherm.solvers.heat import TimeScheme
-from gatetherm.solvers.material import Material
-from gatetherm.studies.run import case_mech
-from gatetherm.studies.run.tables import Table
-from gatetherm.solvers.problem import (AXES, FaceFilm, Film, FixedTemperature, Fluid, Flux, Probe, Problem,
-                                       Relative, Signals, Source, Support, inputs, values)
+from gatetherm.solvers.problem import FaceFilm, Problem, Source, inputs, values
+from gatetherm.studies.run import case_mech, case_mesh, case_tables
 from gatetherm.studies.run.parameters import UNCERTAIN_FIX, mesh_parameter
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
+from gatetherm.studies.run.tables import Table
 from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
             "supports", "probes", "relative", "means", "signals", "time", "actuator") + case_mech.SECTIONS
-MATERIAL_KEYS = {"k": "W/(m K)", "rho": "kg/m³", "c": "J/(kg K)", "E": "Pa", "nu": "1", "alpha": "1/K",
-                 "thickness": "m"}
-MATERIAL = ranges(Material)
-"""Admissible values of the material keys (those of the model file's [material])."""
 SCHEME = ranges(TimeScheme)
-METRES, SECONDS = Range(0.0, lo_open=True, unit="m"), Range(0.0, lo_open=True, unit="s")
-THICKNESS = Range(1e-6, 1e3, unit="m")
-"""Thickness of a 2-D section, from a micrometre to a kilometre: far beyond, the solid's
-matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
-C-frame example, whose other regions are 0.25–0.6 m thick)."""
-FILM = Range(0.0, unit="W/(m² K)")
+SECONDS = Range(0.0, lo_open=True, unit="s")
 KEYS = {
     "case": ("name", "order", "plane", "uncertain"),
-    "mesh": ("file", "size", "parameters", "refine", "groups", "include"),
-    "mesh.refine": ("near", "size", "distance"),
-    "mesh.groups.NAME": ("dim", "box", "rest", "normal", "tolerance"),
-    "materials.REGION": tuple(MATERIAL_KEYS),
     "initial": ("temperature", "reference"),
     "temperature": ("field", "regions"),
-    "thermal.BOUNDARY": ("film", "ambient", "temperature", "flux"),
     "faces": ("film", "ambient"),
     "sources.REGION": ("density", "power"),
-    "fluids.NAME": ("boundary", "volume", "rho_c", "flow_rate", "capacity", "conductance", "film_on", "film_off",
-                    "supply", "pump", "hose_capacity", "hose_loss", "hose_name", "ambient"),
-    "supports.BOUNDARY": ("type", "components", "stiffness", "value"),
-    "probes.NAME": ("point", "quantities", "region"),
-    "relative.NAME": ("a", "b", "axis"),
-    "signals": ("theta_A", "theta_B", "theta_C", "delta"),
     "time": ("end", "step", "output", "schedule", "fields", "scheme"),
     "time.scheme": ("theta", "restart", "restart_intervals"),
-    "actuator": ("type", "stroke", "stack_stiffness", "spring_stiffness", "preload", "dead_band", "hysteresis",
-                 "reset"),
+    **case_mesh.KEYS,
+    **case_tables.KEYS,
     **case_mech.KEYS,
 }
 """The keys of every table of a case file (NAME, REGION, BOUNDARY, POINT: a name of the case or a
@@ -213,237 +192,6 @@ class CaseFile:
         return None
 
 
-def _mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
-    m = top.sub("mesh", KEYS["mesh"])
-    path = base / m.string("file")
-    if not path.is_file():
-        m.fail("file", f"no such file '{path}'", "give a .msh, .geo or CAD file beside the case")
-    suffix = path.suffix.lower()
-    if suffix in (".msh", ".vtu"):
-        for k in ("size", "parameters", "refine", "groups", "include"):
-            if k in m.data:
-                m.fail(k, f"applies only to a geometry that gatetherm meshes ({SCRIPT}, {', '.join(CAD)})",
-                       "mesh the file again in gmsh, or give the .geo")
-        if factor != 1.0:
-            m.fail("file", "a mesh file cannot be refined", "give the .geo or CAD file to mesh it finer")
-        return _in_case(top, load_mesh, path)
-    if suffix not in (SCRIPT, *CAD):
-        m.fail("file", f"unknown mesh or geometry format '{suffix}'", f"use .msh, {SCRIPT} or {', '.join(CAD)}")
-    params = m.sub("parameters")
-    refine = []
-    for i, r in enumerate(m.data.get("refine", [])):
-        rt = Table(top.file, f"mesh.refine[{i + 1}]", r, KEYS["mesh.refine"])
-        refine.append(Refinement(rt.string("near"), factor * rt.number("size", METRES),
-                                 rt.number("distance", METRES)))
-    include = m.data.get("include", [])
-    if not (isinstance(include, list) and all(isinstance(f, str) for f in include)):
-        m.fail("include", f"expected a list of file names, got {include!r}", 'e.g. include = ["../common.geo"]')
-    for f in include:
-        if not (base / f).is_file():
-            m.fail("include", f"no such file '{base / f}'",
-                   "name files the geometry script reads, relative to the case")
-    groups = tuple(_group(m.sub("groups").sub(name, KEYS["mesh.groups.NAME"]), name)
-                   for name in m.data.get("groups", {}))
-    size = factor * m.number("size", METRES, 0.0) or None
-    return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
-                                                 tuple(refine), groups, tuple(base / f for f in include), base, factor))
-
-
-def _in_case(top: Table, read, arg) -> FrameMesh:
-    """``read(arg)``, its errors about case keys (``mesh.…``, ``--mesh-factor``) naming the case file."""
-    try:
-        return read(arg)
-    except InputError as err:
-        raise err.at(str(top.file)) if err.field.startswith(("mesh", "--")) else err from None
-
-
-def _group(g: Table, name: str) -> GroupRule:
-    """A [mesh.groups.NAME] rule: box (one or a list), rest, normal (with tolerance)."""
-    box = g.data.get("box", [])
-    boxes = [box] if box and all(isinstance(b, (int, float)) for b in box) else box
-    if not (isinstance(boxes, list) and all(_numbers(b, (6,)) for b in boxes)):
-        g.fail("box", f"expected [xmin, ymin, zmin, xmax, ymax, zmax] or a list of them, got {box!r}",
-               "give six numbers in m per box")
-    rest = g.data.get("rest", False)
-    if not isinstance(rest, bool):
-        g.fail("rest", f"expected true or false, got {rest!r}")
-    normal = g.data.get("normal")
-    if normal is not None and not (_numbers(normal, (2, 3)) and any(normal)):
-        g.fail("normal", f"expected a direction [nx, ny(, nz)], got {normal!r}", "e.g. normal = [0, 0, 1]")
-    if not (boxes or rest or normal):
-        g.fail("box", "the group selects nothing", "give box, normal or rest = true")
-    if "tolerance" in g.data and normal is None:
-        g.fail("tolerance", "goes with normal only", "remove it or give normal")
-    return GroupRule(name, int(g.number("dim", Range(0, 3, whole=True))), tuple(tuple(map(float, b)) for b in boxes),
-                     rest, tuple(map(float, normal)) if normal else None,
-                     g.number("tolerance", Range(0.0, math.pi, lo_open=True, unit="rad"), NORMAL_TOLERANCE))
-
-
-def _numbers(v, lengths) -> bool:
-    """Whether ``v`` is a list of finite numbers of one of ``lengths``."""
-    return isinstance(v, list) and len(v) in lengths and all(
-        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)
-
-
-def _materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
-    mats = top.sub("materials", tuple(fm.regions))
-    missing = [r for r in fm.regions if r not in mats.data]
-    if missing:
-        mats.fail(missing[0], "region without a material", f"add [materials.{missing[0]}] (regions: "
-                  f"{', '.join(fm.regions)})")
-    materials, thickness = {}, {}
-    for region in fm.regions:
-        t = mats.sub(region, KEYS["materials.REGION"])
-        for k in need - set(t.data):
-            t.fail(k, "missing", f"give {k} in {MATERIAL_KEYS[k]} (needed for "
-                   f"{'elasticity' if k in ('E', 'nu', 'alpha') else 'the heat solve'})")
-        given = {k: t.number(k, MATERIAL[k], math.nan if k not in need else None) for k in MATERIAL}
-        materials[region] = Material(**given)
-        if "thickness" in t.data:
-            if fm.dim == 3:
-                t.fail("thickness", "applies to 2-D sections only", "remove it")
-            thickness[region] = t.number("thickness", THICKNESS)
-    return materials, thickness
-
-
-def _boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
-    th = top.sub("thermal", tuple(fm.boundaries))
-    out = {"films": [], "fixed": [], "fluxes": []}
-    for b in th.data:
-        t = th.sub(b, KEYS["thermal.BOUNDARY"])
-        kinds = [k for k in ("film", "temperature", "flux") if k in t.data]
-        if len(kinds) != 1:
-            t.fail("/".join(kinds) or "film", "give exactly one condition: film (with ambient), temperature or flux",
-                   "a boundary without a condition is adiabatic; leave it out")
-        if kinds == ["film"]:
-            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C")))
-        elif "ambient" in t.data:
-            t.fail("ambient", "goes with a film only", "remove it or give film")
-        elif kinds == ["temperature"]:
-            out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C")))
-        else:
-            out["fluxes"].append(Flux(b, t.value("flux", names, unit="W/m²")))
-    return out
-
-
-def _fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
-    out = []
-    fl = top.sub("fluids")
-    for name in fl.data:
-        t = fl.sub(name, KEYS["fluids.NAME"])
-        wall = t.name("boundary", fm.boundaries, "boundary")
-        hose = t.number("hose_capacity", Range(0.0, unit="J/K"), 0.0)
-        if "capacity" in t.data:  # the lump's own figures
-            capacity = t.number("capacity", Range(0.0, lo_open=True, unit="J/K"))
-            conductance = t.number("conductance", Range(0.0, unit="W/K"))
-        else:  # the fluid's: volume (default: enclosed by the boundary), rho_c and flow
-            depths = set(thickness.values()) | ({1.0} if len(thickness) < len(fm.regions) else set())
-            if fm.dim == 2 and len(depths) > 1 and "volume" not in t.data:
-                t.fail("volume", "missing: the regions of this 2-D section differ in thickness",
-                       "give the volume in m³")
-            volume = t.number("volume", Range(0.0, unit="m³"), 0.0) or enclosed_volume(fm, wall, min(depths))
-            rho_c = t.number("rho_c", Range(0.0, lo_open=True, unit="J/(m³ K)"))
-            capacity, conductance = rho_c * volume, rho_c * t.number("flow_rate", Range(0.0, unit="m³/s"))
-        out.append(Fluid(name, wall, capacity, t.number("film_on", FILM),
-                         t.number("film_off", FILM), conductance, t.value("supply", names, unit="°C"),
-                         t.value("pump", names, default=1.0), hose, t.number("hose_loss", Range(0.0, unit="W/K"), 0.0),
-                         t.value("ambient", names, default=20.0 if not hose else None, unit="°C"),
-                         t.string("hose_name", default="")))
-    return tuple(out)
-
-
-def _supports(top: Table, fm: FrameMesh, names) -> tuple:
-    sup = top.sub("supports", case_mech.support_names(fm))
-    out = []
-    for b in sup.data:
-        t = sup.sub(b, KEYS["supports.BOUNDARY"])
-        kind = t.string("type", choices=("clamped", "normal", "fixed", "foundation", "displacement"))
-        case_mech.check_support(t, fm, b, kind)
-        if kind == "displacement":
-            out.append(case_mech.displacement_support(t, fm, b, names))
-            continue
-        comps = tuple(range(fm.dim))
-        if kind in ("fixed", "foundation") and ("components" in t.data or kind == "fixed"):
-            raw = t.data.get("components")
-            axes = AXES[:fm.dim]
-            if not (isinstance(raw, list) and raw and all(isinstance(c, str) and c in axes for c in raw)):
-                t.fail("components", f"expected a list of {', '.join(axes)}, got {raw!r}", 'e.g. components = ["x"]')
-            comps = tuple(sorted({axes.index(c) for c in raw}))
-        if kind == "normal":
-            comps = (_normal_axis(t, fm, b),)
-        stiff = t.number("stiffness", Range(0.0, lo_open=True, unit="N/m³")) if kind == "foundation" else None
-        if kind != "foundation" and "stiffness" in t.data:
-            t.fail("stiffness", "goes with type = \"foundation\" only", "remove it")
-        out.append(Support(b, comps, stiff))
-    return tuple(out)
-
-
-def _normal_axis(t: Table, fm: FrameMesh, boundary: str) -> int:
-    """The axis normal to a plane boundary parallel to a coordinate plane."""
-    X = fm.points[np.unique(fm.boundaries[boundary])]
-    spread = np.ptp(X, axis=0)
-    flat = np.flatnonzero(spread <= 1e-9 * max(np.ptp(fm.points, axis=0).max(), 1.0))
-    if len(flat) != 1:
-        t.fail("type", f"boundary '{boundary}' is not a plane normal to x, y{' or z' if fm.dim == 3 else ''}",
-               'use type = "fixed" with components')
-    return int(flat[0])
-
-
-def _probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
-    pr = top.sub("probes")
-    out = []
-    finder = None
-    for name in pr.data:
-        t = pr.sub(name, KEYS["probes.NAME"])
-        point = t.data.get("point")
-        if isinstance(point, str):
-            if point not in fm.sensors:
-                t.fail("point", f"'{point}' is not a point group of the mesh", f"points: {', '.join(fm.sensors) or 'none'}"
-                       "; or give coordinates [x, y(, z)] in m")
-            xyz = tuple(float(v) for v in fm.points[fm.sensors[point]])
-        elif _numbers(point, (fm.dim,)):
-            xyz = tuple(float(v) for v in point)
-            if finder is None:
-                from gatetherm.solvers.fem import to_skfem
-
-                finder = to_skfem(fm).element_finder()
-            try:
-                finder(*np.array(xyz)[:, None])
-            except ValueError:
-                t.fail("point", f"{list(xyz)} lies outside the mesh", "give a point inside the body")
-        else:
-            t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
-                   'e.g. point = "A" or point = [0.1, 0.2]')
-        q = t.data.get("quantities", list(quantities))
-        if not (isinstance(q, list) and all(x in quantities for x in q)):
-            t.fail("quantities", f"{q!r} is not admissible", f"choose from {', '.join(quantities)}")
-        region = t.name("region", fm.regions, "region", default="") or None
-        out.append(Probe(name, xyz, tuple(q), region))
-    return tuple(out)
-
-
-def _relative(top: Table, probes, dim: int) -> tuple:
-    rel = top.sub("relative")
-    names = [p.name for p in probes if "u" in p.quantities] + [p.name for p in probes if "u" not in p.quantities]
-    out = []
-    for name in rel.data:
-        t = rel.sub(name, KEYS["relative.NAME"])
-        out.append(Relative(name, t.name("a", names, "probe"), t.name("b", names, "probe"),
-                            AXES.index(t.string("axis", choices=tuple(AXES[:dim])))))
-    return tuple(out)
-
-
-def _signals(top: Table, probes, relative) -> Signals:
-    s = top.sub("signals", KEYS["signals"])
-    temps = [p.name for p in probes if "T" in p.quantities]
-    c = s.data.get("theta_C", [])
-    c = [c] if isinstance(c, str) else c
-    if not (isinstance(c, list) and all(x in temps for x in c)):
-        s.fail("theta_C", f"{c!r} is not a list of probes with T", f"probes: {', '.join(temps)}")
-    return Signals(s.name("theta_A", temps, "probe", "") or None, s.name("theta_B", temps, "probe", "") or None,
-                   tuple(c), s.name("delta", [r.name for r in relative], "relative displacement", "") or None)
-
-
 def _time(top: Table, base: Path):
     """The time settings, the scheme and the schedule file's series (None: no schedule)."""
     if "time" not in top.data:
@@ -528,7 +276,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     order = head.data.get("order", 1)
     if isinstance(order, bool) or order not in (1, 2):
         head.fail("order", f"{order!r} is not admissible", "give 1 (linear) or 2 (quadratic elements)")
-    fm = _mesh(top, path.parent, mesh_factor) if mesh is None else mesh
+    fm = case_mesh.read_mesh(top, path.parent, mesh_factor) if mesh is None else mesh
     plane = head.string("plane", "stress", ("stress", "strain", "axisymmetric"))
     if plane == "axisymmetric":
         case_mech.check_axisymmetric(top, fm, data)
@@ -540,7 +288,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     need = ({"E", "nu", "alpha"} if elastic else set()) | (set() if prescribed else {"k"}) | \
         ({"rho", "c"} if time else set())
     need = ({"E", "nu"} if mechanical else need) | ({"rho"} if "gravity" in data else set())
-    materials, thickness = _materials(top, fm, need)
+    materials, thickness = case_tables.materials(top, fm, need)
     names = ("t", *columns)
     init = top.sub("initial", KEYS["initial"])
     T0 = init.number("temperature", CELSIUS, 20.0)
@@ -558,7 +306,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             reg = tt.sub("regions", tuple(fm.regions))
             kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
     else:
-        kw.update(_boundary_conditions(top, fm, names))
+        kw.update(case_tables.boundary_conditions(top, fm, names))
         src = top.sub("sources", tuple(fm.regions))
         sources = []
         for r in src.data:
@@ -576,8 +324,8 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")
             f = top.sub("faces", KEYS["faces"])
-            kw["faces"] = FaceFilm(f.number("film", FILM), f.value("ambient", names, unit="°C"))
-        kw["fluids"] = _fluids(top, fm, names, thickness)
+            kw["faces"] = FaceFilm(f.number("film", case_tables.FILM), f.value("ambient", names, unit="°C"))
+        kw["fluids"] = case_tables.fluids(top, fm, names, thickness)
     twice = _twice(kw)
     if twice:
         top.fail("thermal", f"boundary '{twice}' is given two conditions", "give each boundary one condition")
@@ -586,7 +334,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     if both:
         top.fail(f"thermal.{both[1]}", f"shares facets with thermal.{both[0]}: two conditions on those facets",
                  "give every part of the boundary one condition (split the groups, or use rest = true)")
-    supports = _supports(top, fm, names) if elastic else ()
+    supports = case_tables.supports(top, fm, names) if elastic else ()
     if elastic:
         kw.update(case_mech.read_loads(top, fm, names))
         both = _overlapping(fm, [ld.boundary for ld in kw.get("loads", ())])
@@ -598,14 +346,14 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                  "hold the body with [supports.BOUNDARY] tables")
     kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
     quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
-    probes = _probes(top, fm, quantities)
-    relative = _relative(top, probes, fm.dim) if elastic or "relative" in data else ()
+    probes = case_tables.probes(top, fm, quantities)
+    relative = case_tables.relative(top, probes, fm.dim) if elastic or "relative" in data else ()
     means = top.sub("means", None)
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)
     problem = Problem(fm.dim, materials, int(order), thickness, plane,
                       T0, init.number("reference", CELSIUS, T0),
                       supports=supports, probes=probes, relative=relative, means=mean_pairs,
-                      signals=_signals(top, probes, relative), elastic=elastic, scheme=scheme,
+                      signals=case_tables.signals(top, probes, relative), elastic=elastic, scheme=scheme,
                       thermal=not mechanical, **kw)
     case_mech.check_assembly(top, fm, problem, time is None)
     if schedule_ts is not None:
@@ -618,44 +366,8 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         schedule = timed_schedule(time.end, time.step, time.output, drive,
                                   f"schedule {time.schedule}" if time.schedule else "no schedule")
     return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
-                case_targets(problem, fm), actuator=_actuator(top), path=path, source=str(path),
+                case_targets(problem, fm), actuator=case_tables.actuator(top), path=path, source=str(path),
                 files=(path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else [])))
-
-
-def _actuator(top: Table):
-    """``[actuator]``: the paper's piezo model with its reach, stiffnesses, preload, dead band,
-    hysteresis and drive set, or ``type = "none"`` (ideal: an offset to the control); None without it."""
-    from gatetherm.studies.control.actuator import ActuatorParams, with_stroke
-
-    if "actuator" not in top.data:
-        return None
-    a = top.sub("actuator", KEYS["actuator"])
-    if a.string("type", "piezo", ("piezo", "none")) == "none":
-        if len(a.data) > 1:
-            a.fail(next(k for k in a.data if k != "type"), "goes with type = \"piezo\" only", "remove it")
-        return None
-    base, stiff = ActuatorParams(), Range(0.0, lo_open=True, unit="N/m")
-    reset = a.data.get("reset", True)
-    if not isinstance(reset, bool):
-        a.fail("reset", f"expected true/false, got {reset!r}", "true: back to 0 V before each new voltage")
-    h = a.number("hysteresis", Range(0.0, 4.0, unit="× the default"), 1.0)
-    p = dataclasses.replace(
-        base, stack_stiffness_N_per_m=a.number("stack_stiffness", stiff, base.stack_stiffness_N_per_m),
-        spring_stiffness_N_per_m=a.number("spring_stiffness", stiff, base.spring_stiffness_N_per_m),
-        preload_N=a.number("preload", Range(0.0, unit="N"), base.preload_N),
-        dead_band_unloaded_um=a.number("dead_band", Range(0.0, 100.0, unit="um"), base.dead_band_unloaded_um),
-        play_weights=(base.play_weights[0], *(w * h for w in base.play_weights[1:])),
-        strategy="reset" if reset else "direct")
-    if "stroke" not in a.data:
-        return p
-    st = a.data["stroke"]
-    if not (isinstance(st, list) and len(st) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                                         for v in st)):
-        a.fail("stroke", f"expected [away, towards] in um, got {st!r}", "e.g. stroke = [-70.0, 10.0]")
-    try:
-        return with_stroke(p, float(st[0]), float(st[1]))
-    except InputError as err:
-        a.fail("stroke", err.problem, err.fix)
 
 
 def case_targets(problem: Problem, fm: FrameMesh) -> Targets:

@@ -1,0 +1,69 @@
+"""Compensation and diagnosis of a run or a measurement (:mod:`gatetherm.api`)."""
+from __future__ import annotations
+
+from gatetherm.api.run import Case, Run
+
+
+def compensate(series, case: Case | None = None, method: str = "paper", *, actuator="case", **settings):
+    """Compensate a run: predict δ and drive the actuator with the command.
+
+    Parameters
+    ----------
+    series : TimeSeries or Run
+        The run (θ_A, θ_B, θ_C and δ, the uncompensated thermal displacement; for ``rom`` the
+        inputs the reduced model reads): a :class:`Run`, or a measured file read with
+        ``gatetherm.studies.run.timeseries.read_timeseries``.
+    case : Case, optional
+        The model (default: a Run's own case): the paper method's beam-theory or FE K, the mlr
+        training run (its own schedule) and the rom reduced model come from it.
+    method : str
+        ``"paper"``, ``"mlr"`` or ``"rom"``.
+    actuator : ActuatorParams, None or "case"
+        The actuator in the loop (``"case"``: the case's ``[actuator]``, the frame's piezo; None:
+        ideal, the command sent to the control as an offset).
+    **settings
+        Fields of :class:`gatetherm.studies.control.methods.Settings` (``Ki``, ``Kc``,
+        ``k_source``, ``states``, ``params``, ``control``, ``sensors``); ``rom=`` a reduced model.
+
+    Returns
+    -------
+    Compensation
+        ``.loop`` (the compensated δ, the strokes, the updates), ``.summary`` (bands, updates).
+    """
+    from gatetherm.studies.control.methods import Settings, compensate as methods_compensate
+
+    if isinstance(series, Run):
+        case = case or series.case
+        series = series.scenario.series({"source": "gatetherm.api.compensate"})
+    rom = settings.pop("rom", None)
+    chosen = (case.actuator if case is not None else None) if actuator == "case" else actuator
+    return methods_compensate(series, case, Settings(method=method, **settings), chosen, rom=rom)
+
+
+def diagnose(case: Case, measured, **settings):
+    """Where ``case`` and a measured run disagree, and the missing pieces that explain it.
+
+    Parameters
+    ----------
+    case : Case
+        The model: a case file's, or the paper frame's.
+    measured : TimeSeries or path
+        The measurement: every input the case reads, and the channels to compare.
+    **settings
+        Fields of :class:`gatetherm.studies.diagnosis.discrepancy.Settings` (``train_fraction``,
+        ``effects``, ``parameters``, ``sensors``, ``max_pieces``, ``uncertain``: dimensions to try
+        besides those the case marks, e.g. ``("mesh.parameters.table_height",)`` …).
+
+    Returns
+    -------
+    Diagnosis
+        ``.verdict``, ``.pieces`` (each with its fitted value), ``.groups`` (what the data cannot
+        tell from a named piece, and what would), ``.stand_ins`` (pieces that make the model fit
+        but fail a model-form check), ``.cause`` (what kind of cause would fit what stays
+        unexplained), ``.summary()``; docs/diagnosis.md.
+    """
+    from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose as run_diagnosis
+    from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
+
+    ts = measured if isinstance(measured, TimeSeries) else read_timeseries(measured, required=("time_s",))
+    return run_diagnosis(case, ts, Settings(**settings))

@@ -1,0 +1,273 @@
+"""Cases, schedules and runs: the public API's core (:mod:`gatetherm.api`)."""
+from __future__ import annotations
+
+import dataclasses
+import logging
+import os
+import time as _time
+from pathlib import Path
+from typing import Callable, Mapping
+
+import numpy as np
+
+from gatetherm import InputError
+from gatetherm.process import configure
+from gatetherm.studies.run.case import Case, load_case
+from gatetherm.studies.run.frame_case import gate_frame
+from gatetherm.studies.run.scenario import ScenarioRun, run_scenario
+from gatetherm.studies.run.schedules import Schedule, condition_schedule, file_schedule
+
+log = logging.getLogger(__name__)
+
+STATE_BUDGET_BYTES = 512e6
+"""Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
+
+__all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "beam_coefficients", "condition", "configure", "gate_frame",
+           "load_case", "run", "schedule_file"]
+
+
+def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:
+    """The paper's condition ``number``: the oil supply unit's set points and pump states.
+
+    Parameters
+    ----------
+    number : int
+        1, 2 or 3 (``docs/paper.md``).
+    case : Case, optional
+        A frame case whose supply unit drives it (default: the shipped paper model's).
+    step_s : float
+        Sample interval, s.
+
+    Returns
+    -------
+    Schedule
+        5 h of ``oil_degC`` (°C), ``pump`` (0/1) and ``ambient_degC`` (°C) samples.
+    """
+    supply = getattr(getattr(case, "origin", None), "config", None)
+    return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
+
+
+def beam_coefficients(case: Case, source: str = "theory") -> tuple[float, float]:
+    """The paper's predictor coefficients, δ = K_i (θ_A − θ_B) − K_C θ_C, of the paper's frame.
+
+    Parameters
+    ----------
+    case : Case
+        A frame from :func:`gate_frame` (a case file has no beam model).
+    source : str
+        ``"theory"``: the beam theory (eqs. 22–29) on the frame's dimensions; ``"fe"``: the FE
+        frame under the theory's two load cases (θ_A − θ_B = 1 K over the heated height, +1 K on
+        the tie bar), δ at the tips.
+
+    Returns
+    -------
+    tuple of float
+        K_i, K_C in µm/K.
+    """
+    from gatetherm.studies.control.methods import Settings, coefficients
+
+    if source not in ("theory", "fe"):
+        raise InputError("source", f"unknown source {source!r}", "choose 'theory' or 'fe'")
+    ki, kc, _ = coefficients(case, None, Settings(k_source=source))
+    return float(ki), float(kc)
+
+
+def schedule_file(path: str | os.PathLike, case: Case, step_s: float = 60.0) -> Schedule:
+    """A schedule file of the inputs ``case`` reads.
+
+    Parameters
+    ----------
+    path : str or path
+        A time-series file (``docs/data-format.md``) with a column for every input the case reads.
+    case : Case
+        The case it drives.
+    step_s : float
+        Sample interval, s (linear between the file's samples; a pump keeps its last one).
+
+    Returns
+    -------
+    Schedule
+    """
+    return file_schedule(path, sorted(case.inputs()), case.held(), case.defaults, step_s)
+
+
+@dataclasses.dataclass(frozen=True)
+class Run:
+    """A finished run of a case: its columns in the data format, and heat states for fields.
+
+    ``run["delta_um"]`` is a column (numpy array), ``run.time`` the sample times (s);
+    :meth:`field` gives a nodal field at a kept time, :meth:`write` the run directory."""
+
+    case: Case
+    scenario: ScenarioRun
+    seconds: float
+    """Wall time of the run, s (model build included)."""
+    order_check: object = None
+    """A linear-element case: its final outputs at P1 and P2 on the same mesh
+    (:class:`~gatetherm.studies.run.order_check.OrderCheck`), if checked."""
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times, s from the start."""
+        return self.scenario.columns["time_s"]
+
+    @property
+    def columns(self) -> dict[str, np.ndarray]:
+        """Every column of the run in the data format (``docs/data-format.md``), name → array."""
+        return self.scenario.columns
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self.columns:
+            raise KeyError(f"{name!r}: columns are {', '.join(self.columns)}")
+        return self.columns[name]
+
+    @property
+    def kept(self) -> list[float]:
+        """Times (s) whose full state is kept: :meth:`field` answers at these."""
+        return [t for t, _ in self.scenario.result.states]
+
+    def state(self, t: float) -> tuple[float, np.ndarray | None]:
+        """(time, heat state) kept nearest ``t`` (s); a time no state is kept near is an error."""
+        from gatetherm.studies.run.output import nearest_state
+
+        kept, U = nearest_state(self.scenario, t)
+        step = float(np.median(np.diff(self.time))) if len(self.time) > 1 else 1.0
+        if abs(kept - t) > 1e-6 * max(step, 1.0):
+            raise InputError("t", f"no state kept at {t:g} s (nearest {kept:g} s)",
+                             "run with keep=... listing the times whose fields you want")
+        return kept, U
+
+    def field(self, name: str, t: float | None = None) -> np.ndarray:
+        """A nodal field at a kept time.
+
+        Parameters
+        ----------
+        name : str
+            ``"T"`` (°C), ``"u"`` (m, nodes × 3), ``"sigma_xx"`` … and ``"von_mises"`` (Pa).
+        t : float, optional
+            Time, s (default: the last sample); one of :attr:`kept`.
+
+        Returns
+        -------
+        numpy.ndarray
+            One value (a row for ``"u"``) per mesh node.
+        """
+        from gatetherm.studies.run.output import nodal_fields
+
+        t = float(self.time[-1]) if t is None else float(t)
+        _, U = self.state(t)
+        fields = nodal_fields(self.scenario.model, U, stress=name not in ("T", "u"))
+        if name not in fields:
+            raise KeyError(f"{name!r}: fields are {', '.join(fields)}")
+        return fields[name]
+
+    def summary(self) -> dict:
+        """What ``summary.json`` holds: the case, its size, every probe and relative displacement
+        at the last sample, and δ's figures where the case has a δ."""
+        from gatetherm.studies.run.output import probe_summary
+        from gatetherm.studies.run.simulate import delta_figures
+
+        c, p = self.case, self.case.problem
+        out = {"case": c.name, "file": c.source, "dim": p.dim, "order": p.order,
+               "analysis": ("prescribed temperature" if p.thermal else "mechanical") if not p.heat else
+               ("transient" if c.time else "steady"),
+               "nodes": len(c.mesh.points), "elements": len(c.mesh.cells), "schedule": self.scenario.schedule.label,
+               "effects": self.scenario.effects.describe(), "wall_time_s": round(self.seconds, 2),
+               "march_s": round(self.scenario.result.seconds, 2), **probe_summary(p, self.columns)}
+        if "delta_um" in self.columns and len(self.time) > 1:
+            out.update(delta_figures(self.time, self["delta_um"]))
+        if self.order_check is not None:
+            out["order_check"] = self.order_check.summary()
+        return out
+
+    def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None) -> dict:
+        """Write the run directory that ``gatetherm run`` writes.
+
+        Parameters
+        ----------
+        out : str or path
+            The folder: ``timeseries.csv``, ``summary.json``, ``fields/`` (ParaView) and the pictures.
+        pictures : bool
+            Write ``channels.png`` and ``deformed.png``.
+        fields_every : float, optional
+            Interval of the fields, s (default: the case's field interval); the last sample always.
+
+        Returns
+        -------
+        dict
+            The summary (:meth:`summary`).
+        """
+        from gatetherm.studies.run.output import write_json, write_run
+
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        every = fields_every or (self.case.time.fields if self.case.time else 1.0)
+        times = [float(t) for t in self.time]
+        fields = {t for t in times if abs(t / every - round(t / every)) < 1e-9} | {times[-1]}
+        fields &= set(self.kept)
+        sched = self.scenario.schedule
+        meta = {"source": "gatetherm", "case": self.case.source, "name": self.case.name, "dim": str(self.case.dim),
+                "schedule": sched.label, **({"condition": str(sched.condition)} if sched.condition else {})}
+        picture = self._picture_time()
+        solved = write_run(out, self.scenario, meta, fields, (picture,) if pictures and picture is not None else ())
+        if pictures:
+            from gatetherm.validation.plots.run import write_pictures
+
+            write_pictures(self.scenario, out, self.case.name, picture, solved)
+        summary = self.summary()
+        write_json(out / "summary.json", summary)
+        return summary
+
+    def _picture_time(self) -> float | None:
+        """When the deformed picture shows the case: δ's first peak where it has one, else the end."""
+        if self.scenario.model.elastic is None:
+            return None
+        figs = self.summary() if "delta_um" in self.columns and len(self.time) > 1 else {}
+        peak = figs.get("first_peak_min")
+        return peak * 60.0 if peak is not None else float(self.time[-1])
+
+
+
+def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
+        keep=None, on_step: Callable[[int, int], None] | None = None, check_order: bool = False) -> Run:
+    """Run ``case``.
+
+    Parameters
+    ----------
+    case : Case
+        From :func:`load_case` or :func:`gate_frame`.
+    schedule : Schedule, optional
+        What drives it (default: its own: the case file's ``[time]`` and schedule, or the frame's
+        condition); :func:`condition`, :func:`schedule_file`.
+    effects : mapping, optional
+        Effects switched on, ``{key: value}`` (``gatetherm diagnose --list-effects``).
+    keep : sequence of float, optional
+        Times (s) whose heat state is kept for :meth:`Run.field` (default: every sample while they
+        take less than :data:`STATE_BUDGET_BYTES`, else the case's field times and the end).
+    on_step : callable, optional
+        ``on_step(i, n)`` after each of the ``n`` samples.
+    check_order : bool
+        A linear-element case on a small mesh: solve its final state once more with quadratic
+        elements and warn (one log line naming the output and the fix) where they differ by more
+        than :data:`gatetherm.studies.run.order_check.TOLERANCE`.
+
+    Returns
+    -------
+    Run
+    """
+    t0 = _time.perf_counter()
+    schedule = case.schedule if schedule is None else schedule
+    times = [float(t) for t in schedule.times]
+    if keep is None:
+        n = len(case.mesh.points) * case.problem.order ** case.dim
+        every = case.time.fields if case.time else 1.0
+        keep = times if len(times) * n * 8 <= STATE_BUDGET_BYTES else \
+            [t for t in times if abs(t / every - round(t / every)) < 1e-9] + [times[-1]]
+    scenario = run_scenario(case, schedule, effects, keep_times=sorted(set(map(float, keep)) | {times[-1]}),
+                            on_step=on_step)
+    check = None
+    if check_order:
+        from gatetherm.studies.run.order_check import order_check
+
+        check = order_check(case, scenario)
+    return Run(case, scenario, _time.perf_counter() - t0, check)
