@@ -62,17 +62,26 @@ class AMG:
         for level in self.ml.levels[1:]:
             if sp.issparse(level.A) and level.A.format == "bsr" and level.A.blocksize == (1, 1):
                 level.A = level.A.tocsr()
+        # the cycle in single precision, conjugate gradients in double: on the 3-D frame's elastic
+        # system the same iterations and solutions, 20-30 % less time (half the memory traffic of
+        # the sweeps); R = Pᵀ as a view of P (pyamg keeps a copy); the coarsest level in double
+        for level in self.ml.levels[:-1]:
+            level.A, level.P = _single(level.A), _single(level.P.tocsr())
+            level.R = level.P.T
         self.A = A
         log.debug("AMG: %d levels %s, operator complexity %.2f", len(self.ml.levels),
                   [lv.A.shape[0] for lv in self.ml.levels], self.ml.operator_complexity())
 
     @property
     def nbytes(self) -> int:
-        """Memory of the hierarchy (matrices and transfer operators), bytes."""
-        return sum(_nbytes(getattr(lv, k, None)) for lv in self.ml.levels for k in ("A", "P", "R"))
+        """Memory of the hierarchy (matrices and transfer operators; the finest level's values,
+        its pattern is the caller's), bytes."""
+        levels = self.ml.levels
+        return levels[0].A.data.nbytes + sum(_nbytes(lv.A) for lv in levels[1:]) + \
+            sum(_nbytes(lv.P) for lv in levels[:-1])  # R: a view of P
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
-        return self._cycle(0, b)
+        return self._cycle(0, np.asarray(b, dtype=np.float32)).astype(float)
 
     def _cycle(self, k: int, b: np.ndarray) -> np.ndarray:
         levels = self.ml.levels
@@ -80,9 +89,15 @@ class AMG:
         x = np.zeros_like(b)
         lv.presmoother(lv.A, x, b)
         coarse = lv.R @ (b - lv.A @ x)
-        x += lv.P @ (self.ml.coarse_solver(levels[-1].A, coarse) if k == len(levels) - 2 else self._cycle(k + 1, coarse))
+        x += lv.P @ (self.ml.coarse_solver(levels[-1].A, coarse.astype(float)).astype(np.float32)
+                     if k == len(levels) - 2 else self._cycle(k + 1, coarse))
         lv.postsmoother(lv.A, x, b)
         return x
+
+
+def _single(M: sp.spmatrix) -> sp.spmatrix:
+    """``M`` (CSR or BSR) with single-precision values, its index arrays shared."""
+    return type(M)((M.data.astype(np.float32), M.indices, M.indptr), shape=M.shape)
 
 
 class PCG:

@@ -238,6 +238,8 @@ class SPDSolver:
     def __call__(self, b: np.ndarray) -> np.ndarray:
         if self._solve is None:
             self._solve, self.path = self._make(1 if np.ndim(b) == 1 else np.shape(b)[1])
+            if self.path == "iterative":  # kept for good (release() frees factors only): the modes are
+                self.near_null = None     # in its hierarchy (7.5 MB on the 3-D frame)
         return self._solve(b)
 
     def _make(self, rhs: int) -> tuple[Solve, str]:
