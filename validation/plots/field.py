@@ -34,8 +34,8 @@ def plot_field(fmesh, name: str, values, title: str = "", ax=None):
     if fmesh.dim == 3:
         from gatetherm.studies.run.output import volume_grid
 
-        grid = volume_grid(fmesh, {name: v})
-        return frame_image(screenshot(grid, name, _limits(v), grid), _limits(v), label, title, ax)
+        surface = volume_grid(fmesh, {name: v}).extract_surface(algorithm="dataset_surface")
+        return frame_image(screenshot(surface, name, _limits(v), surface), _limits(v), label, title, ax)
     ax = figure((7.5, 6.0)) if ax is None else ax
     x, y = np.asarray(fmesh.points, dtype=float)[:, :2].T
     art = ax.tripcolor(x, y, np.asarray(fmesh.cells)[:, :3], v, shading="gouraud", cmap=CMAP)
@@ -45,25 +45,22 @@ def plot_field(fmesh, name: str, values, title: str = "", ax=None):
     return ax
 
 
-def screenshot(shown, name: str, clim, outline_of) -> np.ndarray:
-    """An off-screen pyvista image of the point array ``name`` on ``shown`` (colours over ``clim``)
-    with the feature edges of ``outline_of`` in grey, cropped to its content."""
+def screenshot(surface, name: str, clim, outline_of) -> np.ndarray:
+    """An off-screen pyvista image of the point array ``name`` on the body's ``surface`` (colours
+    over ``clim``), seen from behind and above with y up (the tool side on the left), with the
+    feature edges of the surface ``outline_of`` in grey, cropped to its content."""
     import pyvista as pv
     from vtkmodules.vtkCommonCore import vtkLogger
 
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)  # no X display: VTK falls back quietly
-    flat = outline_of.bounds[5] - outline_of.bounds[4] < 1e-12
-    outline = outline_of.extract_surface(algorithm="dataset_surface").extract_feature_edges(
-        feature_angle=30.0, boundary_edges=flat, feature_edges=not flat, manifold_edges=False, non_manifold_edges=False)
+    outline = outline_of.extract_feature_edges(feature_angle=30.0, boundary_edges=False, feature_edges=True,
+                                               manifold_edges=False, non_manifold_edges=False)
     p = pv.Plotter(off_screen=True, window_size=(1600, 1200))
     try:
         p.set_background("white")
-        p.add_mesh(shown, scalars=name, cmap=CMAP, clim=clim, show_scalar_bar=False)
+        p.add_mesh(surface, scalars=name, cmap=CMAP, clim=clim, show_scalar_bar=False)
         p.add_mesh(outline, color="#8c8c8c", line_width=2)
-        if flat:
-            p.view_xy()
-        else:  # y is up; seen from behind and above, so the tool side stays on the left
-            p.view_vector((0.35, 0.45, 1.0), viewup=(0.0, 1.0, 0.0))
+        p.view_vector((0.35, 0.45, 1.0), viewup=(0.0, 1.0, 0.0))
         return _trim(p.screenshot(return_img=True))
     finally:
         p.close()
@@ -100,8 +97,9 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
     if fmesh.dim == 3:
         from gatetherm.studies.run.output import volume_grid
 
-        grid = volume_grid(fmesh, {name: values, "u": fields["u"]})
-        return frame_image(screenshot(grid.warp_by_vector("u", factor=scale), name, clim, grid), clim, label, title, ax)
+        surface = volume_grid(fmesh, {name: values, "u": fields["u"]}).extract_surface(algorithm="dataset_surface")
+        return frame_image(screenshot(surface.warp_by_vector("u", factor=scale), name, clim, surface), clim, label,
+                           title, ax)
     from matplotlib.collections import LineCollection
 
     ax = figure((7.5, 6.0)) if ax is None else ax
