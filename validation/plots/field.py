@@ -39,7 +39,7 @@ def plot_field(fmesh, name: str, values, title: str = "", ax=None):
     ax = figure((7.5, 6.0)) if ax is None else ax
     x, y = np.asarray(fmesh.points, dtype=float)[:, :2].T
     art = ax.tripcolor(x, y, np.asarray(fmesh.cells)[:, :3], v, shading="gouraud", cmap=CMAP)
-    ax.figure.colorbar(art, ax=ax, fraction=0.04, pad=0.02, shrink=0.85).set_label(label)
+    _colour_bar(ax, art, label)
     ax.set_aspect("equal")
     ax.set(xlabel="x [m]", ylabel="y [m]", title=title)
     return ax
@@ -75,8 +75,7 @@ def frame_image(img: np.ndarray, clim, label: str, title: str, ax=None):
     ax = figure((7.5, 6.0)) if ax is None else ax
     ax.imshow(img, interpolation="lanczos")
     ax.set_axis_off()
-    bar = ax.figure.colorbar(ScalarMappable(Normalize(*clim), CMAP), ax=ax, fraction=0.04, pad=0.02, shrink=0.85)
-    bar.set_label(label)
+    _colour_bar(ax, ScalarMappable(Normalize(*clim), CMAP), label)
     ax.set_title(title, fontsize="medium")
     return ax
 
@@ -110,7 +109,7 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
     ax.add_collection(LineCollection(xy[boundary_edges(tri)], colors="#8c8c8c", linewidths=1.2))
     ax.set_aspect("equal")
     ax.set_axis_off()
-    ax.figure.colorbar(art, ax=ax, fraction=0.04, pad=0.02, shrink=0.85).set_label(label)
+    _colour_bar(ax, art, label)
     ax.set_title(title, fontsize="medium")
     return ax
 
@@ -120,6 +119,10 @@ def boundary_edges(tri: np.ndarray) -> np.ndarray:
     edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
     uniq, count = np.unique(edges, axis=0, return_counts=True)
     return uniq[count == 1]
+
+
+def _colour_bar(ax, mappable, label: str) -> None:
+    ax.figure.colorbar(mappable, ax=ax, fraction=0.04, pad=0.02, shrink=0.85).set_label(label)
 
 
 def _trim(img: np.ndarray, pad: int = 12) -> np.ndarray:
