@@ -74,10 +74,12 @@ def _best_first(trials):
     return sorted(trials, key=lambda t: (t[1].approx, t[1].score))
 
 
-def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: dict, pair_top: int = 2) -> Round:
+def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: dict, pair_top: int = 3) -> Round:
     """Every single addition (fitted for real in the first round, else on the surrogate with
     the best ``top`` refitted for real), then every pair of additions on the surrogate
-    (starting from the single fits), the best ``pair_top`` pairs refitted for real."""
+    (starting from the single fits), the best ``pair_top`` pairs refitted for real (three
+    since the frame's dimensions joined the pool: with two, a dimension's pair, which the
+    surrogate ranks too well, took the place of the hidden pair in a compound case)."""
     ctx = current.values
     if not ctx:
         singles = [(p, obj.scored(fit_one(obj, {}, p))) for p in pool]
