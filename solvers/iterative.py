@@ -43,7 +43,8 @@ class AMG:
     ``near_null`` (n, m): the rigid-body modes of elasticity, with ``block`` DOFs per node
     (aggregated together when every node keeps all of them); None: the constants."""
 
-    def __init__(self, A: sp.spmatrix, near_null: np.ndarray | None = None, block: int = 1):
+    def __init__(self, A: sp.spmatrix, near_null: np.ndarray | None = None, block: int = 1, single: bool = True):
+        """``single``: the cycle in single precision (``benchmarks/amg_precision.py`` measures both)."""
         import pyamg
 
         A = A.tocsr()
@@ -63,10 +64,12 @@ class AMG:
             if sp.issparse(level.A) and level.A.format == "bsr" and level.A.blocksize == (1, 1):
                 level.A = level.A.tocsr()
         # the cycle in single precision, conjugate gradients in double: on the 3-D frame's elastic
-        # system the same iterations and solutions, 20-30 % less time (half the memory traffic of
-        # the sweeps); R = Pᵀ as a view of P (pyamg keeps a copy); the coarsest level in double
+        # system the same iterations and solutions, a quarter less time (half the memory traffic of
+        # the sweeps; benchmarks/amg_precision.py); R = Pᵀ as a view of P (pyamg keeps a copy);
+        # the coarsest level in double
+        self.dtype = np.float32 if single else np.float64
         for level in self.ml.levels[:-1]:
-            level.A, level.P = _single(level.A), _single(level.P.tocsr())
+            level.A, level.P = _cast(level.A, self.dtype), _cast(level.P.tocsr(), self.dtype)
             level.R = level.P.T
         self.A = A
         log.debug("AMG: %d levels %s, operator complexity %.2f", len(self.ml.levels),
@@ -74,14 +77,14 @@ class AMG:
 
     @property
     def nbytes(self) -> int:
-        """Memory of the hierarchy (matrices and transfer operators; the finest level's values,
-        its pattern is the caller's), bytes."""
+        """Memory of the hierarchy beyond the caller's matrix (whose pattern the finest level
+        shares, and in double precision its values too) and the transfer operators, bytes."""
         levels = self.ml.levels
-        return levels[0].A.data.nbytes + sum(_nbytes(lv.A) for lv in levels[1:]) + \
-            sum(_nbytes(lv.P) for lv in levels[:-1])  # R: a view of P
+        own = 0 if np.shares_memory(levels[0].A.data, self.A.data) else levels[0].A.data.nbytes
+        return own + sum(_nbytes(lv.A) for lv in levels[1:]) + sum(_nbytes(lv.P) for lv in levels[:-1])  # R: P's view
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
-        return self._cycle(0, np.asarray(b, dtype=np.float32)).astype(float)
+        return self._cycle(0, np.asarray(b, dtype=self.dtype)).astype(float)
 
     def _cycle(self, k: int, b: np.ndarray) -> np.ndarray:
         levels = self.ml.levels
@@ -89,15 +92,15 @@ class AMG:
         x = np.zeros_like(b)
         lv.presmoother(lv.A, x, b)
         coarse = lv.R @ (b - lv.A @ x)
-        x += lv.P @ (self.ml.coarse_solver(levels[-1].A, coarse.astype(float)).astype(np.float32)
+        x += lv.P @ (self.ml.coarse_solver(levels[-1].A, coarse.astype(float)).astype(self.dtype)
                      if k == len(levels) - 2 else self._cycle(k + 1, coarse))
         lv.postsmoother(lv.A, x, b)
         return x
 
 
-def _single(M: sp.spmatrix) -> sp.spmatrix:
-    """``M`` (CSR or BSR) with single-precision values, its index arrays shared."""
-    return type(M)((M.data.astype(np.float32), M.indices, M.indptr), shape=M.shape)
+def _cast(M: sp.spmatrix, dtype) -> sp.spmatrix:
+    """``M`` (CSR or BSR) with values of ``dtype``, its index arrays shared."""
+    return type(M)((M.data.astype(dtype, copy=False), M.indices, M.indptr), shape=M.shape)
 
 
 class PCG:

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gatetherm import InputError
 from gatetherm.cli import main
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.report import build as b
