@@ -107,6 +107,27 @@ def test_alpha_and_a_delta_gain_are_one_group_with_the_measurement_that_separate
     assert list(named) == [alpha] and regrouped[0].piece == alpha and regrouped[0].members == (gain,)
 
 
+def test_a_sensor_fault_with_a_physical_equivalent_is_checked_as_the_physical_piece(frame):
+    """The checks judge α, not the δ gain standing for it: a gain of 1.10 is at the end of its
+    range, the α it stands for inside its own (the C-frame's spindle case was lost this way)."""
+    from gatetherm.studies.diagnosis.select import Selection, physical_in_place
+
+    _, known, _, _, _ = frame
+    alpha, gain, k = (known[n] for n in ("parameter:expansion", "sensor:sensor_gain@delta_um", "parameter:conductivity"))
+    final = _scored({k: 40.0, gain: 1.1})
+    sel = Selection(final, final, [k, gain], alternatives={gain: [alpha]},
+                    in_place={(gain, alpha): {k: 40.5, alpha: 1.1 * alpha.neutral}})
+    assert physical_in_place(sel) == {k: 40.0, alpha: 1.1 * alpha.neutral}
+    assert list(physical_in_place(sel)) == [k, alpha]  # the order of the chosen set kept
+    assert physical_in_place(dataclasses.replace(sel, alternatives={})) == {k: 40.0, gain: 1.1}
+
+
+def _scored(values):
+    from gatetherm.studies.diagnosis.calibrate import Scored
+
+    return Scored(values, 0.0, 0.0, {}, True)
+
+
 def test_a_sensor_fault_whose_channel_stays_unexplained_has_no_evidence(frame):
     case, known, rep, run_phases, _ = frame
     off = known["sensor:sensor_offset@theta_A_degC"]

@@ -41,7 +41,7 @@ from gatetherm.studies.diagnosis.identify import Group, groups, physical_first
 from gatetherm.studies.diagnosis.locate import Finding, Phase, input_phases, locate, noise_sd, phases
 from gatetherm.studies.diagnosis.pattern import kind_of_cause, unexplained
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
-from gatetherm.studies.diagnosis.select import Round, Selection, select
+from gatetherm.studies.diagnosis.select import Round, Selection, physical_in_place, select
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.timeseries import TimeSeries
 
@@ -281,7 +281,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     chk, stand, grp = None, {}, []
     if discrepant:
         sel = select(obj, pool, settings.margin_min, settings.max_pieces, settings.screen_top)
-        named, stand, chk = confirm(obj, sel.final.values, run_phases, settings.margin_min, sel.base.score)
+        named, stand, chk = confirm(obj, physical_in_place(sel), run_phases, settings.margin_min, sel.base.score)
         solo = {p: s.values[p] for p, s in sel.rounds[0].trials} if sel.rounds else {}
         named, grp = physical_first(named, groups(obj, named, pool, sel.alternatives, solo, settings.margin_min))
         final = sel.final if named == sel.final.values else obj.scored(named)

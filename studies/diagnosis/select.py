@@ -66,6 +66,8 @@ class Selection:
     """Pieces chosen, then dropped by the removal check or swapped out."""
     alternatives: dict = field(default_factory=dict)
     """{piece: [pieces that explain the data as well in its place]}."""
+    in_place: dict = field(default_factory=dict)
+    """{(piece, alternative): the chosen set refitted with the alternative in the piece's place}."""
     best_rejected: tuple[Piece, Scored] | None = None
     """The best addition that did not clear the margin in the last round."""
 
@@ -229,5 +231,19 @@ def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, mos
         swapped = obj.scored(refit(obj, s.values, max_nfev=max_nfev))
         if swapped.score - final.score < margin:
             sel.alternatives.setdefault(p, []).append(q)
+            sel.in_place[p, q] = swapped.values
             log.info("%s and %s explain the data equally well (scores %.1f, %.1f)", p.label, q.label,
                      final.score, swapped.score)
+
+
+def physical_in_place(sel: Selection) -> dict:
+    """The chosen set with each sensor fault that has a physical equivalent (an effect, a
+    parameter, a dimension) replaced by it, at its value refitted in the fault's place: the
+    model-form checks then judge the physical piece, not a fault the data cannot tell from it
+    (a δ gain at the end of its range stands for an α well inside its own)."""
+    values = dict(sel.final.values)
+    for p, alts in sel.alternatives.items():
+        q = next((a for a in alts if a.kind != "sensor"), None)
+        if p.kind == "sensor" and q is not None and p in values and q not in values:
+            values = {(q if k == p else k): (sel.in_place[p, q][q] if k == p else v) for k, v in values.items()}
+    return values
