@@ -32,15 +32,10 @@ def plot_field(fmesh, name: str, values, title: str = "", ax=None):
     in 3-D a picture of the body's surface (pyvista). Returns the Axes."""
     v, label = scalar(name, values)
     if fmesh.dim == 3:
-        from gatetherm.studies.run.output import volume_grid
-
-        surface = volume_grid(fmesh, {name: v}).extract_surface(algorithm="dataset_surface")
+        surface = _surface(fmesh, {name: v})
         return frame_image(screenshot(surface, name, _limits(v), surface), _limits(v), label, title, ax)
     ax = figure((7.5, 6.0)) if ax is None else ax
-    x, y = np.asarray(fmesh.points, dtype=float)[:, :2].T
-    art = ax.tripcolor(x, y, np.asarray(fmesh.cells)[:, :3], v, shading="gouraud", cmap=CMAP)
-    _colour_bar(ax, art, label)
-    ax.set_aspect("equal")
+    _tripcolor(ax, np.asarray(fmesh.points, dtype=float)[:, :2], np.asarray(fmesh.cells)[:, :3], v, label)
     ax.set(xlabel="x [m]", ylabel="y [m]", title=title)
     return ax
 
@@ -94,9 +89,7 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
     clim = _limits(np.asarray(values))
     title = f"{title}\ndisplacement magnified ×{scale:.0f}; grey: undeformed edges"
     if fmesh.dim == 3:
-        from gatetherm.studies.run.output import volume_grid
-
-        surface = volume_grid(fmesh, {name: values, "u": fields["u"]}).extract_surface(algorithm="dataset_surface")
+        surface = _surface(fmesh, {name: values, "u": fields["u"]})
         return frame_image(screenshot(surface.warp_by_vector("u", factor=scale), name, clim, surface), clim, label,
                            title, ax)
     from matplotlib.collections import LineCollection
@@ -104,12 +97,9 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
     ax = figure((7.5, 6.0)) if ax is None else ax
     tri = np.asarray(fmesh.cells)[:, :3]
     xy = np.asarray(fmesh.points, dtype=float)[:, :2]
-    art = ax.tripcolor(*(xy + scale * fields["u"][:, :2]).T, tri, values, shading="gouraud", cmap=CMAP,
-                       vmin=clim[0], vmax=clim[1])
+    _tripcolor(ax, xy + scale * fields["u"][:, :2], tri, values, label, vmin=clim[0], vmax=clim[1])
     ax.add_collection(LineCollection(xy[boundary_edges(tri)], colors="#8c8c8c", linewidths=1.2))
-    ax.set_aspect("equal")
     ax.set_axis_off()
-    _colour_bar(ax, art, label)
     ax.set_title(title, fontsize="medium")
     return ax
 
@@ -119,6 +109,19 @@ def boundary_edges(tri: np.ndarray) -> np.ndarray:
     edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
     uniq, count = np.unique(edges, axis=0, return_counts=True)
     return uniq[count == 1]
+
+
+def _surface(fmesh, point_data: dict):
+    """The pyvista surface of the 3-D body of ``fmesh`` with the nodal arrays ``point_data``."""
+    from gatetherm.studies.run.output import volume_grid
+
+    return volume_grid(fmesh, point_data).extract_surface(algorithm="dataset_surface")
+
+
+def _tripcolor(ax, xy: np.ndarray, tri: np.ndarray, values, label: str, **limits) -> None:
+    """``values`` at the nodes ``xy`` of the triangles ``tri``, Gouraud-shaded, equal axes, with a colour bar."""
+    _colour_bar(ax, ax.tripcolor(*xy.T, tri, values, shading="gouraud", cmap=CMAP, **limits), label)
+    ax.set_aspect("equal")
 
 
 def _colour_bar(ax, mappable, label: str) -> None:
