@@ -58,6 +58,9 @@ def register(sub) -> None:
     p.add_argument("--mesh-factor", type=number(POSITIVE), metavar="F",
                    help="with --case: mesh the case's geometry with its element sizes times F (e.g. 0.5 when the "
                    "discretisation check of the report exceeds the resolution)")
+    p.add_argument("--keep-order", action="store_true",
+                   help="replay with the model's own element order even where its discretisation error (P2 - P1) "
+                   "exceeds the resolution (default: then with P2 elements)")
     p.add_argument("--list-effects", action="store_true",
                    help="list the hypotheses (effects, parameters, sensor faults) and exit")
     p.add_argument("--json", action="store_true", help="with --list-effects: print JSON")
@@ -92,7 +95,7 @@ def settings_from(args):
 
     return Settings(train_fraction=args.train_fraction, effects=_names(args.effects, None),
                     parameters=_names(args.parameters, None), sensors=not args.no_sensors,
-                    uncertain=_names(args.uncertain, ()))
+                    uncertain=_names(args.uncertain, ()), refine=not args.keep_order)
 
 
 def load_model(args):
@@ -154,7 +157,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"held-out RMS of delta: {s['rms_before_um']:.3g} um -> {s['rms_after_um']:.3g} um")
     if diag.too_coarse:
         print(f"warning: the model's discretisation error (P2 - P1) exceeds the resolution on "
-              f"{', '.join(diag.too_coarse)}; refine the mesh (--mesh-factor) or set order = 2 (report.md, 1. Replay)")
+              f"{', '.join(diag.too_coarse)}; " + ("the diagnosis replayed it with P2 elements" if diag.order == 2 else
+                                                  "refine the mesh (--mesh-factor) or set order = 2")
+              + " (report.md, 1. Replay)")
     print(f"wrote {out}/report.md, diagnosis.json ({diag.runs} model runs, {diag.seconds:.0f} s)")
     return 0
 

@@ -1,6 +1,9 @@
 """The discrepancy workflow: replay, locate, select the missing pieces, name them.
 
-1. *Replay* the measured inputs through the model (:mod:`replay`).
+1. *Replay* the measured inputs through the model (:mod:`replay`). A linear-element model is
+   run once with quadratic elements too; where the difference exceeds a sensor's resolution
+   and the baseline residual is significant, the diagnosis replays with quadratic elements: a
+   residual the model's own mesh makes is not a missing piece (:attr:`Settings.refine`).
 2. *Locate* significant residuals per channel and phase (:mod:`locate`).
 3. *Select*: forward selection over every hypothesis (catalogue effects, existing
    parameters off, dimensions marked as uncertain, sensor faults; :mod:`hypotheses`), fitted
@@ -25,7 +28,6 @@
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 import time
 from dataclasses import dataclass
@@ -73,6 +75,9 @@ class Settings:
     p2_check: bool = True
     """A linear-element case is run once more with quadratic elements: its own discretisation error
     against the sensors' resolution (:func:`discretisation`)."""
+    refine: bool = True
+    """Where that error exceeds the resolution and the baseline residual is significant, replay with
+    quadratic elements (a residual the model's own mesh makes is not a missing piece)."""
 
 
 @dataclass(frozen=True)
@@ -141,6 +146,9 @@ class Diagnosis:
     """Named pieces with the hypotheses the data cannot tell from them."""
     cause: str = ""
     """What kind of cause would fit the residual that stays unexplained (:mod:`pattern`)."""
+    order: int = 1
+    """Element order of the replayed model (2 for a P1 case whose discretisation error showed in the data:
+    :attr:`Settings.refine`)."""
 
     @property
     def too_coarse(self) -> list[str]:
@@ -180,7 +188,7 @@ class Diagnosis:
             "channels": list(self.channels), "noise_scale": self.scale, "train_end_s": self.train_end_s,
             "significant": [f.sentence() for f in self.findings if f.significant],
             "remaining": [f.sentence() for f in self.remaining if f.significant],
-            "model_runs": self.runs, "wall_time_s": round(self.seconds, 1), "dim": self.dim,
+            "model_runs": self.runs, "wall_time_s": round(self.seconds, 1), "dim": self.dim, "order": self.order,
             "discretisation_p2_minus_p1_in_resolutions": self.discretisation,
             "checks": self.checks.summary() if self.checks else None,
             "stand_ins": [{"name": p.label, "kind": p.kind, "value": float(v), "why": why}
@@ -269,15 +277,32 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     inputs = tuple(rep.drive.columns)
     channels = compared_channels(ts, base_cols, inputs)
     pool = candidates(case, channels, rep.has_ambient, settings)
-    res0 = residuals(ts, base_cols, channels)
-    scale = {c: max(resolution(c), noise_sd(res0[c])) for c in channels}
     train = t <= settings.train_fraction * t[-1]
     if (~train).sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
     run_phases = case_phases(case, t, rep.drive.columns)
+    res0 = residuals(ts, base_cols, channels)
     findings = locate(t, res0, run_phases)
-    obj = Objective(rep, ts, channels, scale, train)
     discrepant = any(f.significant for f in findings)
+    check, runs, refined = None, 0, ""
+    if case.problem.order == 1 and settings.p2_check:
+        fine = Replayer(case.with_order(2), ts)
+        fine_cols = fine.run()
+        check = {c: float(np.max(np.abs(fine_cols[c] - base_cols[c]))) / resolution(c) for c in channels}
+        coarse = [c for c, v in check.items() if v > 1.0]
+        if discrepant and coarse and settings.refine:
+            log.info("diagnosis: the P1 model's discretisation error exceeds the resolution on %s (%.2g "
+                     "resolutions): replaying with P2 elements", ", ".join(coarse), max(check.values()))
+            runs, rep, base_cols = rep.runs, fine, fine_cols
+            res0 = residuals(ts, base_cols, channels)
+            findings = locate(t, res0, run_phases)
+            discrepant = any(f.significant for f in findings)
+            refined = "" if discrepant else ("with P2 elements the baseline residual is within the sensor "
+                                             "resolution: the P1 model's was its own discretisation error")
+        else:
+            runs = fine.runs
+    scale = {c: max(resolution(c), noise_sd(res0[c])) for c in channels}
+    obj = Objective(rep, ts, channels, scale, train)
     chk, stand, grp = None, {}, []
     if discrepant:
         sel = select(obj, pool, settings.margin_min, settings.max_pieces, settings.screen_top)
@@ -290,6 +315,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
         sel = Selection(base, base, [])
         final = base
     verdict, reason = _verdict(discrepant, sel, final, [p.label for p in stand], chk)
+    reason = refined or reason
     sigma = uncertainty(obj, final.values)
     by_piece = {g.piece: g for g in grp}
     pieces = tuple(PieceResult(p, v, sigma[p], share, by_piece[p].members if p in by_piece else ())
@@ -297,21 +323,13 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     after = obj.residuals(final.values, solve=False)[0] if pieces else None
     remaining = tuple(locate(t, after, run_phases)) if after else ()
     cause = kind_of_cause(t, after or res0, base_cols, list(remaining or findings)) if verdict != "explained" else ""
-    check = discretisation(rep, base_cols, channels) if case.problem.order == 1 and settings.p2_check else None
-    log.info("diagnosis: %s (%s), %d model runs", verdict, reason, rep.runs)
+    runs += rep.runs
+    log.info("diagnosis: %s (%s), %d model runs", verdict, reason, runs)
     return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, final, tuple(sel.rounds),
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
-                     remaining, res0, after, rep.runs, time.perf_counter() - t0, rep.has_ambient, settings.margin_min,
+                     remaining, res0, after, runs, time.perf_counter() - t0, rep.has_ambient, settings.margin_min,
                      rep.dim, inputs, check, chk, tuple((p, v, why) for p, (v, why) in stand.items()), tuple(grp),
-                     cause)
-
-
-def discretisation(rep: Replayer, base: dict, channels) -> dict[str, float]:
-    """The largest |P2 − P1| of the baseline case's run per channel, in units of its resolution:
-    an estimate of the P1 model's own discretisation error (one run with P2 elements)."""
-    case = rep.config
-    p2 = rep.run(dataclasses.replace(case, problem=dataclasses.replace(case.problem, order=2)))
-    return {c: float(np.max(np.abs(p2[c] - base[c]))) / resolution(c) for c in channels}
+                     cause, rep.config.problem.order)
 
 
 def adopted_case(case: Case, diag: Diagnosis) -> Case | None:

@@ -79,10 +79,13 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     if d.discretisation is not None:
         L += ["", "Discretisation check (the baseline run again with P2 elements; largest |P2 − P1| in units of the "
               "resolution): " + ", ".join(f"{label(c)} {v:.2f}×" for c, v in d.discretisation.items()) + ". "
-              + (f"**Above the resolution on {', '.join(label(c) for c in d.too_coarse)}**: the model's own "
-                 "discretisation error shows in the data and the pieces below may partly stand in for it; refine "
-                 "the mesh (`--mesh-factor`, or `size` in the case) or set `order = 2`." if d.too_coarse
-                 else "Below the resolution: the mesh is fine enough for these sensors.")]
+              + (f"**Above the resolution on {', '.join(label(c) for c in d.too_coarse)}**: " + (
+                  "the model's own discretisation error shows in the data, so the diagnosis replayed the model "
+                  "with P2 elements (about four times the cost of a run in 2-D); to diagnose with P1, refine the mesh "
+                  "(`--mesh-factor`, or `size` in the case)." if d.order == 2 else
+                  "the model's own discretisation error shows in the data and the pieces below may partly stand in "
+                  "for it; refine the mesh (`--mesh-factor`, or `size` in the case) or set `order = 2`.")
+                 if d.too_coarse else "Below the resolution: the mesh is fine enough for these sensors.")]
     L += ["",
           "## 2. Locate", "",
           "A residual is significant where its 15-min moving average exceeds the sensor resolution by more "

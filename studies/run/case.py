@@ -129,6 +129,10 @@ class Case:
         return dataclasses.replace(made, effects={**made.effects, **self.effects},
                                    sensors={**made.sensors, **self.sensors})
 
+    def with_order(self, order: int) -> "Case":
+        """The case with elements of ``order`` (1 linear, 2 quadratic), kept by later overrides."""
+        return self.with_overrides({self.origin.ORDER: order})
+
     def with_schedule(self, schedule: Schedule) -> "Case":
         return dataclasses.replace(self, schedule=schedule)
 
@@ -169,6 +173,8 @@ class CaseFile:
     path: Path
     document: dict = field(repr=False, compare=False)
     mesh_factor: float = 1.0
+    ORDER = "case.order"
+    """The key of the element order."""
 
     def remake(self, overrides: dict, previous: Case | None = None) -> Case:
         doc = overlay(self.document, nested(overrides))

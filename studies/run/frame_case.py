@@ -90,6 +90,8 @@ class FrameOrigin:
     config: Config = field(repr=False)
     dim: int = 2
     condition: int = 1
+    ORDER = "model.order"
+    """The key of the element order."""
 
     def remake(self, overrides: dict, previous: Case | None = None) -> Case:
         cfg = parse_config(nested(overrides), self.config.source, base=self.config)

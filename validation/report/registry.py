@@ -107,7 +107,7 @@ SECTIONS: tuple[Section, ...] = (
             subset={"case": "examples/c_frame/case.toml", "seed": 10,
                     "scenarios": ["film+offset", "noise-only, case mesh"]},
             full={"case": "examples/c_frame/case.toml", "seed": 10, "scenarios": None},
-            about="two of the seven scenarios (a film and a thermocouple offset hidden; noise only on the case's "
+            about="two of the nine scenarios (a film and a thermocouple offset hidden; noise only on the case's "
                   "own mesh)",
             inputs=("gatetherm.validation:examples/c_frame/*",), also="gatetherm validate case-diagnosis --out DIR"),
     Section("calculix", "CalculiX cross-check of the 3-D frame", "calculix:compute",
