@@ -18,7 +18,8 @@ from gatetherm.studies.diagnosis.locate import input_phases
 from gatetherm.studies.run.case import load_case
 from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, write_timeseries
-from gatetherm.validation.case_diagnosis import MESH_FACTOR, SCENARIOS, SPINDLE, hidden, measured_run, write_case_diagnosis
+from gatetherm.validation.case_diagnosis import (MESH_FACTOR, SCENARIOS, SPINDLE, hidden, measured_run,
+                                                  write_case_diagnosis)
 from gatetherm.validation.truth import recorded
 from test_bad_input import refused
 

@@ -146,6 +146,21 @@ def test_the_markdown_page_has_every_table_and_says_what_it_shows(tmp_path, regi
     assert "](sections/" not in docs and "Figures (on the HTML page): figure a." in docs
 
 
+def test_a_section_not_computed_keeps_its_text_from_the_page_before(tmp_path, registry):
+    """``--section b --docs DIR``: section a stands as on the page before (its tables numbered again),
+    not as "not computed"."""
+    from gatetherm.validation.report.markdown import results_markdown
+
+    sections, _, _ = registry
+    res = b.build(tmp_path / "R", sections)
+    first = results_markdown(sections, res, "R", False, "code", figures=False)
+    only_b = {**res, "a": None}
+    assert "Not computed for the current code" in results_markdown(sections, only_b, "R", False, "code", False)
+    page = results_markdown(sections, only_b, "R", False, "code", False, first.replace("*Table 1.*", "*Table 7.*"))
+    assert page.splitlines()[3:] == first.splitlines()[3:] and "*Table 1.* table a." in page
+    assert "The sections this run did not compute are those of the page before" in page.splitlines()[2]
+
+
 def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypatch):
     """Absent files are "not measured yet"; a result file is one table of its columns and rows,
     captioned with its command, machine and date, its notes under it; a file that is not a

@@ -57,8 +57,8 @@ SCENARIOS = {
     "spindle length, marked": ({SPINDLE: 0.38}, MESH_FACTOR, (SPINDLE,)),
     "spindle length, not marked": ({SPINDLE: 0.38}, MESH_FACTOR, ()),
 }
-COLUMNS = ("scenario", "mesh_factor", "order", "hidden", "verdict", "pieces", "alternatives", "found", "wrong_names", "missed",
-           "fitted", "p2_minus_p1_delta", "rms_before_um", "rms_after_um", "runs", "seconds")
+COLUMNS = ("scenario", "mesh_factor", "order", "hidden", "verdict", "pieces", "alternatives", "found", "wrong_names",
+           "missed", "fitted", "p2_minus_p1_delta", "rms_before_um", "rms_after_um", "runs", "seconds")
 """Study columns; ``order``: the elements the diagnosis replayed; ``p2_minus_p1_delta``: its discretisation
 check on δ, in resolutions."""
 

@@ -60,7 +60,8 @@ def register(sub) -> None:
                    "discretisation check of the report exceeds the resolution)")
     p.add_argument("--keep-order", action="store_true",
                    help="replay with the model's own element order even where its discretisation error (P2 - P1) "
-                   "exceeds the resolution (default: then with P2 elements); e.g. for a run gatetherm simulated on the same mesh")
+                   "exceeds the resolution (default: then with P2 elements); e.g. for a run gatetherm simulated on "
+                   "the same mesh")
     p.add_argument("--list-effects", action="store_true",
                    help="list the hypotheses (effects, parameters, sensor faults) and exit")
     p.add_argument("--json", action="store_true", help="with --list-effects: print JSON")

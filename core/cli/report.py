@@ -29,7 +29,8 @@ def register(sub) -> None:
                    help="compute only these sections (others are shown if cached): " + ", ".join(s.key for s in SECTIONS))
     p.add_argument("--workers", type=number(WORKERS), default=os.cpu_count() or 1, metavar="N",
                    help="worker processes for the sweeps (default: the CPU count)")
-    p.add_argument("--docs", metavar="DIR", help="also write the results page DIR/validation.md (docs/ of a checkout)")
+    p.add_argument("--docs", metavar="DIR", help="also write the results page DIR/validation.md (docs/ of a checkout); a section this run "
+                   "does not compute keeps its text from the page there")
     p.add_argument("--data", metavar="FILE.csv", help="thermal drift report of this time series (data format)")
     p.set_defaults(func=run)
 
@@ -60,7 +61,9 @@ def run(args) -> int:
         write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code))
         write_text_atomic(out / "validation.md", results_markdown(SECTIONS, results, args.out, args.full, code))
     if docs is not None:
-        write_text_atomic(docs / "validation.md", results_markdown(SECTIONS, results, "R", args.full, code, figures=False))
+        page = docs / "validation.md"
+        before = page.read_text(encoding="utf-8") if page.is_file() else None
+        write_text_atomic(page, results_markdown(SECTIONS, results, "R", args.full, code, False, before))
     print(f"wrote {out}/index.html and validation.md" + (f" and {docs / 'validation.md'}" if docs else "")
           + f" in {time.perf_counter() - t0:.0f} s")
     return 0

@@ -74,7 +74,7 @@ class Settings:
     """Hypotheses that need model runs fitted for real in each round after the first (the rest screened)."""
     p2_check: bool = True
     """A linear-element case is run once more with quadratic elements: its own discretisation error
-    against the sensors' resolution (:func:`discretisation`)."""
+    against the sensors' resolution (:attr:`Diagnosis.discretisation`)."""
     refine: bool = True
     """Where that error exceeds the resolution and the baseline residual is significant, replay with
     quadratic elements (a residual the model's own mesh makes is not a missing piece)."""

@@ -131,6 +131,8 @@ class Case:
 
     def with_order(self, order: int) -> "Case":
         """The case with elements of ``order`` (1 linear, 2 quadratic), kept by later overrides."""
+        if self.origin is None:
+            return dataclasses.replace(self, problem=dataclasses.replace(self.problem, order=order))
         return self.with_overrides({self.origin.ORDER: order})
 
     def with_schedule(self, schedule: Schedule) -> "Case":

@@ -16,9 +16,9 @@ def compute(ctx) -> Result:
     shown = [{**r, "fitted": cell(r["fitted"])} for r in rows]
     return Result(tables=(from_dicts("Every scenario: hidden pieces, verdict, pieces named", shown, COLUMNS,
                                      note=f"{line}. Truth: P2 elements on the case's geometry with its element sizes "
-                                          f"times {MESH_FACTOR:g}; diagnosis: the case's P1 elements with its element sizes times "
-                                          "mesh_factor, replayed with P2 (order 2) where its discretisation check "
-                                          "exceeds the resolution. "
+                                          f"times {MESH_FACTOR:g}; diagnosis: the case's P1 elements with its "
+                                          "element sizes times mesh_factor, replayed with P2 (order 2) where its "
+                                          "discretisation check exceeds the resolution. "
                                           "p2_minus_p1_delta: the diagnosis' discretisation check on δ, in units "
                                           "of the 0.1-µm resolution. Noise at the resolution (0.1 µm, 0.05 K); "
                                           "held-out window: the last 40 % of the 6-h run."),),
