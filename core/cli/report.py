@@ -29,8 +29,8 @@ def register(sub) -> None:
                    help="compute only these sections (others are shown if cached): " + ", ".join(s.key for s in SECTIONS))
     p.add_argument("--workers", type=number(WORKERS), default=os.cpu_count() or 1, metavar="N",
                    help="worker processes for the sweeps (default: the CPU count)")
-    p.add_argument("--docs", metavar="DIR", help="also write the results page DIR/validation.md (docs/ of a checkout); a section this run "
-                   "does not compute keeps its text from the page there")
+    p.add_argument("--docs", metavar="DIR", help="also write the results page DIR/validation.md (docs/ of a "
+                   "checkout); a section this run does not compute keeps its text from the page there")
     p.add_argument("--data", metavar="FILE.csv", help="thermal drift report of this time series (data format)")
     p.set_defaults(func=run)
 

@@ -281,9 +281,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     if (~train).sum() < 5 or train.sum() < 5:
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
     run_phases = case_phases(case, t, rep.drive.columns)
-    res0 = residuals(ts, base_cols, channels)
-    findings = locate(t, res0, run_phases)
-    discrepant = any(f.significant for f in findings)
+    res0, findings, discrepant = _located(ts, base_cols, channels, t, run_phases)
     check, runs, refined = None, 0, ""
     if case.problem.order == 1 and settings.p2_check:
         fine = Replayer(case.with_order(2), ts)
@@ -294,9 +292,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
             log.info("diagnosis: the P1 model's discretisation error exceeds the resolution on %s (%.2g "
                      "resolutions): replaying with P2 elements", ", ".join(coarse), max(check.values()))
             runs, rep, base_cols = rep.runs, fine, fine_cols
-            res0 = residuals(ts, base_cols, channels)
-            findings = locate(t, res0, run_phases)
-            discrepant = any(f.significant for f in findings)
+            res0, findings, discrepant = _located(ts, base_cols, channels, t, run_phases)
             refined = "" if discrepant else ("with P2 elements the baseline residual is within the sensor "
                                              "resolution: the P1 model's was its own discretisation error")
         else:
@@ -330,6 +326,14 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
                      remaining, res0, after, runs, time.perf_counter() - t0, rep.has_ambient, settings.margin_min,
                      rep.dim, inputs, check, chk, tuple((p, v, why) for p, (v, why) in stand.items()), tuple(grp),
                      cause, rep.config.problem.order)
+
+
+def _located(ts: TimeSeries, cols: dict, channels, t: np.ndarray, run_phases) -> tuple[dict, list[Finding], bool]:
+    """The residual of the model's run ``cols`` (at the times ``t``) per channel, its findings per
+    phase, and whether any is significant."""
+    res = residuals(ts, cols, channels)
+    found = locate(t, res, run_phases)
+    return res, found, any(f.significant for f in found)
 
 
 def adopted_case(case: Case, diag: Diagnosis) -> Case | None:

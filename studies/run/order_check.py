@@ -9,7 +9,6 @@ in one warning with the fix, as ``diagnose``'s discretisation check does.
 """
 from __future__ import annotations
 
-import dataclasses
 import logging
 from dataclasses import dataclass
 
@@ -33,7 +32,7 @@ def p2_outputs(case, run) -> dict[str, float]:
     from gatetherm.studies.run.scenario import Schedule, run_scenario
     from gatetherm.studies.run.simulate import output_columns
 
-    p2 = dataclasses.replace(case, problem=dataclasses.replace(case.problem, order=2))
+    p2 = case.with_order(2)
     model1 = run.model
     if model1.heat is None or case.time is None:
         sched = run.schedule

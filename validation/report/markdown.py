@@ -46,6 +46,11 @@ def results_markdown(sections, results: dict, out: str, full: bool, code: str, f
     now = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     kept = {k: v for k, v in previous_sections(previous or "").items() if results.get(k) is None}
     counter = 0
+
+    def renumbered(match) -> str:  # a kept section's table, numbered in this page's order
+        nonlocal counter
+        counter += 1
+        return f"*Table {counter}.*"
     L = ["# Validation results", "",
          f"Written by `gatetherm report --out {out}{' --full' if full else ''}` (gatetherm {__version__}, code "
          f"digest `{code[:12]}`, {now}); `--docs DIR` writes this page into `DIR/validation.md`. Do not edit it: "
@@ -59,7 +64,7 @@ def results_markdown(sections, results: dict, out: str, full: bool, code: str, f
     for s in sections:
         r = results.get(s.key)
         if s.key in kept:
-            L += [f'<a id="{s.key}"></a>', "", kept[s.key][1], ""]
+            L += [f'<a id="{s.key}"></a>', "", re.sub(r"^\*Table \d+\.\*", renumbered, kept[s.key][1], flags=re.M), ""]
             continue
         L += [f'<a id="{s.key}"></a>', "", f"## {s.title}", ""]
         if s.pending or r is None:
@@ -81,6 +86,4 @@ def results_markdown(sections, results: dict, out: str, full: bool, code: str, f
             L += [f"![{f.caption}](sections/{s.key}/{f.file})" for f in r.figures] + ([""] if r.figures else [])
         elif r.figures:
             L += ["Figures (on the HTML page): " + "; ".join(f.caption for f in r.figures) + ".", ""]
-    numbers = iter(range(1, 10 ** 6))
-    page = re.sub(r"^\*Table \d+\.\*", lambda m: f"*Table {next(numbers)}.*", "\n".join(L), flags=re.M)
-    return page.rstrip("\n") + "\n"
+    return "\n".join(L).rstrip("\n") + "\n"
