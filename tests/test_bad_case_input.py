@@ -263,6 +263,16 @@ def test_report_docs_that_is_no_folder(tmp_path, capsys):
             f"--docs: '{tmp_path / 'README.md'}' is not a folder")
 
 
+def test_report_docs_page_that_is_not_text(tmp_path, capsys):
+    """The page whose other sections ``--docs`` keeps is read before anything is computed."""
+    page = tmp_path / "docs" / "validation.md"
+    page.parent.mkdir()
+    page.write_bytes(b"# Validation results\n\xff\n")
+    refused(capsys, 2, ["report", "--docs", page.parent, "--out", tmp_path / "o"],
+            f"{page}, line 2: byte 0xff is not UTF-8 text")
+    assert not (tmp_path / "o").exists() and page.read_bytes() == b"# Validation results\n\xff\n"
+
+
 @pytest.mark.parametrize("columns, needle", [
     ({"time_s": [0.0], "delta_um": [1.0]}, "d.csv: 1 data row: a drift needs two samples or more"),
     ({"time_s": [0.0, 60.0]}, "d.csv: no displacement (*_um) or temperature (*_degC) column"),

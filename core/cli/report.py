@@ -43,6 +43,7 @@ def run(args) -> int:
             raise InputError(f"--data/{given[0]}", "applies to the validation report, not to a drift report",
                              f"drop {given[0]}, or --data")
         return _drift(args)
+    from gatetherm.files import read_text
     from gatetherm.outdir import output_dir
     from gatetherm.validation.report.build import build, code_digest
     from gatetherm.validation.report.markdown import results_markdown
@@ -52,6 +53,9 @@ def run(args) -> int:
     docs = Path(args.docs) if args.docs else None
     if docs is not None and not docs.is_dir():
         raise InputError("--docs", f"'{docs}' is not a folder", "give the docs folder of a checkout (docs)")
+    page = docs / "validation.md" if docs is not None else None
+    before = read_text(page, fix="delete it, or restore it from the checkout") if page and page.exists() else None
+
     def tell(key, status, seconds):
         print(f"{key:<16} {status}" + (f" ({seconds:.0f} s)" if status in ("computed", "cached") else ""), flush=True)
 
@@ -61,10 +65,9 @@ def run(args) -> int:
         write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code))
         write_text_atomic(out / "validation.md", results_markdown(SECTIONS, results, args.out, args.full, code))
     if docs is not None:
-        page = docs / "validation.md"
-        before = page.read_text(encoding="utf-8") if page.is_file() else None
-        write_text_atomic(page, results_markdown(SECTIONS, results, "R", args.full, code, False, before))
-    print(f"wrote {out}/index.html and validation.md" + (f" and {docs / 'validation.md'}" if docs else "")
+        write_text_atomic(page, results_markdown(SECTIONS, results, "R", args.full, code, figures=False,
+                                                 previous=before))
+    print(f"wrote {out}/index.html and validation.md" + (f" and {page}" if page else "")
           + f" in {time.perf_counter() - t0:.0f} s")
     return 0
 
