@@ -180,7 +180,8 @@ class Run:
             out["order_check"] = self.order_check.summary()
         return out
 
-    def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None) -> dict:
+    def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None,
+              painter=None) -> dict:
         """Write the run directory that ``gatetherm run`` writes.
 
         Parameters
@@ -191,6 +192,10 @@ class Run:
             Write ``channels.png`` and ``deformed.png``.
         fields_every : float, optional
             Interval of the fields, s (default: the case's field interval); the last sample always.
+        painter : Painter, optional
+            Draws the pictures while the fields are written
+            (:class:`~gatetherm.validation.plots.painter.Painter`, made before the run; default:
+            drawn here, in turn).
 
         Returns
         -------
@@ -209,11 +214,16 @@ class Run:
         meta = {"source": "gatetherm", "case": self.case.source, "name": self.case.name, "dim": str(self.case.dim),
                 "schedule": sched.label, **({"condition": str(sched.condition)} if sched.condition else {})}
         picture = self._picture_time()
-        solved = write_run(out, self.scenario, meta, fields, (picture,) if pictures and picture is not None else ())
-        if pictures:
+
+        def draw(solved):
             from gatetherm.validation.plots.run import write_pictures
 
-            write_pictures(self.scenario, out, self.case.name, picture, solved)
+            write_pictures(self.scenario, out, self.case.name, picture, solved, painter=painter)
+
+        write_run(out, self.scenario, meta, fields, (picture,) if pictures and picture is not None else (),
+                  draw if pictures else None)
+        if pictures and painter is not None:
+            painter.finish()
         summary = self.summary()
         write_json(out / "summary.json", summary)
         return summary

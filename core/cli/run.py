@@ -23,11 +23,13 @@ def run(args) -> int:
     import gatetherm as gt
     from gatetherm.outdir import output_dir
 
-    case = gt.load_case(args.case)
-    every = case.time.fields if case.time else 1.0
-    with output_dir(args.out, OUTPUTS, keep=case.files) as out:
-        res = gt.run(case, keep=picture_keep(case.schedule, every), on_step=Progress(case.name), check_order=True)
-        summary = res.write(out, pictures=not args.no_pictures)
+    with gt.plot.Painter(0 if args.no_pictures else 2) as painter:  # before the work it overlaps
+        case = gt.load_case(args.case)
+        every = case.time.fields if case.time else 1.0
+        with output_dir(args.out, OUTPUTS, keep=case.files) as out:
+            res = gt.run(case, keep=picture_keep(case.schedule, every), on_step=Progress(case.name),
+                         check_order=True)
+            summary = res.write(out, pictures=not args.no_pictures, painter=painter)
     print(f"wrote {out}/timeseries.csv, summary.json and fields/")
     for name, q in summary["probes"].items():
         print(f"{name}: " + ", ".join(f"{k} {v:.6g}" for k, v in q.items() if v is not None))

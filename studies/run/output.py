@@ -137,10 +137,12 @@ def nearest_state(run, t: float) -> tuple[float, np.ndarray]:
     return min(run.result.states, key=lambda s: abs(s[0] - t))
 
 
-def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_times=()) -> dict[float, np.ndarray]:
+def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_times=(),
+              solved_hook=None) -> dict[float, np.ndarray]:
     """``out/timeseries.csv`` (what the sensors report) and the fields at ``field_times``
     (``out/fields``) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`; returns the
-    :func:`displacements` of those states and of the states nearest ``picture_times``."""
+    :func:`displacements` of those states and of the states nearest ``picture_times``, which
+    ``solved_hook`` (if given) is called with before the fields are written."""
     from gatetherm.studies.run.timeseries import FORMAT, write_timeseries
 
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
@@ -148,6 +150,8 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_tim
     extra = {t: U for t, U in (nearest_state(run, tp) for tp in picture_times) if t not in field_times}
     envs = run.result.envs
     solved = displacements(run.model, states + list(extra.items()), envs)
+    if solved_hook is not None:
+        solved_hook(solved)
     write_fields(run.model, states, out / "fields", solved, envs)
     return solved
 

@@ -7,7 +7,8 @@
 
 Each takes what the API gives (a :class:`~gatetherm.api.Run`, a compensation, a diagnosis …) and
 ``ax=`` (``axes=`` for a figure of several panels), draws on it and returns it. None chooses a
-backend or writes a file (:func:`save` writes a PNG). Given no Axes, a plot draws on a new
+backend or writes a file (:func:`save` writes a PNG; a :class:`Painter` writes them in processes of
+its own, beside the work: ``run.write(out, painter=painter)``). Given no Axes, a plot draws on a new
 *pyplot* figure, so that it shows in a notebook or with ``plt.show()`` as your own figures do:
 pyplot uses the backend matplotlib would anyway (``MPLBACKEND``, ``matplotlibrc``, the
 notebook's) and leaves it so. The pictures the command line and the report write come from the
@@ -18,8 +19,9 @@ from __future__ import annotations
 import os
 
 from gatetherm.validation.plots import save
+from gatetherm.validation.plots.painter import Painter
 
-__all__ = ["channels", "compensation", "deformed", "field", "fluids", "prediction", "residuals", "response", "save",
+__all__ = ["Painter", "channels", "compensation", "deformed", "field", "fluids", "prediction", "residuals", "response", "save",
            "sensor_curve", "sensors", "series", "sweep"]
 
 LABELS = {"_um": "displacement [µm]", "_degC": "temperature [°C]", "_MPa": "stress [MPa]"}

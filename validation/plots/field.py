@@ -137,11 +137,12 @@ def _trim(img: np.ndarray, pad: int = 12) -> np.ndarray:
     return img[max(r0 - pad, 0):r1 + pad + 1, max(c0 - pad, 0):c1 + pad + 1]
 
 
-def draw_deformed(run, t: float, title, solved: dict | None = None, ax=None):
-    """The kept state of ``run`` (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) nearest
-    ``t`` (s) drawn by :func:`render_deformed`, magnified so that the largest displacement shows
-    as about 8 % of the frame's width (a power of ten); ``title``: text or a function of the time
-    drawn; ``solved``: displacements of kept states, by time, if solved already. Returns the Axes."""
+def deformed(run, t: float, title, solved: dict | None = None) -> tuple:
+    """The arguments of :func:`render_deformed` (``fmesh, fields, title, scale``) for the kept
+    state of ``run`` (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) nearest ``t`` (s),
+    magnified so that the largest displacement shows as about 8 % of the frame's width (a power
+    of ten); ``title``: text or a function of the time drawn; ``solved``: displacements of kept
+    states, by time, if solved already."""
     from gatetherm.studies.run.output import nearest_state, nodal_fields
 
     t, U = nearest_state(run, t)
@@ -150,4 +151,10 @@ def draw_deformed(run, t: float, title, solved: dict | None = None, ax=None):
     x = np.asarray(fmesh.points)[:, 0]
     umax = float(np.abs(fields["u"]).max()) or 1.0
     scale = float(10 ** np.floor(np.log10(0.08 * max(x.max() - x.min(), 1e-9) / umax)))
-    return render_deformed(fmesh, fields, title(t) if callable(title) else title, scale, ax)
+    return fmesh, fields, title(t) if callable(title) else title, scale
+
+
+def draw_deformed(run, t: float, title, solved: dict | None = None, ax=None):
+    """The kept state of ``run`` nearest ``t`` (s) drawn by :func:`render_deformed` (see
+    :func:`deformed`). Returns the Axes."""
+    return render_deformed(*deformed(run, t, title, solved), ax=ax)

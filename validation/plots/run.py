@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gatetherm.validation.plots import figure, save
+from gatetherm.validation.plots import figure
 
 THETAS = (("theta_A_degC", "θ_A"), ("theta_B_degC", "θ_B"), ("theta_C_degC", "θ_C"))
 """The response's temperature signals and their labels."""
@@ -106,29 +106,31 @@ def has_response(cols: dict) -> bool:
 
 
 def write_pictures(run, out, title: str, picture_s: float | None, solved: dict | None = None,
-                   caption=None) -> list[str]:
+                   caption=None, painter=None) -> list[str]:
     """The pictures of a run (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) into ``out``,
     by what the case has: ``channels.png`` (every channel of a transient run), ``response.png``
     (θ_A, θ_B, θ_C and δ: Figs. 11–13), ``oil_temperatures.png`` (its fluids' supply, volume and
     wall: Fig. 10) and ``deformed.png`` (the state kept nearest ``picture_s``; ``caption``: its
-    title as a function of the time drawn, default ``title, t = … min``); returns the names written."""
+    title as a function of the time drawn, default ``title, t = … min``); returns the names.
+    Given a :class:`~gatetherm.validation.plots.painter.Painter`, they are handed to it (written
+    once its ``finish`` returns); else written here."""
     from pathlib import Path
 
-    from gatetherm.validation.plots.field import draw_deformed
+    from gatetherm.validation.plots.field import deformed, render_deformed
+    from gatetherm.validation.plots.painter import Painter
 
-    out, cols, written = Path(out), run.columns, []
+    out, cols, jobs = Path(out), run.columns, {}
     transient = len(cols["time_s"]) > 1
-    if transient:
-        save(plot_channels(cols, title), out / "channels.png", tight=False)
-        written.append("channels.png")
-    if has_response(cols):
-        save(plot_response(cols, title), out / "response.png")
-        written.append("response.png")
-    if transient and run.model.problem.fluids:
-        save(plot_fluids(cols, run.model.problem, title), out / "oil_temperatures.png")
-        written.append("oil_temperatures.png")
-    if picture_s is not None and run.model.elastic is not None:
+    if picture_s is not None and run.model.elastic is not None:  # the largest arguments first
         caption = caption or (lambda t: f"{title}, t = {t / 60:.0f} min")
-        save(draw_deformed(run, picture_s, caption, solved), out / "deformed.png")
-        written.append("deformed.png")
-    return written
+        jobs["deformed.png"] = render_deformed, deformed(run, picture_s, caption, solved)
+    if transient:
+        jobs["channels.png"] = plot_channels, (cols, title)
+    if has_response(cols):
+        jobs["response.png"] = plot_response, (cols, title)
+    if transient and run.model.problem.fluids:
+        jobs["oil_temperatures.png"] = plot_fluids, (cols, run.model.problem, title)
+    painter = Painter(0) if painter is None else painter
+    for name, (plot, args) in jobs.items():
+        painter.draw(plot, *args, path=out / name, tight=name != "channels.png")
+    return list(jobs)

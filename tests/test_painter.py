@@ -1,0 +1,102 @@
+"""The painter: pictures drawn in processes of their own are the pictures drawn in turn, its
+failures reach the caller, and it stops with the caller's block.
+
+The painter forks only where no other thread runs (a sweep earlier in the session leaves its
+pool's), so each check runs in a new interpreter."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+
+import gatetherm as gt
+from gatetherm.validation.plots.run import plot_channels
+
+PRELUDE = f"""
+import json, os, sys, time
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+import numpy as np
+import gatetherm as gt
+from gatetherm.validation.plots.run import plot_channels
+"""
+
+
+def fresh(body: str, **values) -> dict:
+    """What ``body`` (with ``values`` formatted in) prints as JSON, run in a new interpreter."""
+    code = PRELUDE + textwrap.dedent(body).format(**{k: repr(v) for k, v in values.items()})
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.splitlines()[-1])
+
+
+def test_a_run_written_with_a_painter_has_the_pictures_drawn_in_turn(tmp_path):
+    out = fresh("""
+        from conftest import fixed_condition
+        case, schedule = fixed_condition(30)
+        with gt.plot.Painter(2) as painter:  # before the run, as the command line makes it
+            workers = painter.workers
+            res = gt.run(case, schedule)
+            res.write({painted}, painter=painter)
+        res.write({here})
+        print(json.dumps({{"workers": workers}}))
+        """, painted=str(tmp_path / "painted"), here=str(tmp_path / "here"))
+    assert out == {"workers": 2}
+    names = sorted(p.name for p in (tmp_path / "here").glob("*.png"))
+    assert names == ["channels.png", "deformed.png", "oil_temperatures.png", "response.png"]
+    for name in names:
+        assert (tmp_path / "painted" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
+
+
+def test_a_failed_picture_is_raised_by_finish_naming_it(tmp_path):
+    out = fresh("""
+        def broken(cols):
+            raise ValueError(f"no column {{sorted(cols)[0]!r}}")
+
+        cols = {{"time_s": np.array([0.0, 60.0]), "a_degC": np.array([20.0, 21.0])}}
+        with gt.plot.Painter(2) as painter:
+            workers = painter.workers
+            painter.draw(plot_channels, cols, path=os.path.join({tmp}, "fine.png"))
+            painter.draw(broken, cols, path=os.path.join({tmp}, "broken.png"))
+            try:
+                painter.finish()
+            except RuntimeError as err:
+                print(json.dumps({{"workers": workers, "error": str(err)}}))
+        """, tmp=str(tmp_path))
+    assert out == {"workers": 2, "error": "broken.png: ValueError: no column 'a_degC'"}
+    assert [p.name for p in tmp_path.iterdir()] == ["fine.png"]  # no temporary left
+
+
+def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):
+    out = fresh("""
+        t = np.arange(6000.0)
+        cols = {{"time_s": t, **{{f"T{{k}}_degC": np.sin(k * t) for k in range(19)}}}}  # 0.96 MB, ~3 s to draw
+        try:
+            with gt.plot.Painter(2) as painter:
+                workers = painter.workers
+                painter.draw(plot_channels, cols, path=os.path.join({tmp}, "slow.png"))
+                time.sleep(2.0)  # matplotlib imported (about 1 s): the picture is being drawn
+                t0 = time.perf_counter()
+                raise KeyError("the run failed")
+        except KeyError:
+            stopped = time.perf_counter() - t0
+        try:
+            os.waitpid(-1, os.WNOHANG)
+            left = True
+        except ChildProcessError:  # none left running or unreaped
+            left = False
+        print(json.dumps({{"workers": workers, "stopped_s": stopped, "left": left}}))
+        """, tmp=str(tmp_path))
+    assert out["workers"] == 2 and not out["left"]
+    assert out["stopped_s"] < 1.0  # without SIGTERM, the 3 s of the picture
+    assert list(tmp_path.iterdir()) == []  # the PNG being written removed
+
+
+def test_painter_0_draws_at_once(tmp_path):
+    painter = gt.plot.Painter(0)
+    painter.draw(plot_channels, {"time_s": np.array([0.0, 60.0]), "a_um": np.array([0.0, 1.0])}, "t",
+                 path=tmp_path / "c.png")
+    assert painter.workers == 0 and (tmp_path / "c.png").stat().st_size > 10_000

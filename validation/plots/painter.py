@@ -1,0 +1,264 @@
+"""Pictures drawn beside the work: a :class:`Painter` hands each picture (a plot function, its
+arguments and the PNG's path) to processes of its own, which import matplotlib while the caller
+computes and draw while it writes its other files.
+
+Created before a run (``gatetherm simulate`` and ``gatetherm run`` make one first), it forks one
+process, which imports matplotlib, draws a small figure (fonts loaded) and forks the second, so
+that matplotlib is imported once. :meth:`Painter.draw` sends a picture to the process with the
+fewer; :meth:`Painter.finish` waits for every PNG and raises the first failure. Each process
+writes its PNG atomically (:func:`gatetherm.validation.plots.save`) and ends with the caller
+(``PR_SET_PDEATHSIG``) or when the painter closes. ``Painter(0)``, and a process that cannot fork
+(not POSIX, one core, or threads running: a forked child would miss them), draws each picture
+when it is given, in the process.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import pickle
+import signal
+import struct
+import sys
+import threading
+import time
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+STOP_S = 2.0
+"""Longest a painting process is given to end on SIGTERM (it removes the PNG it was writing), s."""
+
+PIPE_BYTES = 1 << 20
+"""Pipe buffer asked for (Linux ``F_SETPIPE_SZ``, at most ``/proc/sys/fs/pipe-max-size``): a
+picture's arguments up to this size reach its process at once; larger ones wait in the outbox
+until :meth:`Painter.finish` (the deformed picture of a large 3-D mesh)."""
+
+def _message(obj) -> bytes:
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    return struct.pack("<Q", len(data)) + data
+
+
+def _send(fd: int, obj) -> None:
+    view = memoryview(_message(obj))
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _receive(fd: int):
+    """The next object on ``fd``, or None at its end."""
+    head = _read(fd, 8)
+    return None if head is None else pickle.loads(_read(fd, struct.unpack("<Q", head)[0]) or b"")
+
+
+def _read(fd: int, n: int) -> bytes | None:
+    buf = bytearray()
+    while len(buf) < n:
+        chunk = os.read(fd, n - len(buf))
+        if not chunk:
+            return None
+        buf += chunk
+    return bytes(buf)
+
+
+def _paint(job) -> None:
+    from gatetherm.validation.plots import save
+
+    plot, args, kwargs, path, tight = job
+    save(plot(*args, **kwargs), path, tight=tight)
+
+
+def _warm() -> None:
+    """Import matplotlib and draw a small figure with text: its fonts are loaded."""
+    import io
+
+    from matplotlib.figure import Figure
+
+    import gatetherm.validation.plots.field  # noqa: F401 - the plot modules, imported once
+    import gatetherm.validation.plots.run  # noqa: F401
+
+    fig = Figure(figsize=(1, 1))
+    fig.subplots().set(title="0", xlabel="[°C]")
+    fig.tight_layout()
+    fig.savefig(io.BytesIO(), format="png", dpi=20)
+
+
+def _serve(jobs: int, replies: int) -> None:
+    """A painting process's life: draw every job on ``jobs``, answer each on ``replies``
+    (``(is OSError, error text)``, the text empty once the PNG is written)."""
+    while (job := _receive(jobs)) is not None:
+        try:
+            _paint(job)
+            _send(replies, (False, ""))
+        except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
+            _send(replies, (isinstance(err, OSError), f"{type(err).__name__}: {err}"[:4000]))
+
+
+def _stop(*_) -> None:
+    raise SystemExit(1)  # on SIGTERM: the PNG being written is removed (its temporary) on the way out
+
+
+def _die_with_parent() -> None:
+    """SIGTERM when the parent ends; SIGTERM ends the process through :func:`_stop`."""
+    signal.signal(signal.SIGTERM, _stop)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the painter
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+
+
+def _can_fork() -> bool:
+    from gatetherm.geometry.isolate import THREADS_STARTED
+
+    return (hasattr(os, "fork") and (os.cpu_count() or 1) > 1 and threading.active_count() == 1
+            and not THREADS_STARTED["here"])
+
+
+class Painter:
+    """Draws pictures in processes of its own, beside the caller's work (see the module).
+
+    Parameters
+    ----------
+    workers : int
+        Processes to draw in (at most 2); 0, or where the process cannot fork, each picture is
+        drawn when given.
+
+    A context manager: on its way out it stops the processes (:meth:`close`), at once when the
+    block raised. Make it before the work it should overlap::
+
+        with gt.plot.Painter() as painter:
+            run = gt.run(case)
+            run.write("out", painter=painter)   # pictures drawn while the fields are written
+    """
+
+    def __init__(self, workers: int = 2):
+        self._pipes: list[tuple[int, int]] = []  # (jobs to write, replies to read), one per process
+        self._queued: list[list[Path]] = []  # the pictures each is given and has not answered
+        self._outbox: list[bytearray] = []  # what is not yet written to each one's pipe
+        self._pid = None
+        if workers > 0 and _can_fork():
+            self._start(min(workers, 2))
+        log.debug("pictures drawn by %d processes", self.workers)
+
+    def _start(self, workers: int) -> None:
+        pairs = [(os.pipe(), os.pipe()) for _ in range(workers)]  # (jobs r, w), (replies r, w)
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child's coverage is not collected
+            code, child = 1, None
+            try:
+                _die_with_parent()
+                for (jr, jw), (rr, rw) in pairs:
+                    os.close(jw)
+                    os.close(rr)
+                _warm()
+                mine = pairs[0]
+                if len(pairs) > 1:  # the second process: matplotlib imported already
+                    child = os.fork()
+                    if child == 0:
+                        _die_with_parent()
+                    mine, other = (pairs[1], pairs[0]) if child == 0 else (pairs[0], pairs[1])
+                    os.close(other[0][0])  # the other's jobs and replies
+                    os.close(other[1][1])
+                _serve(mine[0][0], mine[1][1])
+                code = 0
+            except SystemExit:
+                pass
+            except BaseException:  # noqa: BLE001 - the caller reports the pictures not drawn
+                log.exception("the painting process failed")
+            finally:
+                if child:
+                    with contextlib.suppress(OSError):
+                        if code:  # stopped: the second one too
+                            os.kill(child, signal.SIGTERM)
+                        os.waitpid(child, 0)
+                os._exit(code)
+        self._pid = pid
+        for (jr, jw), (rr, rw) in pairs:
+            os.close(jr)
+            os.close(rw)
+            os.set_blocking(jw, False)  # what does not fit in the pipe waits in the outbox
+            with contextlib.suppress(ImportError, OSError):
+                import fcntl
+
+                fcntl.fcntl(jw, 1031, PIPE_BYTES)  # F_SETPIPE_SZ
+            self._pipes.append((jw, rr))
+            self._queued.append([])
+            self._outbox.append(bytearray())
+
+    @property
+    def workers(self) -> int:
+        """The number of processes drawing (0: each picture is drawn in this process)."""
+        return len(self._pipes)
+
+    def draw(self, plot, *args, path: str | os.PathLike, tight: bool = True, **kwargs) -> None:
+        """Write ``plot(*args, **kwargs)`` (a plot function of :mod:`gatetherm.validation.plots`,
+        its arguments picklable) to the PNG ``path``, laid out by ``tight_layout`` if ``tight``;
+        returns at once."""
+        job = (plot, args, kwargs, Path(path), tight)
+        if not self._pipes:
+            return _paint(job)
+        k = min(range(self.workers), key=lambda i: len(self._queued[i]))
+        self._outbox[k] += _message(job)
+        self._queued[k].append(Path(path))
+        self._flush(k)
+
+    def _flush(self, k: int) -> None:
+        box = self._outbox[k]
+        while box:
+            try:
+                del box[:os.write(self._pipes[k][0], box)]
+            except BlockingIOError:
+                return
+
+    def finish(self) -> None:
+        """Wait for every picture given; raise the first failure (OSError for a file that could
+        not be written, else RuntimeError), naming the picture."""
+        import select
+
+        failed = None
+        while any(self._queued):
+            busy = [k for k in range(self.workers) if self._queued[k]]
+            readable, writable, _ = select.select([self._pipes[k][1] for k in busy],
+                                                  [self._pipes[k][0] for k in busy if self._outbox[k]], [])
+            for k in busy:
+                if self._pipes[k][0] in writable:
+                    self._flush(k)
+                if self._pipes[k][1] not in readable:
+                    continue
+                path, reply = self._queued[k].pop(0), _receive(self._pipes[k][1])
+                if reply is None:  # the process is gone
+                    failed = failed or RuntimeError(f"{path.name}: the process drawing it ended")
+                    self._queued[k].clear()
+                elif reply[1]:
+                    failed = failed or (OSError if reply[0] else RuntimeError)(f"{path.name}: {reply[1]}")
+        if failed is not None:
+            raise failed
+
+    def close(self, kill: bool = False) -> None:
+        """Stop the processes: once they have drawn what they were given, or at once if
+        ``kill`` (SIGTERM: the PNG being drawn is not written; SIGKILL after :data:`STOP_S`)."""
+        for jobs, replies in self._pipes:
+            os.close(jobs)
+            os.close(replies)
+        self._pipes, self._queued, self._outbox = [], [], []
+        pid, self._pid = self._pid, None
+        if pid is None:
+            return
+        if kill:
+            os.kill(pid, signal.SIGTERM)
+            end = time.monotonic() + STOP_S
+            while os.waitpid(pid, os.WNOHANG) == (0, 0):
+                if time.monotonic() > end:
+                    os.kill(pid, signal.SIGKILL)
+                    break
+                time.sleep(0.01)
+            else:
+                return
+        os.waitpid(pid, 0)
+
+    def __enter__(self) -> Painter:
+        return self
+
+    def __exit__(self, kind, err, tb) -> None:
+        self.close(kill=kind is not None)
