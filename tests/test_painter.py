@@ -70,6 +70,31 @@ def test_a_failed_picture_is_raised_by_finish_naming_it(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["fine.png"]  # no temporary left
 
 
+def test_a_picture_of_more_than_the_pipe_holds_is_drawn_while_the_caller_works(tmp_path):
+    out = fresh("""
+        def with_mesh(cols, mesh):  # a deformed picture's arguments: a mesh of some MB
+            return plot_channels(cols, f"{{len(mesh)}} nodes")
+
+        t = np.arange(3000.0)
+        cols = {{"time_s": t, **{{f"T{{k}}_degC": np.sin(k * t) for k in range(19)}}}}
+        mesh, t0 = np.zeros((400_000, 3)), time.perf_counter()
+        gt.plot.Painter(0).draw(with_mesh, cols, mesh, path=os.path.join({tmp}, "here.png"))
+        draw = time.perf_counter() - t0
+        with gt.plot.Painter(2) as painter:
+            workers, t0 = painter.workers, time.perf_counter()
+            painter.draw(with_mesh, cols, mesh, path=os.path.join({tmp}, "big.png"))
+            given = time.perf_counter() - t0
+            time.sleep(1.0 + 2.0 * draw)  # the caller's work: matplotlib's import and the picture
+            t0 = time.perf_counter()
+            painter.finish()
+            waited = time.perf_counter() - t0
+        print(json.dumps({{"workers": workers, "given_s": given, "waited": waited / draw}}))
+        """, tmp=str(tmp_path))
+    assert out["workers"] == 2 and out["given_s"] < 0.2  # 10.6 MB: the pipe takes 1 MB
+    assert out["waited"] < 0.25  # of the picture's time: the 9.6 MB left for finish to write, all of it
+    assert (tmp_path / "big.png").stat().st_size > 10_000
+
+
 def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):
     out = fresh("""
         t = np.arange(6000.0)

@@ -17,6 +17,7 @@ import contextlib
 import logging
 import os
 import pickle
+import select
 import signal
 import struct
 import sys
@@ -31,8 +32,8 @@ STOP_S = 2.0
 
 PIPE_BYTES = 1 << 20
 """Pipe buffer asked for (Linux ``F_SETPIPE_SZ``, at most ``/proc/sys/fs/pipe-max-size``): a
-picture's arguments up to this size reach its process at once; larger ones wait in the outbox
-until :meth:`Painter.finish` (the deformed picture of a large 3-D mesh)."""
+picture's arguments up to this size go into the pipe at once; the rest of larger ones (the
+deformed picture of a 3-D mesh) is written by a thread of the painter's as the process reads."""
 
 def _message(obj) -> bytes:
     data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
@@ -136,6 +137,7 @@ class Painter:
         self._pipes: list[tuple[int, int]] = []  # (jobs to write, replies to read), one per process
         self._queued: list[list[Path]] = []  # the pictures each is given and has not answered
         self._outbox: list[bytearray] = []  # what is not yet written to each one's pipe
+        self._lock, self._writer, self._closing = threading.Lock(), None, False
         self._pid = None
         if workers > 0 and _can_fork():
             self._start(min(workers, 2))
@@ -194,42 +196,47 @@ class Painter:
     def draw(self, plot, *args, path: str | os.PathLike, tight: bool = True, **kwargs) -> None:
         """Write ``plot(*args, **kwargs)`` (a plot function of :mod:`gatetherm.validation.plots`,
         its arguments picklable) to the PNG ``path``, laid out by ``tight_layout`` if ``tight``;
-        returns at once."""
+        returns at once (what the pipe does not take, a thread writes while the process reads)."""
         job = (plot, args, kwargs, Path(path), tight)
         if not self._pipes:
             return _paint(job)
         k = min(range(self.workers), key=lambda i: len(self._queued[i]))
-        self._outbox[k] += _message(job)
-        self._queued[k].append(Path(path))
-        self._flush(k)
+        with self._lock:
+            self._outbox[k] += _message(job)
+            self._queued[k].append(Path(path))
+            if not self._flush(k) and not (self._writer and self._writer.is_alive()):
+                self._writer = threading.Thread(target=self._drain, name="painter-writer", daemon=True)
+                self._writer.start()
 
-    def _flush(self, k: int) -> None:
+    def _flush(self, k: int) -> bool:
+        """Write what the pipe of process ``k`` takes now; whether its outbox is empty."""
         box = self._outbox[k]
-        while box:
-            try:
+        with contextlib.suppress(BlockingIOError):
+            while box:
                 del box[:os.write(self._pipes[k][0], box)]
-            except BlockingIOError:
+        return not box
+
+    def _drain(self) -> None:
+        """The writer thread: the outboxes into the pipes as the processes read them."""
+        while not self._closing:
+            with self._lock:
+                waiting = [self._pipes[k][0] for k in range(self.workers) if not self._flush(k)]
+            if not waiting:
                 return
+            select.select([], waiting, [], 0.05)
 
     def finish(self) -> None:
         """Wait for every picture given; raise the first failure (OSError for a file that could
         not be written, else RuntimeError), naming the picture."""
-        import select
-
+        if self._writer is not None:
+            self._writer.join()
         failed = None
-        while any(self._queued):
-            busy = [k for k in range(self.workers) if self._queued[k]]
-            readable, writable, _ = select.select([self._pipes[k][1] for k in busy],
-                                                  [self._pipes[k][0] for k in busy if self._outbox[k]], [])
-            for k in busy:
-                if self._pipes[k][0] in writable:
-                    self._flush(k)
-                if self._pipes[k][1] not in readable:
-                    continue
-                path, reply = self._queued[k].pop(0), _receive(self._pipes[k][1])
+        for (_, replies), queued in zip(self._pipes, self._queued):
+            while queued:
+                path, reply = queued.pop(0), _receive(replies)
                 if reply is None:  # the process is gone
                     failed = failed or RuntimeError(f"{path.name}: the process drawing it ended")
-                    self._queued[k].clear()
+                    queued.clear()
                 elif reply[1]:
                     failed = failed or (OSError if reply[0] else RuntimeError)(f"{path.name}: {reply[1]}")
         if failed is not None:
@@ -238,6 +245,9 @@ class Painter:
     def close(self, kill: bool = False) -> None:
         """Stop the processes: once they have drawn what they were given, or at once if
         ``kill`` (SIGTERM: the PNG being drawn is not written; SIGKILL after :data:`STOP_S`)."""
+        self._closing = True
+        if self._writer is not None:
+            self._writer.join()
         for jobs, replies in self._pipes:
             os.close(jobs)
             os.close(replies)
