@@ -29,7 +29,7 @@ def fresh(body: str, **values) -> dict:
     """What ``body`` (with ``values`` formatted in) prints as JSON, run in a new interpreter."""
     code = PRELUDE + textwrap.dedent(body).format(**{k: repr(v) for k, v in values.items()})
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
+    assert done.returncode == 0 and done.stderr == "", done.stderr  # quiet, whatever befell the pictures
     return json.loads(done.stdout.splitlines()[-1])
 
 
@@ -93,6 +93,22 @@ def test_a_picture_of_more_than_the_pipe_holds_is_drawn_while_the_caller_works(t
     assert out["workers"] == 2 and out["given_s"] < 0.2  # 10.6 MB: the pipe takes 1 MB
     assert out["waited"] < 0.25  # of the picture's time: the 9.6 MB left for finish to write, all of it
     assert (tmp_path / "big.png").stat().st_size > 10_000
+
+
+def test_closed_without_finish_it_draws_what_it_was_given(tmp_path):
+    out = fresh("""
+        def with_mesh(cols, mesh):
+            return plot_channels(cols, f"{{len(mesh)}} nodes")
+
+        cols = {{"time_s": np.array([0.0, 60.0]), "a_degC": np.array([20.0, 21.0])}}
+        with gt.plot.Painter(2) as painter:
+            workers = painter.workers
+            painter.draw(with_mesh, cols, np.zeros((400_000, 3)), path=os.path.join({tmp}, "big.png"))
+            painter.draw(plot_channels, cols, path=os.path.join({tmp}, "small.png"))
+        print(json.dumps({{"workers": workers}}))
+        """, tmp=str(tmp_path))
+    assert out == {"workers": 2}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.png", "small.png"]
 
 
 def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):

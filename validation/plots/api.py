@@ -21,8 +21,8 @@ import os
 from gatetherm.validation.plots import save
 from gatetherm.validation.plots.painter import Painter
 
-__all__ = ["Painter", "channels", "compensation", "deformed", "field", "fluids", "prediction", "residuals", "response", "save",
-           "sensor_curve", "sensors", "series", "sweep"]
+__all__ = ["Painter", "channels", "compensation", "deformed", "field", "fluids", "prediction", "residuals", "response",
+           "save", "sensor_curve", "sensors", "series", "sweep"]
 
 LABELS = {"_um": "displacement [µm]", "_degC": "temperature [°C]", "_MPa": "stress [MPa]"}
 

@@ -4,8 +4,8 @@ computes and draw while it writes its other files.
 
 Created before a run (``gatetherm simulate`` and ``gatetherm run`` make one first), it forks one
 process, which imports matplotlib, draws a small figure (fonts loaded) and forks the second, so
-that matplotlib is imported once. :meth:`Painter.draw` sends a picture to the process with the
-fewer; :meth:`Painter.finish` waits for every PNG and raises the first failure. Each process
+that matplotlib is imported once. :meth:`Painter.draw` sends a picture to the process with fewer
+queued; :meth:`Painter.finish` waits for every PNG and raises the first failure. Each process
 writes its PNG atomically (:func:`gatetherm.validation.plots.save`) and ends with the caller
 (``PR_SET_PDEATHSIG``) or when the painter closes. ``Painter(0)``, and a process that cannot fork
 (not POSIX, one core, or threads running: a forked child would miss them), draws each picture
@@ -35,6 +35,7 @@ PIPE_BYTES = 1 << 20
 picture's arguments up to this size go into the pipe at once; the rest of larger ones (the
 deformed picture of a 3-D mesh) is written by a thread of the painter's as the process reads."""
 
+
 def _message(obj) -> bytes:
     data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
     return struct.pack("<Q", len(data)) + data
@@ -47,9 +48,10 @@ def _send(fd: int, obj) -> None:
 
 
 def _receive(fd: int):
-    """The next object on ``fd``, or None at its end."""
+    """The next object on ``fd``, or None at its end (or where the pipe ends inside one)."""
     head = _read(fd, 8)
-    return None if head is None else pickle.loads(_read(fd, struct.unpack("<Q", head)[0]) or b"")
+    body = None if head is None else _read(fd, struct.unpack("<Q", head)[0])
+    return None if body is None else pickle.loads(body)
 
 
 def _read(fd: int, n: int) -> bytes | None:
@@ -90,9 +92,11 @@ def _serve(jobs: int, replies: int) -> None:
     while (job := _receive(jobs)) is not None:
         try:
             _paint(job)
-            _send(replies, (False, ""))
+            reply = (False, "")
         except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
-            _send(replies, (isinstance(err, OSError), f"{type(err).__name__}: {err}"[:4000]))
+            reply = (isinstance(err, OSError), f"{type(err).__name__}: {err}"[:4000])
+        with contextlib.suppress(BrokenPipeError):  # closed without waiting for the answers
+            _send(replies, reply)
 
 
 def _stop(*_) -> None:
@@ -211,9 +215,13 @@ class Painter:
     def _flush(self, k: int) -> bool:
         """Write what the pipe of process ``k`` takes now; whether its outbox is empty."""
         box = self._outbox[k]
-        with contextlib.suppress(BlockingIOError):
+        try:
             while box:
                 del box[:os.write(self._pipes[k][0], box)]
+        except BlockingIOError:
+            pass
+        except BrokenPipeError:  # the process is gone: finish says so
+            box.clear()
         return not box
 
     def _drain(self) -> None:
@@ -245,7 +253,7 @@ class Painter:
     def close(self, kill: bool = False) -> None:
         """Stop the processes: once they have drawn what they were given, or at once if
         ``kill`` (SIGTERM: the PNG being drawn is not written; SIGKILL after :data:`STOP_S`)."""
-        self._closing = True
+        self._closing = kill  # else the writer thread first writes out what is given
         if self._writer is not None:
             self._writer.join()
         for jobs, replies in self._pipes:
