@@ -7,7 +7,10 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
   once; glibc otherwise raises the threshold as arrays are freed and keeps later ones in
   its heap. Peak memory of ``simulate --condition 1 --dim 3``: 1.58 GB without, 1.49 GB
   with 4 MiB, 1.54 GB with 16 MiB; 1 MiB together with MKL's pool off
-  (``MKL_DISABLE_FAST_MM``) saved 0.02 GB more but cost 9 s of system time.
+  (``MKL_DISABLE_FAST_MM``) saved 0.02 GB more but cost 9 s of system time;
+
+and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's),
+:func:`die_with_parent`.
 """
 from __future__ import annotations
 
@@ -23,6 +26,17 @@ BLAS_THREADS = 1
 """BLAS threads of a command; see docs/performance.md for the measurement."""
 THREADS_ENV = "GATETHERM_BLAS_THREADS"
 _M_MMAP_THRESHOLD = -3
+PR_SET_PDEATHSIG = 1
+"""prctl(2) option: the signal a Linux process gets when its parent dies."""
+
+
+def die_with_parent(sig: int) -> bool:
+    """Have the kernel send ``sig`` to this process when its parent ends, even by SIGKILL
+    (Linux ``prctl(PR_SET_PDEATHSIG)``); whether it could (False elsewhere)."""
+    try:
+        return ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0) == 0
+    except (OSError, AttributeError, TypeError):
+        return False
 
 
 def configure() -> None:

@@ -35,6 +35,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry import sandbox
+from gatetherm.process import die_with_parent
 
 log = logging.getLogger(__name__)
 
@@ -113,10 +114,7 @@ def unpack(payload: bytes) -> tuple[dict, dict[str, np.ndarray]]:
 def _child(work, out: int, logfd: int, sock: socket.socket, go: int, verbose: bool, parent: int) -> None:
     """The child's life: never returns."""
     try:
-        if sys.platform.startswith("linux"):
-            import ctypes
-
-            ctypes.CDLL(None).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG: die with the parent
+        die_with_parent(signal.SIGKILL)
         if os.getppid() != parent:
             os._exit(1)
         null = os.open(os.devnull, os.O_RDONLY)

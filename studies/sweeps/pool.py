@@ -8,7 +8,6 @@ live on, orphaned, after its parent was killed. Signals are blocked while the wo
 from __future__ import annotations
 
 import contextlib
-import ctypes
 import multiprocessing
 import os
 import signal
@@ -16,8 +15,8 @@ import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
 
-PR_SET_PDEATHSIG = 1
-"""prctl(2) option: the signal a Linux process gets when its parent dies."""
+from gatetherm.process import die_with_parent
+
 _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
@@ -37,12 +36,8 @@ def _die_with(parent: int | None) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     _mask("SIG_UNBLOCK")
-    try:
-        if ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL) != 0:
-            raise OSError(ctypes.get_errno(), "prctl failed")
-    except (OSError, AttributeError, TypeError):  # not Linux: poll the parent instead
-        if parent is not None:
-            threading.Thread(target=_watch, args=(parent,), daemon=True).start()
+    if not die_with_parent(signal.SIGKILL) and parent is not None:  # not Linux: poll the parent instead
+        threading.Thread(target=_watch, args=(parent,), daemon=True).start()
     if parent is not None and os.getppid() != parent:  # the parent died before the above
         os._exit(1)
 

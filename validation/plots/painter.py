@@ -20,20 +20,16 @@ import pickle
 import select
 import signal
 import struct
-import sys
 import threading
 import time
 from pathlib import Path
+
+from gatetherm.process import die_with_parent
 
 log = logging.getLogger(__name__)
 
 STOP_S = 2.0
 """Longest a painting process is given to end on SIGTERM (it removes the PNG it was writing), s."""
-
-PIPE_BYTES = 1 << 20
-"""Pipe buffer asked for (Linux ``F_SETPIPE_SZ``, at most ``/proc/sys/fs/pipe-max-size``): a
-picture's arguments up to this size go into the pipe at once; the rest of larger ones (the
-deformed picture of a 3-D mesh) is written by a thread of the painter's as the process reads."""
 
 
 def _message(obj) -> bytes:
@@ -107,10 +103,7 @@ def _die_with_parent() -> None:
     """SIGTERM when the parent ends; SIGTERM ends the process through :func:`_stop`."""
     signal.signal(signal.SIGTERM, _stop)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the painter
-    if sys.platform.startswith("linux"):
-        import ctypes
-
-        ctypes.CDLL(None).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
+    die_with_parent(signal.SIGTERM)
 
 
 def _can_fork() -> bool:
@@ -183,11 +176,7 @@ class Painter:
         for (jr, jw), (rr, rw) in pairs:
             os.close(jr)
             os.close(rw)
-            os.set_blocking(jw, False)  # what does not fit in the pipe waits in the outbox
-            with contextlib.suppress(ImportError, OSError):
-                import fcntl
-
-                fcntl.fcntl(jw, 1031, PIPE_BYTES)  # F_SETPIPE_SZ
+            os.set_blocking(jw, False)  # what the pipe does not take waits in the outbox
             self._pipes.append((jw, rr))
             self._queued.append([])
             self._outbox.append(bytearray())
