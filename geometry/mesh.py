@@ -68,11 +68,11 @@ def _groups(m: FrameMesh):
         yield name, 1, "line", pairs
 
 
-def to_meshio(m: FrameMesh, point_data: dict | None = None):
-    """Convert to ``meshio.Mesh``: gmsh physical tags and names plus one
-    ``group:<name>`` 0/1 cell array per group (VTU keeps no field data)."""
-    import meshio
-
+def mesh_arrays(m: FrameMesh) -> tuple[np.ndarray, list, dict, dict]:
+    """What a VTU or ``.msh`` file holds of ``m``: points (N, 3), cell blocks ``[(type, (C, k)
+    nodes)]`` (the regions, boundaries, sensors and lines in turn), cell arrays by name, one
+    per block (gmsh physical tags, one ``group:<name>`` 0/1 array per group) and the groups'
+    ``[tag, dim]`` by name."""
     groups = list(_groups(m))
     pts = np.zeros((len(m.points), 3))
     pts[:, : m.dim] = m.points
@@ -83,9 +83,15 @@ def to_meshio(m: FrameMesh, point_data: dict | None = None):
         for other in masks:
             masks[other].append(np.full(len(conn), int(other == f"{_MASK}{name}"), dtype=np.int8))
     field_data = {g[0]: np.array([t, g[1]]) for t, g in enumerate(groups, start=1)}
-    return meshio.Mesh(pts, cells, point_data=point_data or {},
-                       cell_data={"gmsh:physical": phys, "gmsh:geometrical": phys, **masks},
-                       field_data=field_data)
+    return pts, cells, {"gmsh:physical": phys, "gmsh:geometrical": phys, **masks}, field_data
+
+
+def to_meshio(m: FrameMesh, point_data: dict | None = None):
+    """Convert to ``meshio.Mesh`` (:func:`mesh_arrays`; VTU keeps no field data)."""
+    import meshio
+
+    pts, cells, cell_data, field_data = mesh_arrays(m)
+    return meshio.Mesh(pts, cells, point_data=point_data or {}, cell_data=cell_data, field_data=field_data)
 
 
 def save_mesh(m: FrameMesh, path: str | os.PathLike) -> None:

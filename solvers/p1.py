@@ -11,6 +11,7 @@ component onto it. Vector DOFs are interleaved, ``dim * node + component``, as s
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from math import factorial
 
@@ -65,13 +66,25 @@ class Pattern:
         """The matrix of element matrices ``Ke`` (E, k, k)."""
         return sp.csr_matrix((self._sum(Ke), self.indices, self.indptr), shape=(self.n, self.n))
 
-    def blocks(self, entry, rows: int, cols: int) -> sp.csr_matrix:
+    @functools.cached_property
+    def transpose(self) -> np.ndarray:
+        """Position of the pair (j, i) for each pair (i, j) of the pattern (which is symmetric)."""
+        inv = self.inv.reshape(-1, self.k, self.k)
+        out = np.empty(self.nnz, dtype=self.inv.dtype)
+        out[inv] = inv.transpose(0, 2, 1)
+        return out
+
+    def blocks(self, entry, rows: int, cols: int, symmetric: bool = False) -> sp.csr_matrix:
         """A matrix of ``rows`` × ``cols`` blocks per node pair, ``entry(a, b)`` giving the
-        element entries (E, k, k) of block component (a, b); DOFs interleaved."""
+        element entries (E, k, k) of block component (a, b); DOFs interleaved. ``symmetric``:
+        the matrix is, and ``entry`` is asked for a ≤ b only (block (b, a) of the pair (i, j)
+        is block (a, b) of (j, i))."""
         data = np.empty((self.nnz, rows, cols))
         for a in range(rows):
-            for b in range(cols):
+            for b in range(a if symmetric else 0, cols):
                 data[:, a, b] = self._sum(entry(a, b))
+                if symmetric and b > a:
+                    data[:, b, a] = data[self.transpose, a, b]
         return sp.bsr_matrix((data, self.indices, self.indptr), shape=(rows * self.n, cols * self.n)).tocsr()
 
 
@@ -91,16 +104,17 @@ def stiffness(pattern: Pattern, G: np.ndarray, vol: np.ndarray, lam: np.ndarray,
     ``K[d i + a, d j + b] = vol (λ G_ia G_jb + μ G_ib G_ja + μ δ_ab G_i·G_j)``, v test (i), u trial (j)."""
     dim = G.shape[2]
     dot = conduction(G, vol, mu)
-    Gl, Gm = (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
+    g = [np.ascontiguousarray(G[:, :, a]) for a in range(dim)]  # (E, k) each: products of contiguous rows
+    gl, gm = [(lam * vol)[:, None] * x for x in g], [(mu * vol)[:, None] * x for x in g]
 
     def entry(a, b):
-        out = Gl[:, :, a][:, :, None] * G[:, :, b][:, None, :]
-        out += Gm[:, :, b][:, :, None] * G[:, :, a][:, None, :]
+        out = np.einsum("ei,ej->eij", gl[a], g[b])
+        out += np.einsum("ei,ej->eij", gm[b], g[a])
         if a == b:
             out += dot
         return out
 
-    return pattern.blocks(entry, dim, dim)
+    return pattern.blocks(entry, dim, dim, symmetric=True)
 
 
 def thermal_load(pattern: Pattern, G: np.ndarray, vol: np.ndarray, b: np.ndarray) -> sp.csr_matrix:

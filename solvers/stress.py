@@ -60,6 +60,64 @@ def von_mises(s: dict[str, np.ndarray]) -> np.ndarray:
                    + 3.0 * (g["xy"] ** 2 + g["yz"] ** 2 + g["xz"] ** 2))
 
 
+@dataclass(frozen=True)
+class Assembled:
+    """The projection's right-hand sides per unit displacement as matrices, one per component."""
+
+    S: dict[str, sp.csr_matrix]
+
+    def __call__(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        return {c: S @ u for c, S in self.S.items()}
+
+    def transposed(self, c: str, z: np.ndarray) -> np.ndarray:
+        return self.S[c].T @ z
+
+
+@dataclass(frozen=True)
+class ElementStress:
+    """The same for linear simplices, element by element and never assembled (six matrices of
+    three blocks per node pair: 0.15 GB on the 3-D frame): the stress is constant on each
+    element, so ``∫ σ_c(u) ψ_i = Σ_{e ∋ i} vol_e σ_c,e(u) / (d+1)``."""
+
+    cells: np.ndarray
+    """(E, d+1) node indices of the elements projected over."""
+    G: np.ndarray
+    """(E, d+1, d) their barycentric gradients."""
+    vol: np.ndarray
+    lam: np.ndarray
+    mu: np.ndarray
+    """Per element: measure (m^d) and Lamé moduli (Pa, thickness included)."""
+    components: tuple[str, ...]
+    n: int
+    """Number of nodes."""
+
+    def __call__(self, u: np.ndarray) -> dict[str, np.ndarray]:
+        d, k = self.G.shape[2], self.G.shape[1]
+        grad = np.matmul(u.reshape(self.n, d)[self.cells].transpose(0, 2, 1), self.G)  # ∂_b u_a per element
+        div = np.trace(grad, axis1=1, axis2=2)
+        w, nodes = self.vol / k, self.cells.ravel()
+        out = {}
+        for c in self.components:
+            i, j = _INDEX[c]
+            s = self.mu * (grad[:, i, j] + grad[:, j, i]) if i < d and j < d else 0.0
+            s = s + (self.lam * div if i == j else 0.0)
+            out[c] = np.bincount(nodes, weights=np.repeat(w * s, k), minlength=self.n)
+        return out
+
+    def transposed(self, c: str, z: np.ndarray) -> np.ndarray:
+        d, k = self.G.shape[2], self.G.shape[1]
+        i, j = _INDEX[c]
+        W = np.zeros(self.G.shape)  # ∂σ_c,e / ∂u[node j, component b]
+        if i < d and j < d:
+            W[:, :, j] += self.mu[:, None] * self.G[:, :, i]
+            W[:, :, i] += self.mu[:, None] * self.G[:, :, j]
+        if i == j:
+            W += self.lam[:, None, None] * self.G
+        zbar = self.vol / k * z[self.cells].sum(axis=1)
+        dofs = (d * self.cells[:, :, None] + np.arange(d)).ravel()
+        return np.bincount(dofs, weights=(W * zbar[:, None, None]).ravel(), minlength=d * self.n)
+
+
 @dataclass
 class Recovery:
     """L2 projection of the stress onto the scalar space ``scalar`` restricted to the
@@ -73,8 +131,9 @@ class Recovery:
     """Its DOFs touched by the region."""
     lu: object
     """Factor of the region's mass matrix on the active DOFs."""
-    S: dict[str, sp.csr_matrix]
-    """Per component: the projection's right-hand side per unit displacement."""
+    S: Assembled | ElementStress
+    """The projection's right-hand sides per unit displacement: ``S(u)`` per component, and
+    ``S.transposed(c, z)`` the products ``Sᵀ z``."""
     Q: dict[str, sp.csr_matrix]
     """Per normal component: the right-hand side per unit nodal temperature rise."""
     components: tuple[str, ...]
@@ -93,12 +152,13 @@ class Recovery:
         """Per component at ``xyz``: ``(g_u, g_T)`` with ``σ = g_u·u + g_T·ΔT`` (g_T None
         for shear components)."""
         z = self._z(xyz)
-        return {c: (self.S[c].T @ z, self.Q[c].T @ z if c in self.Q else None) for c in self.components}
+        return {c: (self.S.transposed(c, z), self.Q[c].T @ z if c in self.Q else None) for c in self.components}
 
     def field(self, u: np.ndarray, rhs_T: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Projected components (on ``scalar``) for displacement ``u`` and the thermal
         right-hand sides ``rhs_T`` (per normal component, see :meth:`thermal_rhs`)."""
-        b = np.column_stack([(self.S[c] @ u + rhs_T.get(c, 0.0))[self.active] for c in self.components])
+        rhs = self.S(u)
+        b = np.column_stack([(rhs[c] + rhs_T.get(c, 0.0))[self.active] for c in self.components])
         s = np.zeros((self.scalar.N, len(self.components)))
         s[self.active] = self.lu.solve(b).reshape(b.shape)  # every component in one solve
         return dict(zip(self.components, s.T))
@@ -130,7 +190,8 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
     from gatetherm.solvers import axisym
 
     form = axisym.stress_of_u if plane == "axisymmetric" else stress_of_u
-    S = {c: asm(form, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr() for c in comps}
+    S = Assembled({c: asm(form, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim).tocsr()
+                   for c in comps})
     if T_elem is not None:
         tb = CellBasis(mesh, T_elem, **kw)
         Q = {c: asm(stress_of_T, tb, sb, b=b).tocsr() for c in normal}
@@ -142,8 +203,7 @@ def recovery(mesh, order: int, fields: dict[str, Field], dim: int, plane: str, T
 
 def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simplices) -> Recovery:
     """:func:`recovery` for linear elements, vectorised (solvers/p1.py): the element stress
-    is constant, so ``∫ σ_c(φ_jb) ψ_i = vol σ_c(φ_jb) / (d+1)`` and the thermal part is the
-    mass matrix times ``−b``."""
+    is constant (:class:`ElementStress`) and the thermal part is the mass matrix times ``−b``."""
     from gatetherm.solvers import p1
     from gatetherm.solvers.linsolve import restrict_order
 
@@ -158,20 +218,13 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
         G, vol = p1.gradients(mesh.p.T, cells)
         lam, mu, b = lam[elements], mu[elements], b[elements]
         pattern, active, order = p1.Pattern(cells, mesh.nvertices), np.unique(cells), None
-    k = dim + 1
     M = pattern.scalar(p1.mass(G, vol, np.ones(len(vol))))[active][:, active]
     order = None if order is None else restrict_order(order, active, mesh.nvertices)
 
-    def s_entry(i, j):  # σ_ij of the trial function of node (last axis), component b, per element
-        def entry(_, bb):
-            s = mu[:, None] * ((j == bb) * G[:, :, i] + (i == bb) * G[:, :, j]) if i < dim and j < dim else 0.0
-            s = s + (lam[:, None] * G[:, :, bb] if i == j else 0.0)
-            return np.broadcast_to((vol / k)[:, None, None] * s[:, None, :], (len(vol), k, k))
-        return entry
-
-    S = {c: pattern.blocks(s_entry(*_INDEX[c]), 1, dim) for c in comps}
+    S = ElementStress(cells, G, vol, lam, mu, tuple(comps), mesh.nvertices)
     if T_at is None:
-        Q = {c: pattern.scalar(p1.mass(G, vol, -b)) for c in normal}
+        Qn = pattern.scalar(p1.mass(G, vol, -b))  # the same for every normal component
+        Q = {c: Qn for c in normal}
     else:
         sb = CellBasis(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))
         Q = {c: sp.csr_matrix(asm(stress_of_T_at, sb, b=Field(b_all).at(sb), T=T_at(sb))[:, None]) for c in normal}

@@ -402,14 +402,14 @@ def test_a_run_never_overwrites_its_input_files(tmp_path):
 def test_disk_full_ends_in_one_line_and_keeps_the_finished_files(tmp_path, capsys, monkeypatch):
     """The disk fills while the fields are written: exit 1, one line naming the file; the
     time series written before is complete, no partial file under a final name, no temporary."""
-    import meshio
+    from gatetherm.studies.run import output
 
     def full(path, *args, **kwargs):
         with open(path, "wb") as fh:
             fh.write(b"<VTKFile partial")
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(meshio, "write", full)
+    monkeypatch.setattr(output, "write_vtu", full)
     cfg = _write(tmp_path / "c.toml", COARSE)
     out = tmp_path / "o"
     refused(capsys, 1, ["simulate", "--condition", "1", "--config", cfg, "--no-pictures", "--out", out],

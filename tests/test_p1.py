@@ -61,9 +61,12 @@ def test_p1_stress_projection_equals_the_forms(dim, plane, frame_2d, frame_3d):
         sb, ub = CellBasis(mesh, element(dim, 1), **kw), CellBasis(mesh, ElementVector(element(dim, 1)), **kw)
         lam, mu, b = (Field(v).at(sb) for v in moduli(f["E"].values, f["nu"].values, f["alpha"].values, dim, plane))
         assert _close(rec.Q[COMPONENTS[(dim, plane)][0]], asm(stress_of_T, sb, sb, b=b)) < 1e-13
+        u, z = rng.normal(size=ub.N), rng.normal(size=sb.N)
+        rhs = rec.S(u)
         for c in COMPONENTS[(dim, plane)]:
             ref = asm(stress_of_u, ub, sb, lam=lam, mu=mu, i=_INDEX[c][0], j=_INDEX[c][1], dim=dim)
-            assert _close(rec.S[c], ref) < 1e-13, c
+            assert _close(rhs[c], ref @ u) < 1e-13, c
+            assert _close(rec.S.transposed(c, z), ref.T @ z) < 1e-13, c
         M = asm(mass, sb)
         a = np.unique(sb.element_dofs)
         x = rng.normal(size=len(a))

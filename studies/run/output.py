@@ -8,6 +8,7 @@ import numpy as np
 
 from gatetherm import atomic_path, write_text_atomic
 from gatetherm.geometry.mesh import to_meshio
+from gatetherm.geometry.vtu import write_vtu
 from gatetherm.solvers.model import Model, field_recovery, static_fields
 
 
@@ -51,8 +52,6 @@ def write_fields(model: Model, states, out: Path, solved: dict[float, np.ndarray
     ``fields.pvd`` collection, and the same as one XDMF time series, ``fields.xdmf`` with
     ``fields.h5`` (one mesh, every step): ParaView opens either as one animated data set.
     ``solved``: their :func:`displacements`, if found already; ``envs``: the inputs by time."""
-    import meshio
-
     out.mkdir(parents=True, exist_ok=True)
     written, entries, steps = [], [], []
     minutes = all(abs(t / 60 - round(t / 60)) < 1e-9 for t, _ in states)
@@ -62,7 +61,7 @@ def write_fields(model: Model, states, out: Path, solved: dict[float, np.ndarray
         name = f"fields_{int(round(t / 60)):04d}min.vtu" if minutes else f"fields_{k:04d}.vtu"
         data = nodal_fields(model, U, rec, u_dofs=solved.get(t), env=(envs or {}).get(t))
         with atomic_path(out / name) as tmp:
-            meshio.write(tmp, to_meshio(model.fmesh, data), file_format="vtu", compression=None)  # zlib: 3 s in 3-D
+            write_vtu(tmp, model.fmesh, data)
         entries.append(f'    <DataSet timestep="{t:g}" file="{name}"/>')
         written.append(out / name)
         steps.append((t, data))

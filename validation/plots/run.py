@@ -126,10 +126,10 @@ def write_pictures(run, out, title: str, picture_s: float | None, solved: dict |
         jobs["deformed.png"] = render_deformed, deformed(run, picture_s, caption, solved)
     if transient:
         jobs["channels.png"] = plot_channels, (cols, title)
-    if has_response(cols):
-        jobs["response.png"] = plot_response, (cols, title)
     if transient and run.model.problem.fluids:
         jobs["oil_temperatures.png"] = plot_fluids, (cols, run.model.problem, title)
+    if has_response(cols):  # handed out in turn: the painter's two processes take about equal work
+        jobs["response.png"] = plot_response, (cols, title)
     painter = Painter(0) if painter is None else painter
     for name, (plot, args) in jobs.items():
         painter.draw(plot, *args, path=out / name, tight=name != "channels.png")
