@@ -2,112 +2,145 @@
 
     python benchmarks/assembly_parts.py [--rounds 5]
 
-Per round, in turn (the pairs interleaved): the elastic stiffness from the node-pair pattern with
-the symmetric blocks found once (``p1.stiffness``) against all nine blocks summed; the stress
-projection's right-hand sides per unit displacement applied element by element
-(``stress.ElementStress``: set up free, one field's six components) against the six assembled
-matrices of before (their assembly, one field's products); one field file written raw
-(``geometry.vtu.write_vtu``) against meshio's VTU writer. Prints the medians, their ratios and
-the largest difference of the results (docs/performance.md, "2026-12-04").
+Each variant once, as a run calls it, in a new interpreter set up as a command is
+(``gt.configure()``): what a part costs there is mostly memory touched for the first time.
+The pairs, the variants interleaved per round: the node-pair pattern's map of element entries
+(``p1.Pattern``, each entry looked up in its row) against one searchsorted over all pairs; the
+stress projection's right-hand sides of one field applied element by element
+(``stress.ElementStress``, nothing to set up) against the six matrices of before, assembled and
+applied; one field file written raw (``geometry.vtu.write_vtu``) against meshio's VTU writer.
+Prints the medians, their ratios, and that the results agree (docs/performance.md,
+"2026-12-04").
 """
 from __future__ import annotations
 
 import argparse
 import os
+import pickle
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 
 import numpy as np
+import scipy.sparse as sp
+
+PAIRS = {"pattern": ("by rows", "searchsorted"),
+         "stress rhs": ("element by element", "six matrices"), "field file": ("raw", "meshio")}
 
 
-def timed(f):
-    t0 = time.perf_counter()
-    out = f()
-    return time.perf_counter() - t0, out
-
-
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--rounds", type=int, default=5)
-    args = ap.parse_args()
+def variants(fm):
+    """``{(part, variant): make}`` on the FrameMesh ``fm``; each ``make()`` returns its result."""
     import meshio
 
-    import gatetherm as gt
     from gatetherm.geometry.mesh import to_meshio
     from gatetherm.geometry.vtu import write_vtu
     from gatetherm.solvers import p1
-    from gatetherm.solvers.fem import to_skfem
     from gatetherm.solvers.stress import _INDEX, COMPONENTS, ElementStress
 
-    gt.configure()
-    fm = gt.gate_frame(dim=3).mesh
-    mesh = to_skfem(fm)
-    s = p1.simplices(mesh)
-    G, vol, pattern, cells = s.G, s.vol, s.pattern, mesh.t.T
+    cells, n, k = fm.cells.astype(np.int64), len(fm.points), 4
+    G, vol = p1.gradients(fm.points, cells)
     rng = np.random.default_rng(0)
     lam, mu = rng.uniform(1.0, 2.0, len(vol)) * 6e10, rng.uniform(1.0, 2.0, len(vol)) * 4e10
-    comps, k, n = COMPONENTS[(3, "stress")], 4, mesh.nvertices
-    u = rng.normal(size=3 * n)
+    comps, u = COMPONENTS[(3, "stress")], rng.normal(size=3 * n)
     data = {"T": rng.normal(size=n), "u": rng.normal(size=(n, 3)),
             **{f"sigma_{c}": rng.normal(size=n) for c in comps}, "von_mises": rng.normal(size=n)}
-    print(f"3-D frame: {n} nodes, {len(vol)} elements, {pattern.nnz} node pairs", flush=True)
+    pattern = p1.Pattern(cells, n)
 
-    def nine_blocks():  # p1.stiffness before: every block (a, b) summed, a, b = 0..2
-        dot = p1.conduction(G, vol, mu)
-        Gl, Gm = (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
+    def searched():  # p1.Pattern before
+        i, j = np.repeat(cells, k, axis=1).ravel(), np.tile(cells, (1, k)).ravel()
+        A = sp.csr_matrix((np.ones(len(i), dtype=np.int8), (i, j)), shape=(n, n))
+        rows = np.repeat(np.arange(n, dtype=np.int64) * n, np.diff(A.indptr))
+        return np.searchsorted(rows + A.indices, i.astype(np.int64) * n + j)
 
-        def entry(a, b):
-            out = Gl[:, :, a][:, :, None] * G[:, :, b][:, None, :]
-            out += Gm[:, :, b][:, :, None] * G[:, :, a][:, None, :]
-            return out + dot if a == b else out
-        return pattern.blocks(entry, 3, 3)
-
-    def assembled():  # stress._p1_recovery before: six matrices of 1 x 3 blocks per node pair
+    def six_matrices():  # stress._p1_recovery before, and Recovery.field's products
         def s_entry(i, j):
             def entry(_, b):
                 sv = mu[:, None] * ((j == b) * G[:, :, i] + (i == b) * G[:, :, j]) + (lam[:, None] * G[:, :, b] if i == j else 0.0)
                 return np.broadcast_to((vol / k)[:, None, None] * sv[:, None, :], (len(vol), k, k))
             return entry
-        return {c: pattern.blocks(s_entry(*_INDEX[c]), 1, 3) for c in comps}
+        S = {c: pattern.blocks(s_entry(*_INDEX[c]), 1, 3) for c in comps}
+        t0 = time.perf_counter()
+        out = {c: S[c] @ u for c in comps}
+        return {**out, "product s": time.perf_counter() - t0,
+                "GB": sum(m.data.nbytes + m.indices.nbytes for m in S.values()) / 1e9}
 
-    element = ElementStress(cells, G, vol, lam, mu, comps, n)
-    times: dict[str, list[float]] = {}
-    worst = {"stiffness": 0.0, "right-hand sides": 0.0}
+    def written(write):  # the file's path: read back after the timing
+        path = os.path.join(tempfile.mkdtemp(), "f.vtu")
+        write(path)
+        return path
+
+    return {("pattern", "by rows"): lambda: p1.Pattern(cells, n).inv, ("pattern", "searchsorted"): searched,
+            ("stress rhs", "element by element"): lambda: ElementStress(cells, G, vol, lam, mu, comps, n)(u),
+            ("stress rhs", "six matrices"): six_matrices,
+            ("field file", "raw"): lambda: written(lambda p: write_vtu(p, fm, data)),
+            ("field file", "meshio"): lambda: written(lambda p: meshio.write(p, to_meshio(fm, data), file_format="vtu",
+                                                                             compression=None))}
+
+
+def _part(mesh_file: str, part: str, variant: str, result_file: str) -> None:
+    """In the new interpreter: time one variant, its result pickled for the comparison."""
+    import gatetherm as gt
+
+    gt.configure()
+    with open(mesh_file, "rb") as f:
+        fm = pickle.load(f)  # written by this script's parent
+    make = variants(fm)[(part, variant)]
+    t0 = time.perf_counter()
+    out = make()
+    secs = time.perf_counter() - t0
+    if isinstance(out, str):  # a field file
+        import meshio
+
+        out = meshio.read(out).point_data["u"]
+    with open(result_file, "wb") as f:
+        pickle.dump((secs, out), f)
+
+
+def _same(a, b) -> float:
+    """Largest relative difference of two results (arrays, matrices or dicts of arrays)."""
+    if isinstance(a, dict):
+        return max(_same(a[c], b[c]) for c in a)
+    a, b = (x.toarray() if sp.issparse(x) and x.shape[0] < 1000 else x for x in (a, b))
+    return float(abs(a - b).max() / abs(b).max())
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--part", nargs=4, help=argparse.SUPPRESS)  # one variant, in a new interpreter
+    args = ap.parse_args()
+    if args.part:
+        return _part(*args.part)
+    import gatetherm as gt
+
+    fm = gt.gate_frame(dim=3).mesh
+    times: dict = {}
     with tempfile.TemporaryDirectory() as tmp:
+        mesh_file = os.path.join(tmp, "mesh.pkl")
+        with open(mesh_file, "wb") as f:
+            pickle.dump(fm, f)
+        print(f"3-D frame: {len(fm.points)} nodes, {len(fm.cells)} elements", flush=True)
+        results = {}
         for r in range(args.rounds):
-            t_new, K = timed(lambda: p1.stiffness(pattern, G, vol, lam, mu))
-            t_old, K0 = timed(nine_blocks)
-            worst["stiffness"] = max(worst["stiffness"], abs(K - K0).max() / abs(K0).max())
-            t_set, held = timed(assembled)
-            t_mat, by_matrix = timed(lambda: {c: held[c] @ u for c in comps})
-            t_el, by_element = timed(lambda: element(u))
-            worst["right-hand sides"] = max(worst["right-hand sides"], max(
-                abs(by_element[c] - by_matrix[c]).max() / abs(by_matrix[c]).max() for c in comps))
-            bytes_S = sum(m.data.nbytes + m.indices.nbytes + m.indptr.nbytes for m in held.values())
-            held = None
-            t_raw, _ = timed(lambda: write_vtu(os.path.join(tmp, "raw.vtu"), fm, data))
-            t_mio, _ = timed(lambda: meshio.write(os.path.join(tmp, "meshio.vtu"), to_meshio(fm, data),
-                                                  file_format="vtu", compression=None))
-            for key, t in (("stiffness, symmetric blocks", t_new), ("stiffness, nine blocks", t_old),
-                           ("stress rhs: assembly of the six matrices", t_set),
-                           ("stress rhs: one field by the matrices", t_mat),
-                           ("stress rhs: one field element by element", t_el),
-                           ("field file, raw", t_raw), ("field file, meshio", t_mio)):
-                times.setdefault(key, []).append(t)
-        sizes = {f: os.path.getsize(os.path.join(tmp, f)) / 1e6 for f in ("raw.vtu", "meshio.vtu")}
-    med = {key: statistics.median(v) for key, v in times.items()}
-    print(f"medians of {args.rounds} rounds, s:")
-    for key, t in med.items():
-        print(f"  {key:45s} {t:7.3f}")
-    print(f"stiffness: symmetric / nine {med['stiffness, symmetric blocks'] / med['stiffness, nine blocks']:.2f} x, "
-          f"largest relative difference {worst['stiffness']:.1e}")
-    print(f"stress rhs: the six matrices held {bytes_S / 1e9:.3f} GB; element by element one field costs "
-          f"{med['stress rhs: one field element by element'] - med['stress rhs: one field by the matrices']:.3f} s more, "
-          f"their assembly {med['stress rhs: assembly of the six matrices']:.3f} s once; largest relative difference "
-          f"{worst['right-hand sides']:.1e}")
-    print(f"field file: raw / meshio {med['field file, raw'] / med['field file, meshio']:.2f} x, "
-          f"{sizes['raw.vtu']:.1f} MB against {sizes['meshio.vtu']:.1f} MB")
+            for part, pair in PAIRS.items():
+                for variant in (pair if r % 2 == 0 else pair[::-1]):
+                    out = os.path.join(tmp, "result.pkl")
+                    subprocess.run([sys.executable, __file__, "--part", mesh_file, part, variant, out], check=True)
+                    with open(out, "rb") as f:
+                        secs, results[part, variant] = pickle.load(f)
+                    times.setdefault((part, variant), []).append(secs)
+    print(f"medians of {args.rounds} rounds, each variant once in a new interpreter, s:")
+    for part, (new, old) in PAIRS.items():
+        a, b = statistics.median(times[part, new]), statistics.median(times[part, old])
+        print(f"  {part:11s} {new:19s} {a:6.3f}  {old:13s} {b:6.3f}  {a / b:5.2f} x  "
+              f"(runs {', '.join(f'{t:.2f}' for t in times[part, new])} against "
+              f"{', '.join(f'{t:.2f}' for t in times[part, old])}); largest relative difference "
+              f"{_same(results[part, new], results[part, old]):.1e}")
+    held = results["stress rhs", "six matrices"]
+    print(f"the six matrices of the stress projection held {held['GB']:.3f} GB; their products with one field "
+          f"took {held['product s']:.3f} s (the last round)")
 
 
 if __name__ == "__main__":
