@@ -146,11 +146,10 @@ def enclosed_volume(fm: FrameMesh, boundary: str, thickness: float = 1.0) -> flo
     theorem over its facets (2-D: area times ``thickness``)."""
     fac = np.sort(fm.boundaries[boundary], axis=1)
     near = np.flatnonzero(np.isin(fm.cells, fac).sum(axis=1) >= fm.dim)  # cells with a whole facet there
-    opposite = {}
-    for c in fm.cells[near]:
-        for k in range(fm.dim + 1):
-            opposite[tuple(np.sort(np.delete(c, k)))] = c[k]
-    X, Y = fm.points[fac], fm.points[[opposite[tuple(f)] for f in fac]]
+    cells = fm.cells[near]  # each facet of each, and the node opposite it
+    faces = np.sort(np.stack([np.delete(cells, k, axis=1) for k in range(fm.dim + 1)], axis=1), axis=2)
+    opposite = dict(zip(map(tuple, faces.reshape(-1, fm.dim).tolist()), cells.ravel().tolist()))
+    X, Y = fm.points[fac], fm.points[[opposite[f] for f in map(tuple, fac.tolist())]]
     E = X[:, 1:] - X[:, :1]
     n = np.stack([-E[:, 0, 1], E[:, 0, 0]], axis=1) if fm.dim == 2 else np.cross(E[:, 0], E[:, 1])
     n *= -np.sign(np.einsum("ij,ij->i", n, Y - X[:, 0]))[:, None]  # away from the solid: into the cavity

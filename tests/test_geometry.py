@@ -316,3 +316,17 @@ def test_a_point_group_off_the_nodes_is_snapped_or_refused(tmp_path, caplog):
     with pytest.raises(InputError, match=r"mesh point loose: at \(3, 3\) is 2\.83 m from the nearest node .* more "
                                          r"than the tolerance 0\.\d+ m"):
         mesh_geometry(MeshSpec(tmp_path / "b.geo", 0.1))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_enclosed_volume_of_the_tank_is_its_box(dim, frame_2d, frame_3d):
+    """The oil volume from the tank wall's facets (divergence theorem) is the tank's box, to
+    round-off: the box's faces are flat and meshed exactly."""
+    from gatetherm.geometry.frame import tank_box
+    from gatetherm.solvers.frame import enclosed_volume
+
+    fm = frame_2d if dim == 2 else frame_3d
+    p = fm.meta["frame"]
+    x0, x1, y0, y1, z0, z1 = tank_box(p, dim)
+    depth = p.depth if dim == 2 else 1.0
+    assert enclosed_volume(fm, "tank_wall", depth) == pytest.approx((x1 - x0) * (y1 - y0) * (z1 - z0), rel=1e-12)
