@@ -141,3 +141,32 @@ def test_painter_0_draws_at_once(tmp_path):
     painter.draw(plot_channels, {"time_s": np.array([0.0, 60.0]), "a_um": np.array([0.0, 1.0])}, "t",
                  path=tmp_path / "c.png")
     assert painter.workers == 0 and (tmp_path / "c.png").stat().st_size > 10_000
+
+
+def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
+    """``prepare(work)`` is called by the process the next picture goes to, before it draws it,
+    and answers nothing; a failing one does not stop the picture. ``Painter(0)`` ignores it."""
+    out = fresh("""
+        def ready(path):
+            with open(path, "w") as f:
+                f.write(str(os.getpid()))
+
+        def failing():
+            raise RuntimeError("not ready")
+
+        cols = {{"time_s": np.array([0.0, 60.0]), "a_degC": np.array([20.0, 21.0])}}
+        with gt.plot.Painter(2) as painter:
+            import functools
+            painter.prepare(failing)
+            painter.prepare(functools.partial(ready, os.path.join({tmp}, "ready")))
+            painter.draw(plot_channels, cols, path=os.path.join({tmp}, "first.png"))
+            painter.draw(plot_channels, cols, path=os.path.join({tmp}, "second.png"))
+            painter.finish()
+        with gt.plot.Painter(0) as here:
+            here.prepare(functools.partial(ready, os.path.join({tmp}, "here")))
+        print(json.dumps({{"caller": os.getpid(), "ready": int(open(os.path.join({tmp}, "ready")).read()),
+                           "ready_s": os.path.getmtime(os.path.join({tmp}, "ready")),
+                           "first_s": os.path.getmtime(os.path.join({tmp}, "first.png"))}}))
+        """, tmp=str(tmp_path))
+    assert out["ready"] != out["caller"] and out["ready_s"] <= out["first_s"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "ready", "second.png"]  # not "here"

@@ -214,6 +214,10 @@ class Run:
         meta = {"source": "gatetherm", "case": self.case.source, "name": self.case.name, "dim": str(self.case.dim),
                 "schedule": sched.label, **({"condition": str(sched.condition)} if sched.condition else {})}
         picture = self._picture_time()
+        if pictures and painter is not None and picture is not None:
+            from gatetherm.validation.plots.run import prepare_pictures
+
+            prepare_pictures(self.scenario, painter)  # while the fields are solved
 
         def draw(solved):
             from gatetherm.validation.plots.run import write_pictures

@@ -61,6 +61,17 @@ def screenshot(surface, name: str, clim, outline_of) -> np.ndarray:
         p.close()
 
 
+def warm_surface() -> None:
+    """Import pyvista and render a small body off screen, as :func:`screenshot` does: the part
+    of a 3-D picture's time that is not its own (the import, the first rendering's set-up),
+    done ahead by :meth:`~gatetherm.validation.plots.painter.Painter.prepare`."""
+    import pyvista as pv
+
+    body = pv.Cube().triangulate()
+    body["v"] = body.points[:, 0]
+    screenshot(body, "v", (0.0, 1.0), body)
+
+
 def frame_image(img: np.ndarray, clim, label: str, title: str, ax=None):
     """``img`` on ``ax`` (axes off) with a colour bar of :data:`CMAP` over ``clim`` labelled
     ``label``. Returns the Axes."""

@@ -86,6 +86,12 @@ def _serve(jobs: int, replies: int) -> None:
     """A painting process's life: draw every job on ``jobs``, answer each on ``replies``
     (``(is OSError, error text)``, the text empty once the PNG is written)."""
     while (job := _receive(jobs)) is not None:
+        if job[3] is None:  # made ready (Painter.prepare): no picture, no answer
+            try:
+                job[0]()
+            except Exception:  # noqa: BLE001 - the picture that needs it reports the failure
+                log.debug("preparing a picture failed", exc_info=True)
+            continue
         try:
             _paint(job)
             reply = (False, "")
@@ -193,10 +199,21 @@ class Painter:
         job = (plot, args, kwargs, Path(path), tight)
         if not self._pipes:
             return _paint(job)
-        k = min(range(self.workers), key=lambda i: len(self._queued[i]))
+        self._hand(job)
+
+    def prepare(self, work) -> None:
+        """Have the process that draws the next picture call ``work()`` (picklable) meanwhile:
+        what that picture needs made ready (an import, a first small rendering) while the caller
+        computes. Without processes nothing is done."""
+        if self._pipes:
+            self._hand((work, (), {}, None, False))
+
+    def _hand(self, job) -> None:
+        k = min(range(self.workers), key=lambda i: len(self._queued[i]))  # a tie: the first
         with self._lock:
             self._outbox[k] += _message(job)
-            self._queued[k].append(Path(path))
+            if job[3] is not None:
+                self._queued[k].append(job[3])
             if not self._flush(k) and not (self._writer and self._writer.is_alive()):
                 self._writer = threading.Thread(target=self._drain, name="painter-writer", daemon=True)
                 self._writer.start()
@@ -225,6 +242,7 @@ class Painter:
     def finish(self) -> None:
         """Wait for every picture given; raise the first failure (OSError for a file that could
         not be written, else RuntimeError), naming the picture."""
+        start = time.monotonic()
         if self._writer is not None:
             self._writer.join()
         failed = None
@@ -236,6 +254,8 @@ class Painter:
                     queued.clear()
                 elif reply[1]:
                     failed = failed or (OSError if reply[0] else RuntimeError)(f"{path.name}: {reply[1]}")
+        if self._pipes:
+            log.info("pictures: %.2f s waited for the painter", time.monotonic() - start)
         if failed is not None:
             raise failed
 

@@ -105,6 +105,15 @@ def has_response(cols: dict) -> bool:
     return len(cols["time_s"]) > 1 and all(k in cols for k in (*dict(THETAS), "delta_um"))
 
 
+def prepare_pictures(run, painter) -> None:
+    """What the pictures of ``run`` need made ready in ``painter``'s process before
+    :func:`write_pictures` gives them: the renderer of a 3-D body's deformed picture."""
+    from gatetherm.validation.plots.field import warm_surface
+
+    if run.model.elastic is not None and run.model.dim == 3:
+        painter.prepare(warm_surface)
+
+
 def write_pictures(run, out, title: str, picture_s: float | None, solved: dict | None = None,
                    caption=None, painter=None) -> list[str]:
     """The pictures of a run (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) into ``out``,
