@@ -14,8 +14,8 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
   0.93-0.97 million without, 0.65-0.66 million with 64 MiB or 1 GiB, 1-2 s less system time,
   the same peak memory (2 runs each, interleaved);
 
-and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's),
-:func:`die_with_parent`.
+and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
+solve's helper), :func:`can_fork` and :func:`die_with_parent`.
 """
 from __future__ import annotations
 
@@ -33,6 +33,17 @@ THREADS_ENV = "GATETHERM_BLAS_THREADS"
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 PR_SET_PDEATHSIG = 1
 """prctl(2) option: the signal a Linux process gets when its parent dies."""
+
+
+def can_fork() -> bool:
+    """Whether this process may fork a helper beside itself: POSIX, more than one core, no other
+    thread running (a forked child would miss it, and any lock it holds), and not itself a
+    worker of a pool (whose siblings have the other cores)."""
+    import multiprocessing
+    import threading
+
+    return (hasattr(os, "fork") and (os.cpu_count() or 1) > 1 and threading.active_count() == 1
+            and multiprocessing.parent_process() is None)
 
 
 def die_with_parent(sig: int) -> bool:

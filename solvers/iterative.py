@@ -5,8 +5,9 @@ too large to factorise: memory grows linearly with the unknowns.
 near-null space the constants, or the rigid-body modes with the DOFs of each node aggregated
 together for elasticity; forward Gauss–Seidel before and backward after the coarse correction,
 so the cycle is a symmetric preconditioner). :class:`PCG` solves with one matrix for any number
-of right-hand sides, one after another, each started from the Galerkin projection of its
-right-hand side onto the last solutions (``x₀ = X (XᵀAX)⁻¹ Xᵀ b``): for the heat steps of a
+of right-hand sides, one after another (on a large system the later half of one call's in a
+forked copy of the solver, beside: the second core), each started from the Galerkin projection
+of its right-hand side onto the last solutions (``x₀ = X (XᵀAX)⁻¹ Xᵀ b``): for the heat steps of a
 run this is at least as good as any extrapolation from the previous steps, for the fields at
 the output times a warm start from the previous ones. A solve that does not reach its
 tolerance raises :class:`~gatetherm.solvers.linsolve.SolverError`.
@@ -14,9 +15,14 @@ tolerance raises :class:`~gatetherm.solvers.linsolve.SolverError`.
 from __future__ import annotations
 
 import logging
+import os
+import pickle
+import signal
 
 import numpy as np
 import scipy.sparse as sp
+
+from gatetherm.process import can_fork, die_with_parent
 
 log = logging.getLogger(__name__)
 
@@ -26,6 +32,9 @@ MAXITER = 400
 """Iterations after which conjugate gradients give up (and raise)."""
 RECYCLE = 6
 """Solutions kept for the Galerkin start of the next right-hand side."""
+SPLIT_UNKNOWNS = 50_000
+"""From this many unknowns on, the right-hand sides of one call are solved in two processes
+(the later half by a forked copy), where the process may fork (:func:`gatetherm.process.can_fork`)."""
 
 
 class SolverError(RuntimeError):
@@ -134,10 +143,54 @@ class PCG:
         b = np.asarray(b, dtype=float)
         if b.ndim == 2:
             before = self.iterations
-            x = np.column_stack([self._solve(col) for col in b.T]) if b.shape[1] else np.zeros(b.shape)
+            x = (self._in_two(b) if b.shape[1] > 1 and self.A.shape[0] >= SPLIT_UNKNOWNS and can_fork()
+                 else self._columns(b))
             log.debug("AMG-CG: %d right-hand sides in %d iterations", b.shape[1], self.iterations - before)
             return x
         return self._solve(b)
+
+    def _columns(self, b: np.ndarray) -> np.ndarray:
+        return np.column_stack([self._solve(col) for col in b.T]) if b.shape[1] else np.zeros(b.shape)
+
+    def _in_two(self, b: np.ndarray) -> np.ndarray:
+        """The columns of ``b``, the later half solved by a forked copy of this solver (its
+        hierarchy shared, not copied) while this process solves the first."""
+        k = (b.shape[1] + 1) // 2
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child's coverage is not collected
+            code = 1
+            try:
+                os.close(r)
+                die_with_parent(signal.SIGKILL)
+                before = self.iterations, self.solves
+                try:
+                    reply = (self._columns(b[:, k:]), self.iterations - before[0], self.solves - before[1], None)
+                except SolverError as err:
+                    reply = (None, 0, 0, str(err))
+                with os.fdopen(w, "wb") as f:
+                    pickle.dump(reply, f, protocol=pickle.HIGHEST_PROTOCOL)
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(w)
+        try:
+            with os.fdopen(r, "rb") as f:
+                mine = self._columns(b[:, :k])
+                try:
+                    x, iterations, solves, error = pickle.load(f)
+                except EOFError:  # killed (out of memory?)
+                    x, iterations, solves, error = None, 0, 0, "AMG-CG's second process ended without its solutions"
+        except BaseException:
+            os.kill(pid, signal.SIGKILL)
+            raise
+        finally:
+            os.waitpid(pid, 0)
+        if error is not None:
+            raise SolverError(error)
+        self.iterations += iterations
+        self.solves += solves
+        return np.column_stack([mine, x])
 
     def _start(self, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The Galerkin start ``x₀`` and its product ``A x₀``."""

@@ -41,6 +41,27 @@ def test_amg_cg_equals_the_factor_and_raises_when_it_cannot_converge(heat_3d, mo
         iterative.PCG(A, rtol=1e-12)(b[:, 0])
 
 
+def test_right_hand_sides_solved_in_two_processes_are_the_factors_solutions(heat_3d, monkeypatch):
+    """The later half of the columns solved by a forked copy: the factor's solutions, its
+    iterations counted (the first half zero: none of its own), its failure raised here."""
+    import os
+
+    _, A = heat_3d
+    monkeypatch.setattr(iterative, "SPLIT_UNKNOWNS", 0)
+    monkeypatch.setattr(iterative, "can_fork", lambda: True)
+    b = np.zeros((A.shape[0], 4))
+    b[:, 2:] = A @ np.random.default_rng(2).normal(size=(A.shape[0], 2))
+    pid, pcg = os.getpid(), iterative.PCG(A, rtol=1e-12)
+    x = pcg(b)
+    ref = spd_factor(A)[0](b[:, 2:])
+    assert os.getpid() == pid and np.array_equal(x[:, :2], np.zeros_like(x[:, :2]))
+    assert np.abs(x[:, 2:] - ref).max() < 1e-9 * np.abs(ref).max()
+    assert pcg.solves == 2 and pcg.iterations > 0  # the second process's
+    monkeypatch.setattr(iterative, "MAXITER", 1)
+    with pytest.raises(iterative.SolverError, match="did not converge"):
+        iterative.PCG(A, rtol=1e-12)(b)
+
+
 def test_galerkin_start_reproduces_a_solution_in_the_span_of_the_last_ones(heat_3d):
     """Solutions on a quadratic path x(k) = x0 + k d1 + k² d2: from the fourth on, the Galerkin
     projection onto the kept solutions is the solution itself, and CG takes no iteration."""

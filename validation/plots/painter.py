@@ -24,7 +24,7 @@ import threading
 import time
 from pathlib import Path
 
-from gatetherm.process import die_with_parent
+from gatetherm.process import can_fork, die_with_parent
 
 log = logging.getLogger(__name__)
 
@@ -115,8 +115,7 @@ def _die_with_parent() -> None:
 def _can_fork() -> bool:
     from gatetherm.geometry.isolate import THREADS_STARTED
 
-    return (hasattr(os, "fork") and (os.cpu_count() or 1) > 1 and threading.active_count() == 1
-            and not THREADS_STARTED["here"])
+    return can_fork() and not THREADS_STARTED["here"]
 
 
 class Painter:
