@@ -1,9 +1,10 @@
 """VTU files (VTK's XML unstructured grid) written directly: the arrays of
 :func:`gatetherm.geometry.mesh.mesh_arrays` and the point data, raw in one appended block.
 
-meshio's writer encodes every array as base64 text inside the XML: 0.12 s for one field file
-of the 3-D frame (40 MB), seven per run; raw bytes take a fraction of that, and ParaView,
-VTK and meshio read them alike (``tests/test_vtu.py``).
+meshio's writer encodes every array as base64 text inside the XML: about 0.1 s for one field
+file of the 3-D frame (40 MB), seven per run; raw bytes take a fifth of that in 28 MB
+(``benchmarks/assembly_parts.py``), and ParaView, VTK and meshio read them alike
+(``tests/test_vtu.py``).
 """
 from __future__ import annotations
 
