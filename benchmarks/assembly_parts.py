@@ -30,8 +30,9 @@ PAIRS = {"pattern": ("by rows", "searchsorted"),
          "stress rhs": ("element by element", "six matrices"), "field file": ("raw", "meshio")}
 
 
-def variants(fm):
-    """``{(part, variant): make}`` on the FrameMesh ``fm``; each ``make()`` returns its result."""
+def variants(fm, work: str):
+    """``{(part, variant): make}`` on the FrameMesh ``fm``; each ``make()`` returns its result
+    (a field file's path, in the folder ``work``)."""
     import meshio
 
     from gatetherm.geometry.mesh import to_meshio
@@ -67,7 +68,7 @@ def variants(fm):
                 "GB": sum(m.data.nbytes + m.indices.nbytes for m in S.values()) / 1e9}
 
     def written(write):  # the file's path: read back after the timing
-        path = os.path.join(tempfile.mkdtemp(), "f.vtu")
+        path = os.path.join(work, "f.vtu")
         write(path)
         return path
 
@@ -86,7 +87,7 @@ def _part(mesh_file: str, part: str, variant: str, result_file: str) -> None:
     gt.configure()
     with open(mesh_file, "rb") as f:
         fm = pickle.load(f)  # written by this script's parent
-    make = variants(fm)[(part, variant)]
+    make = variants(fm, os.path.dirname(result_file))[(part, variant)]
     t0 = time.perf_counter()
     out = make()
     secs = time.perf_counter() - t0

@@ -30,13 +30,13 @@ def write_vtu(path: str | os.PathLike, m: FrameMesh, point_data: dict[str, np.nd
     conn = np.concatenate([c.ravel() for _, c in blocks])
     offsets = np.cumsum(np.concatenate([np.full(len(c), c.shape[1], dtype=np.int64) for _, c in blocks]))
     types = np.concatenate([np.full(len(c), VTK_TYPES[t], dtype=np.uint8) for t, c in blocks])
-    arrays, xml = [], []
+    arrays, xml, end = [], [], [0]  # end: the appended block's length so far
 
     def add(name: str, a: np.ndarray) -> str:
         a = np.ascontiguousarray(a)
         if a.dtype not in _TYPES:
             a = a.astype(np.float64)
-        at = sum(8 + b.nbytes for b in arrays)
+        at, end[0] = end[0], end[0] + 8 + a.nbytes
         arrays.append(a)
         comps = f' NumberOfComponents="{a.shape[1]}"' if a.ndim == 2 else ""
         return (f'<DataArray type="{_TYPES[a.dtype]}" Name={quoteattr(name)}{comps} format="appended" '

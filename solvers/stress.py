@@ -69,8 +69,8 @@ class Assembled:
     def __call__(self, u: np.ndarray) -> dict[str, np.ndarray]:
         return {c: S @ u for c, S in self.S.items()}
 
-    def transposed(self, c: str, z: np.ndarray) -> np.ndarray:
-        return self.S[c].T @ z
+    def transposed(self, z: np.ndarray) -> dict[str, np.ndarray]:
+        return {c: S.T @ z for c, S in self.S.items()}
 
 
 @dataclass(frozen=True)
@@ -104,18 +104,21 @@ class ElementStress:
             out[c] = np.bincount(nodes, weights=np.repeat(w * s, k), minlength=self.n)
         return out
 
-    def transposed(self, c: str, z: np.ndarray) -> np.ndarray:
+    def transposed(self, z: np.ndarray) -> dict[str, np.ndarray]:
         d, k = self.G.shape[2], self.G.shape[1]
-        i, j = _INDEX[c]
-        W = np.zeros(self.G.shape)  # ∂σ_c,e / ∂u[node j, component b]
-        if i < d and j < d:
-            W[:, :, j] += self.mu[:, None] * self.G[:, :, i]
-            W[:, :, i] += self.mu[:, None] * self.G[:, :, j]
-        if i == j:
-            W += self.lam[:, None, None] * self.G
         zbar = self.vol / k * z[self.cells].sum(axis=1)
         dofs = (d * self.cells[:, :, None] + np.arange(d)).ravel()
-        return np.bincount(dofs, weights=(W * zbar[:, None, None]).ravel(), minlength=d * self.n)
+        out = {}
+        for c in self.components:
+            i, j = _INDEX[c]
+            W = np.zeros(self.G.shape)  # ∂σ_c,e / ∂u[node j, component b]
+            if i < d and j < d:
+                W[:, :, j] += self.mu[:, None] * self.G[:, :, i]
+                W[:, :, i] += self.mu[:, None] * self.G[:, :, j]
+            if i == j:
+                W += self.lam[:, None, None] * self.G
+            out[c] = np.bincount(dofs, weights=(W * zbar[:, None, None]).ravel(), minlength=d * self.n)
+        return out
 
 
 @dataclass
@@ -133,7 +136,7 @@ class Recovery:
     """Factor of the region's mass matrix on the active DOFs."""
     S: Assembled | ElementStress
     """The projection's right-hand sides per unit displacement: ``S(u)`` per component, and
-    ``S.transposed(c, z)`` the products ``Sᵀ z``."""
+    ``S.transposed(z)`` the products ``Sᵀ z`` per component."""
     Q: dict[str, sp.csr_matrix]
     """Per normal component: the right-hand side per unit nodal temperature rise."""
     components: tuple[str, ...]
@@ -152,7 +155,8 @@ class Recovery:
         """Per component at ``xyz``: ``(g_u, g_T)`` with ``σ = g_u·u + g_T·ΔT`` (g_T None
         for shear components)."""
         z = self._z(xyz)
-        return {c: (self.S.transposed(c, z), self.Q[c].T @ z if c in self.Q else None) for c in self.components}
+        gu = self.S.transposed(z)
+        return {c: (gu[c], self.Q[c].T @ z if c in self.Q else None) for c in self.components}
 
     def field(self, u: np.ndarray, rhs_T: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Projected components (on ``scalar``) for displacement ``u`` and the thermal
