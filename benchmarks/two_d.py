@@ -2,11 +2,13 @@
 
     python benchmarks/two_d.py [--rounds 5]
 
-Three variants of ``gatetherm simulate --condition 1 --out DIR``, each a fresh process, run in
+Four variants of ``gatetherm simulate --condition 1 --out DIR``, each a fresh process, run in
 turn ``--rounds`` times (interleaved: these 2 cores are shared): as shipped (the pictures drawn
 by :class:`gatetherm.validation.plots.painter.Painter`'s two processes while the run computes
 and writes), ``in turn`` (the same command in a process whose painter cannot fork: the pictures
-drawn one after another after the fields, as before the painter) and ``--no-pictures``. Prints
+drawn one after another after the fields, as before the painter), ``--no-pictures`` and ``no
+gc.freeze`` (:func:`gatetherm.cli.main` called without :func:`gatetherm.cli.console`'s freeze:
+the interpreter's collections on the way out). Prints
 the wall-time medians, the ratios to ``in turn`` and whether the PNGs of the first two are the
 same bytes (docs/performance.md, "The 2-D default condition").
 """
@@ -21,7 +23,8 @@ import tempfile
 import time
 from pathlib import Path
 
-CLI = "import sys; from gatetherm.cli import main; sys.exit(main(sys.argv[1:]))"
+CLI = "from gatetherm.cli import console; console()"
+UNFROZEN = "import sys; from gatetherm.cli import main; sys.exit(main())"  # the collections on the way out
 IN_TURN = "import gatetherm.validation.plots.painter as p; p._can_fork = lambda: False; " + CLI
 
 
@@ -29,7 +32,8 @@ def variants(work: Path) -> dict[str, list[str]]:
     args = ["simulate", "--condition", "1", "--out"]
     return {"painter": [sys.executable, "-c", CLI, *args, str(work / "painter")],
             "in turn": [sys.executable, "-c", IN_TURN, *args, str(work / "in_turn")],
-            "no pictures": [sys.executable, "-c", CLI, *args, str(work / "none"), "--no-pictures"]}
+            "no pictures": [sys.executable, "-c", CLI, *args, str(work / "none"), "--no-pictures"],
+            "no gc.freeze": [sys.executable, "-c", UNFROZEN, *args, str(work / "unfrozen")]}
 
 
 def main() -> None:

@@ -131,3 +131,20 @@ def test_a_command_imports_only_its_own_command_module():
 
     listed = build_parser()._subparsers._group_actions[0].choices
     assert list(listed) == list(COMMAND_MODULES)
+
+
+def test_the_program_ends_with_the_commands_code_its_objects_frozen(monkeypatch):
+    """``gatetherm`` (:func:`gatetherm.cli.console`) exits with :func:`main`'s code, the
+    objects made left out of the interpreter's collections on the way out (``gc.freeze``)."""
+    import gc
+
+    import gatetherm.cli as cli
+
+    monkeypatch.setattr(cli, "main", lambda: 3)
+    assert gc.get_freeze_count() == 0
+    try:
+        with pytest.raises(SystemExit) as done:
+            cli.console()
+        assert done.value.code == 3 and gc.get_freeze_count() > 10_000
+    finally:
+        gc.unfreeze()

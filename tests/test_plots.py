@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 import gatetherm as gt
 from gatetherm import InputError
 from gatetherm.validation.plots import save
+from gatetherm.validation.plots.field import boundary_edges
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "validation" / "examples" / "c_frame" / "case.toml"
@@ -128,10 +129,29 @@ def test_deformed_picture(cframe, tmp_path):
     moved = colours._triangulation
     assert np.allclose(np.c_[moved.x, moved.y], xy + scale * u, rtol=0, atol=1e-12)
     assert np.array_equal(colours.get_array(), cframe.field("T"))
-    boundary = cframe.scenario.model.heat.basis.mesh.boundary_facets()  # scikit-fem's own count
-    assert len(outline.get_segments()) == len(boundary) == 313
+    mesh = cframe.scenario.model.heat.basis.mesh
+    facets = np.sort(mesh.facets[:, mesh.boundary_facets()].T, axis=1)  # scikit-fem's own boundary
+    edges = boundary_edges(np.asarray(cframe.case.mesh.cells)[:, :3])
+    assert np.array_equal(edges, facets[np.lexsort(facets.T[::-1])])
+    assert len(outline.get_segments()) == len(edges) == 313
     save(ax, tmp_path / "d.png")
     assert (tmp_path / "d.png").stat().st_size > 10_000
+
+
+def test_save_writes_matplotlibs_pixels(tmp_path):
+    """The PNG holds the pixels matplotlib's own would, as RGB where the figure is opaque."""
+    from PIL import Image
+
+    fig = Figure(figsize=(2.3, 1.7))
+    fig.subplots().plot([0, 1], [0, 2], label="a")
+    for opaque in (True, False):
+        fig.patch.set_alpha(1.0 if opaque else 0.0)
+        save(fig, tmp_path / "ours.png", dpi=60, tight=False)
+        fig.savefig(tmp_path / "theirs.png", format="png", dpi=60)
+        ours, theirs = Image.open(tmp_path / "ours.png"), Image.open(tmp_path / "theirs.png")
+        assert (ours.mode, theirs.mode, ours.size) == ("RGB" if opaque else "RGBA", "RGBA", (138, 102))
+        assert np.array_equal(np.asarray(ours), np.asarray(theirs)[..., :3] if opaque else np.asarray(theirs))
+        assert ours.info["dpi"] == pytest.approx((60, 60), abs=0.01)
 
 
 def test_compensation(cframe):

@@ -1,6 +1,4 @@
 """``python -m gatetherm.cli``: the same as the ``gatetherm`` command."""
-import sys
+from gatetherm.cli import console
 
-from gatetherm.cli import main
-
-sys.exit(main())
+console()

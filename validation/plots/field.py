@@ -117,9 +117,11 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
 
 def boundary_edges(tri: np.ndarray) -> np.ndarray:
     """The edges (pairs of node indices) that belong to one triangle of ``tri`` only."""
-    edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    uniq, count = np.unique(edges, axis=0, return_counts=True)
-    return uniq[count == 1]
+    edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1).astype(np.int64)
+    n = int(edges.max()) + 1 if len(edges) else 1
+    key, count = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)  # one integer per edge
+    once = key[count == 1]
+    return np.column_stack((once // n, once % n))
 
 
 def _surface(fmesh, point_data: dict):
