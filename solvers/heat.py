@@ -30,11 +30,11 @@ import scipy.sparse as sp
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
-from gatetherm.checks import Range, admissible
 from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.fem import Field, dof_basis, element
 from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
+from gatetherm.solvers.scheme import TimeScheme
 
 log = logging.getLogger(__name__)
 
@@ -62,22 +62,6 @@ def film(u, v, w):
 @LinearForm
 def film_load(v, w):
     return w.h * w.t * v
-
-
-@admissible(theta=Range(0.5, 1.0), restart=Range(1, 1000, whole=True), restart_intervals=Range(0, 1000, whole=True))
-@dataclass(frozen=True)
-class TimeScheme:
-    """The θ-method with Rannacher start-up at input switches."""
-
-    theta: float = 0.5
-    """1: backward Euler; 0.5: Crank–Nicolson (second order)."""
-    restart: int = 4
-    """Steps into which each of the ``restart_intervals`` intervals after a pump switch (and
-    at the start) is divided; for θ < 1 the very first of them is two backward-Euler half
-    steps, which damp the stiff modes the switch excites (oil, wall film) instead of
-    letting CN ring. 1: no grading."""
-    restart_intervals: int = 3
-    """How many intervals after a switch are divided."""
 
 
 def environment(drive: Drive, t: float) -> dict[str, float]:

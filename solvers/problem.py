@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from gatetherm.solvers.expr import Value
-from gatetherm.solvers.heat import TimeScheme
+from gatetherm.solvers.scheme import TimeScheme
 from gatetherm.solvers.material import Material
 
 AXES = "xyz"
