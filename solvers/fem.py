@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.geometry.mesh import FrameMesh, facet_keys
 
 _MESH = {2: skfem.MeshTri, 3: skfem.MeshTet}
 _ELEM = {(2, 1): skfem.ElementTriP1, (2, 2): skfem.ElementTriP2,
@@ -14,25 +14,12 @@ _ELEM = {(2, 1): skfem.ElementTriP1, (2, 2): skfem.ElementTriP2,
 _P0 = {2: skfem.ElementTriP0, 3: skfem.ElementTetP0}
 
 
-def _keys(facets: np.ndarray, n: int) -> np.ndarray:
-    """One key per facet (rows of ``n`` node numbers, any order within a row), ordered as the
-    sorted rows are lexicographically: an integer while n**(nodes per facet) fits in int64 (a
-    3-D mesh of up to 2 million nodes), else a record of the sorted row."""
-    rows = np.sort(facets, axis=1).astype(np.int64)
-    if float(n) ** rows.shape[1] >= 2.0 ** 63:
-        return np.ascontiguousarray(rows).view([(f"n{i}", np.int64) for i in range(rows.shape[1])]).ravel()
-    key = np.zeros(len(rows), dtype=np.int64)
-    for column in rows.T:
-        key = key * n + column
-    return key
-
-
 def _entities(t: np.ndarray, local, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """scikit-fem's ``build_entities``: the facets as sorted node rows in lexicographic order
     and the element-to-facet map, by integer keys instead of ``np.unique(axis=1)`` on the
     rows (1.2 s against 0.25 s on the 3-D frame); also the facets' sorted keys."""
     rows = np.hstack([t[ix] for ix in local])
-    keys, first, inverse = np.unique(_keys(rows.T, n), return_index=True, return_inverse=True)
+    keys, first, inverse = np.unique(facet_keys(rows.T, n), return_index=True, return_inverse=True)
     return np.ascontiguousarray(np.sort(rows[:, first], axis=0)), inverse.reshape(len(local), t.shape[1]), keys
 
 
@@ -44,7 +31,7 @@ def to_skfem(fm: FrameMesh) -> skfem.Mesh:
     mesh._facets, mesh._t2f, keys = _entities(mesh.t, mesh.elem.refdom.facets, n)
     boundaries = {}
     for name, fac in fm.boundaries.items():
-        want = _keys(np.asarray(fac), n)
+        want = facet_keys(np.asarray(fac), n)
         ids = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
         if not np.array_equal(keys[ids], want):
             raise ValueError(f"boundary {name!r} has facets that are not facets of the mesh")

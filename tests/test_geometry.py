@@ -208,10 +208,10 @@ def test_second_tie_bar():
 
 
 def test_facet_keys_order_rows_alike_past_int64():
-    """Boundary facets are matched by key (``to_skfem``); past 2 million nodes in 3-D the integer
+    """Boundary facets are matched by key (``to_skfem``, ``check_mesh``); past 2 million nodes in 3-D the integer
     key n²a + nb + c would overflow int64, so the key is then a record of the sorted row. Both
     kinds order rows alike, and each row is found again."""
-    from gatetherm.solvers.fem import _keys
+    from gatetherm.geometry.mesh import facet_keys as _keys
 
     rows = np.random.default_rng(1).integers(0, 50, (400, 3))
     small, big = _keys(rows, 50), _keys(rows, 3_000_000)
