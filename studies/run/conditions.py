@@ -8,6 +8,7 @@ the forced cooling of condition 3), which is what makes condition 2 start from
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,14 +83,21 @@ def supply_temperature(cond: Condition, sp: SupplyParams, t: np.ndarray) -> np.n
     to the piecewise-constant set point."""
     t = np.atleast_1d(np.asarray(t, dtype=float))
     out = np.empty_like(t)
-    T = sp.T_room if cond.T_supply0 is None else cond.T_supply0
-    ends = [s.start for s in cond.segments[1:]] + [np.inf]
+    for start, end, set_point, T, tau in _responses(cond, sp):
+        on = (t >= start) & (t < end)
+        out[on] = set_point + (T - set_point) * np.exp(-(t[on] - start) / tau)
+    return out
+
+
+def _responses(cond: Condition, sp: SupplyParams) -> list[tuple[float, float, float, float, float]]:
+    """(start, end, set point, temperature at the start, time constant) of each segment."""
+    out, T = [], sp.T_room if cond.T_supply0 is None else cond.T_supply0
+    ends = [s.start for s in cond.segments[1:]] + [math.inf]
     for seg, end in zip(cond.segments, ends):
         tau = sp.tau_heat if seg.set_point >= T else sp.tau_cool
-        on = (t >= seg.start) & (t < end)
-        out[on] = seg.set_point + (T - seg.set_point) * np.exp(-(t[on] - seg.start) / tau)
-        if np.isfinite(end):
-            T = seg.set_point + (T - seg.set_point) * np.exp(-(end - seg.start) / tau)
+        out.append((seg.start, end, seg.set_point, T, tau))
+        if math.isfinite(end):
+            T = seg.set_point + (T - seg.set_point) * math.exp(-(end - seg.start) / tau)
     return out
 
 
@@ -100,9 +108,12 @@ def pump_state(cond: Condition, t: float) -> bool:
 def condition_drive(cond: Condition, sp: SupplyParams) -> Drive:
     """The model input for a paper condition."""
 
-    def drive(t: float) -> dict[str, float]:
-        return {SUPPLY: float(supply_temperature(cond, sp, t)[0]), PUMP: float(pump_state(cond, t)),
-                AMBIENT: sp.T_room}
+    responses = _responses(cond, sp)
+
+    def drive(t: float) -> dict[str, float]:  # a scalar: 2 µs instead of the array function's 50 µs a step
+        supply = next((set_point + (T - set_point) * math.exp(-(t - start) / tau)
+                       for start, end, set_point, T, tau in responses if start <= t < end), math.nan)
+        return {SUPPLY: supply, PUMP: float(pump_state(cond, t)), AMBIENT: sp.T_room}
 
     return drive
 
