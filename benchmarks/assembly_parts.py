@@ -1,4 +1,4 @@
-"""Three parts of a 3-D run, each against the way it was made before, on the 3-D frame.
+"""Four parts of a 3-D run, each against the way it was made before, on the 3-D frame.
 
     python benchmarks/assembly_parts.py [--rounds 5]
 
@@ -8,7 +8,10 @@ The pairs, the variants interleaved per round: the node-pair pattern's map of el
 (``p1.Pattern``, each entry looked up in its row) against one searchsorted over all pairs; the
 stress projection's right-hand sides of one field applied element by element
 (``stress.ElementStress``, nothing to set up) against the six matrices of before, assembled and
-applied; one field file written raw (``geometry.vtu.write_vtu``) against meshio's VTU writer.
+applied; one field file written raw (``geometry.vtu.write_vtu``) against meshio's VTU writer; the
+check of a mesh read from a file (``geometry.mesh.check_mesh``: facets matched by sorted integer
+keys, each element edge once) against its code before (``np.unique`` of byte records, which
+numpy 2.4 hashes, and all 16 node pairs of a tetrahedron).
 Prints the medians, their ratios, and that the results agree (docs/performance.md,
 "2026-12-04").
 """
@@ -27,7 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 
 PAIRS = {"pattern": ("by rows", "searchsorted"),
-         "stress rhs": ("element by element", "six matrices"), "field file": ("raw", "meshio")}
+         "stress rhs": ("element by element", "six matrices"), "field file": ("raw", "meshio"),
+         "mesh check": ("sorted keys", "np.unique")}
 
 
 def variants(fm, work: str):
@@ -35,7 +39,7 @@ def variants(fm, work: str):
     (a field file's path, in the folder ``work``)."""
     import meshio
 
-    from gatetherm.geometry.mesh import to_meshio
+    from gatetherm.geometry.mesh import check_mesh, to_meshio
     from gatetherm.geometry.vtu import write_vtu
     from gatetherm.solvers import p1
     from gatetherm.solvers.stress import _INDEX, COMPONENTS, ElementStress
@@ -67,6 +71,17 @@ def variants(fm, work: str):
         return {**out, "product s": time.perf_counter() - t0,
                 "GB": sum(m.data.nbytes + m.indices.nbytes for m in S.values()) / 1e9}
 
+    def checked_before():  # geometry.mesh.check_mesh before (the mesh is sound: both return, neither raises)
+        X = fm.points[fm.cells]
+        size = np.abs(np.linalg.det(X[:, 1:] - X[:, :1]))
+        edge = np.linalg.norm(X[:, :, None] - X[:, None, :], axis=-1).max(axis=(1, 2))
+        assert not (size <= 1e-10 * edge ** 3).any()
+        rows = np.sort(np.vstack([np.delete(fm.cells, i, axis=1) for i in range(4)]), axis=1)
+        key = lambda a: np.ascontiguousarray(a, dtype=np.int64).view(f"V{8 * a.shape[1]}").ravel()  # noqa: E731
+        facets = np.unique(key(rows))
+        assert all(np.isin(key(np.sort(f, axis=1)), facets).all() for f in fm.boundaries.values())
+        return np.ones(1)
+
     def written(write):  # the file's path: read back after the timing
         path = os.path.join(work, "f.vtu")
         write(path)
@@ -75,6 +90,8 @@ def variants(fm, work: str):
     return {("pattern", "by rows"): lambda: p1.Pattern(cells, n).inv, ("pattern", "searchsorted"): searched,
             ("stress rhs", "element by element"): lambda: ElementStress(cells, G, vol, lam, mu, comps, n)(u),
             ("stress rhs", "six matrices"): six_matrices,
+            ("mesh check", "sorted keys"): lambda: check_mesh(fm, "mesh") or np.ones(1),
+            ("mesh check", "np.unique"): checked_before,
             ("field file", "raw"): lambda: written(lambda p: write_vtu(p, fm, data)),
             ("field file", "meshio"): lambda: written(lambda p: meshio.write(p, to_meshio(fm, data), file_format="vtu",
                                                                              compression=None))}

@@ -5,15 +5,18 @@
 One condition-1 run of ``gate_frame(dim=2)`` (the states of the deformed picture kept), then
 per round (interleaved) each picture ``gatetherm simulate`` writes, drawn on a new figure by the library's
 plot function: the medians of plotting, ``tight_layout`` and drawing with writing the PNG (to
-memory) at 200 dpi (:data:`gatetherm.validation.plots.DPI`), 150 and 100 dpi, and 200 dpi with
-PNG compression level 1. Last, the four drawn in turn against in four threads at once
+memory) at 200 dpi (:data:`gatetherm.validation.plots.DPI`), 150 and 100 dpi, 200 dpi with
+PNG compression level 1, and 200 dpi by the library's writer (:func:`gatetherm.validation.plots.save`:
+RGB, run-length strategy; to a file). Last, the four drawn in turn against in four threads at once
 (docs/performance.md, "The 2-D default condition").
 """
 from __future__ import annotations
 
 import argparse
 import io
+import os
 import statistics
+import tempfile
 import threading
 import time
 
@@ -32,14 +35,20 @@ def pictures(res):
             "deformed": lambda: draw_deformed(run, t, lambda s: "x")}
 
 
-def draw(make, dpi=200, compress=6) -> tuple[float, float, float]:
-    """Seconds to plot, lay out and draw + write one picture."""
+def draw(make, dpi=200, compress=6, library=False) -> tuple[float, float, float]:
+    """Seconds to plot, lay out and draw + write one picture (``library``: by ``save``, to a file)."""
     t0 = time.perf_counter()
     fig = np.asarray(make(), dtype=object).flat[0].figure
     t1 = time.perf_counter()
     fig.tight_layout()
     t2 = time.perf_counter()
-    fig.savefig(io.BytesIO(), format="png", dpi=dpi, pil_kwargs={"compress_level": compress})
+    if library:
+        from gatetherm.validation.plots import save
+
+        with tempfile.TemporaryDirectory() as tmp:
+            save(fig, os.path.join(tmp, "p.png"), dpi=dpi, tight=False)
+    else:
+        fig.savefig(io.BytesIO(), format="png", dpi=dpi, pil_kwargs={"compress_level": compress})
     return t1 - t0, t2 - t1, time.perf_counter() - t2
 
 
@@ -57,7 +66,8 @@ def main() -> None:
     t0 = time.perf_counter()
     draw(makes["channels"])  # matplotlib's import and first draw
     print(f"matplotlib's import and the first picture: {time.perf_counter() - t0:.3f} s")
-    variants = {"200 dpi": {}, "150 dpi": {"dpi": 150}, "100 dpi": {"dpi": 100}, "200 dpi, compression 1": {"compress": 1}}
+    variants = {"200 dpi": {}, "150 dpi": {"dpi": 150}, "100 dpi": {"dpi": 100}, "200 dpi, compression 1": {"compress": 1},
+                "200 dpi, library writer": {"library": True}}
     seen = {(label, name): [] for label in variants for name in makes}
     for _ in range(args.rounds):  # interleaved: each round draws every variant in turn
         for label, kw in variants.items():
