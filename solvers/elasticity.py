@@ -92,8 +92,8 @@ class ElasticSystem:
 
     def point_functional(self, xyz: np.ndarray, component: int) -> np.ndarray:
         """Vector g with g·u = u_component at point ``xyz``."""
-        P = self.basis.probes(np.asarray(xyz, dtype=float).reshape(-1, 1))
-        return P.tocsr()[component].toarray().ravel()
+        P = p1.probes(self.basis, np.asarray(xyz, dtype=float).reshape(-1, 1))
+        return P[component].toarray().ravel()
 
     def weights(self, g: np.ndarray) -> np.ndarray:
         """Temperature weights w with w·dT = g·u(dT) (adjoint solve); ``g`` may be

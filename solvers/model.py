@@ -261,7 +261,7 @@ def _readout(model: Model) -> Readout:
     keys, rows = [], []
     probes = [pr for pr in p.probes if "T" in pr.quantities]
     if probes:
-        P = heat.basis.probes(np.array([pr.xyz for pr in probes]).T).tocsr()
+        P = p1.probes(heat.basis, np.array([pr.xyz for pr in probes]).T)
         keys += [("T", pr.name) for pr in probes]
         rows.append(sp.hstack([P, sp.csr_matrix((len(probes), heat.n - heat.n_solid))]))
     for name, index in heat.lumped.items():

@@ -143,7 +143,9 @@ class Recovery:
 
     def at(self, xyz) -> np.ndarray:
         """Row φ with φ·s = the value at ``xyz`` of a field ``s`` on :attr:`scalar`."""
-        return self.full.probes(np.asarray(xyz, float).reshape(-1, 1)).toarray().ravel()
+        from gatetherm.solvers import p1
+
+        return p1.probes(self.full, np.asarray(xyz, float).reshape(-1, 1)).toarray().ravel()
 
     def _z(self, xyz) -> np.ndarray:
         phi = self.at(xyz)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.sparse import coo_matrix
 from skfem import CellBasis, ElementVector, asm
 
 from gatetherm.solvers import p1
@@ -117,3 +118,29 @@ def test_boundary_films_in_numpy_equal_the_facet_forms(dim, frame_2d, frame_3d):
         fb = FacetBasis(mesh, element(dim, 1), facets=mesh.boundaries[name], intorder=2)
         assert _close(A, asm(film, fb, h=1.0, t=t.at(fb))) < 1e-13
         assert np.abs(a - asm(film_load, fb, h=1.0, t=t.at(fb))).max() < 1e-13 * np.abs(a).max()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_probes_by_barycentric_coordinates_equal_scikit_fems(dim, frame_2d, frame_3d, monkeypatch):
+    """At the frame's sensor nodes and inside elements, scalar and vector P1 bases: the
+    matrix of scikit-fem's element finder to round-off; for P2, and for a point outside the
+    body, scikit-fem's own (it raises there)."""
+    fm = frame_2d if dim == 2 else frame_3d
+    mesh = to_skfem(fm)
+    rng = np.random.default_rng(dim)
+    inside = fm.points[fm.cells[rng.choice(len(fm.cells), 12, replace=False)]]
+    weights = rng.dirichlet(np.ones(dim + 1), 12)
+    X = np.vstack([fm.points[list(fm.sensors.values())], np.einsum("ek,ekd->ed", weights, inside)]).T
+    for elem in (element(dim, 1), ElementVector(element(dim, 1))):
+        basis = CellBasis(mesh, elem, intorder=1)
+        ours, theirs = p1.probes(basis, X), basis.probes(X).tocsr()
+        assert ours.shape == theirs.shape and _close(ours.toarray(), theirs.toarray()) < 1e-13
+        assert ours.nnz == (dim + 1) * X.shape[1] * (dim if isinstance(elem, ElementVector) else 1)
+    asked = []
+    P2 = CellBasis(mesh, element(dim, 2), intorder=2)
+    marker = coo_matrix(np.full((1, 1), 7.0))  # what scikit-fem's probes give, as CSR
+    monkeypatch.setattr(type(P2), "probes", lambda self, x: asked.append(x.shape) or marker)
+    assert p1.probes(P2, X).format == "csr" and p1.probes(P2, X).toarray().tolist() == [[7.0]]
+    outside = np.full((dim, 1), 10.0)  # 10 m away: in no element around the nearest node
+    assert p1.probes(CellBasis(mesh, element(dim, 1), intorder=1), outside).toarray().tolist() == [[7.0]]
+    assert asked == [X.shape, X.shape, (dim, 1)]
