@@ -218,7 +218,7 @@ def check_mesh(fm: FrameMesh, where: str) -> None:
         raise InputError(where, f"has {len(bad)} element(s) of zero {'area' if fm.dim == 2 else 'volume'} "
                          f"(the first at ({at}))", "check the geometry for coincident points or collapsed entities")
     rows = np.vstack([np.delete(fm.cells, i, axis=1) for i in range(fm.dim + 1)])
-    facets = np.sort(facet_keys(rows, len(fm.points)))  # sorted, not np.unique: numpy 2.4 hashes, 50 x slower here
+    facets = np.sort(facet_keys(rows, len(fm.points)))  # not np.unique: numpy 2.4 hashes (benchmarks/assembly_parts.py)
     for name, fac in fm.boundaries.items():
         fac = np.asarray(fac)
         if not fac.size:

@@ -166,8 +166,9 @@ def main(argv: list[str] | None = None) -> int:
 def console() -> None:
     """The ``gatetherm`` program (and ``python -m gatetherm.cli``): :func:`main`, then the
     process ends with its code. What the command made is left to the end of the process
-    (:func:`gc.freeze`): the interpreter's collections on the way out would take 0.1–0.2 s
-    after any run (``benchmarks/two_d.py``) and free nothing the operating system does not."""
+    (:func:`gc.freeze`): the interpreter's collections on the way out would go over all of
+    it (``benchmarks/two_d.py``, variant ``no gc.freeze``) and free nothing the operating system
+    does not."""
     code = main()
     import gc
 

@@ -110,7 +110,7 @@ def condition_drive(cond: Condition, sp: SupplyParams) -> Drive:
 
     responses = _responses(cond, sp)
 
-    def drive(t: float) -> dict[str, float]:  # a scalar: 2 µs instead of the array function's 50 µs a step
+    def drive(t: float) -> dict[str, float]:  # a scalar: each step asks for one time
         supply = next((set_point + (T - set_point) * math.exp(-(t - start) / tau)
                        for start, end, set_point, T, tau in responses if start <= t < end), math.nan)
         return {SUPPLY: supply, PUMP: float(pump_state(cond, t)), AMBIENT: sp.T_room}

@@ -62,5 +62,5 @@ def save(fig, path: str | os.PathLike, dpi: int = DPI, tight: bool = True) -> No
     rgba = np.frombuffer(raw.getbuffer(), np.uint8).reshape(h, w, 4)
     opaque = bool((rgba[..., 3] == 255).all())
     image = Image.fromarray(np.ascontiguousarray(rgba[..., :3]) if opaque else rgba)
-    with atomic_path(path) as tmp:  # RGB where opaque, zlib's run-length strategy: 0.4 x the encoding
+    with atomic_path(path) as tmp:  # RGB where opaque; zlib's run-length strategy
         image.save(tmp, format="png", dpi=(dpi, dpi), compress_type=3)
