@@ -7,7 +7,7 @@ per round (interleaved) each picture ``gatetherm simulate`` writes, drawn on a n
 plot function: the medians of plotting, ``tight_layout`` and drawing with writing the PNG (to
 memory) at 200 dpi (:data:`gatetherm.validation.plots.DPI`), 150 and 100 dpi, 200 dpi with
 PNG compression level 1, and 200 dpi by the library's writer (:func:`gatetherm.validation.plots.save`:
-RGB, run-length strategy; to a file). Last, the four drawn in turn against in four threads at once
+zlib's run-length strategy; to a file). Last, the four drawn in turn against in four threads at once
 (docs/performance.md, "The 2-D default condition").
 """
 from __future__ import annotations

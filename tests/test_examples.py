@@ -41,10 +41,9 @@ def run_example(name: str, tmp_path: Path) -> tuple[list[str], Path]:
 
 
 def image(path: Path) -> np.ndarray:
-    """The picture's colours (an opaque PNG may be stored with or without its alpha)."""
     import matplotlib.image
 
-    return matplotlib.image.imread(path)[..., :3]
+    return matplotlib.image.imread(path)
 
 
 def test_every_example_has_a_docstring_and_uses_only_the_public_api():
