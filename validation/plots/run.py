@@ -105,6 +105,14 @@ def has_response(cols: dict) -> bool:
     return len(cols["time_s"]) > 1 and all(k in cols for k in (*dict(THETAS), "delta_um"))
 
 
+PAINTING_ORDER = {2: ("deformed.png", "response.png", "channels.png", "oil_temperatures.png"),
+                  3: ("deformed.png", "channels.png", "oil_temperatures.png", "response.png")}
+"""The order the pictures are handed out in, by dimension: each goes to the painting process
+given fewer, so that deformed and channels share one in 2-D, response and oil temperatures the
+other (about equal work), while a 3-D deformed picture (pyvista) gets only the cheapest, oil
+temperatures, beside it (``docs/performance.md``, "The 2-D default condition")."""
+
+
 def prepare_pictures(run, painter) -> None:
     """What the pictures of ``run`` need made ready in ``painter``'s process before
     :func:`write_pictures` gives them: the renderer of a 3-D body's deformed picture."""
@@ -133,12 +141,14 @@ def write_pictures(run, out, title: str, picture_s: float | None, solved: dict |
     if picture_s is not None and run.model.elastic is not None:  # the largest arguments first
         caption = caption or (lambda t: f"{title}, t = {t / 60:.0f} min")
         jobs["deformed.png"] = render_deformed, deformed(run, picture_s, caption, solved)
-    if has_response(cols):  # handed out in turn, each to the process given fewer: deformed and channels
-        jobs["response.png"] = plot_response, (cols, title)  # to one, response and oil to the other (2-D:
-    if transient:                                             # about 0.47 s each; in 3-D the field files last longer)
+    if transient:
         jobs["channels.png"] = plot_channels, (cols, title)
     if transient and run.model.problem.fluids:
         jobs["oil_temperatures.png"] = plot_fluids, (cols, run.model.problem, title)
+    if has_response(cols):
+        jobs["response.png"] = plot_response, (cols, title)
+    order = PAINTING_ORDER[3 if run.model.dim == 3 else 2]
+    jobs = dict(sorted(jobs.items(), key=lambda job: order.index(job[0])))
     painter = Painter(0) if painter is None else painter
     for name, (plot, args) in jobs.items():
         painter.draw(plot, *args, path=out / name, tight=name != "channels.png")
