@@ -221,15 +221,7 @@ def check_mesh(fm: FrameMesh, where: str) -> None:
     facets = np.sort(facet_keys(rows, len(fm.points)))  # not np.unique: numpy 2.4 hashes (benchmarks/assembly_parts.py)
     for name, fac in fm.boundaries.items():
         fac = np.asarray(fac)
-        if not fac.size:
-            continue
-        if (fac < 0).any():
-            found = False
-        else:
-            keys = facet_keys(fac, len(fm.points))
-            at = np.minimum(np.searchsorted(facets, keys), len(facets) - 1)
-            found = (facets[at] == keys).all()
-        if not found:
+        if fac.size and ((fac < 0).any() or find_facets(facets, fac, len(fm.points)) is None):
             raise InputError(f"{where}: boundary {name}", "has facets that are not facets of the mesh's elements "
                              "(a surface or curve that is not part of the meshed body?)",
                              "remove it from the group or make it part of the body (fragment it in gmsh)")
@@ -246,6 +238,14 @@ def facet_keys(facets: np.ndarray, n: int) -> np.ndarray:
     for column in rows.T:
         key = key * n + column
     return key
+
+
+def find_facets(keys: np.ndarray, facets: np.ndarray, n: int) -> np.ndarray | None:
+    """Positions in ``keys`` (the sorted :func:`facet_keys` of a mesh's facets) of the rows
+    ``facets``; None if one of them is not there."""
+    want = facet_keys(np.asarray(facets), n)
+    at = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
+    return at if np.array_equal(keys[at], want) else None
 
 
 def components(fm: FrameMesh) -> list[set[str]]:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 import skfem
 
-from gatetherm.geometry.mesh import FrameMesh, facet_keys
+from gatetherm.geometry.mesh import FrameMesh, facet_keys, find_facets
 
 _MESH = {2: skfem.MeshTri, 3: skfem.MeshTet}
 _ELEM = {(2, 1): skfem.ElementTriP1, (2, 2): skfem.ElementTriP2,
@@ -31,9 +31,8 @@ def to_skfem(fm: FrameMesh) -> skfem.Mesh:
     mesh._facets, mesh._t2f, keys = _entities(mesh.t, mesh.elem.refdom.facets, n)
     boundaries = {}
     for name, fac in fm.boundaries.items():
-        want = facet_keys(np.asarray(fac), n)
-        ids = np.minimum(np.searchsorted(keys, want), len(keys) - 1)
-        if not np.array_equal(keys[ids], want):
+        ids = find_facets(keys, fac, n)
+        if ids is None:
             raise ValueError(f"boundary {name!r} has facets that are not facets of the mesh")
         boundaries[name] = ids
     out = mesh.with_boundaries(boundaries).with_subdomains({k: np.asarray(v) for k, v in fm.regions.items()})

@@ -173,7 +173,7 @@ def probes(basis, points: np.ndarray) -> sp.csr_matrix:
         nodes.append(t[:, star[inside[0]]])
         weights.append(bary[inside[0]])
     comps, n = basis.nodal_dofs.shape[0], X.shape[1]
-    rows = (np.arange(comps)[:, None, None] * n + np.arange(n)[None, :, None]) * np.ones(p.shape[0] + 1, int)
     cols = basis.nodal_dofs[:, np.array(nodes)]  # (comps, n, d+1): component c of point j in row c n + j
+    rows = np.broadcast_to((np.arange(comps)[:, None] * n + np.arange(n))[:, :, None], cols.shape)
     data = np.broadcast_to(np.array(weights), cols.shape)
     return sp.csr_matrix((data.ravel(), (rows.ravel(), cols.ravel())), shape=(comps * n, basis.N))

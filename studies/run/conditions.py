@@ -85,8 +85,14 @@ def supply_temperature(cond: Condition, sp: SupplyParams, t: np.ndarray) -> np.n
     out = np.empty_like(t)
     for start, end, set_point, T, tau in _responses(cond, sp):
         on = (t >= start) & (t < end)
-        out[on] = set_point + (T - set_point) * np.exp(-(t[on] - start) / tau)
+        out[on] = _approach(set_point, T, t[on] - start, tau, np.exp)
     return out
+
+
+def _approach(set_point: float, T: float, elapsed, tau: float, exp=math.exp):
+    """The first-order response: ``T`` (°C) approaching ``set_point`` after ``elapsed`` s with
+    time constant ``tau`` s (``exp``: ``np.exp`` for arrays)."""
+    return set_point + (T - set_point) * exp(-elapsed / tau)
 
 
 def _responses(cond: Condition, sp: SupplyParams) -> list[tuple[float, float, float, float, float]]:
@@ -97,7 +103,7 @@ def _responses(cond: Condition, sp: SupplyParams) -> list[tuple[float, float, fl
         tau = sp.tau_heat if seg.set_point >= T else sp.tau_cool
         out.append((seg.start, end, seg.set_point, T, tau))
         if math.isfinite(end):
-            T = seg.set_point + (T - seg.set_point) * math.exp(-(end - seg.start) / tau)
+            T = _approach(seg.set_point, T, end - seg.start, tau)
     return out
 
 
@@ -111,8 +117,8 @@ def condition_drive(cond: Condition, sp: SupplyParams) -> Drive:
     responses = _responses(cond, sp)
 
     def drive(t: float) -> dict[str, float]:  # a scalar: each step asks for one time
-        supply = next((set_point + (T - set_point) * math.exp(-(t - start) / tau)
-                       for start, end, set_point, T, tau in responses if start <= t < end), math.nan)
+        supply = next((_approach(set_point, T, t - start, tau) for start, end, set_point, T, tau in responses
+                       if start <= t < end), math.nan)
         return {SUPPLY: supply, PUMP: float(pump_state(cond, t)), AMBIENT: sp.T_room}
 
     return drive

@@ -117,9 +117,10 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
 
 def boundary_edges(tri: np.ndarray) -> np.ndarray:
     """The edges (pairs of node indices) that belong to one triangle of ``tri`` only."""
-    edges = np.sort(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1).astype(np.int64)
-    n = int(edges.max()) + 1 if len(edges) else 1
-    key, count = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)  # one integer per edge
+    from gatetherm.geometry.mesh import facet_keys
+
+    n = int(tri.max()) + 1 if len(tri) else 1
+    key, count = np.unique(facet_keys(tri[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), n), return_counts=True)
     once = key[count == 1]
     return np.column_stack((once // n, once % n))
 
