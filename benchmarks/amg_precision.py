@@ -38,7 +38,7 @@ def recorded_systems():
     SPDSolver.__call__ = recording
     try:
         run = gt.run(gt.gate_frame(dim=3), keep=[0.0, 780.0, 3600.0, 7200.0, 10800.0, 14400.0, 18000.0])
-        displacements(run.scenario.model, run.scenario.result.states, run.scenario.result.envs)
+        dict(displacements(run.scenario.model, run.scenario.result.states, run.scenario.result.envs))  # each solved
     finally:
         SPDSolver.__call__ = call
     return seen["A"], seen["modes"], seen["block"], seen["batches"]

@@ -41,7 +41,7 @@ def main() -> None:
                 pcg._X, pcg._AX = list(start[0]), list(start[1])
                 before = pcg.iterations
                 t0 = time.perf_counter()
-                u = displacements(model, result.states, result.envs)
+                u = dict(displacements(model, result.states, result.envs))  # each solved
                 times[name].append(time.perf_counter() - t0)
                 iterations[name] = pcg.iterations - before
                 fields[name] = np.column_stack(list(u.values()))

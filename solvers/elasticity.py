@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import re
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import scipy.sparse as sp
@@ -86,9 +87,18 @@ class ElasticSystem:
 
     def from_load(self, load: np.ndarray) -> np.ndarray:
         """Displacement field (m) for a load vector (N) on the displacement basis."""
-        u = np.zeros((self.basis.N,) + np.shape(load)[1:])
-        u[self.free] = self.solve(load[self.free])
-        return u
+        return self.later(load).result()
+
+    def later(self, load: np.ndarray):
+        """:meth:`from_load` as a :class:`~gatetherm.solvers.helper.Pending`: solved beside the
+        caller where the solver runs in a helper process (:meth:`SPDSolver.start`)."""
+        shape = (self.basis.N,) + np.shape(load)[1:]
+
+        def full(x):
+            u = np.zeros(shape)
+            u[self.free] = x
+            return u
+        return self.solve.submit(load[self.free]).then(full)
 
     def point_functional(self, xyz: np.ndarray, component: int) -> np.ndarray:
         """Vector g with g·u = u_component at point ``xyz``."""
@@ -98,11 +108,13 @@ class ElasticSystem:
     def weights(self, g: np.ndarray) -> np.ndarray:
         """Temperature weights w with w·dT = g·u(dT) (adjoint solve); ``g`` may be
         (N,) or (outputs, N), giving (n_T,) or (outputs, n_T)."""
+        return self.weights_later(g).result()
+
+    def weights_later(self, g: np.ndarray):
+        """:meth:`weights` as a :class:`~gatetherm.solvers.helper.Pending` (see :meth:`later`)."""
         G = np.atleast_2d(g)
-        Z = np.zeros((self.basis.N, G.shape[0]))
-        Z[self.free] = self.solve(np.ascontiguousarray(G[:, self.free].T))  # all outputs in one solve
-        W = (self.B.T @ Z).T
-        return W[0] if np.ndim(g) == 1 else W
+        Z = self.later(np.ascontiguousarray(G.T))  # all outputs in one solve
+        return Z.then(lambda z: (self.B.T @ z).T[0] if np.ndim(g) == 1 else (self.B.T @ z).T)
 
 
 def support_dofs(vb: CellBasis, mesh, boundary: str, components, lines=None) -> np.ndarray:
@@ -198,6 +210,11 @@ class _Solver(SPDSolver):
                              "a part is not held: hold every part, or join it to a held one") from None
 
 
+def _free_order(s: p1.Simplices, dim: int, free: np.ndarray, n: int) -> np.ndarray | None:
+    """The order of the free DOFs from the mesh nodes' (``dim`` DOFs per node, ``n`` in all)."""
+    return restrict_order(expand_order(s.order, dim), free, n)
+
+
 def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, alpha: Field,
                      thickness: Field, supports, plane: str = "stress",
                      simplices: p1.Simplices | None = None, lines=None, contacts=()) -> ElasticSystem:
@@ -214,12 +231,12 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     dim, axi = mesh.dim(), plane == "axisymmetric"
     q = 2 * order + 1 if axi else 2 * order - 1  # exact for stiffness and thermal load on affine simplices
     lam, mu, b = moduli(E.values, nu.values, alpha.values, dim, plane)
-    node_order = None
-    if order == 1 and T_basis.elem.maxdeg == 1 and not axi:  # the same matrices, vectorised (solvers/p1.py)
-        s, th = simplices or p1.simplices(mesh), thickness.values
-        vb, node_order = dof_basis(mesh, ElementVector(element(dim, order))), s.order
-        K = p1.stiffness(s.pattern, s.G, s.vol, lam * th, mu * th)
-        B = p1.thermal_load(s.pattern, s.G, s.vol, b * th)
+    linear = order == 1 and T_basis.elem.maxdeg == 1 and not axi
+    if linear:  # the same matrices, vectorised (solvers/p1.py)
+        simplices, th = simplices or p1.simplices(mesh), thickness.values
+        vb = dof_basis(mesh, ElementVector(element(dim, order)))
+        K = p1.stiffness(simplices.pattern, simplices.G, simplices.vol, lam * th, mu * th)
+        B = p1.thermal_load(simplices.pattern, simplices.G, simplices.vol, b * th)
     else:
         vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
         T_basis, t = CellBasis(mesh, T_basis.elem, intorder=q), thickness.at(vb)
@@ -240,8 +257,10 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     K = (K + sum(springs[1:], springs[0]) if springs else K).tocsr()
     free = np.setdiff1d(np.arange(vb.N), fixed)
     K_fixed = K[:, fixed] if any(s.values for s in supports) else None
-    dof_order = nd_order(K, dim) if node_order is None else expand_order(node_order, dim)
-    perm = restrict_order(dof_order, free, vb.N)
+    if linear:  # the nodes' order, found when a factor needs it
+        perm = partial(_free_order, simplices, dim, free, vb.N)
+    else:
+        perm = restrict_order(nd_order(K, dim), free, vb.N)
     K = K[free]  # in two steps: the full matrix goes before the columns are taken
     K = K[:, free]
     rbm = rigid_body_modes(vb.doflocs, vb.split_indices())[free]

@@ -93,6 +93,8 @@ class AMG:
         return own + sum(_nbytes(lv.A) for lv in levels[1:]) + sum(_nbytes(lv.P) for lv in levels[:-1])  # R: P's view
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
+        if len(self.ml.levels) == 1:  # no coarser level (a small matrix): its coarse solve
+            return self.ml.coarse_solver(self.A, np.asarray(b, dtype=float))
         return self._cycle(0, np.asarray(b, dtype=self.dtype)).astype(float)
 
     def _cycle(self, k: int, b: np.ndarray) -> np.ndarray:
@@ -118,11 +120,12 @@ class PCG:
     :data:`RECYCLE` solutions. ``iterations`` counts them all."""
 
     def __init__(self, A: sp.spmatrix, near_null: np.ndarray | None = None, block: int = 1, rtol: float = RTOL,
-                 recycle: int = RECYCLE, amg: AMG | None = None):
-        """``amg``: a hierarchy to precondition with instead of ``A``'s own (of a nearby matrix)."""
+                 recycle: int = RECYCLE, amg: AMG | None = None, split: bool = True):
+        """``amg``: a hierarchy to precondition with instead of ``A``'s own (of a nearby matrix);
+        ``split``: solve the later half of a large call's right-hand sides in a forked copy."""
         self.A = A.tocsr()
         self.amg = AMG(self.A, near_null, block) if amg is None else amg
-        self.rtol, self.recycle = rtol, recycle
+        self.rtol, self.recycle, self.split = rtol, recycle, split
         self._X: list[np.ndarray] = []
         self._AX: list[np.ndarray] = []
         self.iterations = 0
@@ -143,7 +146,7 @@ class PCG:
         b = np.asarray(b, dtype=float)
         if b.ndim == 2:
             before = self.iterations
-            x = (self._in_two(b) if b.shape[1] > 1 and self.A.shape[0] >= SPLIT_UNKNOWNS and can_fork()
+            x = (self._in_two(b) if self.split and b.shape[1] > 1 and self.A.shape[0] >= SPLIT_UNKNOWNS and can_fork()
                  else self._columns(b))
             log.debug("AMG-CG: %d right-hand sides in %d iterations", b.shape[1], self.iterations - before)
             return x

@@ -223,19 +223,58 @@ class SPDSolver:
     start recycling the earlier solutions). :meth:`release` frees a factor (the 3-D frame's
     holds 0.81 GB): a run keeps the heat solvers, not this one, while it marches, and the
     next batch is planned again. AMG-CG is kept: its memory is a fraction of the matrix's and
-    its set-up costs as much as ten solves."""
+    its set-up costs as much as ten solves. :meth:`start` sets AMG-CG up in a helper process
+    (:class:`~gatetherm.solvers.helper.SolveHelper`) where the process may fork: then
+    :meth:`submit` returns at once, and the caller goes on while the helper solves."""
 
     def __init__(self, A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
-                 order: np.ndarray | None = None, nodal: bool = False, what: str = "elastic system"):
-        """``near_null``: the rigid-body modes; ``nodal``: the unknowns are whole nodes' ``dim``
+                 order: np.ndarray | Callable | None = None, nodal: bool = False, what: str = "elastic system"):
+        """``near_null``: the rigid-body modes; ``order``: a fill-reducing order (or a function
+        giving it, called when a factor is made); ``nodal``: the unknowns are whole nodes' ``dim``
         DOFs in turn (then AMG aggregates nodes)."""
         self.A, self.dim, self.near_null, self.order, self.what = A.tocsr(), dim, near_null, order, what
         self.block = dim if nodal else 1
         self._solve: Solve | None = None
+        self._helper = None
         self.path: str | None = None
         """The path of the live solver (None: released)."""
 
+    def start(self, rhs: int) -> bool:
+        """Plan for a first batch of ``rhs`` right-hand sides and, where that is AMG-CG and this
+        process may fork, set it up now in a helper process; whether it did."""
+        from gatetherm.process import can_fork
+        from gatetherm.solvers.helper import SolveHelper
+
+        if self._solve is not None or self._helper is not None or not can_fork():
+            return self._helper is not None
+        if os.environ.get(BACKEND_ENV) != "amg" or self.near_null is None:
+            p = plan(self.A.shape[0], self.A.nnz, self.dim, self.dim, rhs)
+            if p.path != "iterative":
+                return False
+            log.info("%s", p.describe(f"{self.what} ({self.A.shape[0]} unknowns)", rhs))
+        A, near_null, block = self.A, self.near_null, self.block  # the helper solves one column at a time:
+        self._helper = SolveHelper(lambda: PCG(A, near_null, block, RTOL, split=False), self.what)  # a core each
+        self.path = "iterative"
+        return True
+
+    @property
+    def background(self) -> bool:
+        """Whether :meth:`submit` solves in a helper process, beside the caller."""
+        return self._helper is not None and self._helper.owner == os.getpid()
+
+    def submit(self, b: np.ndarray):
+        """The solution of ``b`` (n,) or (n, k) as a :class:`~gatetherm.solvers.helper.Pending`:
+        made in the helper where there is one (:meth:`start`), else here and now."""
+        from gatetherm.solvers.helper import Pending
+
+        if self.background:
+            return self._helper.submit(b)
+        return Pending.of(self._here(b))
+
     def __call__(self, b: np.ndarray) -> np.ndarray:
+        return self.submit(b).result()
+
+    def _here(self, b: np.ndarray) -> np.ndarray:
         if self._solve is None:
             self._solve, self.path = self._make(1 if np.ndim(b) == 1 else np.shape(b)[1])
             if self.path == "iterative":  # kept for good (release() frees factors only): the modes are
@@ -247,12 +286,16 @@ class SPDSolver:
         allow = ("pardiso", "cholmod") + (("superlu",) if small else ())
         if os.environ.get(BACKEND_ENV) == "amg" and self.near_null is not None:
             return PCG(self.A, self.near_null, self.block, RTOL), "iterative"
-        return planned_solver(self.A, self.dim, rhs, self.what, self.dim, self.near_null, self.order, allow=allow,
+        order = self.order() if callable(self.order) else self.order
+        return planned_solver(self.A, self.dim, rhs, self.what, self.dim, self.near_null, order, allow=allow,
                               amg_block=self.block)
 
     def release(self) -> None:
         if self.path == "direct":
             self._solve, self.path = None, None
+
+    def __getstate__(self) -> dict:  # another process has no access to the helper
+        return {**self.__dict__, "_helper": None}
 
 
 def rigid_body_modes(doflocs: np.ndarray, components: list[np.ndarray]) -> np.ndarray:

@@ -27,6 +27,7 @@ from gatetherm.solvers.loads import Terms, mechanical_terms, unit_responses
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
 from gatetherm.solvers.heat import HeatSystem, assemble_heat, boundary_terms
+from gatetherm.solvers.helper import Pending
 from gatetherm.solvers.problem import AXES, Problem
 from gatetherm.solvers.stress import Recovery, recovery, von_mises
 
@@ -64,17 +65,22 @@ class Readout:
     keys: tuple[Key, ...]
     L: sp.csr_matrix
     """Rows on the whole state (temperatures, °C)."""
-    W: np.ndarray
-    """Rows on the solid's temperature rise (displacements in m, stresses in Pa)."""
+    weights: Pending
+    """:attr:`W`, solved beside the caller where the elastic solver runs in a helper process."""
     n_L: int
     """The first ``n_L`` keys are rows of ``L``, the rest rows of ``W``."""
     R: np.ndarray | None = None
     """Rows of ``W``'s outputs on the mechanical loads' values (None: no loads)."""
     terms: Terms | None = None
 
+    @property
+    def W(self) -> np.ndarray:
+        """Rows on the solid's temperature rise (displacements in m, stresses in Pa)."""
+        return self.weights.result()
+
     def __call__(self, U: np.ndarray, n_solid: int, T_ref: float, env=None) -> np.ndarray:
         y = self.L @ U
-        if not len(self.W):
+        if len(self.keys) == self.n_L:
             return y
         mech = self.R @ self.terms.at(env or {}) if self.R is not None else 0.0
         return np.concatenate([y, self.W @ (U[:n_solid] - T_ref) + mech])
@@ -95,7 +101,8 @@ class Model:
     config: object = None
     """What the problem was generated from, if anything (the frame's ModelConfig)."""
     timings: dict[str, float] = field(default_factory=dict, compare=False)
-    """Seconds spent building: mesh, heat_assembly, elastic_setup, adjoint_solves."""
+    """Seconds spent building: mesh, elastic_setup, heat_assembly, adjoint_solves (the read-out; its solves where
+    they are solved here)."""
     simplices: p1.Simplices | None = field(default=None, compare=False)
     """Linear elements: what all P1 matrices and factors on the mesh share."""
     terms: Terms | None = None
@@ -123,12 +130,17 @@ class Model:
     def displacement_field(self, U: np.ndarray, envs=None) -> np.ndarray:
         """Full displacement field (m) on the elastic basis: one elastic solve (``U`` (n, k): k
         fields), plus the mechanical loads' for the inputs ``envs`` (one, or k of them)."""
-        u = self.elastic.displacement(self.rise(U))
+        return self.displacement_later(U, envs).result()
+
+    def displacement_later(self, U: np.ndarray, envs=None) -> Pending:
+        """:meth:`displacement_field` as a :class:`~gatetherm.solvers.helper.Pending`: solved
+        beside the caller where the elastic solver runs in a helper process."""
+        u = self.elastic.later(self.elastic.B @ self.rise(U))
         if self.terms is None:
             return u
-        if np.ndim(U) == 1:
-            return u + self.loads_displacement(envs)
-        return u + np.column_stack([self.loads_displacement(e) for e in (envs or [None] * u.shape[1])])
+        loads = self.loads_displacement(envs) if np.ndim(U) == 1 else \
+            np.column_stack([self.loads_displacement(e) for e in (envs or [None] * np.shape(U)[1])])
+        return u.then(lambda x: x + loads)
 
     def stress_field(self, u: np.ndarray, U: np.ndarray | None = None,
                      rec: Recovery | None = None) -> dict[str, np.ndarray]:
@@ -255,9 +267,59 @@ def field_recovery(model: Model) -> Recovery:
     return _recovery_for(model, None)
 
 
-def _readout(model: Model) -> Readout:
-    """Sparse rows (temperatures) and adjoint weight rows (mechanics) of every output."""
-    p, heat, el = model.problem, model.heat, model.elastic
+@dataclass(frozen=True)
+class _Mechanical:
+    """The outputs of a displacement field: their keys, rows ``G`` on the displacement and
+    rows ``GT`` (or None) on the temperature rise (a stress's thermal part)."""
+
+    keys: list
+    G: list
+    GT: list
+
+
+def _mechanical(problem: Problem, mesh, fields, el: ElasticSystem, simplices) -> _Mechanical:
+    """The relative displacements, displacements and stresses at probes, as rows."""
+    keys, G, GT, recoveries = [], [], [], {}
+    xyz = {pr.name: pr.xyz for pr in problem.probes}
+    for r in problem.relative:
+        keys.append(("relative", r.name))
+        G.append(el.point_functional(xyz[r.a], r.axis) - el.point_functional(xyz[r.b], r.axis))
+        GT.append(None)
+    for pr in problem.probes:
+        if "u" in pr.quantities:
+            for c in range(problem.dim):
+                keys.append(("u", pr.name, AXES[c]))
+                G.append(el.point_functional(pr.xyz, c))
+                GT.append(None)
+        if "sigma" in pr.quantities:
+            if pr.region not in recoveries:
+                recoveries[pr.region] = recovery(mesh, problem.order, fields, problem.dim, problem.plane,
+                                                 element(problem.dim, problem.order), None if pr.region is None
+                                                 else mesh.subdomains[pr.region], None, simplices)
+            for c, (gu, gT) in recoveries[pr.region].point(pr.xyz).items():
+                keys.append(("sigma", pr.name, c))
+                G.append(gu)
+                GT.append(gT)
+    return _Mechanical(keys, G, GT)
+
+
+def _weights(el: ElasticSystem, mech: _Mechanical, n_T: int) -> Pending:
+    """The rows of :attr:`Readout.W`, from one adjoint solve of all outputs (beside the caller
+    where the elastic solver runs in a helper)."""
+    if not mech.G:
+        return Pending.of(np.zeros((0, n_T)))
+
+    def add_thermal(W):
+        for i, gT in enumerate(mech.GT):
+            if gT is not None:
+                W[i] += gT
+        return W
+    return el.weights_later(np.array(mech.G)).then(add_thermal)
+
+
+def _readout(model: Model, mech: _Mechanical, weights: Pending) -> Readout:
+    """Sparse rows (temperatures) and the adjoint weight rows ``weights`` (mechanics) of every output."""
+    p, heat = model.problem, model.heat
     keys, rows = [], []
     probes = [pr for pr in p.probes if "T" in pr.quantities]
     if probes:
@@ -272,37 +334,15 @@ def _readout(model: Model) -> Readout:
         w = boundary_mean(model.mesh, heat.basis, boundary, model.fields["thickness"])
         rows.append(sp.csr_matrix(np.r_[w, np.zeros(heat.n - heat.n_solid)][None, :]))
     L = sp.vstack(rows).tocsr() if rows else sp.csr_matrix((0, heat.n))
-    n_L = len(keys)
-    G, GT, recoveries = [], [], {}
-    if el is not None:
-        xyz = {pr.name: pr.xyz for pr in p.probes}
-        for r in p.relative:
-            keys.append(("relative", r.name))
-            G.append(el.point_functional(xyz[r.a], r.axis) - el.point_functional(xyz[r.b], r.axis))
-            GT.append(None)
-        for pr in p.probes:
-            if "u" in pr.quantities:
-                for c in range(model.dim):
-                    keys.append(("u", pr.name, AXES[c]))
-                    G.append(el.point_functional(pr.xyz, c))
-                    GT.append(None)
-            if "sigma" in pr.quantities:
-                if pr.region not in recoveries:
-                    recoveries[pr.region] = _probe_recovery(model, pr.region)
-                for c, (gu, gT) in recoveries[pr.region].point(pr.xyz).items():
-                    keys.append(("sigma", pr.name, c))
-                    G.append(gu)
-                    GT.append(gT)
-    W = el.weights(np.array(G)) if G else np.zeros((0, heat.n_solid))
-    for i, gT in enumerate(GT):
-        if gT is not None:
-            W[i] += gT
-    R = np.array(G) @ model.unit if G and model.terms is not None else None
-    return Readout(tuple(keys), L, W, n_L, R, model.terms)
+    R = np.array(mech.G) @ model.unit if mech.G and model.terms is not None else None
+    return Readout(tuple(keys + mech.keys), L, weights, len(keys), R, model.terms)
 
 
 def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float = 0.0) -> Model:
-    """Assemble ``problem`` on ``fmesh``."""
+    """Assemble ``problem`` on ``fmesh``. The elastic system first: where its solver runs in a
+    helper process (:meth:`~gatetherm.solvers.linsolve.SPDSolver.start`: AMG-CG on a large 3-D
+    mesh), its set-up and the adjoint read-out are made there while the heat system is
+    assembled and marched."""
     clock = [time.perf_counter()]
     timings = {"mesh": mesh_seconds}
 
@@ -317,20 +357,26 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
     f = region_fields(problem, mesh)
     s = p1.simplices(mesh) if problem.order == 1 else None
     axi = problem.axisymmetric
-    heat = assemble_heat(mesh, problem, f, 2 * problem.order + 1 if axi else None, s) if problem.heat else None
-    lap("heat_assembly")
-    el, terms, unit = None, None, None
+    el, terms, unit, weights = None, None, None, None
     if problem.elastic:
-        T_basis = heat.basis if heat is not None else dof_basis(mesh, element(problem.dim, problem.order))
+        T_basis = dof_basis(mesh, element(problem.dim, problem.order))  # the heat basis's DOFs
         el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
                               problem.supports, problem.plane, simplices=s, lines=fmesh.lines,
                               contacts=problem.contacts)
+        mech = _mechanical(problem, mesh, f, el, s) if problem.heat else None
+        if mech is not None:
+            el.solve.start(max(1, len(mech.G)))
         terms = mechanical_terms(problem, mesh, el.basis, f, fmesh.sensors, lambda sup, c: support_dofs(
             el.basis, mesh, sup.boundary, (c,), fmesh.lines))
         unit = unit_responses(el, terms) if terms is not None else None
+        if mech is not None:
+            weights = _weights(el, mech, T_basis.N)
     lap("elastic_setup")
+    heat = assemble_heat(mesh, problem, f, 2 * problem.order + 1 if axi else None, s) if problem.heat else None
+    lap("heat_assembly")
     model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s, terms, unit)
     if heat is not None:
-        model = dataclasses.replace(model, readout=_readout(model))
+        mech = mech if el is not None else _Mechanical([], [], [])
+        model = dataclasses.replace(model, readout=_readout(model, mech, weights or _weights(el, mech, heat.n_solid)))
     lap("adjoint_solves")
     return model

@@ -206,10 +206,7 @@ class Run:
 
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        every = fields_every or (self.case.time.fields if self.case.time else 1.0)
-        times = [float(t) for t in self.time]
-        fields = {t for t in times if abs(t / every - round(t / every)) < 1e-9} | {times[-1]}
-        fields &= set(self.kept)
+        fields = field_times(self.time, fields_every or _fields_every(self.case)) & set(self.kept)
         sched = self.scenario.schedule
         meta = {"source": "gatetherm", "case": self.case.source, "name": self.case.name, "dim": str(self.case.dim),
                 "schedule": sched.label, **({"condition": str(sched.condition)} if sched.condition else {})}
@@ -242,8 +239,19 @@ class Run:
 
 
 
+def field_times(times, every: float) -> set[float]:
+    """The sample times of the fields written every ``every`` s: its multiples, and the end."""
+    times = [float(t) for t in times]
+    return {t for t in times if abs(t / every - round(t / every)) < 1e-9} | {times[-1]}
+
+
+def _fields_every(case: Case) -> float:
+    return case.time.fields if case.time else 1.0
+
+
 def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
-        keep=None, on_step: Callable[[int, int], None] | None = None, check_order: bool = False) -> Run:
+        keep=None, on_step: Callable[[int, int], None] | None = None, check_order: bool = False,
+        fields_every: float | None = None) -> Run:
     """Run ``case``.
 
     Parameters
@@ -260,6 +268,10 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
         take less than :data:`STATE_BUDGET_BYTES`, else the case's field times and the end).
     on_step : callable, optional
         ``on_step(i, n)`` after each of the ``n`` samples.
+    fields_every : float, optional
+        The interval (s) of the fields :meth:`Run.write` will write (default: the case's): where
+        the elastic solver runs in a helper process (a large 3-D model), their displacements
+        are solved there during the march.
     check_order : bool
         A linear-element case on a small mesh: solve its final state once more with quadratic
         elements and warn (one log line naming the output and the fix) where they differ by more
@@ -272,13 +284,12 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
     t0 = _time.perf_counter()
     schedule = case.schedule if schedule is None else schedule
     times = [float(t) for t in schedule.times]
+    fields = field_times(times, fields_every or _fields_every(case))
     if keep is None:
         n = len(case.mesh.points) * case.problem.order ** case.dim
-        every = case.time.fields if case.time else 1.0
-        keep = times if len(times) * n * 8 <= STATE_BUDGET_BYTES else \
-            [t for t in times if abs(t / every - round(t / every)) < 1e-9] + [times[-1]]
+        keep = times if len(times) * n * 8 <= STATE_BUDGET_BYTES else fields
     scenario = run_scenario(case, schedule, effects, keep_times=sorted(set(map(float, keep)) | {times[-1]}),
-                            on_step=on_step)
+                            on_step=on_step, solve_at=fields)
     check = None
     if check_order:
         from gatetherm.studies.run.order_check import order_check

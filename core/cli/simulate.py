@@ -38,7 +38,7 @@ def run(args) -> int:
         every = max(args.fields_every, 1.0) * 60.0
         with output_dir(args.out, OUTPUTS, keep=(args.config, args.schedule)) as out:
             res = gt.run(case, schedule, effects, keep=picture_keep(schedule, every),
-                         on_step=Progress(f"condition {args.condition or 'file'}"))
+                         on_step=Progress(f"condition {args.condition or 'file'}"), fields_every=every)
             s = res.write(out, pictures=not args.no_pictures, fields_every=every, painter=painter)
     print(f"wrote {out}/timeseries.csv, summary.json, fields/ and plots")
     print("first peak {first_peak_um} µm at {first_peak_min} min, swing {swing_um} µm, wall time {w} s"

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
+from typing import Callable
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +11,7 @@ import numpy as np
 from gatetherm import atomic_path, write_text_atomic
 from gatetherm.geometry.mesh import to_meshio
 from gatetherm.geometry.vtu import write_vtu
+from gatetherm.solvers.helper import Pending
 from gatetherm.solvers.model import Model, field_recovery, static_fields
 
 
@@ -34,30 +37,65 @@ def nodal_fields(model: Model, U: np.ndarray | None, rec=None, stress: bool = Tr
     return out
 
 
-def displacements(model: Model, states, envs=None) -> dict[float, np.ndarray]:
+class Solved(Mapping):
+    """Displacement DOFs by time, each solved (or waited for) when first looked up."""
+
+    def __init__(self, pending: dict):
+        self._pending = pending
+
+    def __getitem__(self, t: float) -> np.ndarray:
+        return self._pending[t].result()
+
+    def __iter__(self):
+        return iter(self._pending)
+
+    def __len__(self) -> int:
+        return len(self._pending)
+
+    def __contains__(self, t) -> bool:  # not Mapping's: it looks the value up
+        return t in self._pending
+
+    def ready(self, t: float) -> bool:
+        """Whether the displacement at ``t`` is in (looking it up does not wait)."""
+        return self._pending[t].done()
+
+
+def displacements(model: Model, states, envs=None, ahead=None) -> Solved:
     """The displacement DOFs of the heat states ``[(t, U)]`` by time (with the loads for
-    the inputs ``envs`` by time), in one elastic solve,
-    after which the elastic factor is released: the writers and pictures that follow need
-    memory of their own (in 3-D the factor holds 0.86 GB)."""
+    the inputs ``envs`` by time): those of ``ahead`` (by time, :class:`~gatetherm.solvers.helper.Pending`:
+    solved during the march) as they come, the others in one elastic solve, or, where the
+    elastic solver runs in a helper, one solve each in their order, looked up as they come.
+    A factor is released after its solve: the writers and pictures that follow need memory of
+    their own (in 3-D a factor holds 0.86 GB)."""
     if model.elastic is None or model.heat is None or not states:
-        return {}
-    u = model.displacement_field(np.column_stack([U for _, U in states]), [(envs or {}).get(t) for t, _ in states])
-    model.elastic.solve.release()
-    return {t: u[:, k] for k, (t, _) in enumerate(states)}
+        return Solved({})
+    ahead, envs = ahead or {}, envs or {}
+    out = {t: ahead[t] for t, _ in states if t in ahead}
+    rest = [(t, U) for t, U in states if t not in ahead]
+    if model.elastic.solve.background:
+        out.update({t: model.displacement_later(U, envs.get(t)) for t, U in rest})
+    elif rest:
+        u = model.displacement_field(np.column_stack([U for _, U in rest]), [envs.get(t) for t, _ in rest])
+        model.elastic.solve.release()
+        out.update({t: Pending.of(u[:, k]) for k, (t, _) in enumerate(rest)})
+    return Solved(out)
 
 
 def write_fields(model: Model, states, out: Path, solved: dict[float, np.ndarray] | None = None,
-                 envs=None) -> list[Path]:
+                 envs=None, between: Callable[[], None] | None = None) -> list[Path]:
     """One ``.vtu`` per saved state (point arrays of :func:`nodal_fields`) with a
     ``fields.pvd`` collection, and the same as one XDMF time series, ``fields.xdmf`` with
     ``fields.h5`` (one mesh, every step): ParaView opens either as one animated data set.
-    ``solved``: their :func:`displacements`, if found already; ``envs``: the inputs by time."""
+    ``solved``: their :func:`displacements`, if found already; ``envs``: the inputs by time;
+    ``between``: called before each state is written."""
     out.mkdir(parents=True, exist_ok=True)
     written, entries, steps = [], [], []
     minutes = all(abs(t / 60 - round(t / 60)) < 1e-9 for t, _ in states)
     solved = displacements(model, states, envs) if solved is None else solved
     rec = field_recovery(model) if solved else None
     for k, (t, U) in enumerate(states):
+        if between is not None:
+            between()
         name = f"fields_{int(round(t / 60)):04d}min.vtu" if minutes else f"fields_{k:04d}.vtu"
         data = nodal_fields(model, U, rec, u_dofs=solved.get(t), env=(envs or {}).get(t))
         with atomic_path(out / name) as tmp:
@@ -137,21 +175,29 @@ def nearest_state(run, t: float) -> tuple[float, np.ndarray]:
 
 
 def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_times=(),
-              solved_hook=None) -> dict[float, np.ndarray]:
+              solved_hook=None) -> Solved:
     """``out/timeseries.csv`` (what the sensors report) and the fields at ``field_times``
     (``out/fields``) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`; returns the
-    :func:`displacements` of those states and of the states nearest ``picture_times``, which
-    ``solved_hook`` (if given) is called with before the fields are written."""
+    :func:`displacements` of those states and of the states nearest ``picture_times`` (those
+    first), which ``solved_hook`` (if given) is called with as soon as those of the picture
+    states are in: before the fields are written, or while they are (a helper process solves)."""
     from gatetherm.studies.run.timeseries import FORMAT, write_timeseries
 
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
     states = [(t, U) for t, U in run.result.states if t in field_times]
     extra = {t: U for t, U in (nearest_state(run, tp) for tp in picture_times) if t not in field_times}
     envs = run.result.envs
-    solved = displacements(run.model, states + list(extra.items()), envs)
-    if solved_hook is not None:
-        solved_hook(solved)
-    write_fields(run.model, states, out / "fields", solved, envs)
+    solved = displacements(run.model, list(extra.items()) + states, envs, run.result.solved)
+    pictured = [nearest_state(run, tp)[0] for tp in picture_times]
+    hook = [solved_hook] if solved_hook is not None else []
+
+    def between():
+        if hook and all(solved.ready(t) for t in pictured if t in solved):
+            hook.pop()(solved)
+    between()
+    write_fields(run.model, states, out / "fields", solved, envs, between)
+    if hook:
+        hook.pop()(solved)
     return solved
 
 

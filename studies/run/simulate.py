@@ -36,6 +36,9 @@ class RunResult:
     envs: dict[float, dict] = field(default_factory=dict)
     """The inputs (``t`` and the drive's) at the times of :attr:`states`: the mechanical
     loads' values there."""
+    solved: dict[float, object] = field(default_factory=dict)
+    """The displacement fields of states solved during the march, by time
+    (:class:`~gatetherm.solvers.helper.Pending`)."""
 
 
 def sample_times(duration_s: float, step_s: float = 60.0) -> np.ndarray:
@@ -106,33 +109,54 @@ def check_temperatures(U: np.ndarray, t: float) -> None:
 
 def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
-              U0: np.ndarray | None = None, solver: HeatSolver | None = None) -> RunResult:
+              U0: np.ndarray | None = None, solver: HeatSolver | None = None, solve_at=()) -> RunResult:
     """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0)
     with ``scheme`` (default: the problem's); keep full states at ``keep_times``. A
-    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs.
+    ``solver`` of ``model.heat`` carries its factorisations over from earlier runs. Where the
+    elastic solver runs in a helper process, the steps are read out once its adjoint weights
+    are in (the states kept till then), and the displacement fields of the kept states at
+    ``solve_at`` but the last are solved there during the march (:attr:`RunResult.solved`).
     Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
-    inputs, Y, states, envs = [], [], [], {}
+    inputs, Y, states, envs, waiting, solved = [], [], [], {}, [], {}
     t0 = _time.perf_counter()
     scheme = model.problem.scheme if scheme is None else scheme
+    ahead = set()
     if model.elastic is not None:  # outputs come from adjoint weights: room for the heat factors
         model.elastic.solve.release()
+        # not the last sample's: a caller's first wish after the march may be another (a picture's)
+        ahead = ({float(t) for t in solve_at} & keep) - {float(times[-1])} if model.elastic.solve.background else set()
+    weights = model.readout.weights
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
         env = environment(drive, t)
         check_temperatures(U, t)
         inputs.append({"time_s": t, **drive(t)})
-        Y.append(model.read(U, env))
         if t in keep:
-            states.append((t, U.copy()))
+            U = U.copy()
+            states.append((t, U))
             envs[t] = env
+        if waiting and weights.done():
+            for k, Uk, ek in waiting:
+                Y[k] = model.read(Uk, ek)
+            waiting = []
+        if waiting or not weights.done():
+            waiting.append((i, U if t in keep else U.copy(), env))
+            Y.append(None)
+        else:
+            Y.append(model.read(U, env))
+        if t in ahead:
+            solved[t] = model.displacement_later(U, env)
         if on_step:
             on_step(i + 1, len(times))
+    for k, Uk, ek in waiting:
+        Y[k] = model.read(Uk, ek)
     cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
     cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
     secs = _time.perf_counter() - t0
-    log.info("marched %d steps in %.2f s", len(Y) - 1, secs)
-    return RunResult(cols, states, secs, envs)
+    log.info("marched %d steps in %.2f s%s", len(Y) - 1, secs,
+             f" ({len(ahead)} displacement fields solved beside)" if ahead else "")
+    return RunResult(cols, states, secs, envs, solved)
 
 
 def prominent_peaks(x: np.ndarray, prominence: float) -> list[int]:

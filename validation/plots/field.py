@@ -79,7 +79,7 @@ def frame_image(img: np.ndarray, clim, label: str, title: str, ax=None):
     from matplotlib.colors import Normalize
 
     ax = figure((7.5, 6.0)) if ax is None else ax
-    ax.imshow(img, interpolation="lanczos")
+    ax.imshow(img, interpolation="antialiased")  # lanczos: 0.46 s against 0.19 s in savefig (3-D deformed)
     ax.set_axis_off()
     _colour_bar(ax, ScalarMappable(Normalize(*clim), CMAP), label)
     ax.set_title(title, fontsize="medium")

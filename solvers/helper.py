@@ -1,0 +1,208 @@
+"""A solver set up and run in a helper process beside the caller, and values still being made.
+
+:class:`SolveHelper` forks a process that makes a solver (an AMG hierarchy: seconds of set-up)
+and then solves each right-hand side it is given, in turn, while the caller goes on: on the
+3-D frame the elastic hierarchy, the adjoint read-out and the fields at the output times are
+solved on the second core while the first marches the heat equation
+(``benchmarks/peer.py``). :meth:`SolveHelper.submit` returns a :class:`Pending`, whose
+:meth:`~Pending.result` waits for the solution.
+
+The arrays go through files in a private temporary folder (``/dev/shm`` where there is one),
+the pipes carry only their names: neither side ever waits on the other to read a large
+message. The helper ends when the caller closes it (or is collected), and with the caller
+(``PR_SET_PDEATHSIG``). A solve that fails in the helper raises
+:class:`~gatetherm.solvers.iterative.SolverError` in the caller; so does a helper that ended
+(killed: out of memory?).
+"""
+from __future__ import annotations
+
+import logging
+import os
+import pickle
+import select
+import shutil
+import signal
+import struct
+import tempfile
+import threading
+import time
+import weakref
+from typing import Any, Callable
+
+import numpy as np
+
+from gatetherm.process import die_with_parent
+from gatetherm.solvers.iterative import SolverError
+
+log = logging.getLogger(__name__)
+
+
+class Pending:
+    """A value being made elsewhere: :meth:`result` waits for it (once), :meth:`done` asks."""
+
+    def __init__(self, wait: Callable[[], Any], poll: Callable[[], bool] = lambda: True):
+        self._wait, self._poll, self._value, self._has = wait, poll, None, False
+
+    @classmethod
+    def of(cls, value) -> "Pending":
+        """A value made already."""
+        p = cls(lambda: value)
+        p._value, p._has = value, True
+        return p
+
+    def done(self) -> bool:
+        return self._has or self._poll()
+
+    def result(self):
+        if not self._has:
+            self._value, self._has = self._wait(), True
+            self._wait = self._poll = None
+        return self._value
+
+    def then(self, f: Callable[[Any], Any]) -> "Pending":
+        """The pending ``f(value)``."""
+        return Pending(lambda: f(self.result()), self.done)
+
+    def __reduce__(self):  # pickled (to another process) as the value itself
+        return _identity, (self.result(),)
+
+
+def _identity(value):
+    return value
+
+
+def _send(fd: int, obj) -> None:
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    view = memoryview(struct.pack("<I", len(data)) + data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _receive(fd: int):
+    """The next message on ``fd``, or None at its end."""
+    head = _read(fd, 4)
+    body = None if head is None else _read(fd, struct.unpack("<I", head)[0])
+    return None if body is None else pickle.loads(body)
+
+
+def _read(fd: int, n: int) -> bytes | None:
+    buf = bytearray()
+    while len(buf) < n:
+        chunk = os.read(fd, n - len(buf))
+        if not chunk:
+            return None
+        buf += chunk
+    return bytes(buf)
+
+
+def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
+    """The helper's life: make the solver, then answer each job ``(k, path of b)`` with
+    ``(k, path of x, None)`` or ``(k, None, error text)``."""
+    try:
+        t0 = time.perf_counter()
+        solve, error = make(), None
+        log.debug("helper: solver made in %.2f s", time.perf_counter() - t0)
+    except Exception as err:  # noqa: BLE001 - reported with every job
+        solve, error = None, f"{type(err).__name__}: {err}"
+    while (job := _receive(jobs)) is not None:
+        k, path = job
+        reply = (k, None, error)
+        if solve is not None:
+            try:
+                t0 = time.perf_counter()
+                x = solve(np.load(path))
+                log.debug("helper: job %d (%d right-hand sides) in %.2f s", k, x.shape[1] if x.ndim == 2 else 1,
+                          time.perf_counter() - t0)
+                np.save(path := path.replace(".b.npy", ".x.npy"), x)
+                reply = (k, path, None)
+            except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
+                reply = (k, None, f"{type(err).__name__}: {err}")
+        _send(replies, reply)
+
+
+class SolveHelper:
+    """A process beside the caller that makes a solver with ``make()`` (at once) and solves
+    what :meth:`submit` gives it, in turn. The caller must be able to fork
+    (:func:`gatetherm.process.can_fork`)."""
+
+    def __init__(self, make: Callable[[], Callable[[np.ndarray], np.ndarray]], what: str = "solver"):
+        self.what = what
+        self._dir = tempfile.mkdtemp(prefix="gatetherm-", dir="/dev/shm" if os.path.isdir("/dev/shm") else None)
+        if threading.current_thread() is threading.main_thread():  # Python's own setting (gmsh's start undoes
+            signal.signal(signal.SIGPIPE, signal.SIG_IGN)  # it): a job sent to an ended helper raises, no signal
+        (jobs_r, jobs_w), (replies_r, replies_w) = os.pipe(), os.pipe()
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child's coverage is not collected
+            code = 1
+            try:
+                _close_others((jobs_r, replies_w))  # the caller's other pipes: their readers see their end
+                die_with_parent(signal.SIGKILL)
+                signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller ends the helper
+                _serve(make, jobs_r, replies_w)
+                code = 0
+            finally:
+                os._exit(code)
+        os.close(jobs_r)
+        os.close(replies_w)
+        self.pid, self.owner = pid, os.getpid()
+        self._jobs, self._replies = jobs_w, replies_r
+        self._next, self._answers = 0, {}
+        self._finalize = weakref.finalize(self, _close, self.owner, pid, jobs_w, replies_r, self._dir)
+        log.debug("%s: set up in helper process %d", what, pid)
+
+    def submit(self, b: np.ndarray) -> Pending:
+        """Solve ``b`` (n,) or (n, k) in the helper, after what it was given before."""
+        if not self._finalize.alive:
+            raise SolverError(f"{self.what}: the helper process is closed")
+        k, self._next = self._next, self._next + 1
+        path = os.path.join(self._dir, f"{k}.b.npy")
+        np.save(path, np.asarray(b, dtype=float))
+        try:
+            _send(self._jobs, (k, path))
+        except BrokenPipeError:
+            raise SolverError(f"{self.what}: the helper process ended without its solutions") from None
+        return Pending(lambda: self._wait(k), lambda: self._collect(k, block=False))
+
+    def _collect(self, k: int, block: bool) -> bool:
+        """Read the answers that have come (waiting for one if ``block``); whether ``k``'s is in."""
+        while k not in self._answers and select.select([self._replies], [], [], None if block else 0)[0]:
+            reply = _receive(self._replies)
+            if reply is None:
+                raise SolverError(f"{self.what}: the helper process ended without its solutions")
+            j, path, error = reply
+            self._answers[j] = SolverError(f"{self.what}: {error}") if error else np.load(path)
+            if path:
+                os.unlink(path)
+        return k in self._answers
+
+    def _wait(self, k: int) -> np.ndarray:
+        self._collect(k, block=True)
+        x = self._answers.pop(k)
+        if isinstance(x, SolverError):
+            raise x
+        return x
+
+    def close(self) -> None:
+        """End the helper (at once: nothing it holds outlives it but its folder, removed here)."""
+        self._finalize()
+
+
+def _close_others(keep) -> None:
+    """Close every file descriptor from 3 on but ``keep``."""
+    low = 3
+    for fd in sorted(keep):
+        os.closerange(low, fd)
+        low = fd + 1
+    os.closerange(low, os.sysconf("SC_OPEN_MAX") if hasattr(os, "sysconf") else 4096)
+
+
+def _close(owner: int, pid: int, jobs: int, replies: int, folder: str) -> None:
+    if os.getpid() == owner:  # not in a forked copy of the owner
+        for fd in (jobs, replies):
+            os.close(fd)
+        try:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+        except (ProcessLookupError, ChildProcessError):  # ended and reaped already
+            pass
+        shutil.rmtree(folder, ignore_errors=True)

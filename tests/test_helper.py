@@ -1,0 +1,113 @@
+"""The elastic solver in a helper process beside the caller: the helper's solutions are the
+factor's, several in flight come back each to its own, a failure (of a solve, of the set-up,
+of the process) is raised in the caller, the helper holds none of the caller's other pipes
+open, and a run with the helper gives the outputs and fields of a run without it."""
+from __future__ import annotations
+
+import os
+import pickle
+import select
+import signal
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from gatetherm import process
+from gatetherm.solvers import plan
+from gatetherm.solvers.frame import build_model
+from gatetherm.solvers.helper import Pending, SolveHelper
+from gatetherm.solvers.iterative import PCG, SolverError
+from gatetherm.solvers.linsolve import spd_factor
+from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+from gatetherm.studies.run.output import displacements
+from gatetherm.studies.run.simulate import run_model, sample_times
+
+from conftest import FIXED_MODEL
+
+
+def _laplacian(n: int = 40) -> sp.csr_matrix:
+    """The 5-point Laplacian of an n × n grid plus the identity (SPD)."""
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    return (sp.kronsum(T, T) + sp.identity(n * n)).tocsr()
+
+
+def test_helper_solutions_are_the_factors_each_to_its_own_submission():
+    A = _laplacian()
+    rng = np.random.default_rng(0)
+    bs = [rng.normal(size=A.shape[0]), rng.normal(size=(A.shape[0], 3)), rng.normal(size=A.shape[0])]
+    helper = SolveHelper(lambda: PCG(A, rtol=1e-12, split=False), "test system")
+    try:
+        pending = [helper.submit(b) for b in bs]  # all in flight, then looked up last first
+        xs = [p.result() for p in reversed(pending)][::-1]
+        assert helper.pid != os.getpid() and all(p.done() for p in pending)
+    finally:
+        helper.close()
+    ref = spd_factor(A)[0]
+    for b, x in zip(bs, xs):
+        assert x.shape == b.shape and np.abs(x - ref(b)).max() < 1e-9 * np.abs(ref(b)).max()
+    with pytest.raises(SolverError, match="closed"):
+        helper.submit(bs[0])
+
+
+def test_a_failure_in_the_helper_is_raised_in_the_caller():
+    A = _laplacian(10)
+    b = np.ones(A.shape[0])
+
+    def failing():
+        raise ValueError("no such matrix")
+    bad = SolveHelper(failing, "set-up")
+    solver = SolveHelper(lambda: PCG(A, rtol=1e-12, split=False, recycle=0), "solve")
+    try:
+        with pytest.raises(SolverError, match="set-up: ValueError: no such matrix"):
+            bad.submit(b).result()
+        first = solver.submit(b).result()  # made and working
+        assert np.abs(A @ first - b).max() < 1e-10
+        os.kill(solver.pid, signal.SIGKILL)
+        os.waitpid(solver.pid, 0)
+        with pytest.raises(SolverError, match="ended without its solutions"):
+            solver.submit(2 * b).result()
+    finally:
+        bad.close()
+        solver.close()
+
+
+def test_the_helper_holds_none_of_the_callers_pipes_open():
+    """A pipe the caller opened before the helper and then closed its writing end of: its
+    reader sees the end at once (the painter's processes end so), the helper alive."""
+    r, w = os.pipe()
+    helper = SolveHelper(lambda: (lambda b: b), "identity")
+    try:
+        os.close(w)
+        assert select.select([r], [], [], 2.0)[0] and os.read(r, 1) == b""
+        assert np.array_equal(helper.submit(np.arange(3.0)).result(), np.arange(3.0))
+    finally:
+        os.close(r)
+        helper.close()
+
+
+def test_a_pending_value_pickles_as_the_value_and_maps():
+    p = Pending(lambda: np.arange(4.0)).then(lambda x: 2 * x)
+    assert np.array_equal(pickle.loads(pickle.dumps(p)), [0.0, 2.0, 4.0, 6.0])
+    assert Pending.of(3).done() and Pending.of(3).then(str).result() == "3"
+
+
+def test_a_run_with_the_elastic_helper_gives_the_outputs_and_fields_of_one_without(frame_3d, monkeypatch):
+    """An hour of condition 1 on the coarse 3-D frame on the iterative path, with the elastic
+    solver in a helper (its read-out waited for, the 30-min field solved during the march) and
+    in the process: δ agrees to 1e-9 µm, the fields to 1e-8 of their size."""
+    monkeypatch.setenv(plan.PATH_ENV, "iterative")
+    times, drive = sample_times(3600.0), condition_drive(CONDITIONS[1], SupplyParams())
+    keep = (0.0, 1800.0, 3600.0)
+    out = {}
+    for beside in (True, False):
+        monkeypatch.setattr(process, "can_fork", lambda: beside)  # whatever threads earlier tests left
+        model = build_model(FIXED_MODEL, 3, frame_3d)
+        assert model.elastic.solve.background is beside
+        res = run_model(model, drive, times, keep, solve_at=keep)
+        assert sorted(res.solved) == ([0.0, 1800.0] if beside else [])  # not the last sample's
+        u = displacements(model, res.states, res.envs, res.solved)
+        out[beside] = res.columns["delta_um"], np.column_stack([u[t] for t in keep])
+    d = np.abs(out[True][0] - out[False][0]).max()
+    du = np.abs(out[True][1] - out[False][1]).max() / np.abs(out[False][1]).max()
+    assert d < 1e-9 and du < 1e-8, (d, du)
