@@ -10,7 +10,7 @@ solved on the second core while the first marches the heat equation
 The arrays go through files in a private temporary folder (``/dev/shm`` where there is one),
 the pipes carry only their names: neither side ever waits on the other to read a large
 message. The helper ends when the caller closes it (or is collected), and with the caller
-(``PR_SET_PDEATHSIG``). A solve that fails in the helper raises
+(``PR_SET_PDEATHSIG``), the folder with it. A solve that fails in the helper raises
 :class:`~gatetherm.solvers.iterative.SolverError` in the caller; so does a helper that ended
 (killed: out of memory?).
 """
@@ -35,6 +35,8 @@ from gatetherm.process import die_with_parent
 from gatetherm.solvers.iterative import SolverError
 
 log = logging.getLogger(__name__)
+
+ENDED = "the helper process ended without its solutions"
 
 
 class Pending:
@@ -110,7 +112,9 @@ def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
         if solve is not None:
             try:
                 t0 = time.perf_counter()
-                x = solve(np.load(path))
+                b = np.load(path)
+                os.unlink(path)
+                x = solve(b)
                 log.debug("helper: job %d (%d right-hand sides) in %.2f s", k, x.shape[1] if x.ndim == 2 else 1,
                           time.perf_counter() - t0)
                 np.save(path := path.replace(".b.npy", ".x.npy"), x)
@@ -136,11 +140,13 @@ class SolveHelper:
             code = 1
             try:
                 _close_others((jobs_r, replies_w))  # the caller's other pipes: their readers see their end
-                die_with_parent(signal.SIGKILL)
+                signal.signal(signal.SIGTERM, _stop)
                 signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller ends the helper
+                die_with_parent(signal.SIGTERM)  # and its folder goes with it
                 _serve(make, jobs_r, replies_w)
                 code = 0
             finally:
+                shutil.rmtree(self._dir, ignore_errors=True)
                 os._exit(code)
         os.close(jobs_r)
         os.close(replies_w)
@@ -160,7 +166,7 @@ class SolveHelper:
         try:
             _send(self._jobs, (k, path))
         except BrokenPipeError:
-            raise SolverError(f"{self.what}: the helper process ended without its solutions") from None
+            raise SolverError(f"{self.what}: {ENDED}") from None
         return Pending(lambda: self._wait(k), lambda: self._collect(k, block=False))
 
     def _collect(self, k: int, block: bool) -> bool:
@@ -168,7 +174,7 @@ class SolveHelper:
         while k not in self._answers and select.select([self._replies], [], [], None if block else 0)[0]:
             reply = _receive(self._replies)
             if reply is None:
-                raise SolverError(f"{self.what}: the helper process ended without its solutions")
+                raise SolverError(f"{self.what}: {ENDED}")
             j, path, error = reply
             self._answers[j] = SolverError(f"{self.what}: {error}") if error else np.load(path)
             if path:
@@ -185,6 +191,10 @@ class SolveHelper:
     def close(self) -> None:
         """End the helper (at once: nothing it holds outlives it but its folder, removed here)."""
         self._finalize()
+
+
+def _stop(*_) -> None:
+    raise SystemExit(1)
 
 
 def _close_others(keep) -> None:

@@ -268,7 +268,7 @@ def field_recovery(model: Model) -> Recovery:
 
 
 @dataclass(frozen=True)
-class _Mechanical:
+class _Rows:
     """The outputs of a displacement field: their keys, rows ``G`` on the displacement and
     rows ``GT`` (or None) on the temperature rise (a stress's thermal part)."""
 
@@ -277,7 +277,7 @@ class _Mechanical:
     GT: list
 
 
-def _mechanical(problem: Problem, mesh, fields, el: ElasticSystem, simplices) -> _Mechanical:
+def _mechanical_rows(problem: Problem, mesh, fields, el: ElasticSystem, simplices) -> _Rows:
     """The relative displacements, displacements and stresses at probes, as rows."""
     keys, G, GT, recoveries = [], [], [], {}
     xyz = {pr.name: pr.xyz for pr in problem.probes}
@@ -300,10 +300,10 @@ def _mechanical(problem: Problem, mesh, fields, el: ElasticSystem, simplices) ->
                 keys.append(("sigma", pr.name, c))
                 G.append(gu)
                 GT.append(gT)
-    return _Mechanical(keys, G, GT)
+    return _Rows(keys, G, GT)
 
 
-def _weights(el: ElasticSystem, mech: _Mechanical, n_T: int) -> Pending:
+def _weights(el: ElasticSystem, mech: _Rows, n_T: int) -> Pending:
     """The rows of :attr:`Readout.W`, from one adjoint solve of all outputs (beside the caller
     where the elastic solver runs in a helper)."""
     if not mech.G:
@@ -317,7 +317,7 @@ def _weights(el: ElasticSystem, mech: _Mechanical, n_T: int) -> Pending:
     return el.weights_later(np.array(mech.G)).then(add_thermal)
 
 
-def _readout(model: Model, mech: _Mechanical, weights: Pending) -> Readout:
+def _readout(model: Model, mech: _Rows, weights: Pending) -> Readout:
     """Sparse rows (temperatures) and the adjoint weight rows ``weights`` (mechanics) of every output."""
     p, heat = model.problem, model.heat
     keys, rows = [], []
@@ -363,7 +363,7 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
         el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
                               problem.supports, problem.plane, simplices=s, lines=fmesh.lines,
                               contacts=problem.contacts)
-        mech = _mechanical(problem, mesh, f, el, s) if problem.heat else None
+        mech = _mechanical_rows(problem, mesh, f, el, s) if problem.heat else None
         if mech is not None:
             el.solve.start(max(1, len(mech.G)))
         terms = mechanical_terms(problem, mesh, el.basis, f, fmesh.sensors, lambda sup, c: support_dofs(
@@ -376,7 +376,7 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
     lap("heat_assembly")
     model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s, terms, unit)
     if heat is not None:
-        mech = mech if el is not None else _Mechanical([], [], [])
+        mech = mech if el is not None else _Rows([], [], [])
         model = dataclasses.replace(model, readout=_readout(model, mech, weights or _weights(el, mech, heat.n_solid)))
     lap("adjoint_solves")
     return model

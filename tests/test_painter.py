@@ -145,7 +145,8 @@ def test_painter_0_draws_at_once(tmp_path):
 
 def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
     """``prepare(work)`` is called by the process the next picture goes to, before it draws it,
-    and answers nothing; a failing one does not stop the picture. ``Painter(0)`` ignores it."""
+    and answers nothing; a failing one does not stop the picture; the same work is handed once.
+    ``Painter(0)`` ignores it."""
     out = fresh("""
         def ready(path):
             with open(path, "w") as f:
@@ -154,10 +155,16 @@ def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
         def failing():
             raise RuntimeError("not ready")
 
+        def mark():
+            with open(os.path.join({tmp}, "marks"), "a") as f:
+                f.write("x")
+
         cols = {{"time_s": np.array([0.0, 60.0]), "a_degC": np.array([20.0, 21.0])}}
         with gt.plot.Painter(2) as painter:
             import functools
             painter.prepare(failing)
+            painter.prepare(mark)
+            painter.prepare(mark)
             painter.prepare(functools.partial(ready, os.path.join({tmp}, "ready")))
             painter.draw(plot_channels, cols, path=os.path.join({tmp}, "first.png"))
             painter.draw(plot_channels, cols, path=os.path.join({tmp}, "second.png"))
@@ -166,7 +173,8 @@ def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
             here.prepare(functools.partial(ready, os.path.join({tmp}, "here")))
         print(json.dumps({{"caller": os.getpid(), "ready": int(open(os.path.join({tmp}, "ready")).read()),
                            "ready_s": os.path.getmtime(os.path.join({tmp}, "ready")),
-                           "first_s": os.path.getmtime(os.path.join({tmp}, "first.png"))}}))
+                           "first_s": os.path.getmtime(os.path.join({tmp}, "first.png")),
+                           "marks": open(os.path.join({tmp}, "marks")).read()}}))
         """, tmp=str(tmp_path))
-    assert out["ready"] != out["caller"] and out["ready_s"] <= out["first_s"]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "ready", "second.png"]  # not "here"
+    assert out["ready"] != out["caller"] and out["ready_s"] <= out["first_s"] and out["marks"] == "x"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "marks", "ready", "second.png"]  # no "here"

@@ -211,15 +211,19 @@ class Run:
         meta = {"source": "gatetherm", "case": self.case.source, "name": self.case.name, "dim": str(self.case.dim),
                 "schedule": sched.label, **({"condition": str(sched.condition)} if sched.condition else {})}
         picture = self._picture_time()
-        if pictures and painter is not None and picture is not None:
-            from gatetherm.validation.plots.run import prepare_pictures
+        later = None
+        if pictures and painter is not None:  # the plots of the columns at once, the deformed one later
+            from gatetherm.validation.plots.run import prepare_pictures, write_pictures
 
-            prepare_pictures(self.scenario, painter)  # while the fields are solved
+            if picture is not None:
+                prepare_pictures(self.scenario, painter)  # while the fields are solved (if not done before)
+            later = ("deformed.png",)
+            write_pictures(self.scenario, out, self.case.name, None, painter=painter)
 
         def draw(solved):
             from gatetherm.validation.plots.run import write_pictures
 
-            write_pictures(self.scenario, out, self.case.name, picture, solved, painter=painter)
+            write_pictures(self.scenario, out, self.case.name, picture, solved, painter=painter, only=later)
 
         write_run(out, self.scenario, meta, fields, (picture,) if pictures and picture is not None else (),
                   draw if pictures else None)

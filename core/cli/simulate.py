@@ -30,9 +30,11 @@ def run(args) -> int:
     import gatetherm as gt
     from gatetherm.outdir import output_dir
     from gatetherm.solvers.effects import parse_effect
+    from gatetherm.validation.plots.run import prepare_pictures
 
     with gt.plot.Painter(0 if args.no_pictures else 2) as painter:  # before the work it overlaps
         case = gt.gate_frame(args.dim, args.config, args.condition or 1)
+        prepare_pictures(case, painter)  # the 3-D picture's renderer, while the model is built
         effects = dict(parse_effect(s, case.targets) for s in args.effect)  # on top of the model file's
         schedule = gt.schedule_file(args.schedule, case) if args.schedule else case.schedule
         every = max(args.fields_every, 1.0) * 60.0

@@ -140,7 +140,7 @@ class Painter:
         self._queued: list[list[Path]] = []  # the pictures each is given and has not answered
         self._outbox: list[bytearray] = []  # what is not yet written to each one's pipe
         self._lock, self._writer, self._closing = threading.Lock(), None, False
-        self._pid = None
+        self._pid, self._prepared = None, set()
         if workers > 0 and _can_fork():
             self._start(min(workers, 2))
         log.debug("pictures drawn by %d processes", self.workers)
@@ -203,8 +203,9 @@ class Painter:
     def prepare(self, work) -> None:
         """Have the process that draws the next picture call ``work()`` (picklable) meanwhile:
         what that picture needs made ready (an import, a first small rendering) while the caller
-        computes. Without processes nothing is done."""
-        if self._pipes:
+        computes (once: the same ``work`` again is not handed). Without processes nothing is done."""
+        if self._pipes and work not in self._prepared:
+            self._prepared.add(work)
             self._hand((work, (), {}, None, False))
 
     def _hand(self, job) -> None:

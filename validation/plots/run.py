@@ -114,23 +114,25 @@ temperatures, beside it (``docs/performance.md``, "The 2-D default condition")."
 
 
 def prepare_pictures(run, painter) -> None:
-    """What the pictures of ``run`` need made ready in ``painter``'s process before
+    """What the pictures of ``run`` (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`, or
+    the case it will run: made ready the sooner) need made ready in ``painter``'s process before
     :func:`write_pictures` gives them: the renderer of a 3-D body's deformed picture."""
     from gatetherm.validation.plots.field import warm_surface
 
-    if run.model.elastic is not None and run.model.dim == 3:
+    problem = run.model.problem if hasattr(run, "model") else run.problem
+    if problem.elastic and problem.dim == 3:
         painter.prepare(warm_surface)
 
 
 def write_pictures(run, out, title: str, picture_s: float | None, solved: dict | None = None,
-                   caption=None, painter=None) -> list[str]:
+                   caption=None, painter=None, only=None) -> list[str]:
     """The pictures of a run (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`) into ``out``,
     by what the case has: ``channels.png`` (every channel of a transient run), ``response.png``
     (θ_A, θ_B, θ_C and δ: Figs. 11–13), ``oil_temperatures.png`` (its fluids' supply, volume and
     wall: Fig. 10) and ``deformed.png`` (the state kept nearest ``picture_s``; ``caption``: its
     title as a function of the time drawn, default ``title, t = … min``); returns the names.
     Given a :class:`~gatetherm.validation.plots.painter.Painter`, they are handed to it (written
-    once its ``finish`` returns); else written here."""
+    once its ``finish`` returns); else written here. ``only``: the names to write (default: all)."""
     from pathlib import Path
 
     from gatetherm.validation.plots.field import deformed, render_deformed
@@ -138,7 +140,8 @@ def write_pictures(run, out, title: str, picture_s: float | None, solved: dict |
 
     out, cols, jobs = Path(out), run.columns, {}
     transient = len(cols["time_s"]) > 1
-    if picture_s is not None and run.model.elastic is not None:  # the largest arguments first
+    wanted = (lambda name: True) if only is None else only.__contains__
+    if picture_s is not None and run.model.elastic is not None and wanted("deformed.png"):  # the largest first
         caption = caption or (lambda t: f"{title}, t = {t / 60:.0f} min")
         jobs["deformed.png"] = render_deformed, deformed(run, picture_s, caption, solved)
     if transient:
@@ -148,7 +151,7 @@ def write_pictures(run, out, title: str, picture_s: float | None, solved: dict |
     if has_response(cols):
         jobs["response.png"] = plot_response, (cols, title)
     order = PAINTING_ORDER[3 if run.model.dim == 3 else 2]
-    jobs = dict(sorted(jobs.items(), key=lambda job: order.index(job[0])))
+    jobs = dict(sorted(((k, v) for k, v in jobs.items() if wanted(k)), key=lambda job: order.index(job[0])))
     painter = Painter(0) if painter is None else painter
     for name, (plot, args) in jobs.items():
         painter.draw(plot, *args, path=out / name, tight=name != "channels.png")
