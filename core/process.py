@@ -15,13 +15,16 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
   the same peak memory (2 runs each, interleaved);
 
 and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
-solve's helper), :func:`can_fork` and :func:`die_with_parent`.
+solve's helper), :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
+(:func:`message`, :func:`send`, :func:`receive`: a pickle behind its length).
 """
 from __future__ import annotations
 
 import ctypes
 import logging
 import os
+import pickle
+import struct
 
 from gatetherm import InputError
 
@@ -53,6 +56,49 @@ def die_with_parent(sig: int) -> bool:
         return ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0) == 0
     except (OSError, AttributeError, TypeError):
         return False
+
+
+def end_with_parent() -> bool:
+    """A helper process's signals: SIGTERM when its parent ends (:func:`die_with_parent`), and
+    SIGTERM raises SystemExit, so that its ``finally`` blocks run (a temporary file removed);
+    Ctrl-C is left to the parent, which ends its helpers. Whether the kernel will send it."""
+    import signal
+
+    def stop(*_):
+        raise SystemExit(1)
+    signal.signal(signal.SIGTERM, stop)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return die_with_parent(signal.SIGTERM)
+
+
+def message(obj) -> bytes:
+    """``obj`` as one message of a pipe: its pickle behind its length."""
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    return struct.pack("<Q", len(data)) + data
+
+
+def send(fd: int, obj) -> None:
+    """Write ``obj`` as one :func:`message` to ``fd`` (all of it)."""
+    view = memoryview(message(obj))
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def receive(fd: int):
+    """The next message's object on ``fd``, or None at its end (or where the pipe ends inside one)."""
+    head = _read(fd, 8)
+    body = None if head is None else _read(fd, struct.unpack("<Q", head)[0])
+    return None if body is None else pickle.loads(body)
+
+
+def _read(fd: int, n: int) -> bytes | None:
+    buf = bytearray()
+    while len(buf) < n:
+        chunk = os.read(fd, n - len(buf))
+        if not chunk:
+            return None
+        buf += chunk
+    return bytes(buf)
 
 
 def configure() -> None:

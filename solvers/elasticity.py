@@ -91,7 +91,8 @@ class ElasticSystem:
 
     def later(self, load: np.ndarray):
         """:meth:`from_load` as a :class:`~gatetherm.solvers.helper.Pending`: solved beside the
-        caller where the solver runs in a helper process (:meth:`SPDSolver.start`)."""
+        caller where the solver runs in a helper process
+        (:meth:`~gatetherm.solvers.linsolve.SPDSolver.start`)."""
         shape = (self.basis.N,) + np.shape(load)[1:]
 
         def full(x):

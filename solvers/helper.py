@@ -18,11 +18,9 @@ from __future__ import annotations
 
 import logging
 import os
-import pickle
 import select
 import shutil
 import signal
-import struct
 import tempfile
 import threading
 import time
@@ -31,7 +29,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from gatetherm.process import die_with_parent
+from gatetherm.process import end_with_parent, receive, send
 from gatetherm.solvers.iterative import SolverError
 
 log = logging.getLogger(__name__)
@@ -73,30 +71,6 @@ def _identity(value):
     return value
 
 
-def _send(fd: int, obj) -> None:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-    view = memoryview(struct.pack("<I", len(data)) + data)
-    while view:
-        view = view[os.write(fd, view):]
-
-
-def _receive(fd: int):
-    """The next message on ``fd``, or None at its end."""
-    head = _read(fd, 4)
-    body = None if head is None else _read(fd, struct.unpack("<I", head)[0])
-    return None if body is None else pickle.loads(body)
-
-
-def _read(fd: int, n: int) -> bytes | None:
-    buf = bytearray()
-    while len(buf) < n:
-        chunk = os.read(fd, n - len(buf))
-        if not chunk:
-            return None
-        buf += chunk
-    return bytes(buf)
-
-
 def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
     """The helper's life: make the solver, then answer each job ``(k, path of b)`` with
     ``(k, path of x, None)`` or ``(k, None, error text)``."""
@@ -106,7 +80,7 @@ def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
         log.debug("helper: solver made in %.2f s", time.perf_counter() - t0)
     except Exception as err:  # noqa: BLE001 - reported with every job
         solve, error = None, f"{type(err).__name__}: {err}"
-    while (job := _receive(jobs)) is not None:
+    while (job := receive(jobs)) is not None:
         k, path = job
         reply = (k, None, error)
         if solve is not None:
@@ -121,7 +95,7 @@ def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
                 reply = (k, path, None)
             except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
                 reply = (k, None, f"{type(err).__name__}: {err}")
-        _send(replies, reply)
+        send(replies, reply)
 
 
 class SolveHelper:
@@ -140,9 +114,7 @@ class SolveHelper:
             code = 1
             try:
                 _close_others((jobs_r, replies_w))  # the caller's other pipes: their readers see their end
-                signal.signal(signal.SIGTERM, _stop)
-                signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller ends the helper
-                die_with_parent(signal.SIGTERM)  # and its folder goes with it
+                end_with_parent()  # and its folder goes with it
                 _serve(make, jobs_r, replies_w)
                 code = 0
             finally:
@@ -164,7 +136,7 @@ class SolveHelper:
         path = os.path.join(self._dir, f"{k}.b.npy")
         np.save(path, np.asarray(b, dtype=float))
         try:
-            _send(self._jobs, (k, path))
+            send(self._jobs, (k, path))
         except BrokenPipeError:
             raise SolverError(f"{self.what}: {ENDED}") from None
         return Pending(lambda: self._wait(k), lambda: self._collect(k, block=False))
@@ -172,7 +144,7 @@ class SolveHelper:
     def _collect(self, k: int, block: bool) -> bool:
         """Read the answers that have come (waiting for one if ``block``); whether ``k``'s is in."""
         while k not in self._answers and select.select([self._replies], [], [], None if block else 0)[0]:
-            reply = _receive(self._replies)
+            reply = receive(self._replies)
             if reply is None:
                 raise SolverError(f"{self.what}: {ENDED}")
             j, path, error = reply
@@ -191,10 +163,6 @@ class SolveHelper:
     def close(self) -> None:
         """End the helper (at once: nothing it holds outlives it but its folder, removed here)."""
         self._finalize()
-
-
-def _stop(*_) -> None:
-    raise SystemExit(1)
 
 
 def _close_others(keep) -> None:

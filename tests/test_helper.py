@@ -111,3 +111,33 @@ def test_a_run_with_the_elastic_helper_gives_the_outputs_and_fields_of_one_witho
     d = np.abs(out[True][0] - out[False][0]).max()
     du = np.abs(out[True][1] - out[False][1]).max() / np.abs(out[False][1]).max()
     assert d < 1e-9 and du < 1e-8, (d, du)
+
+
+def test_a_written_run_with_the_helper_has_the_fields_and_pictures_of_one_without(tmp_path, monkeypatch):
+    """``gt.run`` and ``Run.write`` (a painter) on the coarse 3-D frame, 30 min of condition 1,
+    fields every 10 min, the iterative path with and without the helper: the same displacement
+    fields in ``fields.h5`` (to 1e-8 of their size), every picture written."""
+    import dataclasses
+
+    import h5py
+
+    import gatetherm as gt
+    from conftest import fixed_case
+    from gatetherm.studies.run.schedules import condition_schedule
+
+    monkeypatch.setenv(plan.PATH_ENV, "iterative")
+    case = fixed_case(3)
+    sched = condition_schedule(1)
+    sched = dataclasses.replace(sched, times=sched.times[:31])
+    u = {}
+    for beside in (True, False):
+        monkeypatch.setattr(process, "can_fork", lambda: beside)
+        run = gt.run(case, sched, fields_every=600.0)
+        assert sorted(run.scenario.result.solved) == ([0.0, 600.0, 1200.0] if beside else [])
+        with gt.plot.Painter() as painter:
+            run.write(tmp_path / str(beside), fields_every=600.0, painter=painter)
+        with h5py.File(tmp_path / str(beside) / "fields" / "fields.h5") as f:
+            u[beside] = np.array([f[f"step{n}/u"][()] for n in range(4)])
+        assert (tmp_path / str(beside) / "deformed.png").stat().st_size > 10_000
+        assert (tmp_path / str(beside) / "response.png").stat().st_size > 10_000
+    assert np.abs(u[True] - u[False]).max() < 1e-8 * np.abs(u[False]).max()

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
-from typing import Callable
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -185,17 +185,16 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_tim
 
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
     states = [(t, U) for t, U in run.result.states if t in field_times]
-    extra = {t: U for t, U in (nearest_state(run, tp) for tp in picture_times) if t not in field_times}
-    envs = run.result.envs
-    solved = displacements(run.model, list(extra.items()) + states, envs, run.result.solved)
-    pictured = [nearest_state(run, tp)[0] for tp in picture_times]
+    pictured = dict(nearest_state(run, tp) for tp in picture_times)
+    extra = [(t, U) for t, U in pictured.items() if t not in field_times]
+    solved = displacements(run.model, extra + states, run.result.envs, run.result.solved)
     hook = [solved_hook] if solved_hook is not None else []
 
     def between():
         if hook and all(solved.ready(t) for t in pictured if t in solved):
             hook.pop()(solved)
     between()
-    write_fields(run.model, states, out / "fields", solved, envs, between)
+    write_fields(run.model, states, out / "fields", solved, run.result.envs, between)
     if hook:
         hook.pop()(solved)
     return solved

@@ -16,48 +16,18 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
-import pickle
 import select
 import signal
-import struct
 import threading
 import time
 from pathlib import Path
 
-from gatetherm.process import can_fork, die_with_parent
+from gatetherm.process import can_fork, end_with_parent, message, receive, send
 
 log = logging.getLogger(__name__)
 
 STOP_S = 2.0
 """Longest a painting process is given to end on SIGTERM (it removes the PNG it was writing), s."""
-
-
-def _message(obj) -> bytes:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-    return struct.pack("<Q", len(data)) + data
-
-
-def _send(fd: int, obj) -> None:
-    view = memoryview(_message(obj))
-    while view:
-        view = view[os.write(fd, view):]
-
-
-def _receive(fd: int):
-    """The next object on ``fd``, or None at its end (or where the pipe ends inside one)."""
-    head = _read(fd, 8)
-    body = None if head is None else _read(fd, struct.unpack("<Q", head)[0])
-    return None if body is None else pickle.loads(body)
-
-
-def _read(fd: int, n: int) -> bytes | None:
-    buf = bytearray()
-    while len(buf) < n:
-        chunk = os.read(fd, n - len(buf))
-        if not chunk:
-            return None
-        buf += chunk
-    return bytes(buf)
 
 
 def _paint(job) -> None:
@@ -85,7 +55,7 @@ def _warm() -> None:
 def _serve(jobs: int, replies: int) -> None:
     """A painting process's life: draw every job on ``jobs``, answer each on ``replies``
     (``(is OSError, error text)``, the text empty once the PNG is written)."""
-    while (job := _receive(jobs)) is not None:
+    while (job := receive(jobs)) is not None:
         if job[3] is None:  # made ready (Painter.prepare): no picture, no answer
             try:
                 job[0]()
@@ -98,18 +68,7 @@ def _serve(jobs: int, replies: int) -> None:
         except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
             reply = (isinstance(err, OSError), f"{type(err).__name__}: {err}"[:4000])
         with contextlib.suppress(BrokenPipeError):  # closed without waiting for the answers
-            _send(replies, reply)
-
-
-def _stop(*_) -> None:
-    raise SystemExit(1)  # on SIGTERM: the PNG being written is removed (its temporary) on the way out
-
-
-def _die_with_parent() -> None:
-    """SIGTERM when the parent ends; SIGTERM ends the process through :func:`_stop`."""
-    signal.signal(signal.SIGTERM, _stop)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C: the caller stops the painter
-    die_with_parent(signal.SIGTERM)
+            send(replies, reply)
 
 
 def _can_fork() -> bool:
@@ -151,7 +110,7 @@ class Painter:
         if pid == 0:  # pragma: no cover - the child's coverage is not collected
             code, child = 1, None
             try:
-                _die_with_parent()
+                end_with_parent()  # on SIGTERM the PNG being written (its temporary) is removed
                 for (jr, jw), (rr, rw) in pairs:
                     os.close(jw)
                     os.close(rr)
@@ -160,7 +119,7 @@ class Painter:
                 if len(pairs) > 1:  # the second process: matplotlib imported already
                     child = os.fork()
                     if child == 0:
-                        _die_with_parent()
+                        end_with_parent()
                     mine, other = (pairs[1], pairs[0]) if child == 0 else (pairs[0], pairs[1])
                     os.close(other[0][0])  # the other's jobs and replies
                     os.close(other[1][1])
@@ -211,7 +170,7 @@ class Painter:
     def _hand(self, job) -> None:
         k = min(range(self.workers), key=lambda i: len(self._queued[i]))  # a tie: the first
         with self._lock:
-            self._outbox[k] += _message(job)
+            self._outbox[k] += message(job)
             if job[3] is not None:
                 self._queued[k].append(job[3])
             if not self._flush(k) and not (self._writer and self._writer.is_alive()):
@@ -248,7 +207,7 @@ class Painter:
         failed = None
         for (_, replies), queued in zip(self._pipes, self._queued):
             while queued:
-                path, reply = queued.pop(0), _receive(replies)
+                path, reply = queued.pop(0), receive(replies)
                 if reply is None:  # the process is gone
                     failed = failed or RuntimeError(f"{path.name}: the process drawing it ended")
                     queued.clear()
