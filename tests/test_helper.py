@@ -141,3 +141,21 @@ def test_a_written_run_with_the_helper_has_the_fields_and_pictures_of_one_withou
         assert (tmp_path / str(beside) / "deformed.png").stat().st_size > 10_000
         assert (tmp_path / str(beside) / "response.png").stat().st_size > 10_000
     assert np.abs(u[True] - u[False]).max() < 1e-8 * np.abs(u[False]).max()
+
+
+def test_the_memory_a_plan_counts_holds_the_child_processes_own():
+    """A child process holding 200 MB of its own: the budget's ``resident_bytes`` counts it."""
+    import subprocess
+    import sys
+    import time
+
+    before = plan.resident_bytes()
+    child = subprocess.Popen([sys.executable, "-c", "import sys, numpy as np; a = np.ones(25_000_000); "
+                              "print(1, flush=True); sys.stdin.read()"], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+    try:
+        assert child.stdout.readline().strip() == b"1"
+        time.sleep(0.2)
+        held = plan.resident_bytes() - before
+    finally:
+        child.communicate(b"")
+    assert 0.19e9 < held < 0.4e9, held  # the 200 MB array and the child's own interpreter
