@@ -252,10 +252,15 @@ def _prescribed_load(model: Model) -> np.ndarray:
 
 
 def _recovery_for(model: Model, elements) -> Recovery:
-    p = model.problem
-    T_elem = model.heat.basis.elem if model.heat is not None else None
     T_at = None if model.heat is not None else _prescribed_rise(model)
-    return recovery(model.mesh, p.order, model.fields, model.dim, p.plane, T_elem, elements, T_at, model.simplices)
+    return _recovery(model.problem, model.mesh, model.fields, model.simplices, elements, T_at)
+
+
+def _recovery(p: Problem, mesh, fields, simplices, elements, T_at=None) -> Recovery:
+    """The stress projection over ``elements`` (None: all) of a problem's mesh; the temperature
+    on the heat basis where there is a heat solve, else ``T_at``."""
+    T_elem = element(p.dim, p.order) if p.heat else None
+    return recovery(mesh, p.order, fields, p.dim, p.plane, T_elem, elements, T_at, simplices)
 
 
 def _probe_recovery(model: Model, region: str | None) -> Recovery:
@@ -293,9 +298,8 @@ def _mechanical_rows(problem: Problem, mesh, fields, el: ElasticSystem, simplice
                 GT.append(None)
         if "sigma" in pr.quantities:
             if pr.region not in recoveries:
-                recoveries[pr.region] = recovery(mesh, problem.order, fields, problem.dim, problem.plane,
-                                                 element(problem.dim, problem.order), None if pr.region is None
-                                                 else mesh.subdomains[pr.region], None, simplices)
+                recoveries[pr.region] = _recovery(problem, mesh, fields, simplices,
+                                                  None if pr.region is None else mesh.subdomains[pr.region])
             for c, (gu, gT) in recoveries[pr.region].point(pr.xyz).items():
                 keys.append(("sigma", pr.name, c))
                 G.append(gu)
@@ -357,26 +361,24 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
     f = region_fields(problem, mesh)
     s = p1.simplices(mesh) if problem.order == 1 else None
     axi = problem.axisymmetric
-    el, terms, unit, weights = None, None, None, None
+    el, terms, unit, mech, weights = None, None, None, _Rows([], [], []), None
     if problem.elastic:
         T_basis = dof_basis(mesh, element(problem.dim, problem.order))  # the heat basis's DOFs
         el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
                               problem.supports, problem.plane, simplices=s, lines=fmesh.lines,
                               contacts=problem.contacts)
-        mech = _mechanical_rows(problem, mesh, f, el, s) if problem.heat else None
-        if mech is not None:
+        if problem.heat:  # the read-out's solver set up now, in a helper where it can be
+            mech = _mechanical_rows(problem, mesh, f, el, s)
             el.solve.start(max(1, len(mech.G)))
         terms = mechanical_terms(problem, mesh, el.basis, f, fmesh.sensors, lambda sup, c: support_dofs(
             el.basis, mesh, sup.boundary, (c,), fmesh.lines))
         unit = unit_responses(el, terms) if terms is not None else None
-        if mech is not None:
-            weights = _weights(el, mech, T_basis.N)
+        weights = _weights(el, mech, T_basis.N) if problem.heat else None
     lap("elastic_setup")
     heat = assemble_heat(mesh, problem, f, 2 * problem.order + 1 if axi else None, s) if problem.heat else None
     lap("heat_assembly")
     model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s, terms, unit)
     if heat is not None:
-        mech = mech if el is not None else _Rows([], [], [])
         model = dataclasses.replace(model, readout=_readout(model, mech, weights or _weights(el, mech, heat.n_solid)))
     lap("adjoint_solves")
     return model

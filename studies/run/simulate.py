@@ -126,7 +126,7 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
         model.elastic.solve.release()
         # not the last sample's: a caller's first wish after the march may be another (a picture's)
         ahead = ({float(t) for t in solve_at} & keep) - {float(times[-1])} if model.elastic.solve.background else set()
-    weights = model.readout.weights
+    weights, ready = model.readout.weights, False
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
         env = environment(drive, t)
@@ -136,20 +136,17 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
             U = U.copy()
             states.append((t, U))
             envs[t] = env
-        if waiting and weights.done():
-            for k, Uk, ek in waiting:
-                Y[k] = model.read(Uk, ek)
-            waiting = []
-        if waiting or not weights.done():
+        ready = ready or weights.done()  # asked until it is
+        if ready:
+            Y.append(model.read(U, env))
+        else:
             waiting.append((i, U if t in keep else U.copy(), env))
             Y.append(None)
-        else:
-            Y.append(model.read(U, env))
         if t in ahead:
             solved[t] = model.displacement_later(U, env)
         if on_step:
             on_step(i + 1, len(times))
-    for k, Uk, ek in waiting:
+    for k, Uk, ek in waiting:  # the weights waited for here if not in yet
         Y[k] = model.read(Uk, ek)
     cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
     cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
