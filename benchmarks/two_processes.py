@@ -31,14 +31,14 @@ def main() -> None:
     run = gt.run(gt.gate_frame(dim=3), keep=[0.0, 780.0, 3600.0, 7200.0, 10800.0, 14400.0, 18000.0])
     model, result = run.scenario.model, run.scenario.result
     pcg = model.elastic.solve._solve
-    start = list(pcg._X), list(pcg._AX)
+    start = pcg.kept
     times: dict[str, list[float]] = {"two processes": [], "one process": []}
     iterations, fields = {}, {}
     try:
         for r in range(args.rounds):
             for name in (("two processes", "one process") if r % 2 == 0 else ("one process", "two processes")):
                 iterative.can_fork = can_fork if name == "two processes" else (lambda: False)
-                pcg._X, pcg._AX = list(start[0]), list(start[1])
+                pcg.seed(start)
                 before = pcg.iterations
                 t0 = time.perf_counter()
                 u = dict(displacements(model, result.states, result.envs))  # each solved

@@ -21,6 +21,7 @@ from skfem.helpers import ddot, div, sym_grad
 from gatetherm import InputError
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element
+from gatetherm.solvers.helper import Pending
 from gatetherm.solvers.linsolve import SPDSolver, expand_order, nd_order, restrict_order, rigid_body_modes
 from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
 
@@ -68,8 +69,9 @@ class ElasticSystem:
     """Assembled elastic operators on the free DOFs, solver set up once."""
 
     basis: CellBasis
-    K: sp.csr_matrix
-    """Stiffness on the free DOFs."""
+    stiffness: Pending
+    """:attr:`K`, assembled where it is first needed: in the solver's helper process where
+    :meth:`~gatetherm.solvers.linsolve.SPDSolver.start` sets one up (then never here)."""
     B: sp.csr_matrix
     """Thermal load per unit temperature rise (all DOFs × heat DOFs)."""
     free: np.ndarray
@@ -79,6 +81,11 @@ class ElasticSystem:
     """2-D: "stress", "strain" or "axisymmetric"."""
     K_fixed: sp.csr_matrix | None = None
     """Stiffness columns of the held DOFs (all rows), where a support prescribes a displacement."""
+
+    @property
+    def K(self) -> sp.csr_matrix:
+        """Stiffness on the free DOFs."""
+        return self.stiffness.result()
 
     def displacement(self, dT: np.ndarray) -> np.ndarray:
         """Displacement field (m) for the temperature rise ``dT`` (K) on the heat basis
@@ -236,7 +243,7 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     if linear:  # the same matrices, vectorised (solvers/p1.py)
         simplices, th = simplices or p1.simplices(mesh), thickness.values
         vb = dof_basis(mesh, ElementVector(element(dim, order)))
-        K = p1.stiffness(simplices.pattern, simplices.G, simplices.vol, lam * th, mu * th)
+        K = partial(p1.stiffness, simplices.pattern, simplices.G, simplices.vol, lam * th, mu * th)
         B = p1.thermal_load(simplices.pattern, simplices.G, simplices.vol, b * th)
     else:
         vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
@@ -255,18 +262,36 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     loose = free_modes(vb, fixed, springs, pieces, axi)
     if loose:
         _refuse_loose(vb, mesh, loose, pieces)
-    K = (K + sum(springs[1:], springs[0]) if springs else K).tocsr()
     free = np.setdiff1d(np.arange(vb.N), fixed)
-    K_fixed = K[:, fixed] if any(s.values for s in supports) else None
-    if linear:  # the nodes' order, found when a factor needs it
+
+    def whole():  # with the supports' springs
+        A = K() if callable(K) else K
+        return (A + sum(springs[1:], springs[0]) if springs else A).tocsr()
+
+    def on_free(A):  # in two steps: the full matrix goes before the columns are taken
+        A = A[free]
+        return A[:, free]
+    K_fixed = None
+    if linear and not any(s.values for s in supports):  # the nodes' order, found when a factor needs it
+        Kf, size = Pending(lambda: on_free(whole())), (len(free), _free_nonzeros(simplices.pattern, free, dim))
         perm = partial(_free_order, simplices, dim, free, vb.N)
     else:
-        perm = restrict_order(nd_order(K, dim), free, vb.N)
-    K = K[free]  # in two steps: the full matrix goes before the columns are taken
-    K = K[:, free]
+        A = whole()
+        K_fixed = A[:, fixed] if any(s.values for s in supports) else None
+        perm = partial(_free_order, simplices, dim, free, vb.N) if linear else \
+            restrict_order(nd_order(A, dim), free, vb.N)
+        Kf = Pending.of(on_free(A))
+        size = Kf.result().shape[0], Kf.result().nnz
     rbm = rigid_body_modes(vb.doflocs, vb.split_indices())[free]
     log.info("elastic system: %d free DOFs (P%d, %d-D%s)", len(free), order, dim,
              f" plane {plane}" if dim == 2 else "")
     nodal = len(free) % dim == 0 and bool(np.all(free.reshape(-1, dim) == (free[::dim] // dim * dim)[:, None]
                                                    + np.arange(dim)))
-    return ElasticSystem(vb, K, B.tocsr(), free, _Solver(K, dim, rbm, perm, nodal), plane, K_fixed)
+    return ElasticSystem(vb, Kf, B.tocsr(), free, _Solver(Kf, dim, rbm, perm, nodal, size=size), plane, K_fixed)
+
+
+def _free_nonzeros(pattern: p1.Pattern, free: np.ndarray, dim: int) -> int:
+    """Nonzeros of the stiffness on the ``free`` DOFs (``dim`` per node, interleaved) without
+    assembling it: each node pair's block has (free DOFs of one) × (free DOFs of the other)."""
+    c = np.bincount(free // dim, minlength=pattern.n).astype(float)
+    return int(c @ (pattern.graph() @ c))

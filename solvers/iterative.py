@@ -126,21 +126,36 @@ class PCG:
         self.A = A.tocsr()
         self.amg = AMG(self.A, near_null, block) if amg is None else amg
         self.rtol, self.recycle, self.split = rtol, recycle, split
-        self._X: list[np.ndarray] = []
-        self._AX: list[np.ndarray] = []
+        # the kept solutions and their products, in place (a ring of columns): no copies per solve
+        self._X, self._AX = (np.empty((self.A.shape[0], recycle), order="F") for _ in range(2))
+        self._kept = self._next = 0
         self.iterations = 0
         self.solves = 0
 
     @property
     def nbytes(self) -> int:
         """Memory held: the matrix, the hierarchy and the kept solutions, bytes."""
-        return _nbytes(self.A) + self.amg.nbytes + 16 * self.A.shape[0] * len(self._X)
+        return _nbytes(self.A) + self.amg.nbytes + 16 * self.A.shape[0] * self._kept
+
+    @property
+    def kept(self) -> np.ndarray:
+        """The solutions the Galerkin start projects onto (a copy, n × at most :attr:`recycle`)."""
+        return self._X[:, :self._kept].copy()
 
     def seed(self, X: np.ndarray) -> None:
         """Start the Galerkin projection from the columns of ``X`` (solutions of a nearby
         problem), as many as :attr:`recycle` allows."""
-        X = np.asarray(X, dtype=float).reshape(self.A.shape[0], -1)[:, -self.recycle:] if self.recycle else X[:, :0]
-        self._X, self._AX = list(X.T), list((self.A @ X).T)
+        X = np.asarray(X, dtype=float).reshape(self.A.shape[0], -1)
+        X = X[:, X.shape[1] - min(self.recycle, X.shape[1]):]
+        k = X.shape[1]
+        self._X[:, :k], self._AX[:, :k] = X, self.A @ X
+        self._kept, self._next = k, k % max(self.recycle, 1)
+
+    def _keep(self, x: np.ndarray, Ax: np.ndarray) -> None:
+        """Keep the solution ``x`` (and ``A x``) in place of the oldest."""
+        if self.recycle:
+            self._X[:, self._next], self._AX[:, self._next] = x, Ax
+            self._kept, self._next = min(self._kept + 1, self.recycle), (self._next + 1) % self.recycle
 
     def __call__(self, b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)
@@ -197,9 +212,9 @@ class PCG:
 
     def _start(self, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The Galerkin start ``x₀`` and its product ``A x₀``."""
-        if not self._X:
+        if not self._kept:
             return np.zeros_like(b), np.zeros_like(b)
-        X, AX = np.column_stack(self._X), np.column_stack(self._AX)
+        X, AX = self._X[:, :self._kept], self._AX[:, :self._kept]
         G = X.T @ AX
         c = np.linalg.lstsq(0.5 * (G + G.T), X.T @ b, rcond=1e-13)[0]  # the kept solutions may be near dependent
         return X @ c, AX @ c
@@ -229,7 +244,5 @@ class PCG:
                                   f"{MAXITER} iterations (tolerance {self.rtol:g})")
         self.iterations += k
         self.solves += 1
-        if self.recycle:
-            self._X = (self._X + [x])[-self.recycle:]
-            self._AX = (self._AX + [b - r])[-self.recycle:]  # A x, without a product
+        self._keep(x, b - r)  # A x, without a product
         return x

@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from gatetherm.solvers.helper import Pending, SolveHelper
 from gatetherm.solvers.iterative import PCG, SolverError
 from gatetherm.solvers.plan import plan
 
@@ -227,33 +228,43 @@ class SPDSolver:
     (:class:`~gatetherm.solvers.helper.SolveHelper`) where the process may fork: then
     :meth:`submit` returns at once, and the caller goes on while the helper solves."""
 
-    def __init__(self, A: sp.spmatrix, dim: int, near_null: np.ndarray | None = None,
-                 order: np.ndarray | Callable | None = None, nodal: bool = False, what: str = "elastic system"):
-        """``near_null``: the rigid-body modes; ``order``: a fill-reducing order (or a function
-        giving it, called when a factor is made); ``nodal``: the unknowns are whole nodes' ``dim``
-        DOFs in turn (then AMG aggregates nodes)."""
-        self.A, self.dim, self.near_null, self.order, self.what = A.tocsr(), dim, near_null, order, what
+    def __init__(self, A: sp.spmatrix | Pending, dim: int, near_null: np.ndarray | None = None,
+                 order: np.ndarray | Callable | None = None, nodal: bool = False, what: str = "elastic system",
+                 size: tuple[int, int] | None = None):
+        """``A``: the matrix, or a :class:`~gatetherm.solvers.helper.Pending` of it, made where
+        first needed (in the helper, where :meth:`start` sets one up); ``size``: its (unknowns,
+        nonzeros), for the plan without making it; ``near_null``: the rigid-body modes;
+        ``order``: a fill-reducing order (or a function giving it, called when a factor is
+        made); ``nodal``: the unknowns are whole nodes' ``dim`` DOFs in turn (then AMG
+        aggregates nodes)."""
+        self._A = A if isinstance(A, Pending) else Pending.of(A.tocsr())
+        self.size = size or (self.A.shape[0], self.A.nnz)
+        self.dim, self.near_null, self.order, self.what = dim, near_null, order, what
         self.block = dim if nodal else 1
         self._solve: Solve | None = None
         self._helper = None
         self.path: str | None = None
         """The path of the live solver (None: released)."""
 
+    @property
+    def A(self) -> sp.csr_matrix:
+        return self._A.result()
+
     def start(self, rhs: int) -> bool:
         """Plan for a first batch of ``rhs`` right-hand sides and, where that is AMG-CG and this
         process may fork, set it up now in a helper process; whether it did."""
         from gatetherm.process import can_fork
-        from gatetherm.solvers.helper import SolveHelper
 
         if self._solve is not None or self._helper is not None or not can_fork():
             return self._helper is not None
         if os.environ.get(BACKEND_ENV) != "amg" or self.near_null is None:
-            p = plan(self.A.shape[0], self.A.nnz, self.dim, self.dim, rhs)
+            p = plan(*self.size, self.dim, self.dim, rhs)
             if p.path != "iterative":
                 return False
-            log.info("%s", p.describe(f"{self.what} ({self.A.shape[0]} unknowns)", rhs))
-        A, near_null, block = self.A, self.near_null, self.block  # the helper solves one column at a time:
-        self._helper = SolveHelper(lambda: PCG(A, near_null, block, RTOL, split=False), self.what)  # a core each
+            log.info("%s", p.describe(f"{self.what} ({self.size[0]} unknowns)", rhs))
+        A, near_null, block = self._A, self.near_null, self.block  # the helper makes A if it is not made yet
+        self._helper = SolveHelper(lambda: PCG(A.result(), near_null, block, RTOL, split=False),  # and solves
+                                   self.what)  # one column at a time: a core each
         self.path = "iterative"
         return True
 
@@ -265,8 +276,6 @@ class SPDSolver:
     def submit(self, b: np.ndarray):
         """The solution of ``b`` (n,) or (n, k) as a :class:`~gatetherm.solvers.helper.Pending`:
         made in the helper where there is one (:meth:`start`), else here and now."""
-        from gatetherm.solvers.helper import Pending
-
         if self.background:
             return self._helper.submit(b)
         return Pending.of(self._here(b))
@@ -282,7 +291,7 @@ class SPDSolver:
         return self._solve(b)
 
     def _make(self, rhs: int) -> tuple[Solve, str]:
-        small = self.dim == 2 or self.A.shape[0] <= DIRECT_LIMIT_3D or self.near_null is None
+        small = self.dim == 2 or self.size[0] <= DIRECT_LIMIT_3D or self.near_null is None
         allow = ("pardiso", "cholmod") + (("superlu",) if small else ())
         if os.environ.get(BACKEND_ENV) == "amg" and self.near_null is not None:
             return PCG(self.A, self.near_null, self.block, RTOL), "iterative"

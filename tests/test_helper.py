@@ -14,7 +14,7 @@ import pytest
 import scipy.sparse as sp
 
 from gatetherm import process
-from gatetherm.solvers import plan
+from gatetherm.solvers import p1, plan
 from gatetherm.solvers.frame import build_model
 from gatetherm.solvers.helper import Pending, SolveHelper
 from gatetherm.solvers.iterative import PCG, SolverError
@@ -94,17 +94,23 @@ def test_a_pending_value_pickles_as_the_value_and_maps():
 
 def test_a_run_with_the_elastic_helper_gives_the_outputs_and_fields_of_one_without(frame_3d, monkeypatch):
     """An hour of condition 1 on the coarse 3-D frame on the iterative path, with the elastic
-    solver in a helper (its read-out waited for, the 30-min field solved during the march) and
-    in the process: δ agrees to 1e-9 µm, the fields to 1e-8 of their size."""
+    solver in a helper (its stiffness assembled there, never in the caller; its read-out waited
+    for, the 30-min field solved during the march) and in the process: δ agrees to 1e-9 µm, the
+    fields to 1e-8 of their size; the plan's size of the stiffness, found without it, is its own."""
     monkeypatch.setenv(plan.PATH_ENV, "iterative")
     times, drive = sample_times(3600.0), condition_drive(CONDITIONS[1], SupplyParams())
     keep = (0.0, 1800.0, 3600.0)
     out = {}
+    assembled = []  # by this process
+    monkeypatch.setattr(p1, "stiffness", lambda *a, f=p1.stiffness: assembled.append(1) or f(*a))
     for beside in (True, False):
         monkeypatch.setattr(process, "can_fork", lambda: beside)  # whatever threads earlier tests left
         model = build_model(FIXED_MODEL, 3, frame_3d)
         assert model.elastic.solve.background is beside
         res = run_model(model, drive, times, keep, solve_at=keep)
+        assert len(assembled) == (0 if beside else 1)
+        if not beside:
+            assert model.elastic.solve.size == (model.elastic.K.shape[0], model.elastic.K.nnz) == (16905, 605853)
         assert sorted(res.solved) == ([0.0, 1800.0] if beside else [])  # not the last sample's
         u = displacements(model, res.states, res.envs, res.solved)
         out[beside] = res.columns["delta_um"], np.column_stack([u[t] for t in keep])

@@ -3,6 +3,8 @@ surface picture in 3-D). pyvista renders off screen into an image (its own plott
 ``pyvista.OFF_SCREEN`` is left as it was), which matplotlib frames with a labelled colour bar."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from gatetherm.validation.plots import figure
@@ -91,7 +93,8 @@ def render_deformed(fmesh, fields: dict, title: str, scale: float, ax=None):
     in grey, with a labelled colour bar; returns the Axes. A 2-D mesh is drawn by matplotlib
     (a tripcolor), a 3-D body by pyvista off screen and framed on ``ax``.
 
-    ``fields`` are nodal arrays of ``fmesh`` (a :class:`~gatetherm.geometry.mesh.FrameMesh`):
+    ``fields`` are nodal arrays of ``fmesh`` (a :class:`~gatetherm.geometry.mesh.FrameMesh`, or a
+    3-D body's :class:`Surface`):
     ``T`` (°C) and ``u`` (m, 3 components); without ``T`` (a purely mechanical case) the
     colours show the displacement's magnitude.
     """
@@ -125,11 +128,51 @@ def boundary_edges(tri: np.ndarray) -> np.ndarray:
     return np.column_stack((once // n, once % n))
 
 
+@dataclass(frozen=True)
+class Surface:
+    """The boundary triangles of a 3-D body: what its picture draws, a fraction of the mesh (no
+    tetrahedra, the surface's nodes only), so that a painting process is sent and handles that only."""
+
+    points: np.ndarray
+    """(n, 3) coordinates of the surface's nodes, m."""
+    triangles: np.ndarray
+    """(m, 3) node indices into :attr:`points`."""
+    nodes: np.ndarray
+    """(n,) the mesh nodes that :attr:`points` are: a nodal field's values on the surface are ``values[nodes]``."""
+    dim: int = 3
+
+
+def surface_of(mesh) -> Surface:
+    """The :class:`Surface` of a scikit-fem tetrahedral mesh: its facets that one element has,
+    each turned to face out of it (as VTK's surface of the cells: feature edges are found by
+    the normals)."""
+    t2f = mesh.t2f.ravel()
+    at = np.flatnonzero(np.bincount(t2f, minlength=mesh.facets.shape[1])[t2f] == 1)  # (local facet, element)
+    element = at % mesh.t.shape[1]
+    tri = mesh.facets[:, t2f[at]].T
+    p = mesh.p.T
+    inner = p[mesh.t[:, element].sum(axis=0) - tri.sum(axis=1)]  # the element's node off the facet
+    a, b, c = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), inner - a) > 0
+    tri[inward] = tri[inward][:, ::-1]
+    nodes, inverse = np.unique(tri, return_inverse=True)
+    return Surface(np.ascontiguousarray(p[nodes]), inverse.reshape(tri.shape), nodes)
+
+
 def _surface(fmesh, point_data: dict):
-    """The pyvista surface of the 3-D body of ``fmesh`` with the nodal arrays ``point_data``."""
+    """The pyvista surface of the 3-D body of ``fmesh`` (a FrameMesh or its :class:`Surface`)
+    with the nodal arrays ``point_data``."""
+    import pyvista as pv
+
     from gatetherm.studies.run.output import volume_grid
 
-    return volume_grid(fmesh, point_data).extract_surface(algorithm="dataset_surface")
+    if not isinstance(fmesh, Surface):
+        return volume_grid(fmesh, point_data).extract_surface(algorithm="dataset_surface")
+    tri = fmesh.triangles
+    body = pv.PolyData(fmesh.points, np.column_stack([np.full(len(tri), 3), tri]).ravel())
+    for name, values in point_data.items():
+        body.point_data[name] = values
+    return body
 
 
 def _tripcolor(ax, xy: np.ndarray, tri: np.ndarray, values, label: str, **limits) -> None:
@@ -165,6 +208,9 @@ def deformed(run, t: float, title, solved: dict | None = None) -> tuple:
     x = np.asarray(fmesh.points)[:, 0]
     umax = float(np.abs(fields["u"]).max()) or 1.0
     scale = float(10 ** np.floor(np.log10(0.08 * max(x.max() - x.min(), 1e-9) / umax)))
+    if fmesh.dim == 3:  # the body's surface is what is drawn
+        fmesh = surface_of(run.model.mesh)
+        fields = {k: np.asarray(v)[fmesh.nodes] for k, v in fields.items()}
     return fmesh, fields, title(t) if callable(title) else title, scale
 
 
