@@ -21,7 +21,7 @@ from gatetherm.solvers.iterative import PCG, SolverError
 from gatetherm.solvers.linsolve import spd_factor
 from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
 from gatetherm.studies.run.output import displacements
-from gatetherm.studies.run.simulate import run_model, sample_times
+from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
 
 from conftest import FIXED_MODEL
 
@@ -117,6 +117,25 @@ def test_a_run_with_the_elastic_helper_gives_the_outputs_and_fields_of_one_witho
     d = np.abs(out[True][0] - out[False][0]).max()
     du = np.abs(out[True][1] - out[False][1]).max() / np.abs(out[False][1]).max()
     assert d < 1e-9 and du < 1e-8, (d, du)
+
+
+def test_the_state_of_the_first_peak_is_solved_during_the_march(frame_3d, monkeypatch):
+    """With the read-out's weights in before the march (δ known step by step), an hour of
+    condition 1 on the coarse 3-D frame, states kept every 5 min: ``solve_first_peak`` solves
+    beside the march the kept state nearest δ's first peak (the deformed picture's), and its
+    displacement is the one solved afterwards."""
+    monkeypatch.setenv(plan.PATH_ENV, "iterative")
+    monkeypatch.setattr(process, "can_fork", lambda: True)
+    model = build_model(FIXED_MODEL, 3, frame_3d)
+    model.readout.weights.result()
+    times, drive = sample_times(3600.0), condition_drive(CONDITIONS[1], SupplyParams())
+    keep = [float(t) for t in times[::5]]
+    res = run_model(model, drive, times, keep, solve_at=(0.0,), solve_first_peak=True)
+    peak = 60.0 * delta_figures(res.columns["time_s"], res.columns["delta_um"])["first_peak_min"]
+    nearest = min(keep, key=lambda t: abs(t - peak))
+    assert sorted(res.solved) == [0.0, nearest] == [0.0, 300.0]
+    u = res.solved[nearest].result()
+    assert np.abs(u - model.displacement_field(dict(res.states)[nearest])).max() < 1e-8 * np.abs(u).max()
 
 
 def test_a_written_run_with_the_helper_has_the_fields_and_pictures_of_one_without(tmp_path, monkeypatch):

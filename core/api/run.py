@@ -274,8 +274,9 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
         ``on_step(i, n)`` after each of the ``n`` samples.
     fields_every : float, optional
         The interval (s) of the fields :meth:`Run.write` will write (default: the case's): where
-        the elastic solver runs in a helper process (a large 3-D model), their displacements
-        are solved there during the march.
+        the elastic solver runs in a helper process (a large 3-D model), their displacements,
+        and that of the deformed picture's state (δ's first peak), are solved there during the
+        march.
     check_order : bool
         A linear-element case on a small mesh: solve its final state once more with quadratic
         elements and warn (one log line naming the output and the fix) where they differ by more
@@ -293,7 +294,7 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
         n = len(case.mesh.points) * case.problem.order ** case.dim
         keep = times if len(times) * n * 8 <= STATE_BUDGET_BYTES else fields
     scenario = run_scenario(case, schedule, effects, keep_times=sorted(set(map(float, keep)) | {times[-1]}),
-                            on_step=on_step, solve_at=fields)
+                            on_step=on_step, solve_at=fields, solve_first_peak=True)  # Run.write's picture
     check = None
     if check_order:
         from gatetherm.studies.run.order_check import order_check

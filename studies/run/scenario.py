@@ -153,10 +153,11 @@ class ScenarioRun:
 
 def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
                  cache: ScenarioCache | None = None, keep_times=(), on_step: Callable[[int, int], None] | None = None,
-                 U0: np.ndarray | None = None, solve_at=()) -> ScenarioRun:
+                 U0: np.ndarray | None = None, solve_at=(), solve_first_peak: bool = False) -> ScenarioRun:
     """Run ``case`` (its effects, plus ``effects``) through ``schedule`` (default: its own); keep
-    full states at ``keep_times`` (their displacement fields at ``solve_at`` solved during the
-    march where it can: :func:`~gatetherm.studies.run.simulate.run_model`). With a ``cache`` the model, its factorisations and (for a plain
+    full states at ``keep_times`` (their displacement fields at ``solve_at``, and with
+    ``solve_first_peak`` δ's first peak's, solved during the march where it can:
+    :func:`~gatetherm.studies.run.simulate.run_model`). With a ``cache`` the model, its factorisations and (for a plain
     run from the initial state) the run itself are reused."""
     t0 = time.perf_counter()
     schedule = case.schedule if schedule is None else schedule
@@ -167,7 +168,7 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
         if p.model.heat is None or len(schedule.times) == 1:
             return _once(p, schedule)
         return run_model(p.model, schedule.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver,
-                         solve_at=solve_at)
+                         solve_at=solve_at, solve_first_peak=solve_first_peak)
 
     if cache is not None and U0 is None and not keep_times:
         key = (repr(target.problem), id(case.mesh), schedule.label, schedule.times.tobytes())

@@ -109,23 +109,30 @@ def check_temperatures(U: np.ndarray, t: float) -> None:
 
 def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
-              U0: np.ndarray | None = None, solver: HeatSolver | None = None, solve_at=()) -> RunResult:
+              U0: np.ndarray | None = None, solver: HeatSolver | None = None, solve_at=(),
+              solve_first_peak: bool = False) -> RunResult:
     """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0)
     with ``scheme`` (default: the problem's); keep full states at ``keep_times``. A
     ``solver`` of ``model.heat`` carries its factorisations over from earlier runs. Where the
     elastic solver runs in a helper process, the steps are read out once its adjoint weights
     are in (the states kept till then), and the displacement fields of the kept states at
-    ``solve_at`` but the last are solved there during the march (:attr:`RunResult.solved`).
+    ``solve_at`` but the last are solved there during the march (:attr:`RunResult.solved`);
+    so is, with ``solve_first_peak``, the kept state of δ's first peak (the deformed
+    picture's) as soon as the samples settle it (:func:`settled_first_peak`).
     Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
     inputs, Y, states, envs, waiting, solved = [], [], [], {}, [], {}
     t0 = _time.perf_counter()
     scheme = model.problem.scheme if scheme is None else scheme
-    ahead = set()
+    ahead, peak = set(), None
     if model.elastic is not None:  # outputs come from adjoint weights: room for the heat factors
         model.elastic.solve.release()
-        # not the last sample's: a caller's first wish after the march may be another (a picture's)
-        ahead = ({float(t) for t in solve_at} & keep) - {float(times[-1])} if model.elastic.solve.background else set()
+        if model.elastic.solve.background:
+            # not the last sample's: a caller's first wish after the march may be another (a picture's)
+            ahead = ({float(t) for t in solve_at} & keep) - {float(times[-1])}
+            delta = ("relative", model.problem.signals.delta)
+            peak = model.readout.keys.index(delta) if solve_first_peak and delta in model.readout.keys else None
+    delta_um, look_every = [], max(1, len(times) // 300)  # looked for at most 300 times: each look is O(samples)
     weights, ready = model.readout.weights, False
     steps = march(solver or HeatSolver(model.heat), drive, np.asarray(times, float), scheme, U0)
     for i, (t, U) in enumerate(steps):
@@ -136,13 +143,26 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
             U = U.copy()
             states.append((t, U))
             envs[t] = env
-        ready = ready or weights.done()  # asked until it is
+        if not ready and weights.done():  # asked until it is; then the steps so far read out
+            ready = True
+            for k, Uk, ek in waiting:
+                Y[k] = model.read(Uk, ek)
+            waiting = []
         if ready:
             Y.append(model.read(U, env))
         else:
             waiting.append((i, U if t in keep else U.copy(), env))
             Y.append(None)
-        if t in ahead:
+        if peak is not None and ready:
+            delta_um += [1e6 * y[peak] for y in Y[len(delta_um):]]
+            first = settled_first_peak(delta_um) if i % look_every == 0 else None
+            if first is not None:  # the kept state nearest it (the earlier of two), as the picture takes
+                tp, peak = inputs[first]["time_s"], None
+                ahead.add(min(sorted(keep), key=lambda s: abs(s - tp)))
+                ahead -= {float(times[-1])}
+                solved.update({s: model.displacement_later(Us, envs[s]) for s, Us in states
+                               if s in ahead and s not in solved})  # reached already
+        if t in ahead and t not in solved:
             solved[t] = model.displacement_later(U, env)
         if on_step:
             on_step(i + 1, len(times))
@@ -180,6 +200,21 @@ def prominent_peaks(x: np.ndarray, prominence: float) -> list[int]:
                 i = ahead
         i += 1
     return out
+
+
+def settled_first_peak(delta_um) -> int | None:
+    """The index of the first peak :func:`delta_figures` will find in a δ history (µm) of which
+    these are the first samples, once they settle it, else None. Settled: it is prominent on
+    the samples so far (more of them can only lower the minima beside it), and every earlier
+    positive local maximum is followed by a higher sample (its prominence is final)."""
+    x = np.asarray(delta_um, dtype=float)
+    seen = np.concatenate([[-np.inf], x, [np.inf]])  # what comes next may be higher than anything
+    first = next((p - 1 for p in prominent_peaks(seen, PEAK_PROMINENCE_UM) if x[p - 1] > 0), None)
+    if first is None:
+        return None
+    later = np.r_[np.maximum.accumulate(x[::-1])[::-1][1:], -np.inf]  # the highest sample after each
+    earlier = [q for q in (p - 1 for p in prominent_peaks(seen, 0.0)) if q < first and x[q] > 0]
+    return first if all(later[q] > x[q] for q in earlier) else None
 
 
 def delta_figures(time_s: np.ndarray, delta_um: np.ndarray) -> dict[str, float | None]:
