@@ -105,7 +105,7 @@ def test_plan_follows_the_budget_and_the_forced_path(heat_3d, monkeypatch, caplo
 
 def test_the_iterative_path_gives_the_direct_paths_outputs(frame_3d, monkeypatch):
     """An hour of condition 1 on the coarse 3-D frame, every system forced onto each path: the
-    outputs (δ, temperatures) agree to 1e-5 µm and 1e-6 K."""
+    outputs (δ, temperatures) agree to 1e-4 µm (issue 24's band) and 1e-5 K."""
     times = sample_times(3600.0)
     drive = condition_drive(CONDITIONS[1], SupplyParams())
     out = {}
@@ -116,7 +116,7 @@ def test_the_iterative_path_gives_the_direct_paths_outputs(frame_3d, monkeypatch
         assert model.elastic.solve.path in (path, None)
     d = np.abs(out["direct"]["delta_um"] - out["iterative"]["delta_um"]).max()
     T = np.abs(out["direct"]["theta_A_degC"] - out["iterative"]["theta_A_degC"]).max()
-    assert d < 1e-5 and T < 1e-6, (d, T)  # achieved 4.7e-7 µm, 2.9e-7 K
+    assert d < 1e-4 and T < 1e-5, (d, T)  # achieved 2.1e-5 µm, 4.1e-6 K (heat steps to HEAT_RTOL = 1e-7)
 
 
 @pytest.mark.slow
