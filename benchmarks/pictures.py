@@ -1,6 +1,6 @@
 """What each picture of a 2-D run costs, and two ways of drawing them that were tried.
 
-    python benchmarks/pictures.py [--rounds 5]
+    python benchmarks/pictures.py [--rounds 5] [--deformed-3d]
 
 One condition-1 run of ``gate_frame(dim=2)`` (the states of the deformed picture kept), then
 per round (interleaved) each picture ``gatetherm simulate`` writes, drawn on a new figure by the library's
@@ -9,6 +9,12 @@ memory) at 200 dpi (:data:`gatetherm.validation.plots.DPI`), 150 and 100 dpi, 20
 PNG compression level 1, and 200 dpi by the library's writer (:func:`gatetherm.validation.plots.save`:
 zlib's run-length strategy; to a file). Last, the four drawn in turn against in four threads at once
 (docs/performance.md, "The 2-D default condition").
+
+``--deformed-3d`` instead: one condition-1 run of ``gate_frame(dim=3)``, then per round
+(interleaved) its deformed picture drawn as a painting process gets it (its arguments pickled and
+unpickled, then :func:`~gatetherm.validation.plots.field.render_deformed` and the PNG) from the
+body's surface (``deformed``: what the library hands the painter) and from the whole mesh and
+its nodal fields (before): the medians, the pickled sizes and how many pixels differ.
 """
 from __future__ import annotations
 
@@ -52,10 +58,48 @@ def draw(make, dpi=200, compress=6, library=False) -> tuple[float, float, float]
     return t1 - t0, t2 - t1, time.perf_counter() - t2
 
 
+def deformed_3d(rounds: int) -> None:
+    """The 3-D deformed picture from the surface and from the whole mesh (see the module's text)."""
+    import pickle
+
+    import matplotlib.image
+
+    import gatetherm as gt
+    from gatetherm.studies.run.output import nearest_state, nodal_fields
+    from gatetherm.validation.plots import save
+    from gatetherm.validation.plots.field import deformed, render_deformed
+
+    res = gt.run(gt.gate_frame(3))
+    run = res.scenario
+    t = nearest_state(run, res.summary()["first_peak_min"] * 60.0)[0]
+    surface, fields, title, scale = deformed(run, t, "x")
+    ways = {"surface": (surface, fields), "whole mesh": (run.model.fmesh, nodal_fields(run.model, dict(
+        run.result.states)[t], stress=False))}
+    seen = {name: [] for name in ways}
+    with tempfile.TemporaryDirectory() as tmp:
+        for r in range(rounds + 1):  # the first round warms pyvista up
+            for name, args in ways.items():
+                t0 = time.perf_counter()
+                blob = pickle.dumps(args)
+                save(render_deformed(*pickle.loads(blob), title, scale), os.path.join(tmp, f"{name}.png"))
+                if r:
+                    seen[name].append(time.perf_counter() - t0)
+        a, b = (np.round(255 * matplotlib.image.imread(os.path.join(tmp, f"{n}.png"))) for n in ways)
+    for name, args in ways.items():
+        print(f"{name:10s} {statistics.median(seen[name]):.3f} s (runs {', '.join(f'{x:.3f}' for x in seen[name])}), "
+              f"pickled {len(pickle.dumps(args)) / 1e6:.1f} MB")
+    d = np.abs(a - b).max(axis=-1)
+    print(f"pixels differing: {np.count_nonzero(d)} of {d.size}, by more than one level: {np.count_nonzero(d > 1)}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--deformed-3d", action="store_true", help="the 3-D deformed picture: surface or whole mesh")
     args = ap.parse_args()
+    if args.deformed_3d:
+        deformed_3d(args.rounds)
+        return
 
     import gatetherm as gt
 

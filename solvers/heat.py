@@ -166,9 +166,10 @@ class HeatSystem:
 
 
 HEAT_RTOL = 1e-7
-"""Relative residual of a heat step solved iteratively: 3.0 AMG-CG iterations a step against
-4.4 at 1e-8 on the 3-D frame (0.7 × the march), δ's first peak and swing within 1e-5 µm of the
-factor's (``python benchmarks/scaling.py --dims 3 --factors 1 --paths direct iterative``)."""
+"""Relative residual of a heat step solved iteratively: on the 3-D frame δ's first peak and
+swing within 1e-5 µm of the factor's (``python benchmarks/scaling.py --dims 3 --factors 1
+--paths direct iterative``); the march three quarters of its time at 1e-8
+(``docs/performance.md``)."""
 
 
 class HeatSolver:
