@@ -71,31 +71,66 @@ def _identity(value):
     return value
 
 
+WAITING = (-1, None)
+"""The message the caller sends when it waits for a solution: the helper then solves the jobs it
+has together, their columns in two processes where the solver splits a call's right-hand sides
+(AMG-CG's ``split``), the caller's core being idle."""
+
+
 def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
     """The helper's life: make the solver, then answer each job ``(k, path of b)`` with
-    ``(k, path of x, None)`` or ``(k, None, error text)``."""
+    ``(k, path of x, None)`` or ``(k, None, error text)``: one at a time while the caller works,
+    those it has together once the caller waits (:data:`WAITING`)."""
     try:
         t0 = time.perf_counter()
         solve, error = make(), None
         log.debug("helper: solver made in %.2f s", time.perf_counter() - t0)
     except Exception as err:  # noqa: BLE001 - reported with every job
         solve, error = None, f"{type(err).__name__}: {err}"
-    while (job := receive(jobs)) is not None:
-        k, path = job
-        reply = (k, None, error)
-        if solve is not None:
-            try:
-                t0 = time.perf_counter()
-                b = np.load(path)
-                os.unlink(path)
-                x = solve(b)
-                log.debug("helper: job %d (%d right-hand sides) in %.2f s", k, x.shape[1] if x.ndim == 2 else 1,
-                          time.perf_counter() - t0)
-                np.save(path := path.replace(".b.npy", ".x.npy"), x)
-                reply = (k, path, None)
-            except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
-                reply = (k, None, f"{type(err).__name__}: {err}")
-        send(replies, reply)
+    queue, waited = [], False
+    while True:
+        while not queue or select.select([jobs], [], [], 0)[0]:  # what has come; wait only with nothing to do
+            job = receive(jobs)
+            if job is None:
+                return
+            if job[0] < 0:
+                waited = True
+            else:
+                queue.append(job)
+        batch, both = (queue, True) if waited else (queue[:1], False)
+        queue, waited = queue[len(batch):], False
+        for reply in _answer(solve, error, batch, both):
+            send(replies, reply)
+
+
+def _answer(solve, error: str | None, batch: list, both: bool) -> list[tuple]:
+    """The replies to the jobs of ``batch``: one-column right-hand sides of one length stacked
+    into one call, others each alone; with ``both`` (the caller waits) the solver's ``split``
+    on, so that a call's columns are solved in two processes."""
+    if solve is None:
+        return [(k, None, error) for k, _ in batch]
+    try:
+        t0 = time.perf_counter()
+        bs = [np.load(path) for _, path in batch]
+        for _, path in batch:
+            os.unlink(path)
+        stack = len(bs) > 1 and all(b.ndim == 1 and b.shape == bs[0].shape for b in bs)
+        split = getattr(solve, "split", None)
+        if split is not None:
+            solve.split = both
+        try:
+            xs = list(solve(np.column_stack(bs)).T) if stack else [solve(b) for b in bs]
+        finally:
+            if split is not None:
+                solve.split = split
+        log.debug("helper: jobs %s in %.2f s", [k for k, _ in batch], time.perf_counter() - t0)
+        out = []
+        for (k, path), x in zip(batch, xs):
+            np.save(path := path.replace(".b.npy", ".x.npy"), x)
+            out.append((k, path, None))
+        return out
+    except Exception as err:  # noqa: BLE001 - reported to the caller, which raises
+        return [(k, None, f"{type(err).__name__}: {err}") for k, _ in batch]
 
 
 class SolveHelper:
@@ -154,6 +189,11 @@ class SolveHelper:
         return k in self._answers
 
     def _wait(self, k: int) -> np.ndarray:
+        if not self._collect(k, block=False):  # the caller waits: the helper may take both cores
+            try:
+                send(self._jobs, WAITING)
+            except BrokenPipeError:
+                raise SolverError(f"{self.what}: {ENDED}") from None
         self._collect(k, block=True)
         x = self._answers.pop(k)
         if isinstance(x, SolverError):

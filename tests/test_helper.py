@@ -8,13 +8,14 @@ import os
 import pickle
 import select
 import signal
+import time
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from gatetherm import process
-from gatetherm.solvers import p1, plan
+from gatetherm.solvers import iterative, p1, plan
 from gatetherm.solvers.frame import build_model
 from gatetherm.solvers.helper import Pending, SolveHelper
 from gatetherm.solvers.iterative import PCG, SolverError
@@ -48,6 +49,50 @@ def test_helper_solutions_are_the_factors_each_to_its_own_submission():
         assert x.shape == b.shape and np.abs(x - ref(b)).max() < 1e-9 * np.abs(ref(b)).max()
     with pytest.raises(SolverError, match="closed"):
         helper.submit(bs[0])
+
+
+class _Spy:
+    """A 'solver' giving ``b`` while its ``split`` is off, ``2 b`` while on (as the helper sets
+    it), sleeping 0.5 s on a right-hand side starting with -1."""
+
+    split = False
+
+    def __call__(self, b):
+        if np.ravel(b)[0] == -1.0:
+            time.sleep(0.5)
+        return b * (2.0 if self.split else 1.0)
+
+
+def test_what_the_helper_has_when_the_caller_waits_is_solved_together_in_two_processes(monkeypatch):
+    """Jobs queued behind a slow one while the caller works are solved one at a time, as they
+    come; once the caller waits, those queued are solved in one call with the solver's split on
+    (its columns in two processes); the AMG-CG helper's answers so are the factor's."""
+    spy = SolveHelper(_Spy, "spy")
+    try:
+        slow, b = -np.ones(4), np.arange(1.0, 5.0)
+        first = [spy.submit(x) for x in (slow, b)]
+        time.sleep(1.0)  # the caller works: each solved alone
+        assert [np.array_equal(p.result(), x) for p, x in zip(first, (slow, b))] == [True, True]
+        queued = [spy.submit(slow)]
+        time.sleep(0.2)  # the slow one taken up
+        queued += [spy.submit(x) for x in (b, 2 * b, np.column_stack([b, b]))]
+        got = [p.result() for p in reversed(queued)][::-1]  # the caller waits behind the slow one
+    finally:
+        spy.close()
+    assert np.array_equal(got[0], slow)  # being solved when the caller began to wait
+    assert np.array_equal(got[1], 2 * b) and np.array_equal(got[2], 4 * b)  # stacked, split on
+    assert np.array_equal(got[3], 2 * np.column_stack([b, b]))  # alone, split on
+    monkeypatch.setattr(iterative, "SPLIT_UNKNOWNS", 0)  # the coarse system splits too
+    A = _laplacian()
+    rng = np.random.default_rng(1)
+    bs = [rng.normal(size=A.shape[0]) for _ in range(4)]
+    helper = SolveHelper(lambda: PCG(A, rtol=1e-12, split=False), "test system")
+    try:
+        xs = [p.result() for p in [helper.submit(x) for x in bs]]
+    finally:
+        helper.close()
+    ref = spd_factor(A)[0]
+    assert max(np.abs(x - ref(x_b)).max() / np.abs(ref(x_b)).max() for x, x_b in zip(xs, bs)) < 1e-9
 
 
 def test_a_failure_in_the_helper_is_raised_in_the_caller():
