@@ -249,7 +249,7 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
         vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
         T_basis, t = CellBasis(mesh, T_basis.elem, intorder=q), thickness.at(vb)
         forms = (axisym.stiffness, axisym.thermal_load) if axi else (stiffness, thermal_load)
-        K = asm(forms[0], vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
+        K = partial(asm, forms[0], vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
         B = asm(forms[1], T_basis, vb, b=Field(b).at(vb), t=t)
     springs = []
     for s in supports:
@@ -265,13 +265,13 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     free = np.setdiff1d(np.arange(vb.N), fixed)
 
     def whole():  # with the supports' springs
-        A = K() if callable(K) else K
+        A = K()
         return (A + sum(springs[1:], springs[0]) if springs else A).tocsr()
 
     def on_free(A):  # in two steps: the full matrix goes before the columns are taken
         A = A[free]
         return A[:, free]
-    K_fixed = None
+    K_fixed, size = None, None  # the size: the made matrix's
     if linear and not any(s.values for s in supports):  # the nodes' order, found when a factor needs it
         Kf, size = Pending(lambda: on_free(whole())), (len(free), _free_nonzeros(simplices.pattern, free, dim))
         perm = partial(_free_order, simplices, dim, free, vb.N)
@@ -281,7 +281,6 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
         perm = partial(_free_order, simplices, dim, free, vb.N) if linear else \
             restrict_order(nd_order(A, dim), free, vb.N)
         Kf = Pending.of(on_free(A))
-        size = Kf.result().shape[0], Kf.result().nnz
     rbm = rigid_body_modes(vb.doflocs, vb.split_indices())[free]
     log.info("elastic system: %d free DOFs (P%d, %d-D%s)", len(free), order, dim,
              f" plane {plane}" if dim == 2 else "")

@@ -262,9 +262,9 @@ class SPDSolver:
             if p.path != "iterative":
                 return False
             log.info("%s", p.describe(f"{self.what} ({self.size[0]} unknowns)", rhs))
-        A, near_null, block = self._A, self.near_null, self.block  # the helper makes A if it is not made yet
-        self._helper = SolveHelper(lambda: PCG(A.result(), near_null, block, RTOL, split=False),  # and solves
-                                   self.what)  # one column at a time: a core each
+        A, near_null, block = self._A, self.near_null, self.block  # the helper makes A if it is not made yet;
+        # it solves one column at a time while the caller works (a core each), in two processes while it waits
+        self._helper = SolveHelper(lambda: PCG(A.result(), near_null, block, RTOL, split=False), self.what)
         self.path = "iterative"
         return True
 

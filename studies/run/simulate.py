@@ -158,8 +158,7 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
             first = settled_first_peak(delta_um) if i % look_every == 0 else None
             if first is not None:  # the kept state nearest it (the earlier of two), as the picture takes
                 tp, peak = inputs[first]["time_s"], None
-                ahead.add(min(sorted(keep), key=lambda s: abs(s - tp)))
-                ahead -= {float(times[-1])}
+                ahead |= {min(sorted(keep), key=lambda s: abs(s - tp))} - {float(times[-1])}
                 solved.update({s: model.displacement_later(Us, envs[s]) for s, Us in states
                                if s in ahead and s not in solved})  # reached already
         if t in ahead and t not in solved:
