@@ -61,7 +61,9 @@ def job(dim: int, factor: float) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         (Path(tmp) / "mesh.toml").write_text(f"[mesh]\n{key} = {size!r}\n")
         cfg = load_config(Path(tmp) / "mesh.toml")
-        case = frame_case(cfg, dim)
+        t = time.perf_counter()
+        case = frame_case(cfg, dim)  # meshed (gmsh, in a process of its own)
+        mesh_s = time.perf_counter() - t
         schedule = case.schedule
         p = prepare(case)
         out_times = schedule.times[::60]
@@ -71,7 +73,7 @@ def job(dim: int, factor: float) -> dict:
         del p  # the heat factors go, as in ``simulate``, before the output-time elastic solves
         t = time.perf_counter()
         dict(displacements(model, res.states, res.envs, res.solved))  # each waited for (or solved here)
-        parts = dict(model.timings, heat_factor=factor_s, steps=res.seconds - factor_s,
+        parts = dict(model.timings, mesh=mesh_s, heat_factor=factor_s, steps=res.seconds - factor_s,
                      output_solves=time.perf_counter() - t)
     el = model.elastic
     figs = delta_figures(res.columns["time_s"], res.columns["delta_um"])

@@ -211,21 +211,19 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
     """:func:`recovery` for linear elements, vectorised (solvers/p1.py): the element stress
     is constant (:class:`ElementStress`) and the thermal part is the mass matrix times ``−b``."""
     from gatetherm.solvers import p1
-    from gatetherm.solvers.linsolve import restrict_order
 
     b_all = b
     if elements is None:
         s = simplices or p1.simplices(mesh)
         cells, G, vol, pattern = mesh.t.T, s.G, s.vol, s.pattern
         active = np.arange(mesh.nvertices)
-        order = s.order
+        order = lambda: s.order  # noqa: E731  (all nodes active; found only if the projection is factorised)
     else:
         cells = mesh.t.T[elements]
         G, vol = p1.gradients(mesh.p.T, cells)
         lam, mu, b = lam[elements], mu[elements], b[elements]
         pattern, active, order = p1.Pattern(cells, mesh.nvertices), np.unique(cells), None
     M = pattern.scalar(p1.mass(G, vol, np.ones(len(vol))))[active][:, active]
-    order = None if order is None else restrict_order(order, active, mesh.nvertices)
 
     S = ElementStress(cells, G, vol, lam, mu, tuple(comps), mesh.nvertices)
     if T_at is None:
@@ -238,14 +236,15 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
     return Recovery(full, full, active, _factor(M, order, dim), S, Q, comps)
 
 
-def _factor(M: sp.spmatrix, order: np.ndarray | None = None, dim: int = 3):
+def _factor(M: sp.spmatrix, order=None, dim: int = 3):
     """A solver of the mass matrix as an object with ``solve``: a sparse Cholesky factor in a
-    METIS order, or AMG-CG where that would not fit (:func:`~gatetherm.solvers.linsolve.planned_solver`,
-    planned for the six components of a few fields)."""
+    METIS order (``order``, or a function giving it; None: found from ``M``), or AMG-CG where that
+    would not fit (:func:`~gatetherm.solvers.linsolve.planned_solver`, planned for the six components
+    of a few fields)."""
     from types import SimpleNamespace
 
     from gatetherm.solvers.linsolve import nd_order, planned_solver
 
-    solve = planned_solver(M, dim, 6 * 8, "stress projection", order=nd_order(M) if order is None else order,
+    solve = planned_solver(M, dim, 6 * 8, "stress projection", order=order or (lambda: nd_order(M)),
                            rtol=1e-12)[0]
     return SimpleNamespace(solve=solve)
