@@ -213,7 +213,7 @@ class HeatSolver:
         """A solver of the solid block ``S`` (of the step ``θ dt``) for ``rhs`` solves: one METIS
         order for all the factors (the step matrices share a pattern); one AMG hierarchy for the
         modes of a ``θ dt`` (the pumps change only a wall's film; on the 3-D frame at 8 × the nodes
-        the iterations are the same to 1 %: ``benchmarks/heat_amg.py``)."""
+        2 % more iterations than with a hierarchy of its own: ``benchmarks/heat_amg.py``)."""
         sys = self.system
 
         def order():  # asked for only by a factor

@@ -64,8 +64,8 @@ class AMG:
         kw = dict(symmetry="symmetric", max_coarse=500,
                   presmoother=("gauss_seidel", {"sweep": "forward"}), postsmoother=("gauss_seidel", {"sweep": "backward"}))
         if near_null is None:  # heat: all connections strong; energy-minimising prolongation in two
-            # steps: on the 3-D frame's heat steps at 8 × the nodes 20 % fewer iterations than Jacobi
-            # smoothing of P (7 % at 1 ×), the set-up 0.4 s longer (benchmarks/heat_amg.py)
+            # steps: on the 3-D frame's heat steps at 8 × the nodes a quarter fewer iterations than
+            # Jacobi smoothing of P, the set-up 1.1 s longer (benchmarks/heat_amg.py)
             kw.update(smooth=smooth or ("energy", {"maxiter": 2}))
         else:  # energy-minimising prolongation: 25 iterations on the 3-D frame against 58 of Jacobi
             # smoothing; the rigid-body modes are exact, no relaxation improves them (40 % of the set-up)
