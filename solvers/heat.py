@@ -125,8 +125,9 @@ class HeatSystem:
     T0: float
     """Initial temperature, °C."""
     simplices: p1.Simplices | None = None
-    """The P1 mesh's, whose fill-reducing node order the other factors on the mesh share
-    (None: an order found from the first step matrix that is factorised)."""
+    """The linear mesh's :class:`~gatetherm.solvers.p1.Simplices`: their METIS node order, found
+    when a step matrix is first factorised, is the one every factor on the mesh shares (None: an
+    order found from that step matrix)."""
 
     @property
     def n(self) -> int:
