@@ -33,7 +33,6 @@ from skfem.helpers import dot, grad
 from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.fem import Field, dof_basis, element
-from gatetherm.solvers.iterative import PCG
 from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
 from gatetherm.solvers.scheme import TimeScheme
 
@@ -191,7 +190,7 @@ class HeatSolver:
         self._K: dict[Mode, sp.csr_matrix] = {}
         self._lu: dict[tuple[float, Mode], tuple[Bordered, sp.csr_matrix | None]] = {}
         self._order: list = []
-        self._amg: dict[float | None, object] = {}  # AMG hierarchies by θ dt, shared by the modes
+        self._amg: dict = {}  # AMG hierarchies by θ dt, shared by the modes
         self._expected: dict[tuple[float, Mode], int] = {}
         self.factor_seconds = 0.0
         """Seconds spent setting the step solvers up so far."""
@@ -222,9 +221,9 @@ class HeatSolver:
                 self._order.append(nd_order(S) if sys.simplices is None else
                                    restrict_order(sys.simplices.order, self.free[:self.n_inner], sys.n_solid))
             return self._order[0]
-        solve = planned_solver(S, sys.basis.mesh.dim(), rhs, what, order=order, rtol=HEAT_RTOL, warm=rhs > 1,
-                               amg=self._amg.get(theta_dt))[0]
-        if isinstance(solve, PCG):
+        solve, path = planned_solver(S, sys.basis.mesh.dim(), rhs, what, order=order, rtol=HEAT_RTOL, warm=rhs > 1,
+                                     amg=self._amg.get(theta_dt))
+        if path == "iterative":
             self._amg.setdefault(theta_dt, solve.amg)
         return solve
 
