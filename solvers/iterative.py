@@ -15,6 +15,7 @@ tolerance raises :class:`~gatetherm.solvers.linsolve.SolverError`.
 from __future__ import annotations
 
 import logging
+import math
 import os
 import pickle
 import signal
@@ -32,6 +33,17 @@ MAXITER = 400
 """Iterations after which conjugate gradients give up (and raise)."""
 RECYCLE = 6
 """Solutions kept for the Galerkin start of the next right-hand side."""
+
+
+def max_coarse(blocks: int) -> int:
+    """The largest coarsest level (in node blocks) of a hierarchy of ``blocks`` node blocks: pyamg's
+    500, or √blocks if more, solved exactly by sparse LU (whose cost then grows no faster than the
+    unknowns). With 500, the 3-D frame's elastic hierarchy at 20 × the nodes went on from 594
+    aggregates (3 564 unknowns) to 12, and conjugate gradients took about twice the iterations of
+    the 594 solved exactly (``benchmarks/amg_coarse.py``); up to 8 × no level changes."""
+    return max(500, math.isqrt(blocks))
+
+
 SPLIT_UNKNOWNS = 50_000
 """From this many unknowns on, the right-hand sides of one call are solved in two processes
 (the later half by a forked copy), where the process may fork (:func:`gatetherm.process.can_fork`)."""
@@ -53,15 +65,17 @@ class AMG:
     (aggregated together when every node keeps all of them); None: the constants."""
 
     def __init__(self, A: sp.spmatrix, near_null: np.ndarray | None = None, block: int = 1, single: bool = True,
-                 smooth=None):
+                 smooth=None, coarsest: int | None = None):
         """``single``: the cycle in single precision (``benchmarks/amg_precision.py`` measures both);
         ``smooth``: pyamg's prolongation smoother instead of the energy minimisation
-        (``benchmarks/heat_amg.py`` measures Jacobi's)."""
+        (``benchmarks/heat_amg.py`` measures Jacobi's); ``coarsest``: the largest level solved
+        exactly, in node blocks, instead of :func:`max_coarse`'s."""
         import pyamg
 
         A = A.tocsr()
         whole_nodes = block > 1 and A.shape[0] % block == 0
-        kw = dict(symmetry="symmetric", max_coarse=500,
+        blocks = A.shape[0] // block if whole_nodes else A.shape[0]  # pyamg counts a level's size in blocks
+        kw = dict(symmetry="symmetric", max_coarse=coarsest or max_coarse(blocks), coarse_solver="splu",
                   presmoother=("gauss_seidel", {"sweep": "forward"}), postsmoother=("gauss_seidel", {"sweep": "backward"}))
         if near_null is None:  # heat: all connections strong; energy-minimising prolongation in two
             # steps: on the 3-D frame's heat steps at 8 × the nodes a quarter fewer iterations than
