@@ -2,7 +2,8 @@
 
     python benchmarks/two_processes.py [--rounds 3]
 
-A condition-1 run of ``gate_frame(dim=3)`` keeping the seven field and picture states, then per
+A condition-1 run of ``gate_frame(dim=3)`` keeping the seven field and picture states (its elastic
+solver AMG-CG in this process, not in a helper), then per
 round, in turn: their displacements (``studies.run.output.displacements``: one AMG-CG call of
 seven right-hand sides) with the later half solved by a forked copy of the solver
 (``PCG._in_two``, as a command does) and all in this process (``gatetherm.solvers.iterative
@@ -12,6 +13,7 @@ iterations and how far the two solutions lie apart (docs/performance.md, "2026-1
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import time
 
@@ -23,12 +25,18 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args()
     import gatetherm as gt
+    import gatetherm.process
     import gatetherm.solvers.iterative as iterative
     from gatetherm.process import can_fork
     from gatetherm.studies.run.output import displacements
 
     gt.configure()
-    run = gt.run(gt.gate_frame(dim=3), keep=[0.0, 780.0, 3600.0, 7200.0, 10800.0, 14400.0, 18000.0])
+    os.environ["GATETHERM_SPD_BACKEND"] = "amg"  # the elastic solver AMG-CG, set up here (no helper process),
+    gatetherm.process.can_fork = lambda: False  # so that this process holds it
+    try:
+        run = gt.run(gt.gate_frame(dim=3), keep=[0.0, 780.0, 3600.0, 7200.0, 10800.0, 14400.0, 18000.0])
+    finally:
+        gatetherm.process.can_fork = can_fork
     model, result = run.scenario.model, run.scenario.result
     pcg = model.elastic.solve._solve
     start = pcg.kept
