@@ -41,6 +41,17 @@ def test_amg_cg_equals_the_factor_and_raises_when_it_cannot_converge(heat_3d, mo
         iterative.PCG(A, rtol=1e-12)(b[:, 0])
 
 
+def test_coarsening_stops_at_the_bound_and_the_coarsest_level_is_solved_exactly(heat_3d):
+    _, A = heat_3d
+    assert (iterative.max_coarse(52_812), iterative.max_coarse(961_358)) == (500, 980)  # the 1 × and 20 × heat
+    sizes = [lv.A.shape[0] for lv in iterative.AMG(A, coarsest=20).ml.levels]
+    assert len(sizes) >= 3 and sizes[-1] <= 20 < sizes[-2], sizes
+    b = np.random.default_rng(1).normal(size=A.shape[0])
+    whole = iterative.AMG(A, coarsest=A.shape[0])  # one level: the V-cycle is its sparse LU solve
+    assert len(whole.ml.levels) == 1
+    assert np.linalg.norm(A @ whole(b) - b) < 1e-12 * np.linalg.norm(b)
+
+
 def test_right_hand_sides_solved_in_two_processes_are_the_factors_solutions(heat_3d, monkeypatch):
     """The later half of the columns solved by a forked copy: the factor's solutions, its
     iterations counted (the first half zero: none of its own), its failure raised here."""
