@@ -31,6 +31,7 @@ def recorded(factor: float, keep: int) -> dict[str, tuple]:
     used heat step system of a condition-1 run, with (at most ``keep`` of) their right-hand sides."""
     import gatetherm.process
     from gatetherm.solvers import iterative, linsolve
+    from gatetherm.solvers.heat import HEAT_RTOL
     from scaling import job
 
     seen: dict = {}
@@ -55,7 +56,6 @@ def recorded(factor: float, keep: int) -> dict[str, tuple]:
         iterative.AMG.__init__, iterative.PCG.__call__ = init, call
     elastic = next(r for r in seen.values() if r[1] is not None)
     heat = max((r for r in seen.values() if r[1] is None), key=lambda r: len(r[3]))
-    from gatetherm.solvers.heat import HEAT_RTOL
     return {"elastic": elastic[:3] + (linsolve.RTOL, elastic[3]), "heat": heat[:3] + (HEAT_RTOL, heat[3])}
 
 

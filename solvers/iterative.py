@@ -1,10 +1,11 @@
 """Conjugate gradients preconditioned by smoothed-aggregation AMG, for the SPD systems of meshes
 too large to factorise: memory grows linearly with the unknowns.
 
-:class:`AMG` is one V-cycle of a pyamg smoothed-aggregation hierarchy (built once per matrix:
-near-null space the constants, or the rigid-body modes with the DOFs of each node aggregated
-together for elasticity; forward Gauss–Seidel before and backward after the coarse correction,
-so the cycle is a symmetric preconditioner). :class:`PCG` solves with one matrix for any number
+:class:`AMG` is one V-cycle of a pyamg smoothed-aggregation hierarchy (built once per matrix,
+down to :func:`max_coarse` node blocks solved by sparse LU; near-null space the constants, or the
+rigid-body modes with the DOFs of each node aggregated together for elasticity; forward
+Gauss–Seidel before and backward after the coarse correction, so the cycle is a symmetric
+preconditioner). :class:`PCG` solves with one matrix for any number
 of right-hand sides, one after another (on a large system the later half of one call's in a
 forked copy of the solver, beside: the second core), each started from the Galerkin projection
 of its right-hand side onto the last solutions (``x₀ = X (XᵀAX)⁻¹ Xᵀ b``): for the heat steps of a
@@ -33,20 +34,18 @@ MAXITER = 400
 """Iterations after which conjugate gradients give up (and raise)."""
 RECYCLE = 6
 """Solutions kept for the Galerkin start of the next right-hand side."""
+SPLIT_UNKNOWNS = 50_000
+"""From this many unknowns on, the right-hand sides of one call are solved in two processes
+(the later half by a forked copy), where the process may fork (:func:`gatetherm.process.can_fork`)."""
 
 
 def max_coarse(blocks: int) -> int:
     """The largest coarsest level (in node blocks) of a hierarchy of ``blocks`` node blocks: pyamg's
     500, or √blocks if more, solved exactly by sparse LU (whose cost then grows no faster than the
     unknowns). With 500, the 3-D frame's elastic hierarchy at 20 × the nodes went on from 594
-    aggregates (3 564 unknowns) to 12, and conjugate gradients took about twice the iterations of
+    aggregates (3 564 unknowns) to 12, and conjugate gradients took 2.1 times the iterations of
     the 594 solved exactly (``benchmarks/amg_coarse.py``); up to 8 × no level changes."""
     return max(500, math.isqrt(blocks))
-
-
-SPLIT_UNKNOWNS = 50_000
-"""From this many unknowns on, the right-hand sides of one call are solved in two processes
-(the later half by a forked copy), where the process may fork (:func:`gatetherm.process.can_fork`)."""
 
 
 class SolverError(RuntimeError):
