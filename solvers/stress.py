@@ -245,6 +245,6 @@ def _factor(M: sp.spmatrix, order=None, dim: int = 3):
 
     from gatetherm.solvers.linsolve import nd_order, planned_solver
 
-    solve = planned_solver(M, dim, 6 * 8, "stress projection", order=order or (lambda: nd_order(M)),
-                           rtol=1e-12)[0]
+    order = (lambda: nd_order(M)) if order is None else order  # an array or a function: planned_solver takes both
+    solve = planned_solver(M, dim, 6 * 8, "stress projection", order=order, rtol=1e-12)[0]
     return SimpleNamespace(solve=solve)
