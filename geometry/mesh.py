@@ -206,22 +206,26 @@ def check_mesh(fm: FrameMesh, where: str) -> None:
     (zero-area or zero-volume) elements, boundary facets that are not facets of the elements."""
     if not np.isfinite(fm.points).all():
         raise InputError(where, "has node coordinates that are not finite numbers", "check the file")
-    X = fm.points[fm.cells]
-    E = X[:, 1:] - X[:, :1]
+    E = fm.points[fm.cells[:, 1:]] - fm.points[fm.cells[:, :1]]  # the edges from the first node
     size = np.abs(E[:, 0, 0] * E[:, 1, 1] - E[:, 0, 1] * E[:, 1, 0] if fm.dim == 2 else
                   np.einsum("ij,ij->i", E[:, 0], np.cross(E[:, 1], E[:, 2])))
-    i, j = np.triu_indices(fm.dim + 1, 1)  # the element's edges
-    edge2 = np.einsum("ijk,ijk->ij", X[:, i] - X[:, j], X[:, i] - X[:, j]).max(axis=1)
+    i, j = np.triu_indices(fm.dim, 1)
+    edges = np.concatenate([E, E[:, i] - E[:, j]], axis=1)  # and the others
+    edge2 = np.einsum("ijk,ijk->ij", edges, edges).max(axis=1)
     bad = np.flatnonzero(size <= DEGENERATE * edge2 ** (fm.dim / 2))
     if len(bad):
-        at = ", ".join(f"{v:.4g}" for v in X[bad[0]].mean(axis=0))
+        at = ", ".join(f"{v:.4g}" for v in fm.points[fm.cells[bad[0]]].mean(axis=0))
         raise InputError(where, f"has {len(bad)} element(s) of zero {'area' if fm.dim == 2 else 'volume'} "
                          f"(the first at ({at}))", "check the geometry for coincident points or collapsed entities")
-    rows = np.vstack([np.delete(fm.cells, i, axis=1) for i in range(fm.dim + 1)])
+    listed = {name: np.asarray(fac) for name, fac in fm.boundaries.items() if np.size(fac)}
+    on = np.zeros(len(fm.points) + 1, dtype=bool)  # the nodes of the boundaries' facets (-1: the last)
+    for fac in listed.values():
+        on[fac.ravel()] = True
+    near = fm.cells[np.count_nonzero(on[fm.cells], axis=1) >= fm.dim]  # the elements that may own one
+    rows = np.vstack([np.delete(near, i, axis=1) for i in range(fm.dim + 1)])
     facets = np.sort(facet_keys(rows, len(fm.points)))  # not np.unique: numpy 2.4 hashes (benchmarks/assembly_parts.py)
-    for name, fac in fm.boundaries.items():
-        fac = np.asarray(fac)
-        if fac.size and ((fac < 0).any() or find_facets(facets, fac, len(fm.points)) is None):
+    for name, fac in listed.items():
+        if (fac < 0).any() or find_facets(facets, fac, len(fm.points)) is None:
             raise InputError(f"{where}: boundary {name}", "has facets that are not facets of the mesh's elements "
                              "(a surface or curve that is not part of the meshed body?)",
                              "remove it from the group or make it part of the body (fragment it in gmsh)")

@@ -9,7 +9,7 @@ from skfem import CellBasis, ElementVector, asm
 
 from gatetherm.solvers import p1
 from gatetherm.solvers.elasticity import moduli, stiffness, thermal_load
-from gatetherm.solvers.fem import Field, element, to_skfem
+from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
 from gatetherm.solvers.heat import capacity, conduction
 
 
@@ -101,6 +101,23 @@ def test_facets_by_integer_keys_equal_scikit_fem_entities(dim, frame_2d, frame_3
     ref = (MeshTri if dim == 2 else MeshTet)(np.ascontiguousarray(fm.points.T), np.ascontiguousarray(fm.cells.T))
     facets, t2f = ref.build_entities(ref.t, ref.elem.refdom.facets)
     assert np.array_equal(mesh.facets, facets) and np.array_equal(mesh.t2f, t2f)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_dof_basis_numbers_locates_and_probes_as_a_full_basis(dim, order, frame_2d, frame_3d):
+    """``dof_basis`` is made on one element and widened: its DOFs, element DOFs, DOF locations
+    and probes equal those of scikit-fem's basis on every element."""
+    fm = frame_2d if dim == 2 else frame_3d
+    mesh = to_skfem(fm)
+    x = fm.points[fm.cells[::997]].mean(axis=1).T  # element centroids
+    for elem in (element(dim, order), ElementVector(element(dim, order))):
+        got = dof_basis(mesh, elem)
+        want = CellBasis(mesh, elem, quadrature=(np.zeros((dim, 0)), np.zeros(0)))
+        assert got.N == want.N and got.nelems == want.nelems == mesh.nelements
+        assert np.array_equal(got.element_dofs, want.element_dofs)
+        assert np.abs(got.doflocs - want.doflocs).max() < 1e-15
+        assert abs(got.probes(x) - want.probes(x)).max() < 1e-12
 
 
 @pytest.mark.parametrize("dim", [2, 3])

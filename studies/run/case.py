@@ -25,7 +25,7 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, ranges
 from gatetherm.files import read_text
-from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.geometry.mesh import FrameMesh, facet_keys
 from gatetherm.solvers.effects import Targets
 from gatetherm.solvers.frame import region_volume
 from gatetherm.solvers.heat import TimeScheme
@@ -389,12 +389,16 @@ def case_targets(problem: Problem, fm: FrameMesh) -> Targets:
 
 def _overlapping(fm: FrameMesh, boundaries: list[str]) -> tuple[str, str] | None:
     """Two different ``boundaries`` of the mesh that share a facet (the first such pair), if any."""
-    owner: dict = {}
-    for b in dict.fromkeys(boundaries):
-        for f in map(tuple, np.sort(fm.boundaries[b], axis=1)):
-            if owner.setdefault(f, b) != b:
-                return owner[f], b
-    return None
+    names = list(dict.fromkeys(boundaries))
+    if not names:
+        return None
+    facets = [np.asarray(fm.boundaries[b]) for b in names]
+    label = np.repeat(np.arange(len(names)), [len(f) for f in facets])
+    _, first, inverse = np.unique(facet_keys(np.concatenate(facets), len(fm.points)), return_index=True,
+                                  return_inverse=True)
+    owner = label[first][inverse]  # the boundary that lists each facet first
+    clash = np.flatnonzero(owner != label)
+    return (names[owner[clash[0]]], names[label[clash[0]]]) if len(clash) else None
 
 
 def _twice(kw: dict) -> str | None:
