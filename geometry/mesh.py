@@ -11,6 +11,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm import atomic_path
+from gatetherm.geometry import msh22
 
 _CELL = {2: "triangle", 3: "tetra"}
 _FACET = {2: "line", 3: "triangle"}
@@ -312,7 +313,9 @@ def load_mesh(path: str | os.PathLike) -> FrameMesh:
         raise InputError(str(path), f"unknown mesh format '{path.suffix}'", "give a .msh or .vtu file")
     try:
         # the format's reader itself: meshio.read prints an unreadable file's error and exits
-        mm = (meshio.gmsh if path.suffix == ".msh" else meshio.vtu).read(str(path))
+        mm = msh22.read_binary(path.read_bytes()) if path.suffix == ".msh" else None
+        if mm is None:
+            mm = (meshio.gmsh if path.suffix == ".msh" else meshio.vtu).read(str(path))
         dim = max((b.dim for b in mm.cells if b.type in _CORNERS), default=0)
         if dim < 2:
             raise InputError(str(path), "holds no triangles or tetrahedra", "mesh a surface (2-D) or a volume (3-D)")

@@ -249,6 +249,31 @@ def _msh(nodes, tris, edges=((1, 2),)) -> str:
 GOOD = _msh([(0, 0), (1, 0), (1, 1), (0, 1)], [(1, 2, 3), (1, 3, 4)])
 
 
+def test_binary_msh_is_read_as_meshio_reads_it_and_other_msh_is_left_to_meshio(frame, tmp_path):
+    """``save_mesh``'s binary gmsh 2.2 is read in whole arrays: meshio's points, cell blocks,
+    physical tags and names; ASCII is left to meshio; a cut binary file is one InputError."""
+    import meshio
+
+    from gatetherm.geometry import msh22
+
+    path = tmp_path / "frame.msh"
+    save_mesh(frame, path)
+    got, want = msh22.read_binary(path.read_bytes()), meshio.gmsh.read(str(path))
+    np.testing.assert_array_equal(got.points, want.points)
+    assert [b.type for b in got.cells] == [b.type for b in want.cells] == \
+        (["triangle", "line", "vertex"] if frame.dim == 2 else ["tetra", "triangle", "vertex"])
+    for a, b, ta, tb in zip(got.cells, want.cells, got.cell_data["gmsh:physical"], want.cell_data["gmsh:physical"]):
+        np.testing.assert_array_equal(a.data, b.data)
+        np.testing.assert_array_equal(ta, tb)
+    assert {k: list(v) for k, v in got.field_data.items()} == {k: list(v) for k, v in want.field_data.items()}
+    meshio.write(tmp_path / "ascii.msh", want, file_format="gmsh22", binary=False)
+    assert msh22.read_binary((tmp_path / "ascii.msh").read_bytes()) is None
+    (tmp_path / "cut.msh").write_bytes(path.read_bytes()[:-1000])
+    with pytest.raises(InputError, match="cut.msh: is not a readable .msh file"):
+        load_mesh(tmp_path / "cut.msh")
+
+
+
 @pytest.mark.parametrize("name, body", [
     ("truncated.msh", GOOD[: len(GOOD) // 2]),
     ("garbage.msh", bytes(range(256)) * 4),
