@@ -36,9 +36,10 @@ class _Buffer:
 
 
 def read_binary(data: bytes):
-    """The ``meshio.Mesh`` of a binary gmsh 2.2 file's bytes (corner order of meshio's
-    reader, consecutive blocks of one element type merged as it does), or None for a file
-    this reader leaves to meshio. A truncated file raises ``ValueError``."""
+    """The ``meshio.Mesh`` of a binary gmsh 2.2 file's bytes, as meshio's reader makes it
+    (consecutive blocks of one element type merged; the corners first, higher-order nodes in
+    gmsh's order), or None for a file this reader leaves to meshio. A truncated file raises
+    ``ValueError``."""
     import meshio
 
     buf = _Buffer(data)
