@@ -63,10 +63,25 @@ def read_binary(data: bytes):
         buf.end(section)
     if points is None:
         raise ValueError("no $Nodes section")
-    remap = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
-    remap[tags] = np.arange(len(tags))
-    return meshio.Mesh(points, [(kind, remap[conn]) for kind, conn, _ in blocks],
+    return meshio.Mesh(points, [(kind, _positions(tags, conn)) for kind, conn, _ in blocks],
                        cell_data={"gmsh:physical": [phys for *_, phys in blocks]}, field_data=names)
+
+
+def _positions(tags: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """The positions in ``tags`` (the nodes' numbers, in file order) of the node numbers ``conn``:
+    by a table where the numbers are about as many as the nodes, else by sorted search (a file
+    numbering its nodes sparsely); a number of no node raises ``ValueError``."""
+    if int(tags.max()) <= 4 * len(tags) + 1000:
+        table = np.full(int(tags.max()) + 1, -1, dtype=np.int64)
+        table[tags] = np.arange(len(tags))
+        at = np.where((conn >= 0) & (conn < len(table)), table[np.clip(conn, 0, len(table) - 1)], -1)
+    else:
+        order = np.argsort(tags, kind="stable")
+        i = np.minimum(np.searchsorted(tags[order], conn), len(tags) - 1)
+        at = np.where(tags[order][i] == conn, order[i], -1)
+    if (at < 0).any():
+        raise ValueError(f"an element has node {int(conn[at < 0][0])}, which $Nodes does not list")
+    return at
 
 
 def _elements(buf: _Buffer, count: int):

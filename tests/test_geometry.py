@@ -274,6 +274,35 @@ def test_binary_msh_is_read_as_meshio_reads_it_and_other_msh_is_left_to_meshio(f
 
 
 
+def _binary_msh(nodes: dict, elements: list) -> bytes:
+    """A binary gmsh 2.2 file: ``nodes`` {number: xyz}, ``elements`` [(gmsh type, physical, numbers)];
+    physical group 1 is the volume "solid", 2 the surface "face"."""
+    out = [b"$MeshFormat\n2.2 1 8\n", np.int32(1).tobytes(), b"\n$EndMeshFormat\n",
+           b'$PhysicalNames\n2\n3 1 "solid"\n2 2 "face"\n$EndPhysicalNames\n', f"$Nodes\n{len(nodes)}\n".encode()]
+    out += [np.int32(k).tobytes() + np.asarray(x, dtype="<f8").tobytes() for k, x in nodes.items()]
+    out.append(f"\n$EndNodes\n$Elements\n{len(elements)}\n".encode())
+    for i, (kind, phys, numbers) in enumerate(elements, start=1):
+        out.append(np.array([kind, 1, 2, i, phys, phys, *numbers], dtype="<i4").tobytes())
+    return b"".join(out + [b"\n$EndElements\n"])
+
+
+def test_binary_msh_numbered_sparsely_loads_and_a_missing_node_is_one_input_error(tmp_path):
+    """Node numbers need not be 1..n: a tetrahedron numbered up to 2e9 loads; an element naming
+    a node that ``$Nodes`` does not list is refused, naming the file and the node."""
+    xyz = {7: (0, 0, 0), 2_000_000_000: (1, 0, 0), 40: (0, 1, 0), 3: (0, 0, 1)}
+    tet, face = (4, 1, [7, 2_000_000_000, 40, 3]), (2, 2, [7, 40, 2_000_000_000])
+    (tmp_path / "sparse.msh").write_bytes(_binary_msh(xyz, [tet, face]))
+    fm = load_mesh(tmp_path / "sparse.msh")
+    np.testing.assert_array_equal(fm.points[fm.cells[0]], [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)])
+    np.testing.assert_array_equal(fm.points[fm.boundaries["face"][0]], [(0, 0, 0), (0, 1, 0), (1, 0, 0)])
+    assert list(fm.regions) == ["solid"]
+    (tmp_path / "missing.msh").write_bytes(_binary_msh(xyz, [(4, 1, [7, 2_000_000_000, 40, 5]), face]))
+    with pytest.raises(InputError, match=r"missing\.msh: is not a readable \.msh file \(ValueError: an element has "
+                                         r"node 5, which \$Nodes does not list\)"):
+        load_mesh(tmp_path / "missing.msh")
+
+
+
 @pytest.mark.parametrize("name, body", [
     ("truncated.msh", GOOD[: len(GOOD) // 2]),
     ("garbage.msh", bytes(range(256)) * 4),
