@@ -5,7 +5,8 @@ and then solves each right-hand side it is given, in turn, while the caller goes
 3-D frame the elastic hierarchy, the adjoint read-out and the fields at the output times are
 solved on the second core while the first marches the heat equation
 (``benchmarks/peer.py``). :meth:`SolveHelper.submit` returns a :class:`Pending`, whose
-:meth:`~Pending.result` waits for the solution.
+:meth:`~Pending.result` waits for the solution. :func:`forked` makes one value in a process of
+its own (a mesh's METIS order, beside the set-up that comes before the first factor).
 
 The arrays go through files in a private temporary folder (``/dev/shm`` where there is one),
 the pipes carry only their names: neither side ever waits on the other to read a large
@@ -29,7 +30,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from gatetherm.process import end_with_parent, receive, send
+from gatetherm.process import die_with_parent, end_with_parent, receive, send
 from gatetherm.solvers.iterative import SolverError
 
 log = logging.getLogger(__name__)
@@ -69,6 +70,59 @@ class Pending:
 
 def _identity(value):
     return value
+
+
+def forked(make: Callable[[], Any], what: str) -> Pending:
+    """``make()`` computed in a forked process while the caller goes on (the caller must be able to
+    fork: :func:`gatetherm.process.can_fork`): its :class:`Pending` value, sent back pickled
+    through a pipe (widened to hold it where Linux allows, so that the process ends when done).
+    A ``make`` that fails, or a process that ends without its value, raises
+    :class:`~gatetherm.solvers.iterative.SolverError` from :meth:`Pending.result`."""
+    r, w = os.pipe()
+    try:
+        import fcntl
+        fcntl.fcntl(w, getattr(fcntl, "F_SETPIPE_SZ", 1031), 1 << 20)
+    except (ImportError, OSError):  # not Linux, or above its limit: the process waits to be read
+        pass
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child's coverage is not collected
+        try:
+            _close_others((w,))  # the caller's pipes: their readers see their end
+            die_with_parent(signal.SIGKILL)
+            try:
+                reply = (make(), None)
+            except Exception as err:  # noqa: BLE001 - raised in the caller
+                reply = (None, f"{type(err).__name__}: {err}")
+            send(w, reply)
+        finally:
+            os._exit(0)
+    os.close(w)
+    live = [True]
+
+    def end():  # once: after the value is read, or when the Pending is dropped unread
+        if live:
+            live.clear()
+            os.close(r)
+            try:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+            except (ProcessLookupError, ChildProcessError):
+                pass
+
+    def wait():
+        try:
+            reply = receive(r)
+        finally:
+            end()
+        if reply is None:
+            raise SolverError(f"{what}: {ENDED}")
+        value, error = reply
+        if error is not None:
+            raise SolverError(f"{what}: {error}")
+        return value
+    pending = Pending(wait, lambda: bool(select.select([r], [], [], 0)[0]))
+    weakref.finalize(pending, end)
+    return pending
 
 
 WAITING = (-1, None)

@@ -28,6 +28,7 @@ from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
 from gatetherm.solvers.heat import HeatSystem, assemble_heat, boundary_terms
 from gatetherm.solvers.helper import Pending
+from gatetherm.solvers.plan import plan
 from gatetherm.solvers.problem import AXES, Problem
 from gatetherm.solvers.stress import Recovery, recovery, von_mises
 
@@ -36,6 +37,11 @@ log = logging.getLogger(__name__)
 Key = tuple
 """An output: ("T", probe), ("u", probe, axis), ("sigma", probe, component), ("relative", name),
 ("fluid", name), ("mean", name)."""
+ORDER_BESIDE = {"nodes": 20_000, "steps": 100}
+"""A mesh's METIS order is found in a process beside the set-up (:meth:`~gatetherm.solvers.p1.
+Simplices.find_order_beside`) from this many nodes (below, it takes under 0.1 s), where the plan
+would factor a heat step matrix for this many steps: then the first factor finds it made (the 3-D
+frame: 0.3 s off the caller's set-up)."""
 
 
 def region_fields(problem: Problem, mesh) -> dict[str, Field]:
@@ -360,6 +366,9 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
     mesh = to_skfem(fmesh)
     f = region_fields(problem, mesh)
     s = p1.simplices(mesh) if problem.order == 1 else None
+    if s is not None and problem.heat and s.pattern.n >= ORDER_BESIDE["nodes"] and plan(
+            s.pattern.n, s.pattern.nnz, 1, problem.dim, ORDER_BESIDE["steps"], warm=True).path == "direct":
+        s.find_order_beside()
     axi = problem.axisymmetric
     el, terms, unit, mech, weights = None, None, None, _Rows([], [], []), None
     if problem.elastic:

@@ -11,6 +11,7 @@ component onto it. Vector DOFs are interleaved, ``dim * node + component``, as s
 """
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 from functools import cached_property
 from math import factorial
@@ -18,7 +19,10 @@ from math import factorial
 import numpy as np
 import scipy.sparse as sp
 
+from gatetherm.solvers.iterative import SolverError
 from gatetherm.solvers.linsolve import nd_order
+
+log = logging.getLogger(__name__)
 
 
 def gradients(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,9 +146,26 @@ class Simplices:
 
     @cached_property
     def order(self) -> np.ndarray | None:
-        """Found when first asked for (0.4 s on the 3-D frame): an elastic system solved by
-        AMG-CG in a helper process is set up before it."""
+        """Found when first asked for (0.3 s on the 3-D frame; an elastic system solved by
+        AMG-CG in a helper process is set up before it), or by the process
+        :meth:`find_order_beside` started."""
+        pending = self.__dict__.pop("_order_beside", None)
+        if pending is not None:
+            try:
+                return pending.result()
+            except SolverError as err:
+                log.debug("%s: found here", err)
         return nd_order(self.pattern.graph())
+
+    def find_order_beside(self) -> None:
+        """Start finding :attr:`order` in a forked process (:func:`~gatetherm.solvers.helper.forked`),
+        so that the caller's first factor finds it made; where the process may fork."""
+        from gatetherm.process import can_fork
+        from gatetherm.solvers.helper import forked
+
+        if "order" not in self.__dict__ and "_order_beside" not in self.__dict__ and can_fork():
+            graph = self.pattern.graph()
+            self.__dict__["_order_beside"] = forked(lambda: nd_order(graph), "METIS order")
 
 
 def simplices(mesh) -> Simplices:

@@ -4,6 +4,7 @@ of the process) is raised in the caller, the helper holds none of the caller's o
 open, and a run with the helper gives the outputs and fields of a run without it."""
 from __future__ import annotations
 
+import gc
 import os
 import pickle
 import select
@@ -17,9 +18,10 @@ import scipy.sparse as sp
 from gatetherm import process
 from gatetherm.solvers import iterative, p1, plan
 from gatetherm.solvers.frame import build_model
-from gatetherm.solvers.helper import Pending, SolveHelper
+from gatetherm.solvers import model as model_module
+from gatetherm.solvers.helper import Pending, SolveHelper, forked
 from gatetherm.solvers.iterative import PCG, SolverError
-from gatetherm.solvers.linsolve import spd_factor
+from gatetherm.solvers.linsolve import nd_order, spd_factor
 from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
 from gatetherm.studies.run.output import displacements
 from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
@@ -135,6 +137,36 @@ def test_a_pending_value_pickles_as_the_value_and_maps():
     p = Pending(lambda: np.arange(4.0)).then(lambda x: 2 * x)
     assert np.array_equal(pickle.loads(pickle.dumps(p)), [0.0, 2.0, 4.0, 6.0])
     assert Pending.of(3).done() and Pending.of(3).then(str).result() == "3"
+
+
+
+def test_a_forked_value_comes_back_a_failure_is_raised_and_a_dropped_one_leaves_no_process():
+    got = forked(lambda: np.arange(300_000), "a value")  # 2.4 MB: more than the widened pipe holds
+    assert np.array_equal(got.result(), np.arange(300_000)) and got.done()
+    with pytest.raises(SolverError, match=r"^a failure: ZeroDivisionError: division by zero$"):
+        forked(lambda: 1 / 0, "a failure").result()
+    def children() -> set[str]:
+        return set(open(f"/proc/{os.getpid()}/task/{os.getpid()}/children").read().split())
+    before = children()
+    dropped = forked(lambda: time.sleep(60), "dropped")
+    assert len(children() - before) == 1
+    del dropped
+    gc.collect()
+    assert children() - before == set()  # killed and reaped
+
+
+def test_the_order_found_beside_the_set_up_is_the_one_found_here(frame_3d, monkeypatch):
+    """Where the plan would factor a heat step, ``build`` starts the mesh's METIS order in a forked
+    process (from any size here); the order it gives is the caller's own."""
+    from gatetherm.solvers import helper
+
+    started = []
+    monkeypatch.setitem(model_module.ORDER_BESIDE, "nodes", 0)
+    monkeypatch.setattr(process, "can_fork", lambda: True)
+    monkeypatch.setattr(helper, "forked", lambda make, what, f=helper.forked: started.append(what) or f(make, what))
+    model = build_model(FIXED_MODEL, 3, frame_3d)  # its elastic factor (for the read-out) takes the order
+    assert started == ["METIS order"] and "_order_beside" not in model.simplices.__dict__
+    assert np.array_equal(model.simplices.order, nd_order(model.simplices.pattern.graph()))
 
 
 def test_a_run_with_the_elastic_helper_gives_the_outputs_and_fields_of_one_without(frame_3d, monkeypatch):
