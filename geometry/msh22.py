@@ -9,7 +9,8 @@ import numpy as np
 TYPES = {1: ("line", 2), 2: ("triangle", 3), 4: ("tetra", 4), 8: ("line3", 3), 9: ("triangle6", 6),
          11: ("tetra10", 10), 15: ("vertex", 1)}
 """gmsh element types read: meshio's name and the nodes per element."""
-SECTIONS = ("MeshFormat", "PhysicalNames", "Nodes", "Elements")
+SECTIONS = ("PhysicalNames", "Nodes", "Elements")
+"""The sections read after ``$MeshFormat``; a file with another is left to meshio."""
 
 
 class _Buffer:
@@ -58,7 +59,7 @@ def read_binary(data: bytes):
             points, tags = np.array(nodes["x"]), nodes["tag"]
         elif section == "Elements":
             blocks = _elements(buf, int(buf.line()))
-        if section not in SECTIONS[1:] or blocks is None:
+        if section not in SECTIONS or blocks is None:
             return None
         buf.end(section)
     if points is None:

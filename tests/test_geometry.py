@@ -273,7 +273,6 @@ def test_binary_msh_is_read_as_meshio_reads_it_and_other_msh_is_left_to_meshio(f
         load_mesh(tmp_path / "cut.msh")
 
 
-
 def _binary_msh(nodes: dict, elements: list) -> bytes:
     """A binary gmsh 2.2 file: ``nodes`` {number: xyz}, ``elements`` [(gmsh type, physical, numbers)];
     physical group 1 is the volume "solid", 2 the surface "face"."""
@@ -300,7 +299,6 @@ def test_binary_msh_numbered_sparsely_loads_and_a_missing_node_is_one_input_erro
     with pytest.raises(InputError, match=r"missing\.msh: is not a readable \.msh file \(ValueError: an element has "
                                          r"node 5, which \$Nodes does not list\)"):
         load_mesh(tmp_path / "missing.msh")
-
 
 
 @pytest.mark.parametrize("name, body", [

@@ -139,12 +139,12 @@ def test_a_pending_value_pickles_as_the_value_and_maps():
     assert Pending.of(3).done() and Pending.of(3).then(str).result() == "3"
 
 
-
 def test_a_forked_value_comes_back_a_failure_is_raised_and_a_dropped_one_leaves_no_process():
     got = forked(lambda: np.arange(300_000), "a value")  # 2.4 MB: more than the widened pipe holds
     assert np.array_equal(got.result(), np.arange(300_000)) and got.done()
     with pytest.raises(SolverError, match=r"^a failure: ZeroDivisionError: division by zero$"):
         forked(lambda: 1 / 0, "a failure").result()
+
     def children() -> set[str]:
         return set(open(f"/proc/{os.getpid()}/task/{os.getpid()}/children").read().split())
     before = children()
