@@ -204,18 +204,30 @@ def snap_points(points: np.ndarray, cells: np.ndarray, sensors: dict[str, int]) 
     return out, notes
 
 
+CHUNK = 1 << 15
+"""Elements checked at a time: the arrays of a chunk stay in the cache and are made again without
+page faults (the 3-D frame's check of element sizes 61-88 ms against 98-239 ms all at once)."""
+
+
+def _degenerate(points: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """The rows of ``cells`` whose area or volume is below :data:`DEGENERATE` times their longest
+    edge to the power of the dimension."""
+    dim = cells.shape[1] - 1
+    E = points[cells[:, 1:]] - points[cells[:, :1]]  # the edges from the first node
+    size = np.abs(E[:, 0, 0] * E[:, 1, 1] - E[:, 0, 1] * E[:, 1, 0] if dim == 2 else
+                  np.einsum("ij,ij->i", E[:, 0], np.cross(E[:, 1], E[:, 2])))
+    i, j = np.triu_indices(dim, 1)
+    edges = np.concatenate([E, E[:, i] - E[:, j]], axis=1)  # and the others
+    return np.flatnonzero(size <= DEGENERATE * np.einsum("ijk,ijk->ij", edges, edges).max(axis=1) ** (dim / 2))
+
+
 def check_mesh(fm: FrameMesh, where: str) -> None:
     """Refuse a mesh that cannot be solved on: coordinates that are not finite, degenerate
     (zero-area or zero-volume) elements, boundary facets that are not facets of the elements."""
     if not np.isfinite(fm.points).all():
         raise InputError(where, "has node coordinates that are not finite numbers", "check the file")
-    E = fm.points[fm.cells[:, 1:]] - fm.points[fm.cells[:, :1]]  # the edges from the first node
-    size = np.abs(E[:, 0, 0] * E[:, 1, 1] - E[:, 0, 1] * E[:, 1, 0] if fm.dim == 2 else
-                  np.einsum("ij,ij->i", E[:, 0], np.cross(E[:, 1], E[:, 2])))
-    i, j = np.triu_indices(fm.dim, 1)
-    edges = np.concatenate([E, E[:, i] - E[:, j]], axis=1)  # and the others
-    edge2 = np.einsum("ijk,ijk->ij", edges, edges).max(axis=1)
-    bad = np.flatnonzero(size <= DEGENERATE * edge2 ** (fm.dim / 2))
+    bad = np.concatenate([start + _degenerate(fm.points, fm.cells[start:start + CHUNK])
+                          for start in range(0, len(fm.cells), CHUNK)] or [np.zeros(0, dtype=np.int64)])
     if len(bad):
         at = ", ".join(f"{v:.4g}" for v in fm.points[fm.cells[bad[0]]].mean(axis=0))
         raise InputError(where, f"has {len(bad)} element(s) of zero {'area' if fm.dim == 2 else 'volume'} "
