@@ -1,4 +1,4 @@
-"""Four parts of a 3-D run, each against the way it was made before, on the 3-D frame.
+"""Parts of a 3-D run, each against the way it was made before, on the 3-D frame.
 
     python benchmarks/assembly_parts.py [--rounds 5]
 
@@ -11,9 +11,15 @@ stress projection's right-hand sides of one field applied element by element
 applied; one field file written raw (``geometry.vtu.write_vtu``) against meshio's VTU writer; the
 check of a mesh read from a file (``geometry.mesh.check_mesh``: facets matched by sorted integer
 keys, each element edge once) against its code before (``np.unique`` of byte records, which
-numpy 2.4 hashes, and all 16 node pairs of a tetrahedron).
+numpy 2.4 hashes, and all 16 node pairs of a tetrahedron). From 2026-12-06: reading the frame's
+binary gmsh 2.2 file (``geometry.msh22``) against meshio's reader; the vector DOF basis made on one
+element and widened (``fem.dof_basis``) against scikit-fem's on every element; the mesh check in
+chunks of elements, facets of the elements touching the boundaries, against its code of 12-05
+(whole arrays, every element's facets); the mesh's nodes by a mask against ``np.unique``; the METIS
+order with one refinement pass per level against METIS's default; shared facets of two boundaries
+by keys against a loop over tuples.
 Prints the medians, their ratios, and that the results agree (docs/performance.md,
-"2026-12-04").
+"2026-12-04" and "Against DOLFINx"; a METIS order is compared as a permutation only).
 """
 from __future__ import annotations
 
@@ -31,7 +37,10 @@ import scipy.sparse as sp
 
 PAIRS = {"pattern": ("by rows", "searchsorted"),
          "stress rhs": ("element by element", "six matrices"), "field file": ("raw", "meshio"),
-         "mesh check": ("sorted keys", "np.unique")}
+         "mesh check": ("sorted keys", "np.unique"), "mesh read": ("whole arrays", "meshio"),
+         "dof basis": ("one element", "every element"), "mesh check 12-06": ("chunks", "whole"),
+         "mesh nodes": ("mask", "np.unique"), "METIS order": ("one pass", "ten passes"),
+         "shared facets": ("keys", "tuples")}
 
 
 def variants(fm, work: str):
@@ -39,10 +48,16 @@ def variants(fm, work: str):
     (a field file's path, in the folder ``work``)."""
     import meshio
 
-    from gatetherm.geometry.mesh import check_mesh, to_meshio
+    from skfem import CellBasis, ElementVector
+
+    from gatetherm.geometry import msh22
+    from gatetherm.geometry.mesh import check_mesh, facet_keys, find_facets, to_meshio
     from gatetherm.geometry.vtu import write_vtu
     from gatetherm.solvers import p1
+    from gatetherm.solvers.fem import dof_basis, element, to_skfem
+    from gatetherm.solvers.linsolve import nd_order
     from gatetherm.solvers.stress import _INDEX, COMPONENTS, ElementStress
+    from gatetherm.studies.run.case import _overlapping
 
     cells, n, k = fm.cells.astype(np.int64), len(fm.points), 4
     G, vol = p1.gradients(fm.points, cells)
@@ -82,6 +97,42 @@ def variants(fm, work: str):
         assert all(np.isin(key(np.sort(f, axis=1)), facets).all() for f in fm.boundaries.values())
         return np.ones(1)
 
+    def checked_12_05():  # geometry.mesh.check_mesh of 2026-12-05 (the mesh is sound: both return)
+        X = fm.points[fm.cells]
+        E = X[:, 1:] - X[:, :1]
+        size = np.abs(np.einsum("ij,ij->i", E[:, 0], np.cross(E[:, 1], E[:, 2])))
+        i, j = np.triu_indices(4, 1)
+        edge2 = np.einsum("ijk,ijk->ij", X[:, i] - X[:, j], X[:, i] - X[:, j]).max(axis=1)
+        assert not (size <= 1e-10 * edge2 ** 1.5).any()
+        facets = np.sort(facet_keys(np.vstack([np.delete(fm.cells, i, axis=1) for i in range(4)]), n))
+        assert all(find_facets(facets, f, n) is not None for f in fm.boundaries.values())
+        return np.ones(1)
+
+    def metis_default():  # linsolve.nd_order before: METIS's default refinement
+        import pymetis
+
+        G = pattern.graph()
+        G.setdiag(0)
+        G.eliminate_zeros()
+        return np.sort(pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr.astype(np.int32),
+                                                                      G.indices.astype(np.int32)))[0])
+
+    def shared_by_tuples():  # studies.run.case._overlapping before
+        owner: dict = {}
+        for b in names:
+            for f in map(tuple, np.sort(fm.boundaries[b], axis=1)):
+                if owner.setdefault(f, b) != b:
+                    return np.full(1, 2.0)
+        return np.ones(1)
+
+    def nodes_by_mask():
+        used = np.zeros(n, dtype=bool)
+        used[fm.cells.ravel()] = True
+        return np.flatnonzero(used)
+
+    msh, mesh, names = os.path.join(work, "frame.msh"), to_skfem(fm), list(fm.boundaries)
+    vector, none = ElementVector(element(3, 1)), (np.zeros((3, 0)), np.zeros(0))
+
     def written(write):  # the file's path: read back after the timing
         path = os.path.join(work, "f.vtu")
         write(path)
@@ -94,7 +145,19 @@ def variants(fm, work: str):
             ("mesh check", "np.unique"): checked_before,
             ("field file", "raw"): lambda: written(lambda p: write_vtu(p, fm, data)),
             ("field file", "meshio"): lambda: written(lambda p: meshio.write(p, to_meshio(fm, data), file_format="vtu",
-                                                                             compression=None))}
+                                                                             compression=None)),
+            ("mesh read", "whole arrays"): lambda: msh22.read_binary(open(msh, "rb").read()).points,
+            ("mesh read", "meshio"): lambda: meshio.gmsh.read(msh).points,
+            ("dof basis", "one element"): lambda: dof_basis(mesh, vector).element_dofs,
+            ("dof basis", "every element"): lambda: CellBasis(mesh, vector, quadrature=none,
+                                                              disable_doflocs=True).element_dofs,
+            ("mesh check 12-06", "chunks"): lambda: check_mesh(fm, "mesh") or np.ones(1),
+            ("mesh check 12-06", "whole"): checked_12_05,
+            ("mesh nodes", "mask"): nodes_by_mask, ("mesh nodes", "np.unique"): lambda: np.unique(fm.cells),
+            ("METIS order", "one pass"): lambda: np.sort(nd_order(pattern.graph())),
+            ("METIS order", "ten passes"): metis_default,
+            ("shared facets", "keys"): lambda: np.full(1, 2.0) if _overlapping(fm, names) else np.ones(1),
+            ("shared facets", "tuples"): shared_by_tuples}
 
 
 def _part(mesh_file: str, part: str, variant: str, result_file: str) -> None:
@@ -132,6 +195,7 @@ def main() -> None:
     if args.part:
         return _part(*args.part)
     import gatetherm as gt
+    from gatetherm.geometry.mesh import save_mesh
 
     fm = gt.gate_frame(dim=3).mesh
     times: dict = {}
@@ -139,6 +203,7 @@ def main() -> None:
         mesh_file = os.path.join(tmp, "mesh.pkl")
         with open(mesh_file, "wb") as f:
             pickle.dump(fm, f)
+        save_mesh(fm, os.path.join(tmp, "frame.msh"))  # the file the reads read
         print(f"3-D frame: {len(fm.points)} nodes, {len(fm.cells)} elements", flush=True)
         results = {}
         for r in range(args.rounds):
@@ -152,7 +217,7 @@ def main() -> None:
     print(f"medians of {args.rounds} rounds, each variant once in a new interpreter, s:")
     for part, (new, old) in PAIRS.items():
         a, b = statistics.median(times[part, new]), statistics.median(times[part, old])
-        print(f"  {part:11s} {new:19s} {a:6.3f}  {old:13s} {b:6.3f}  {a / b:5.2f} x  "
+        print(f"  {part:16s} {new:19s} {a:6.3f}  {old:13s} {b:6.3f}  {a / b:5.2f} x  "
               f"(runs {', '.join(f'{t:.2f}' for t in times[part, new])} against "
               f"{', '.join(f'{t:.2f}' for t in times[part, old])}); largest relative difference "
               f"{_same(results[part, new], results[part, old]):.1e}")

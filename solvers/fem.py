@@ -47,7 +47,7 @@ def dof_basis(mesh: skfem.Mesh, elem: skfem.Element) -> skfem.CellBasis:
     d = mesh.dim()
     linear = elem.maxdeg == 1 and elem.interior_dofs == 0 and elem.edge_dofs == 0 and elem.facet_dofs == 0
     # made on one element, then widened to all: the basis functions at no points still cost an
-    # einsum over every element (0.12 s for the vector P1 basis of the 3-D frame, 0.04 s the scalar)
+    # einsum over every element (the 3-D frame's vector P1 basis 0.056 s against 0.167 s, benchmarks/assembly_parts.py)
     basis = skfem.CellBasis(mesh, elem, quadrature=(np.zeros((d, 0)), np.zeros(0)), elements=np.array([0]),
                             disable_doflocs=linear)
     basis.tind, basis.nelems, basis.dx = None, mesh.nelements, np.zeros((mesh.nelements, 0))

@@ -78,8 +78,8 @@ def nd_order(A: sp.spmatrix, block: int = 1) -> np.ndarray | None:
     G.setdiag(0)
     G.eliminate_zeros()
     G.sort_indices()
-    # one refinement pass per level, not METIS's ten: on the 3-D frame's nodes 0.31 s against 0.41 s,
-    # the heat factor 0.7 % larger, its solves as fast
+    # one refinement pass per level, not METIS's ten: on the 3-D frame's nodes 0.35 s against 0.48 s
+    # (benchmarks/assembly_parts.py); the heat steps factored in it as fast (benchmarks/peer.py's parts)
     perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr.astype(np.int32), G.indices.astype(np.int32)),
                                         options=pymetis.Options(niter=1))
     return expand_order(np.asarray(perm, dtype=np.int64), block)
