@@ -6,7 +6,8 @@ and then solves each right-hand side it is given, in turn, while the caller goes
 solved on the second core while the first marches the heat equation
 (``benchmarks/peer.py``). :meth:`SolveHelper.submit` returns a :class:`Pending`, whose
 :meth:`~Pending.result` waits for the solution. :func:`forked` makes one value in a process of
-its own (a mesh's METIS order, beside the set-up that comes before the first factor).
+its own (a mesh's METIS order beside the set-up before the first factor; the later half of an
+AMG-CG call's right-hand sides).
 
 The arrays go through files in a private temporary folder (``/dev/shm`` where there is one),
 the pipes carry only their names: neither side ever waits on the other to read a large

@@ -17,14 +17,11 @@ from __future__ import annotations
 
 import logging
 import math
-import os
-import pickle
-import signal
 
 import numpy as np
 import scipy.sparse as sp
 
-from gatetherm.process import can_fork, die_with_parent
+from gatetherm.process import can_fork
 
 log = logging.getLogger(__name__)
 
@@ -190,40 +187,18 @@ class PCG:
 
     def _in_two(self, b: np.ndarray) -> np.ndarray:
         """The columns of ``b``, the later half solved by a forked copy of this solver (its
-        hierarchy shared, not copied) while this process solves the first."""
+        hierarchy shared, not copied: :func:`~gatetherm.solvers.helper.forked`) while this process
+        solves the first."""
+        from gatetherm.solvers.helper import forked
+
         k = (b.shape[1] + 1) // 2
-        r, w = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # pragma: no cover - the child's coverage is not collected
-            code = 1
-            try:
-                os.close(r)
-                die_with_parent(signal.SIGKILL)
-                before = self.iterations, self.solves
-                try:
-                    reply = (self._columns(b[:, k:]), self.iterations - before[0], self.solves - before[1], None)
-                except SolverError as err:
-                    reply = (None, 0, 0, str(err))
-                with os.fdopen(w, "wb") as f:
-                    pickle.dump(reply, f, protocol=pickle.HIGHEST_PROTOCOL)
-                code = 0
-            finally:
-                os._exit(code)
-        os.close(w)
-        try:
-            with os.fdopen(r, "rb") as f:
-                mine = self._columns(b[:, :k])
-                try:
-                    x, iterations, solves, error = pickle.load(f)
-                except EOFError:  # killed (out of memory?)
-                    x, iterations, solves, error = None, 0, 0, "AMG-CG's second process ended without its solutions"
-        except BaseException:
-            os.kill(pid, signal.SIGKILL)
-            raise
-        finally:
-            os.waitpid(pid, 0)
-        if error is not None:
-            raise SolverError(error)
+        before = self.iterations, self.solves
+
+        def later():
+            return self._columns(b[:, k:]), self.iterations - before[0], self.solves - before[1]
+        other = forked(later, "AMG-CG's second process")
+        mine = self._columns(b[:, :k])
+        x, iterations, solves = other.result()
         self.iterations += iterations
         self.solves += solves
         return np.column_stack([mine, x])
