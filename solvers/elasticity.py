@@ -20,7 +20,7 @@ from skfem.helpers import ddot, div, sym_grad
 
 from gatetherm import InputError
 from gatetherm.solvers import p1
-from gatetherm.solvers.fem import Field, dof_basis, element
+from gatetherm.solvers.fem import Field, complement, dof_basis, element
 from gatetherm.solvers.helper import Pending
 from gatetherm.solvers.linsolve import SPDSolver, expand_order, nd_order, restrict_order, rigid_body_modes
 from gatetherm.solvers.material import lame, lame_plane_stress, thermal_stress_modulus
@@ -262,7 +262,7 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
     loose = free_modes(vb, fixed, springs, pieces, axi)
     if loose:
         _refuse_loose(vb, mesh, loose, pieces)
-    free = np.setdiff1d(np.arange(vb.N), fixed)
+    free = complement(vb.N, fixed)
 
     def whole():  # with the supports' springs
         A = K()

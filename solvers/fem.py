@@ -56,6 +56,14 @@ def dof_basis(mesh: skfem.Mesh, elem: skfem.Element) -> skfem.CellBasis:
     return basis
 
 
+def complement(n: int, taken: np.ndarray) -> np.ndarray:
+    """The indices ``0 … n−1`` not in ``taken``, ascending: by a mask, not ``np.setdiff1d``'s sort
+    (0.2 ms against 40 ms for the free displacement DOFs of the 3-D frame)."""
+    keep = np.ones(n, dtype=bool)
+    keep[np.asarray(taken, dtype=np.int64)] = False
+    return np.flatnonzero(keep)
+
+
 def element(dim: int, order: int) -> skfem.Element:
     """Lagrange element of ``order`` (1 or 2) on simplices."""
     return _ELEM[(dim, order)]()

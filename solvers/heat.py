@@ -32,7 +32,7 @@ from skfem.helpers import dot, grad
 
 from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
-from gatetherm.solvers.fem import Field, dof_basis, element
+from gatetherm.solvers.fem import Field, complement, dof_basis, element
 from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
 from gatetherm.solvers.scheme import TimeScheme
 
@@ -183,7 +183,7 @@ class HeatSolver:
 
     def __init__(self, system: HeatSystem):
         self.system = system
-        self.free = np.setdiff1d(np.arange(system.n), system.fixed_dofs)
+        self.free = complement(system.n, system.fixed_dofs)
         """Unknowns not held by a fixed temperature (the solid's first, then the lumped ones)."""
         self.n_inner = int(np.sum(self.free < system.n_solid))
         """Free unknowns of the solid: the SPD block of every step matrix."""

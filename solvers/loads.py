@@ -17,7 +17,7 @@ from skfem import CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot
 
 from gatetherm.solvers.expr import Value
-from gatetherm.solvers.fem import Field
+from gatetherm.solvers.fem import Field, complement
 
 
 @LinearForm
@@ -112,5 +112,5 @@ def unit_responses(elastic, terms: Terms) -> np.ndarray:
     the elastic system's factor."""
     load = terms.F
     if elastic.K_fixed is not None:
-        load = load - elastic.K_fixed @ terms.D[np.setdiff1d(np.arange(len(terms.D)), elastic.free)]
+        load = load - elastic.K_fixed @ terms.D[complement(len(terms.D), elastic.free)]
     return terms.D + elastic.from_load(load)

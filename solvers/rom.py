@@ -36,6 +36,7 @@ from scipy.sparse.linalg import splu
 
 from gatetherm import InputError
 from gatetherm.solvers import krylov
+from gatetherm.solvers.fem import complement
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 
 log = logging.getLogger(__name__)
@@ -101,7 +102,7 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
     h, prob, r = model.heat, model.problem, model.readout
     T0, n = float(prob.T0), h.n
     fixed = h.fixed_dofs
-    free = np.setdiff1d(np.arange(n), fixed)
+    free = complement(n, fixed)
     groups: dict = {}  # (value, temperature?) -> [(kind, vector over n or callable of mode)]
     for p in h.pumped:
         groups.setdefault((p.supply, True), [])

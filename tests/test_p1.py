@@ -120,6 +120,17 @@ def test_dof_basis_numbers_locates_and_probes_as_a_full_basis(dim, order, frame_
         assert abs(got.probes(x) - want.probes(x)).max() < 1e-12
 
 
+def test_complement_equals_setdiff():
+    """``complement`` gives what ``np.setdiff1d(np.arange(n), taken)`` gives: repeated, unsorted
+    or no indices taken, and all of them."""
+    from gatetherm.solvers.fem import complement
+
+    rng = np.random.default_rng(5)
+    for n, taken in ((10, [7, 2, 2, 9]), (10, []), (4, [3, 0, 1, 2]), (1000, rng.integers(0, 1000, 300))):
+        got = complement(n, np.array(taken, dtype=int))
+        assert got.dtype.kind == "i" and np.array_equal(got, np.setdiff1d(np.arange(n), taken))
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_boundary_films_in_numpy_equal_the_facet_forms(dim, frame_2d, frame_3d):
     """The P1 facet mass and load of :func:`~gatetherm.solvers.heat.boundary_terms` equal

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.solvers.fem import complement
 from gatetherm.solvers.rom import ReducedModel
 from gatetherm.solvers.rom_time import discretise, march_rom, outputs
 from gatetherm.studies.run.reduce import series_inputs
@@ -50,7 +51,7 @@ def candidate_rows(model, basis: np.ndarray, nodes: np.ndarray) -> tuple[np.ndar
     ``nodes``: (rows, mask of the nodes kept); a node whose temperature is held (a fixed
     temperature) is no candidate."""
     h = model.heat
-    free = np.setdiff1d(np.arange(h.n), h.fixed_dofs)
+    free = complement(h.n, h.fixed_dofs)
     dofs = h.basis.nodal_dofs[0][np.asarray(nodes, int)]
     pos = np.searchsorted(free, dofs)
     ok = (pos < free.size) & (free[np.minimum(pos, free.size - 1)] == dofs)
