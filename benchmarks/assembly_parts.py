@@ -17,7 +17,8 @@ element and widened (``fem.dof_basis``) against scikit-fem's on every element; t
 chunks of elements, facets of the elements touching the boundaries, against its code of 12-05
 (whole arrays, every element's facets); the mesh's nodes by a mask against ``np.unique``; the METIS
 order with one refinement pass per level against METIS's default; shared facets of two boundaries
-by keys against a loop over tuples.
+by keys against a loop over tuples; the free displacement DOFs (those the mounting face does not
+hold) by a mask (``fem.complement``) against ``np.setdiff1d``.
 Prints the medians, their ratios, and that the results agree (docs/performance.md,
 "2026-12-04" and "Against DOLFINx"; a METIS order is compared as a permutation only).
 """
@@ -40,7 +41,7 @@ PAIRS = {"pattern": ("by rows", "searchsorted"),
          "mesh check": ("sorted keys", "np.unique"), "mesh read": ("whole arrays", "meshio"),
          "dof basis": ("one element", "every element"), "mesh check 12-06": ("chunks", "whole"),
          "mesh nodes": ("mask", "np.unique"), "METIS order": ("one pass", "ten passes"),
-         "shared facets": ("keys", "tuples")}
+         "shared facets": ("keys", "tuples"), "free DOFs": ("mask", "setdiff1d")}
 
 
 def variants(fm, work: str):
@@ -54,7 +55,7 @@ def variants(fm, work: str):
     from gatetherm.geometry.mesh import check_mesh, facet_keys, find_facets, to_meshio
     from gatetherm.geometry.vtu import write_vtu
     from gatetherm.solvers import p1
-    from gatetherm.solvers.fem import dof_basis, element, to_skfem
+    from gatetherm.solvers.fem import complement, dof_basis, element, to_skfem
     from gatetherm.solvers.linsolve import nd_order
     from gatetherm.solvers.stress import _INDEX, COMPONENTS, ElementStress
     from gatetherm.studies.run.case import _overlapping
@@ -132,6 +133,7 @@ def variants(fm, work: str):
 
     msh, mesh, names = os.path.join(work, "frame.msh"), to_skfem(fm), list(fm.boundaries)
     vector, none = ElementVector(element(3, 1)), (np.zeros((3, 0)), np.zeros(0))
+    held = (3 * np.unique(fm.boundaries["mounting_face"])[:, None] + np.arange(3)).ravel()
 
     def written(write):  # the file's path: read back after the timing
         path = os.path.join(work, "f.vtu")
@@ -157,7 +159,9 @@ def variants(fm, work: str):
             ("METIS order", "one pass"): lambda: np.sort(nd_order(pattern.graph())),
             ("METIS order", "ten passes"): metis_default,
             ("shared facets", "keys"): lambda: np.full(1, 2.0) if _overlapping(fm, names) else np.ones(1),
-            ("shared facets", "tuples"): shared_by_tuples}
+            ("shared facets", "tuples"): shared_by_tuples,
+            ("free DOFs", "mask"): lambda: complement(3 * n, held),
+            ("free DOFs", "setdiff1d"): lambda: np.setdiff1d(np.arange(3 * n), held)}
 
 
 def _part(mesh_file: str, part: str, variant: str, result_file: str) -> None:

@@ -58,7 +58,8 @@ def dof_basis(mesh: skfem.Mesh, elem: skfem.Element) -> skfem.CellBasis:
 
 def complement(n: int, taken: np.ndarray) -> np.ndarray:
     """The indices ``0 … n−1`` not in ``taken``, ascending: by a mask, not ``np.setdiff1d``'s sort
-    (0.2 ms against 40 ms for the free displacement DOFs of the 3-D frame)."""
+    (under 1 ms against 29 ms for the free displacement DOFs of the 3-D frame,
+    ``benchmarks/assembly_parts.py``)."""
     keep = np.ones(n, dtype=bool)
     keep[np.asarray(taken, dtype=np.int64)] = False
     return np.flatnonzero(keep)
