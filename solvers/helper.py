@@ -98,19 +98,17 @@ def forked(make: Callable[[], Any], what: str) -> Pending:
         finally:
             os._exit(0)
     os.close(w)
-    live = [True]
+    live, owner = [True], os.getpid()
 
-    def end():  # once: after the value is read, or when the Pending is dropped unread
-        if live:
+    def end():  # once, in the caller: after the value is read, or when the Pending is dropped unread
+        if live and os.getpid() == owner:
             live.clear()
             os.close(r)
-            try:
-                os.kill(pid, signal.SIGKILL)
-                os.waitpid(pid, 0)
-            except (ProcessLookupError, ChildProcessError):
-                pass
+            _kill(pid)
 
     def wait():
+        if os.getpid() != owner:  # a forked copy of the caller: the pipe and the process are not its own
+            raise SolverError(f"{what}: made for another process")
         try:
             reply = receive(r)
         finally:
@@ -269,13 +267,18 @@ def _close_others(keep) -> None:
     os.closerange(low, os.sysconf("SC_OPEN_MAX") if hasattr(os, "sysconf") else 4096)
 
 
+def _kill(pid: int) -> None:
+    """End the child ``pid`` and reap it."""
+    try:
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+    except (ProcessLookupError, ChildProcessError):  # ended and reaped already
+        pass
+
+
 def _close(owner: int, pid: int, jobs: int, replies: int, folder: str) -> None:
     if os.getpid() == owner:  # not in a forked copy of the owner
         for fd in (jobs, replies):
             os.close(fd)
-        try:
-            os.kill(pid, signal.SIGKILL)
-            os.waitpid(pid, 0)
-        except (ProcessLookupError, ChildProcessError):  # ended and reaped already
-            pass
+        _kill(pid)
         shutil.rmtree(folder, ignore_errors=True)
