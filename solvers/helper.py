@@ -133,20 +133,20 @@ has together, their columns in two processes where the solver splits a call's ri
 def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
     """The helper's life: make the solver, then answer each job ``(k, path of b)`` with
     ``(k, path of x, None)`` or ``(k, None, error text)``: one at a time while the caller works,
-    those it has together once the caller waits (:data:`WAITING`)."""
+    those it has together once the caller waits (:data:`WAITING`), till the caller sends no more."""
     try:
         t0 = time.perf_counter()
         solve, error = make(), None
         log.debug("helper: solver made in %.2f s", time.perf_counter() - t0)
     except Exception as err:  # noqa: BLE001 - reported with every job
         solve, error = None, f"{type(err).__name__}: {err}"
-    queue, waited = [], False
-    while True:
-        while not queue or select.select([jobs], [], [], 0)[0]:  # what has come; wait only with nothing to do
+    queue, waited, last = [], False, False
+    while queue or not last:
+        while not last and (not queue or select.select([jobs], [], [], 0)[0]):  # wait only with nothing to do
             job = receive(jobs)
-            if job is None:
-                return
-            if job[0] < 0:
+            if job is None:  # no more jobs: those queued are answered, then the helper ends
+                last = True
+            elif job[0] < 0:
                 waited = True
             else:
                 queue.append(job)
@@ -204,27 +204,34 @@ class SolveHelper:
                 _close_others((jobs_r, replies_w))  # the caller's other pipes: their readers see their end
                 end_with_parent()  # and its folder goes with it
                 _serve(make, jobs_r, replies_w)
-                code = 0
+                code = 0  # its answers' files are the caller's to read and remove
             finally:
-                shutil.rmtree(self._dir, ignore_errors=True)
+                if code:
+                    shutil.rmtree(self._dir, ignore_errors=True)
                 os._exit(code)
         os.close(jobs_r)
         os.close(replies_w)
         self.pid, self.owner = pid, os.getpid()
-        self._jobs, self._replies = jobs_w, replies_r
+        self._fds = [jobs_w, replies_r]  # the jobs' end closed (None) once :meth:`finish` is called
+        self._replies = replies_r
         self._next, self._answers = 0, {}
-        self._finalize = weakref.finalize(self, _close, self.owner, pid, jobs_w, replies_r, self._dir)
+        self._finalize = weakref.finalize(self, _close, self.owner, pid, self._fds, self._dir)
         log.debug("%s: set up in helper process %d", what, pid)
+
+    @property
+    def open(self) -> bool:
+        """Whether it takes jobs (not closed, not finished)."""
+        return self._finalize.alive and self._fds[0] is not None
 
     def submit(self, b: np.ndarray) -> Pending:
         """Solve ``b`` (n,) or (n, k) in the helper, after what it was given before."""
-        if not self._finalize.alive:
+        if not self.open:
             raise SolverError(f"{self.what}: the helper process is closed")
         k, self._next = self._next, self._next + 1
         path = os.path.join(self._dir, f"{k}.b.npy")
         np.save(path, np.asarray(b, dtype=float))
         try:
-            send(self._jobs, (k, path))
+            send(self._fds[0], (k, path))
         except BrokenPipeError:
             raise SolverError(f"{self.what}: {ENDED}") from None
         return Pending(lambda: self._wait(k), lambda: self._collect(k, block=False))
@@ -242,9 +249,9 @@ class SolveHelper:
         return k in self._answers
 
     def _wait(self, k: int) -> np.ndarray:
-        if not self._collect(k, block=False):  # the caller waits: the helper may take both cores
+        if not self._collect(k, block=False) and self.open:  # the caller waits: the helper may take both cores
             try:
-                send(self._jobs, WAITING)
+                send(self._fds[0], WAITING)
             except BrokenPipeError:
                 raise SolverError(f"{self.what}: {ENDED}") from None
         self._collect(k, block=True)
@@ -252,6 +259,13 @@ class SolveHelper:
         if isinstance(x, SolverError):
             raise x
         return x
+
+    def finish(self) -> None:
+        """Give no more jobs: the helper answers those given, then ends, its memory freed (their
+        :class:`Pending` values stay readable; :meth:`close` or collection removes the folder)."""
+        if self.open:
+            os.close(self._fds[0])
+            self._fds[0] = None
 
     def close(self) -> None:
         """End the helper (at once: nothing it holds outlives it but its folder, removed here)."""
@@ -276,9 +290,10 @@ def _kill(pid: int) -> None:
         pass
 
 
-def _close(owner: int, pid: int, jobs: int, replies: int, folder: str) -> None:
+def _close(owner: int, pid: int, fds: list, folder: str) -> None:
     if os.getpid() == owner:  # not in a forked copy of the owner
-        for fd in (jobs, replies):
-            os.close(fd)
+        for fd in fds:
+            if fd is not None:
+                os.close(fd)
         _kill(pid)
         shutil.rmtree(folder, ignore_errors=True)

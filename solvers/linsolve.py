@@ -234,7 +234,8 @@ class SPDSolver:
     next batch is planned again. AMG-CG is kept: its memory is a fraction of the matrix's and
     its set-up costs as much as ten solves. :meth:`start` sets AMG-CG up in a helper process
     (:class:`~gatetherm.solvers.helper.SolveHelper`) where the process may fork: then
-    :meth:`submit` returns at once, and the caller goes on while the helper solves."""
+    :meth:`submit` returns at once, and the caller goes on while the helper solves, till
+    :meth:`retire` says no more will come."""
 
     def __init__(self, A: sp.spmatrix | Pending, dim: int, near_null: np.ndarray | None = None,
                  order: np.ndarray | Callable | None = None, nodal: bool = False, what: str = "elastic system",
@@ -263,8 +264,8 @@ class SPDSolver:
         process may fork, set it up now in a helper process; whether it did."""
         from gatetherm.process import can_fork
 
-        if self._solve is not None or self._helper is not None or not can_fork():
-            return self._helper is not None
+        if self._solve is not None or self.background or not can_fork():
+            return self.background
         if os.environ.get(BACKEND_ENV) != "amg" or self.near_null is None:
             p = plan(*self.size, self.dim, self.dim, rhs)
             if p.path != "iterative":
@@ -279,7 +280,14 @@ class SPDSolver:
     @property
     def background(self) -> bool:
         """Whether :meth:`submit` solves in a helper process, beside the caller."""
-        return self._helper is not None and self._helper.owner == os.getpid()
+        return self._helper is not None and self._helper.owner == os.getpid() and self._helper.open
+
+    def retire(self) -> None:
+        """The solves submitted so far are the last asked for: a helper process ends once it has
+        answered them, its memory freed (a later solve is made here, set up anew)."""
+        if self.background:
+            self._helper.finish()
+            self.path = None
 
     def submit(self, b: np.ndarray):
         """The solution of ``b`` (n,) or (n, k) as a :class:`~gatetherm.solvers.helper.Pending`:

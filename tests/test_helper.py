@@ -53,6 +53,56 @@ def test_helper_solutions_are_the_factors_each_to_its_own_submission():
         helper.submit(bs[0])
 
 
+def _ends(pid: int, within_s: float = 10.0) -> bool:
+    """Whether the child ``pid`` ends (a zombie: not reaped, so its number is not reused) within ``within_s``."""
+    deadline = time.monotonic() + within_s
+    while time.monotonic() < deadline:
+        with open(f"/proc/{pid}/stat") as f:
+            if f.read().rsplit(")", 1)[1].split()[0] == "Z":
+                return True
+        time.sleep(0.01)
+    return False
+
+
+def test_a_finished_helper_answers_what_it_was_given_then_ends():
+    """After ``finish`` the helper answers the jobs queued (their values readable after it has
+    ended), then its process ends by itself, its folder left for ``close``; nothing more is taken."""
+    helper = SolveHelper(_Spy, "spy")
+    try:
+        slow, b = -np.ones(4), np.arange(1.0, 5.0)
+        pending = [helper.submit(x) for x in (slow, b, 3 * b)]
+        helper.finish()
+        assert not helper.open
+        with pytest.raises(SolverError, match="closed"):
+            helper.submit(b)
+        assert [p.result().tolist() for p in pending] == [slow.tolist(), b.tolist(), (3 * b).tolist()]
+        assert _ends(helper.pid) and os.path.isdir(helper._dir)  # without being killed
+    finally:
+        helper.close()
+    assert not os.path.exists(helper._dir)
+
+
+def test_a_retired_solver_ends_its_helper_and_solves_here_after(monkeypatch):
+    """``SPDSolver.retire``: the solutions submitted before come from the helper, which then
+    ends by itself; a later solve is made in the caller, the same to the solver's tolerance."""
+    from gatetherm.solvers.linsolve import SPDSolver
+
+    monkeypatch.setenv(plan.PATH_ENV, "iterative")
+    monkeypatch.setattr(process, "can_fork", lambda: True)
+    A = _laplacian()
+    b = A @ np.random.default_rng(2).normal(size=A.shape[0])
+    solver = SPDSolver(A, 2)
+    assert solver.start(1) and solver.background
+    before = solver.submit(b)
+    solver.retire()
+    assert not solver.background and solver.path is None
+    after = solver(b)
+    assert solver.path == "iterative"
+    x = before.result()
+    assert _ends(solver._helper.pid)
+    assert np.abs(x - after).max() < 1e-6 * np.abs(after).max()
+
+
 class _Spy:
     """A 'solver' giving ``b`` while its ``split`` is off, ``2 b`` while on (as the helper sets
     it), sleeping 0.5 s on a right-hand side starting with -1."""
@@ -218,7 +268,8 @@ def test_the_state_of_the_first_peak_is_solved_during_the_march(frame_3d, monkey
 def test_a_written_run_with_the_helper_has_the_fields_and_pictures_of_one_without(tmp_path, monkeypatch):
     """``gt.run`` and ``Run.write`` (a painter) on the coarse 3-D frame, 30 min of condition 1,
     fields every 10 min, the iterative path with and without the helper: the same displacement
-    fields in ``fields.h5`` (to 1e-8 of their size), every picture written."""
+    fields in ``fields.h5`` (to 1e-8 of their size), every picture written; written with
+    ``release``, the helper ends once it has solved them."""
     import dataclasses
 
     import h5py
@@ -237,7 +288,9 @@ def test_a_written_run_with_the_helper_has_the_fields_and_pictures_of_one_withou
         run = gt.run(case, sched, fields_every=600.0)
         assert sorted(run.scenario.result.solved) == ([0.0, 600.0, 1200.0] if beside else [])
         with gt.plot.Painter() as painter:
-            run.write(tmp_path / str(beside), fields_every=600.0, painter=painter)
+            run.write(tmp_path / str(beside), fields_every=600.0, painter=painter, release=beside)
+        helper = run.scenario.model.elastic.solve._helper
+        assert not run.scenario.model.elastic.solve.background and (helper is None or _ends(helper.pid))
         with h5py.File(tmp_path / str(beside) / "fields" / "fields.h5") as f:
             u[beside] = np.array([f[f"step{n}/u"][()] for n in range(4)])
         assert (tmp_path / str(beside) / "deformed.png").stat().st_size > 10_000

@@ -143,10 +143,11 @@ def test_painter_0_draws_at_once(tmp_path):
     assert painter.workers == 0 and (tmp_path / "c.png").stat().st_size > 10_000
 
 
-def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
-    """``prepare(work)`` is called by the process the next picture goes to, before it draws it,
-    and answers nothing; a failing one does not stop the picture; the same work is handed once.
-    ``Painter(0)`` ignores it."""
+def test_prepare_runs_in_the_process_that_draws_the_picture_needing_it(tmp_path):
+    """``prepare(work)`` is called by a painting process before the pictures given after it, and
+    answers nothing; a failing one does not stop the picture; the same work is handed once. The
+    picture drawn with ``needs=work`` goes to that process, others given meanwhile to the other
+    one (the work counts as a picture). ``Painter(0)`` ignores it."""
     out = fresh("""
         def ready(path):
             with open(path, "w") as f:
@@ -154,6 +155,10 @@ def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
 
         def failing():
             raise RuntimeError("not ready")
+
+        def drawn_by(cols, path):
+            ready(path)
+            return plot_channels(cols)
 
         def mark():
             with open(os.path.join({tmp}, "marks"), "a") as f:
@@ -169,12 +174,24 @@ def test_prepare_runs_in_the_process_that_draws_the_next_picture(tmp_path):
             painter.draw(plot_channels, cols, path=os.path.join({tmp}, "first.png"))
             painter.draw(plot_channels, cols, path=os.path.join({tmp}, "second.png"))
             painter.finish()
+        with gt.plot.Painter(2) as painter:
+            work = functools.partial(ready, os.path.join({tmp}, "renderer"))
+            painter.prepare(work)
+            painter.draw(drawn_by, cols, os.path.join({tmp}, "other"), path=os.path.join({tmp}, "third.png"))
+            painter.draw(drawn_by, cols, os.path.join({tmp}, "needing"), path=os.path.join({tmp}, "fourth.png"),
+                         needs=work)
+            painter.finish()
         with gt.plot.Painter(0) as here:
             here.prepare(functools.partial(ready, os.path.join({tmp}, "here")))
         print(json.dumps({{"caller": os.getpid(), "ready": int(open(os.path.join({tmp}, "ready")).read()),
                            "ready_s": os.path.getmtime(os.path.join({tmp}, "ready")),
                            "first_s": os.path.getmtime(os.path.join({tmp}, "first.png")),
-                           "marks": open(os.path.join({tmp}, "marks")).read()}}))
+                           "marks": open(os.path.join({tmp}, "marks")).read(),
+                           "renderer": int(open(os.path.join({tmp}, "renderer")).read()),
+                           "needing": int(open(os.path.join({tmp}, "needing")).read()),
+                           "other": int(open(os.path.join({tmp}, "other")).read())}}))
         """, tmp=str(tmp_path))
     assert out["ready"] != out["caller"] and out["ready_s"] <= out["first_s"] and out["marks"] == "x"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "marks", "ready", "second.png"]  # no "here"
+    assert out["needing"] == out["renderer"] != out["other"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "fourth.png", "marks", "needing", "other",
+                                                          "ready", "renderer", "second.png", "third.png"]  # no "here"

@@ -181,7 +181,7 @@ class Run:
         return out
 
     def write(self, out: str | os.PathLike, pictures: bool = True, fields_every: float | None = None,
-              painter=None) -> dict:
+              painter=None, release: bool = False) -> dict:
         """Write the run directory that ``gatetherm run`` writes.
 
         Parameters
@@ -196,6 +196,11 @@ class Run:
             Draws the pictures while the fields are written
             (:class:`~gatetherm.validation.plots.painter.Painter`, made before the run; default:
             drawn here, in turn).
+        release : bool
+            Nothing more is asked of the run's model after these fields (a one-shot run, as the
+            command's): the helper process solving its displacements ends once they are in, its
+            memory (0.3 GB on the 3-D frame) free for the pictures. A later solve sets the
+            solver up again in this process.
 
         Returns
         -------
@@ -226,7 +231,7 @@ class Run:
             write_pictures(self.scenario, out, self.case.name, picture, solved, painter=painter, only=later)
 
         write_run(out, self.scenario, meta, fields, (picture,) if pictures and picture is not None else (),
-                  draw if pictures else None)
+                  draw if pictures else None, release)
         if pictures and painter is not None:
             painter.finish()
         summary = self.summary()

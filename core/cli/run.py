@@ -22,16 +22,14 @@ def register(sub) -> None:
 def run(args) -> int:
     import gatetherm as gt
     from gatetherm.outdir import output_dir
-    from gatetherm.validation.plots.run import prepare_pictures
 
     with gt.plot.Painter(0 if args.no_pictures else 2) as painter:  # before the work it overlaps
         case = gt.load_case(args.case)
-        prepare_pictures(case, painter)  # the 3-D picture's renderer, while the model is built
         every = case.time.fields if case.time else 1.0
         with output_dir(args.out, OUTPUTS, keep=case.files) as out:
             res = gt.run(case, keep=picture_keep(case.schedule, every), on_step=Progress(case.name),
                          check_order=True)
-            summary = res.write(out, pictures=not args.no_pictures, painter=painter)
+            summary = res.write(out, pictures=not args.no_pictures, painter=painter, release=True)
     print(f"wrote {out}/timeseries.csv, summary.json and fields/")
     for name, q in summary["probes"].items():
         print(f"{name}: " + ", ".join(f"{k} {v:.6g}" for k, v in q.items() if v is not None))

@@ -175,12 +175,14 @@ def nearest_state(run, t: float) -> tuple[float, np.ndarray]:
 
 
 def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_times=(),
-              solved_hook=None) -> Solved:
+              solved_hook=None, release: bool = False) -> Solved:
     """``out/timeseries.csv`` (what the sensors report) and the fields at ``field_times``
     (``out/fields``) of a :class:`~gatetherm.studies.run.scenario.ScenarioRun`; returns the
     :func:`displacements` of those states and of the states nearest ``picture_times`` (those
     first), which ``solved_hook`` (if given) is called with as soon as those of the picture
-    states are in: before the fields are written, or while they are (a helper process solves)."""
+    states are in: before the fields are written, or while they are (a helper process solves).
+    ``release``: the model's elastic solver is asked for nothing more (a one-shot run), so a
+    helper process ends once it has solved these (:meth:`~gatetherm.solvers.linsolve.SPDSolver.retire`)."""
     from gatetherm.studies.run.timeseries import FORMAT, write_timeseries
 
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
@@ -188,6 +190,8 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_tim
     pictured = dict(nearest_state(run, tp) for tp in picture_times)
     extra = [(t, U) for t, U in pictured.items() if t not in field_times]
     solved = displacements(run.model, extra + states, run.result.envs, run.result.solved)
+    if release and run.model.elastic is not None:
+        run.model.elastic.solve.retire()
     hook = [solved_hook] if solved_hook is not None else []
 
     def between():

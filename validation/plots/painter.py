@@ -99,7 +99,9 @@ class Painter:
         self._queued: list[list[Path]] = []  # the pictures each is given and has not answered
         self._outbox: list[bytearray] = []  # what is not yet written to each one's pipe
         self._lock, self._writer, self._closing = threading.Lock(), None, False
-        self._pid, self._prepared = None, set()
+        self._pid = None
+        self._prepared: dict = {}  # work made ready: the process it was given to
+        self._reserved = [0] * 2  # per process, prepared work whose picture is not yet given
         if workers > 0 and _can_fork():
             self._start(min(workers, 2))
         log.debug("pictures drawn by %d processes", self.workers)
@@ -150,25 +152,36 @@ class Painter:
         """The number of processes drawing (0: each picture is drawn in this process)."""
         return len(self._pipes)
 
-    def draw(self, plot, *args, path: str | os.PathLike, tight: bool = True, **kwargs) -> None:
+    def draw(self, plot, *args, path: str | os.PathLike, tight: bool = True, needs=None, **kwargs) -> None:
         """Write ``plot(*args, **kwargs)`` (a plot function of :mod:`gatetherm.validation.plots`,
         its arguments picklable) to the PNG ``path``, laid out by ``tight_layout`` if ``tight``;
-        returns at once (what the pipe does not take, a thread writes while the process reads)."""
+        returns at once (what the pipe does not take, a thread writes while the process reads).
+        ``needs``: work given to :meth:`prepare` for this picture; it goes to the process that did it."""
         job = (plot, args, kwargs, Path(path), tight)
         if not self._pipes:
             return _paint(job)
-        self._hand(job)
+        k = self._prepared.pop(needs, None) if needs is not None else None
+        if k is not None:
+            self._reserved[k] -= 1
+        self._hand(job, k)
 
     def prepare(self, work) -> None:
-        """Have the process that draws the next picture call ``work()`` (picklable) meanwhile:
-        what that picture needs made ready (an import, a first small rendering) while the caller
-        computes (once: the same ``work`` again is not handed). Without processes nothing is done."""
+        """Have the process given fewer pictures call ``work()`` (picklable) meanwhile: what a
+        picture drawn later with ``needs=work`` needs made ready (an import, a first small
+        rendering) while the caller computes; till then that picture counts as given to it. The
+        same ``work`` again, before its picture is drawn, is not handed. Without processes nothing
+        is done."""
         if self._pipes and work not in self._prepared:
-            self._prepared.add(work)
-            self._hand((work, (), {}, None, False))
+            self._prepared[work] = k = self._least()
+            self._reserved[k] += 1
+            self._hand((work, (), {}, None, False), k)
 
-    def _hand(self, job) -> None:
-        k = min(range(self.workers), key=lambda i: len(self._queued[i]))  # a tie: the first
+    def _least(self) -> int:
+        """The process given fewer pictures (a tie: the first)."""
+        return min(range(self.workers), key=lambda i: len(self._queued[i]) + self._reserved[i])
+
+    def _hand(self, job, k: int | None = None) -> None:
+        k = self._least() if k is None else k
         with self._lock:
             self._outbox[k] += message(job)
             if job[3] is not None:
@@ -227,7 +240,7 @@ class Painter:
         for jobs, replies in self._pipes:
             os.close(jobs)
             os.close(replies)
-        self._pipes, self._queued, self._outbox = [], [], []
+        self._pipes, self._queued, self._outbox, self._prepared = [], [], [], {}
         pid, self._pid = self._pid, None
         if pid is None:
             return

@@ -113,15 +113,22 @@ other (about equal work), while a 3-D deformed picture (pyvista) gets only the c
 temperatures, beside it (``docs/performance.md``, "The 2-D default condition")."""
 
 
+def _renderer(problem):
+    """What the deformed picture of a run of ``problem`` needs made ready in a painting
+    process: a 3-D body's renderer (:func:`~gatetherm.validation.plots.field.warm_surface`), or None."""
+    from gatetherm.validation.plots.field import warm_surface
+
+    return warm_surface if problem.elastic and problem.dim == 3 else None
+
+
 def prepare_pictures(run, painter) -> None:
     """What the pictures of ``run`` (a :class:`~gatetherm.studies.run.scenario.ScenarioRun`, or
     the case it will run: made ready the sooner) need made ready in ``painter``'s process before
-    :func:`write_pictures` gives them: the renderer of a 3-D body's deformed picture."""
-    from gatetherm.validation.plots.field import warm_surface
-
-    problem = run.model.problem if hasattr(run, "model") else run.problem
-    if problem.elastic and problem.dim == 3:
-        painter.prepare(warm_surface)
+    :func:`write_pictures` gives them: the renderer of a 3-D body's deformed picture, in the
+    process that will draw it."""
+    work = _renderer(run.model.problem if hasattr(run, "model") else run.problem)
+    if work is not None:
+        painter.prepare(work)
 
 
 def write_pictures(run, out, title: str, picture_s: float | None, solved: dict | None = None,
@@ -154,5 +161,6 @@ def write_pictures(run, out, title: str, picture_s: float | None, solved: dict |
     jobs = dict(sorted(((k, v) for k, v in jobs.items() if wanted(k)), key=lambda job: order.index(job[0])))
     painter = Painter(0) if painter is None else painter
     for name, (plot, args) in jobs.items():
-        painter.draw(plot, *args, path=out / name, tight=name != "channels.png")
+        painter.draw(plot, *args, path=out / name, tight=name != "channels.png",
+                     needs=_renderer(run.model.problem) if name == "deformed.png" else None)
     return list(jobs)
