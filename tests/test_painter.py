@@ -184,14 +184,14 @@ def test_prepare_runs_in_the_process_that_draws_the_picture_needing_it(tmp_path)
         with gt.plot.Painter(0) as here:
             here.prepare(functools.partial(ready, os.path.join({tmp}, "here")))
         print(json.dumps({{"caller": os.getpid(), "ready": int(open(os.path.join({tmp}, "ready")).read()),
-                           "ready_s": os.path.getmtime(os.path.join({tmp}, "ready")),
-                           "first_s": os.path.getmtime(os.path.join({tmp}, "first.png")),
+                           "renderer_s": os.path.getmtime(os.path.join({tmp}, "renderer")),
+                           "fourth_s": os.path.getmtime(os.path.join({tmp}, "fourth.png")),
                            "marks": open(os.path.join({tmp}, "marks")).read(),
                            "renderer": int(open(os.path.join({tmp}, "renderer")).read()),
                            "needing": int(open(os.path.join({tmp}, "needing")).read()),
                            "other": int(open(os.path.join({tmp}, "other")).read())}}))
         """, tmp=str(tmp_path))
-    assert out["ready"] != out["caller"] and out["ready_s"] <= out["first_s"] and out["marks"] == "x"
-    assert out["needing"] == out["renderer"] != out["other"]
+    assert out["ready"] != out["caller"] and out["marks"] == "x"
+    assert out["needing"] == out["renderer"] != out["other"] and out["renderer_s"] <= out["fourth_s"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "fourth.png", "marks", "needing", "other",
                                                           "ready", "renderer", "second.png", "third.png"]  # no "here"
