@@ -98,10 +98,10 @@ class Painter:
         self._pipes: list[tuple[int, int]] = []  # (jobs to write, replies to read), one per process
         self._queued: list[list[Path]] = []  # the pictures each is given and has not answered
         self._outbox: list[bytearray] = []  # what is not yet written to each one's pipe
+        self._reserved: list[int] = []  # prepared work whose picture is not yet given, per process
         self._lock, self._writer, self._closing = threading.Lock(), None, False
         self._pid = None
         self._prepared: dict = {}  # work made ready: the process it was given to
-        self._reserved = [0] * 2  # per process, prepared work whose picture is not yet given
         if workers > 0 and _can_fork():
             self._start(min(workers, 2))
         log.debug("pictures drawn by %d processes", self.workers)
@@ -146,6 +146,7 @@ class Painter:
             self._pipes.append((jw, rr))
             self._queued.append([])
             self._outbox.append(bytearray())
+            self._reserved.append(0)
 
     @property
     def workers(self) -> int:
@@ -240,7 +241,7 @@ class Painter:
         for jobs, replies in self._pipes:
             os.close(jobs)
             os.close(replies)
-        self._pipes, self._queued, self._outbox, self._prepared = [], [], [], {}
+        self._pipes, self._queued, self._outbox, self._reserved, self._prepared = [], [], [], [], {}
         pid, self._pid = self._pid, None
         if pid is None:
             return
