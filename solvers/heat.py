@@ -34,6 +34,7 @@ from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.fem import Field, complement, dof_basis, element
 from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
+from gatetherm.solvers.pardiso import Analyses
 from gatetherm.solvers.scheme import TimeScheme
 
 log = logging.getLogger(__name__)
@@ -190,6 +191,7 @@ class HeatSolver:
         self._K: dict[Mode, sp.csr_matrix] = {}
         self._lu: dict[tuple[float, Mode], tuple[Bordered, sp.csr_matrix | None]] = {}
         self._order: list = []
+        self._analyses = Analyses()  # the step matrices' factors share one PARDISO analysis
         self._amg: dict = {}  # AMG hierarchies by θ dt, shared by the modes
         self._expected: dict[tuple[float, Mode], int] = {}
         self.factor_seconds = 0.0
@@ -211,7 +213,8 @@ class HeatSolver:
 
     def _inner(self, S: sp.csr_matrix, rhs: int, what: str, theta_dt: float | None):
         """A solver of the solid block ``S`` (of the step ``θ dt``) for ``rhs`` solves: one METIS
-        order for all the factors (the step matrices share a pattern); one AMG hierarchy for the
+        order and one PARDISO analysis for all the factors (the step matrices share a pattern:
+        :mod:`~gatetherm.solvers.pardiso`); one AMG hierarchy for the
         modes of a ``θ dt`` (the pumps change only a wall's film; on the 3-D frame at 8 × the nodes
         2 % more iterations than with a hierarchy of its own: ``benchmarks/heat_amg.py``)."""
         sys = self.system
@@ -222,7 +225,7 @@ class HeatSolver:
                                    restrict_order(sys.simplices.order, self.free[:self.n_inner], sys.n_solid))
             return self._order[0]
         solve, path = planned_solver(S, sys.basis.mesh.dim(), rhs, what, order=order, rtol=HEAT_RTOL, warm=rhs > 1,
-                                     amg=self._amg.get(theta_dt))
+                                     amg=self._amg.get(theta_dt), shared=self._analyses)
         if path == "iterative":
             self._amg.setdefault(theta_dt, solve.amg)
         return solve

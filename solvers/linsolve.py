@@ -5,7 +5,8 @@ A Cholesky factorisation in a nested-dissection order (METIS through pymetis) is
 workhorse. The backend is the first of :data:`BACKENDS` that is installed and works:
 
 * ``pardiso``: Intel MKL PARDISO through py-mkl-pardiso (wheels for Linux x86_64 and
-  Windows), with METIS ordering;
+  Windows), with METIS ordering; the factors of a family of matrices of one pattern (a heat
+  march's steps) share one analysis (:mod:`.pardiso`);
 * ``cholmod``: CHOLMOD through cvxopt (GPL-3, not a dependency; used if installed), in the
   pymetis order;
 * ``superlu``: scipy's SuperLU on the METIS-permuted matrix (symmetric mode, no column
@@ -103,30 +104,21 @@ def restrict_order(order: np.ndarray | None, keep: np.ndarray, n: int) -> np.nda
     return order[order >= 0]
 
 
-def _pardiso(A: sp.spmatrix, order) -> Solve:
-    # the extension class itself: the package's wrapper checks the upper triangle row by
-    # row in Python (1.4 s on the 3-D elastic matrix); our order skips PARDISO's own
-    # reordering (its analysis 2.2 s → 1.0 s there)
-    from pymklpardiso._mkl_pardiso import MTYPE_REAL_SYM_POSDEF, PardisoSolver
+def _pardiso(A: sp.spmatrix, order, shared=None) -> Solve:
+    # our order skips PARDISO's own reordering (its analysis 2.2 s → 1.0 s on the 3-D elastic
+    # matrix); ``shared``: the analyses of matrices of the same pattern (:mod:`.pardiso`)
+    from gatetherm.solvers.pardiso import Analyses, PardisoError
 
     U = sp.triu(A, format="csr")
     U.sort_indices()
-    solver = PardisoSolver(MTYPE_REAL_SYM_POSDEF, 0)
-    solver.set_pattern(ia=U.indptr.astype(np.int64), ja=U.indices.astype(np.int64), n=A.shape[0])
-    if order is None:
-        solver.set_iparm(1, 2)  # PARDISO's METIS
-    else:
-        solver.set_iparm(4, 1)  # the given order
-        solver.set_perm(np.asarray(order, dtype=np.int64))
     try:
-        solver.factor(U.data.astype(float))
-    except RuntimeError as err:
+        return (shared or Analyses()).factor(U, order)
+    except PardisoError as err:
         raise SolverError(f"the matrix cannot be factorised ({err}): material constants or thicknesses many "
                           "orders of magnitude apart?") from None
-    return solver.solve
 
 
-def _cholmod(A: sp.spmatrix, order) -> Solve:
+def _cholmod(A: sp.spmatrix, order, shared=None) -> Solve:
     import cvxopt
     import cvxopt.cholmod as cholmod
 
@@ -144,7 +136,7 @@ def _cholmod(A: sp.spmatrix, order) -> Solve:
     return solve
 
 
-def _superlu(A: sp.spmatrix, order) -> Solve:
+def _superlu(A: sp.spmatrix, order, shared=None) -> Solve:
     opts = {"diag_pivot_thresh": 0.0, "options": {"SymmetricMode": True}}
     if order is None:
         return splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", **opts).solve
@@ -158,18 +150,22 @@ def _superlu(A: sp.spmatrix, order) -> Solve:
 
 
 BACKENDS = {"pardiso": _pardiso, "cholmod": _cholmod, "superlu": _superlu}
-"""Cholesky backends in order of preference."""
+"""Cholesky backends in order of preference: ``factor(A, order, shared)`` (``shared``: a
+:class:`~gatetherm.solvers.pardiso.Analyses` for matrices of one pattern, used by pardiso)."""
 
 
-def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACKENDS)) -> tuple[Solve, str]:
+def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACKENDS),
+               shared=None) -> tuple[Solve, str]:
     """Factor the SPD matrix ``A`` (in ``order``, from :func:`nd_order`, where the backend
     takes one) with the first backend of ``allow`` that works (only the one forced by
-    ``GATETHERM_SPD_BACKEND``, if that names one); ``(solve, backend name)``."""
+    ``GATETHERM_SPD_BACKEND``, if that names one); ``(solve, backend name)``. ``shared``: a
+    :class:`~gatetherm.solvers.pardiso.Analyses` whose analysis a matrix of the same pattern
+    shares (PARDISO)."""
     forced = os.environ.get(BACKEND_ENV)
     names = [forced] if forced in allow else [] if forced in BACKENDS else list(allow)
     for name in names:
         try:
-            solve = BACKENDS[name](A, order)
+            solve = BACKENDS[name](A, order, shared)
         except ImportError as err:
             _say_once(f"missing {name}", logging.INFO, "solver backend %s not installed (%s): %s", name, err,
                       HINTS.get(name, ""))
@@ -205,7 +201,7 @@ def planned_solver(A: sp.spmatrix, dim: int, rhs: int, what: str, block: int = 1
                    order: np.ndarray | Callable[[], np.ndarray | None] | None = None, rtol: float = RTOL,
                    held: float | None = None,
                    allow=("pardiso", "cholmod", "superlu"), amg_block: int = 1,
-                   warm: bool = False, amg=None) -> tuple[Solve, str]:
+                   warm: bool = False, amg=None, shared=None) -> tuple[Solve, str]:
     """A solver of the SPD matrix ``A`` (``block`` DOFs per node of a ``dim``-D mesh) for
     ``rhs`` right-hand sides by the path :func:`.plan.plan` chooses (logged in one line as
     ``what``; ``held``: bytes held already, default this process's): a Cholesky factor of the first
@@ -214,13 +210,14 @@ def planned_solver(A: sp.spmatrix, dim: int, rhs: int, what: str, block: int = 1
     ``rtol`` (``near_null``: the rigid-body modes, aggregated by nodes of ``amg_block`` DOFs;
     ``warm``: the right-hand sides are a sequence, each close to the last; ``amg``: the
     :class:`~gatetherm.solvers.iterative.AMG` hierarchy of a nearby matrix to precondition with,
-    instead of one of ``A``'s own). ``(solve, path)``."""
+    instead of one of ``A``'s own; ``shared``: the analyses a factor of the same pattern shares,
+    :func:`spd_factor`). ``(solve, path)``."""
     A = A.tocsr()
     p = plan(A.shape[0], A.nnz, block, dim, rhs, held, warm=warm)
     log.info("%s", p.describe(f"{what} ({A.shape[0]} unknowns)", rhs))
     if p.path == "direct":
         try:
-            return spd_factor(A, order() if callable(order) else order, allow)[0], "direct"
+            return spd_factor(A, order() if callable(order) else order, allow, shared)[0], "direct"
         except NoBackend:
             _say_once(f"amg {what}", logging.INFO, "no Cholesky backend for the %s: AMG-CG; %s", what, HINTS["pardiso"])
     return PCG(A, near_null, amg_block, rtol, amg=amg), "iterative"

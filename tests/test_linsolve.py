@@ -91,7 +91,7 @@ def test_without_a_cholesky_backend_large_3d_elasticity_uses_amg(elastic_3d, mon
     AMG-CG (logged), not to SuperLU's fill."""
     Kff, rbm, *_ = elastic_3d
     for name in ("pardiso", "cholmod"):
-        monkeypatch.setitem(linsolve.BACKENDS, name, lambda A, order: (_ for _ in ()).throw(ImportError("absent")))
+        monkeypatch.setitem(linsolve.BACKENDS, name, lambda A, order, shared: (_ for _ in ()).throw(ImportError("absent")))
     monkeypatch.setattr(linsolve, "DIRECT_LIMIT_3D", 0)
     monkeypatch.setattr(linsolve, "_say_once", lambda key, level, msg, *a: linsolve.log.log(level, msg, *a))
     b = np.ones(Kff.shape[0])

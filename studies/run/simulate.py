@@ -145,6 +145,7 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
             envs[t] = env
         if not ready and weights.done():  # asked until it is; then the steps so far read out
             ready = True
+            log.debug("read-out weights in at step %d of %d (%.2f s)", i, len(times) - 1, _time.perf_counter() - t0)
             for k, Uk, ek in waiting:
                 Y[k] = model.read(Uk, ek)
             waiting = []
