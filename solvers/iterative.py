@@ -22,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from gatetherm.process import can_fork
+from gatetherm.solvers.aggregation import hierarchy
 
 log = logging.getLogger(__name__)
 
@@ -63,24 +64,34 @@ class AMG:
     def __init__(self, A: sp.spmatrix, near_null: np.ndarray | None = None, block: int = 1, single: bool = True,
                  smooth=None, coarsest: int | None = None):
         """``single``: the cycle in single precision (``benchmarks/amg_precision.py`` measures both);
-        ``smooth``: pyamg's prolongation smoother instead of the energy minimisation
-        (``benchmarks/heat_amg.py`` measures Jacobi's); ``coarsest``: the largest level solved
-        exactly, in node blocks, instead of :func:`max_coarse`'s."""
-        import pyamg
-
+        ``smooth``: pyamg's prolongation smoother instead of the energy minimisation, the
+        hierarchy made by pyamg's ``smoothed_aggregation_solver`` (``benchmarks/heat_amg.py``
+        measures Jacobi's, ``benchmarks/amg_setup.py`` pyamg's energy minimisation against
+        :mod:`.aggregation`'s); ``coarsest``: the largest level solved exactly, in node blocks,
+        instead of :func:`max_coarse`'s."""
         A = A.tocsr()
         whole_nodes = block > 1 and A.shape[0] % block == 0
         blocks = A.shape[0] // block if whole_nodes else A.shape[0]  # pyamg counts a level's size in blocks
-        kw = dict(symmetry="symmetric", max_coarse=coarsest or max_coarse(blocks), coarse_solver="splu",
-                  presmoother=("gauss_seidel", {"sweep": "forward"}), postsmoother=("gauss_seidel", {"sweep": "backward"}))
-        if near_null is None:  # heat: all connections strong; energy-minimising prolongation in two
-            # steps: on the 3-D frame's heat steps at 8 × the nodes a quarter fewer iterations than
-            # Jacobi smoothing of P, the set-up 1.1 s longer (benchmarks/heat_amg.py)
-            kw.update(smooth=smooth or ("energy", {"maxiter": 2}))
-        else:  # energy-minimising prolongation: 25 iterations on the 3-D frame against 58 of Jacobi
-            # smoothing; the rigid-body modes are exact, no relaxation improves them (40 % of the set-up)
-            kw.update(B=near_null, smooth=smooth or "energy", strength=("symmetric", {"theta": 0.0}), improve_candidates=None)
-        self.ml = pyamg.smoothed_aggregation_solver(A.tobsr(blocksize=(block, block)) if whole_nodes else A, **kw)
+        smoothers = dict(presmoother=("gauss_seidel", {"sweep": "forward"}),
+                         postsmoother=("gauss_seidel", {"sweep": "backward"}))
+        top = A.tobsr(blocksize=(block, block)) if whole_nodes else A
+        # heat: all connections strong; energy-minimising prolongation in two steps: on the 3-D
+        # frame's heat steps at 8 × the nodes a quarter fewer iterations than Jacobi smoothing of
+        # P, the set-up 1.1 s longer (benchmarks/heat_amg.py). Elasticity: energy minimisation in
+        # pyamg's four steps, 25 iterations on the 3-D frame against 58 of Jacobi smoothing; the
+        # rigid-body modes are exact, no relaxation improves them (40 % of the set-up)
+        maxiter = 2 if near_null is None else 4
+        if smooth is None:
+            B = np.ones((A.shape[0], 1)) if near_null is None else near_null
+            self.ml = hierarchy(top, B, coarsest or max_coarse(blocks), maxiter, near_null is None, **smoothers)
+        else:
+            import pyamg
+
+            kw = dict(symmetry="symmetric", max_coarse=coarsest or max_coarse(blocks), coarse_solver="splu",
+                      smooth=smooth, **smoothers)
+            if near_null is not None:
+                kw.update(B=near_null, strength=("symmetric", {"theta": 0.0}), improve_candidates=None)
+            self.ml = pyamg.smoothed_aggregation_solver(top, **kw)
         # the caller's CSR matrix on the finest level (no block copy): its point Gauss-Seidel sweeps
         # cost 2/3 of a block sweep for the same iterations; 1-by-1 block levels as CSR too
         self.ml.levels[0].A = A
