@@ -22,7 +22,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from gatetherm.process import can_fork
-from gatetherm.solvers.aggregation import hierarchy
 
 log = logging.getLogger(__name__)
 
@@ -81,7 +80,9 @@ class AMG:
         # pyamg's four steps, 25 iterations on the 3-D frame against 58 of Jacobi smoothing; the
         # rigid-body modes are exact, no relaxation improves them (40 % of the set-up)
         maxiter = 2 if near_null is None else 4
-        if smooth is None:
+        if smooth is None:  # pyamg imported only where a hierarchy is made
+            from gatetherm.solvers.aggregation import hierarchy
+
             B = np.ones((A.shape[0], 1)) if near_null is None else near_null
             self.ml = hierarchy(top, B, coarsest or max_coarse(blocks), maxiter, near_null is None, **smoothers)
         else:
