@@ -112,7 +112,7 @@ def _pardiso(A: sp.spmatrix, order, shared=None) -> Solve:
     U = sp.triu(A, format="csr")
     U.sort_indices()
     try:
-        return (shared or Analyses()).factor(U, order)
+        return (Analyses() if shared is None else shared).factor(U, order)
     except PardisoError as err:
         raise SolverError(f"the matrix cannot be factorised ({err}): material constants or thicknesses many "
                           "orders of magnitude apart?") from None
