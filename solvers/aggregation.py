@@ -90,7 +90,7 @@ def energy_smoothed(A: sp.spmatrix, T: sp.bsr_array, C: sp.csr_array, B: np.ndar
 
     blocks, rows = (len(indices), rb, cb), np.repeat(np.arange(shape[0]), np.diff(indptr))
     P = on_pattern(np.zeros(blocks, dtype=T.dtype))  # T on the pattern (which holds T's blocks)
-    P.data[_positions(T, indptr, indices, shape[1])] = T.data
+    P.data[_positions(T, rows, indices, shape[1])] = T.data
     R = times_A(P, on_pattern(np.zeros(blocks, dtype=T.dtype)))
     R.data *= -1.0
     if not np.any(R.data):
@@ -121,10 +121,9 @@ def energy_smoothed(A: sp.spmatrix, T: sp.bsr_array, C: sp.csr_array, B: np.ndar
     return sp.bsr_array((P.data[keep], indices[keep], np.r_[0, np.cumsum(counts)]), shape=T.shape)
 
 
-def _positions(T: sp.bsr_array, indptr: np.ndarray, indices: np.ndarray, columns: int) -> np.ndarray:
-    """Where ``T``'s blocks are among the blocks of the pattern ``(indptr, indices)`` (sorted,
-    holding them)."""
-    rows = np.repeat(np.arange(len(indptr) - 1, dtype=np.int64), np.diff(indptr))
-    keys = rows * columns + indices
+def _positions(T: sp.bsr_array, rows: np.ndarray, indices: np.ndarray, columns: int) -> np.ndarray:
+    """Where ``T``'s blocks are among the blocks of a pattern (each block's row and column,
+    sorted by row then column, holding ``T``'s)."""
+    keys = rows.astype(np.int64) * columns + indices
     t_rows = np.repeat(np.arange(len(T.indptr) - 1, dtype=np.int64), np.diff(T.indptr))
     return np.searchsorted(keys, t_rows * columns + T.indices)
