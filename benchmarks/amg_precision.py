@@ -21,11 +21,13 @@ import numpy as np
 
 def recorded_systems():
     """(matrix, rigid-body modes, node block, [right-hand-side batches]) of the elastic system
-    of a 3-D condition-1 run with its field displacements, as the run solves them."""
+    of a 3-D condition-1 run with its field displacements, as the run solves them (the
+    thread pools configured as the commands do)."""
     import gatetherm as gt
     from gatetherm.solvers.linsolve import SPDSolver
     from gatetherm.studies.run.output import displacements
 
+    gt.configure()
     seen: dict = {"batches": []}
     submit = SPDSolver.submit
 
@@ -49,10 +51,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args()
-    import gatetherm as gt
     from gatetherm.solvers.iterative import AMG, PCG
 
-    gt.configure()
     A, modes, block, batches = recorded_systems()
     print(f"elastic system: {A.shape[0]} unknowns; batches of {', '.join(str(b.shape[1]) for b in batches)} "
           "right-hand sides", flush=True)

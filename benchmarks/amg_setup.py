@@ -24,11 +24,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args()
-    import gatetherm as gt
     from gatetherm.solvers.iterative import AMG, PCG
     from gatetherm.solvers.linsolve import RTOL
 
-    gt.configure()
     A, modes, block, batches = recorded_systems()
     print(f"elastic system: {A.shape[0]} unknowns, {len(batches)} batches", flush=True)
     ways = {"pyamg": {"smooth": "energy"}, "gatetherm": {}}
