@@ -1,10 +1,12 @@
-"""BLAS threads of a command, measured: ``gatetherm simulate --condition 1 --dim 3`` with
-one and with two BLAS threads (``GATETHERM_BLAS_THREADS``), interleaved.
+"""Process settings of a command, measured: ``gatetherm simulate --condition 1 --dim 3`` with
+one and with two BLAS threads (``GATETHERM_BLAS_THREADS``), or with and without numpy's
+huge-page advice (``--huge-pages``: ``NUMPY_MADVISE_HUGEPAGE=1``, numpy's default, against
+gatetherm's, off), interleaved.
 
-    python benchmarks/blas_threads.py [--rounds 3] [--threads 1 2] [--json FILE]
+    python benchmarks/blas_threads.py [--rounds 3] [--threads 1 2] [--huge-pages] [--json FILE]
 
-Prints the medians of wall time, CPU time and peak memory per thread count; the default of
-``gatetherm.process.BLAS_THREADS`` is chosen from this table (docs/performance.md).
+Prints the medians of wall time, CPU time, its system part and peak memory per setting; the
+defaults of :func:`gatetherm.process.configure` are chosen from these tables (docs/performance.md).
 """
 from __future__ import annotations
 
@@ -26,22 +28,27 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
-    ap.add_argument("--json", type=Path, default=HERE / "results" / "blas_threads.json")
+    ap.add_argument("--huge-pages", action="store_true", help="numpy's huge-page advice on and off, one BLAS thread")
+    ap.add_argument("--json", type=Path)
     args = ap.parse_args()
+    name = "huge_pages" if args.huge_pages else "blas_threads"
+    settings = ({"huge pages advised": {"NUMPY_MADVISE_HUGEPAGE": "1"}, "not advised": {}} if args.huge_pages else
+                {f"{n} BLAS threads": {"GATETHERM_BLAS_THREADS": str(n)} for n in args.threads})
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMPY_MADVISE_HUGEPAGE", "GATETHERM_BLAS_THREADS")}
     work = Path(tempfile.mkdtemp(prefix="blas-"))
     atexit.register(shutil.rmtree, work, True)
-    runs = {n: [] for n in args.threads}
-    for r, n in interleaved(args.threads, args.rounds):
+    runs = {n: [] for n in settings}
+    for r, n in interleaved(settings, args.rounds):
         cmd = [sys.executable, "-m", "gatetherm.cli", "simulate", "--condition", "1", "--dim", "3",
-               "--out", str(work / f"r{r}-t{n}")]
-        res = rusage_run(cmd, env=dict(os.environ, GATETHERM_BLAS_THREADS=str(n)))
+               "--out", str(work / f"r{r}-{len(runs[n])}")]
+        res = rusage_run(cmd, env={**env, **settings[n]})
         runs[n].append(res)
-        print(f"round {r + 1} threads {n}: wall {res['wall']:.1f} s, CPU {res['cpu']:.1f} s, "
+        print(f"round {r + 1} {n}: wall {res['wall']:.1f} s, CPU {res['cpu']:.1f} s (system {res['sys']:.1f} s), "
               f"peak {res['rss_gb']:.2f} GB, load {os.getloadavg()[0]:.1f}", flush=True)
-    rows = [[n, *(round(statistics.median(x[m] for x in v), 2) for m in ("wall", "cpu", "rss_gb"))]
+    rows = [[n, *(round(statistics.median(x[m] for x in v), 2) for m in ("wall", "cpu", "sys", "rss_gb"))]
             for n, v in runs.items()]
-    write_table(args.json, ["BLAS threads", "wall s", "CPU s", "peak GB"], rows,
-                [f"medians of {args.rounds} interleaved rounds of gatetherm simulate --condition 1 --dim 3"])
+    write_table(args.json or HERE / "results" / f"{name}.json", ["setting", "wall s", "CPU s", "system s", "peak GB"],
+                rows, [f"medians of {args.rounds} interleaved rounds of gatetherm simulate --condition 1 --dim 3"])
 
 
 if __name__ == "__main__":

@@ -13,6 +13,14 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
   and fault in anew as the next are made. ``simulate --condition 1 --dim 3``: page faults
   0.93-0.97 million without, 0.65-0.66 million with 64 MiB or 1 GiB, 1-2 s less system time,
   the same peak memory (2 runs each, interleaved);
+* numpy's advice of transparent huge pages for its arrays of 4 MiB and more off, unless
+  numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: with the mmap threshold above, every large
+  array is memory new to the process, and on a virtual machine whose host backs the guest's
+  memory as it is first touched (this one, Firecracker) a fault of a 2 MiB page costs
+  milliseconds of system time. The 3-D frame's elastic stiffness took 1.8-2.1 s (1.3 s of it
+  in the kernel) the first time in a process, 0.7 s without the advice, 0.45 s the fifth
+  time either way; ``simulate --condition 1 --dim 3`` (``benchmarks/blas_threads.py
+  --huge-pages``) in docs/performance.md;
 
 and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
 solve's helper), :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
@@ -33,6 +41,9 @@ log = logging.getLogger(__name__)
 BLAS_THREADS = 1
 """BLAS threads of a command; see docs/performance.md for the measurement."""
 THREADS_ENV = "GATETHERM_BLAS_THREADS"
+HUGE_PAGES_ENV = "NUMPY_MADVISE_HUGEPAGE"
+"""numpy's switch of its huge-page advice: where it is set, :func:`configure` leaves the advice
+as numpy made it."""
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 PR_SET_PDEATHSIG = 1
 """prctl(2) option: the signal a Linux process gets when its parent dies."""
@@ -101,13 +112,28 @@ def _read(fd: int, n: int) -> bytes | None:
     return bytes(buf)
 
 
+def _huge_page_advice(on: bool) -> bool | None:
+    """Set numpy's advice of huge pages for its large arrays; what it was (None: this numpy has
+    no such switch)."""
+    import numpy as np
+
+    core = getattr(np, "_core", None) or np.core
+    switch = getattr(core.multiarray, "_set_madvise_hugepage", None)
+    if switch is None:
+        log.debug("numpy has no huge-page switch: left as it is")
+        return None
+    return bool(switch(on))
+
+
 def configure() -> None:
     """Set up the running process for gatetherm's numerics, as every command does first.
 
     One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
     sweeps and studies do not oversubscribe the cores; glibc's mmap threshold at 4 MiB, so
     that freed large arrays go back to the system at once, and its trim threshold at 64 MiB,
-    so that freed small ones are made again without page faults. Optional in a script.
+    so that freed small ones are made again without page faults; numpy's huge-page advice off
+    unless ``NUMPY_MADVISE_HUGEPAGE`` is set (docs/performance.md gives the measurements).
+    Optional in a script.
 
     Returns
     -------
@@ -119,6 +145,8 @@ def configure() -> None:
         libc.mallopt(_M_TRIM_THRESHOLD, 64 << 20)
     except (OSError, AttributeError):  # not glibc
         log.debug("no glibc: malloc settings left as they are")
+    if HUGE_PAGES_ENV not in os.environ:
+        _huge_page_advice(False)
     from threadpoolctl import threadpool_limits
 
     threads = os.environ.get(THREADS_ENV, str(BLAS_THREADS))
