@@ -72,8 +72,9 @@ class ElasticSystem:
     stiffness: Pending
     """:attr:`K`, assembled where it is first needed: in the solver's helper process where
     :meth:`~gatetherm.solvers.linsolve.SPDSolver.start` sets one up (then never here)."""
-    B: sp.csr_matrix
-    """Thermal load per unit temperature rise (all DOFs × heat DOFs)."""
+    thermal: Pending
+    """:attr:`B`, assembled where it is first needed (linear elements: after the solver's helper
+    process is started, which does not need it)."""
     free: np.ndarray
     solve: SPDSolver
     """Solves with the stiffness on the free DOFs (one or more right-hand sides)."""
@@ -86,6 +87,11 @@ class ElasticSystem:
     def K(self) -> sp.csr_matrix:
         """Stiffness on the free DOFs."""
         return self.stiffness.result()
+
+    @property
+    def B(self) -> sp.csr_matrix:
+        """Thermal load per unit temperature rise (all DOFs × heat DOFs)."""
+        return self.thermal.result()
 
     def displacement(self, dT: np.ndarray) -> np.ndarray:
         """Displacement field (m) for the temperature rise ``dT`` (K) on the heat basis
@@ -244,13 +250,13 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
         simplices, th = simplices or p1.simplices(mesh), thickness.values
         vb = dof_basis(mesh, ElementVector(element(dim, order)))
         K = partial(p1.stiffness, simplices.pattern, simplices.G, simplices.vol, lam * th, mu * th)
-        B = p1.thermal_load(simplices.pattern, simplices.G, simplices.vol, b * th)
+        B = Pending(lambda: p1.thermal_load(simplices.pattern, simplices.G, simplices.vol, b * th).tocsr())
     else:
         vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
         T_basis, t = CellBasis(mesh, T_basis.elem, intorder=q), thickness.at(vb)
         forms = (axisym.stiffness, axisym.thermal_load) if axi else (stiffness, thermal_load)
         K = partial(asm, forms[0], vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t)
-        B = asm(forms[1], T_basis, vb, b=Field(b).at(vb), t=t)
+        B = Pending.of(asm(forms[1], T_basis, vb, b=Field(b).at(vb), t=t).tocsr())
     springs = []
     for s in supports:
         if s.stiffness is not None:
@@ -286,7 +292,7 @@ def assemble_elastic(mesh, order: int, T_basis: CellBasis, E: Field, nu: Field, 
              f" plane {plane}" if dim == 2 else "")
     nodal = len(free) % dim == 0 and bool(np.all(free.reshape(-1, dim) == (free[::dim] // dim * dim)[:, None]
                                                    + np.arange(dim)))
-    return ElasticSystem(vb, Kf, B.tocsr(), free, _Solver(Kf, dim, rbm, perm, nodal, size=size), plane, K_fixed)
+    return ElasticSystem(vb, Kf, B, free, _Solver(Kf, dim, rbm, perm, nodal, size=size), plane, K_fixed)
 
 
 def _free_nonzeros(pattern: p1.Pattern, free: np.ndarray, dim: int) -> int:
