@@ -16,11 +16,10 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
 * numpy's advice of transparent huge pages for its arrays of 4 MiB and more off, unless
   numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: with the mmap threshold above, every large
   array is memory new to the process, and on a virtual machine whose host backs the guest's
-  memory as it is first touched (this one, Firecracker) a fault of a 2 MiB page costs
-  milliseconds of system time. The 3-D frame's elastic stiffness took 1.8-2.1 s (1.3 s of it
-  in the kernel) the first time in a process, 0.7 s without the advice, 0.45 s the fifth
-  time either way; ``simulate --condition 1 --dim 3`` (``benchmarks/blas_threads.py
-  --huge-pages``) in docs/performance.md;
+  memory as it is first touched (this one, Firecracker) the faults of 2 MiB pages cost more
+  system time than the 4 KiB pages' they replace. ``simulate --condition 1 --dim 3``: 15.48 s against 19.03 s,
+  3.97 s of system time against 6.33 s (medians of 5 interleaved runs,
+  ``benchmarks/blas_threads.py --huge-pages``; docs/performance.md);
 
 and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
 solve's helper), :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
