@@ -119,10 +119,16 @@ class AMG:
         own = 0 if np.shares_memory(levels[0].A.data, self.A.data) else levels[0].A.data.nbytes
         return own + sum(_nbytes(lv.A) for lv in levels[1:]) + sum(_nbytes(lv.P) for lv in levels[:-1])  # R: P's view
 
-    def __call__(self, b: np.ndarray) -> np.ndarray:
+    def __call__(self, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """``z = amg(b)``, into ``out`` (double precision, ``b``'s shape) where given."""
         if len(self.ml.levels) == 1:  # no coarser level (a small matrix): its coarse solve
-            return self.ml.coarse_solver(self.A, np.asarray(b, dtype=float))
-        return self._cycle(0, np.asarray(b, dtype=self.dtype)).astype(float)
+            z = self.ml.coarse_solver(self.A, np.asarray(b, dtype=float))
+        else:
+            z = self._cycle(0, np.asarray(b, dtype=self.dtype))
+        if out is None:
+            return z.astype(float)
+        np.copyto(out, z)
+        return out
 
     def _cycle(self, k: int, b: np.ndarray) -> np.ndarray:
         levels = self.ml.levels
@@ -232,18 +238,21 @@ class PCG:
         r = b - Ax
         goal, k = self.rtol * nb, 0
         if np.linalg.norm(r) > goal:
+            # the vectors of an iteration made once and updated in place: on a large mesh (20 × the
+            # 3-D frame's nodes) each new one is memory faulted in (glibc's mmap threshold, 4 MiB)
             z = self.amg(r)
-            p, rz = z.copy(), float(r @ z)
+            p, rz, w = z.copy(), float(r @ z), np.empty_like(r)
             for k in range(1, MAXITER + 1):
                 q = self.A @ p
                 alpha = rz / float(p @ q)
-                x += alpha * p
-                r -= alpha * q
+                x += np.multiply(alpha, p, out=w)
+                r -= np.multiply(alpha, q, out=w)
                 if np.linalg.norm(r) <= goal:
                     break
-                z = self.amg(r)
+                self.amg(r, out=z)
                 rz, rz_old = float(r @ z), rz
-                p = z + (rz / rz_old) * p
+                p *= rz / rz_old
+                p += z
             else:
                 raise SolverError(f"AMG-CG did not converge: relative residual {np.linalg.norm(r) / nb:.2e} after "
                                   f"{MAXITER} iterations (tolerance {self.rtol:g})")
