@@ -17,9 +17,9 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
   numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: with the mmap threshold above, every large
   array is memory new to the process, and on a virtual machine whose host backs the guest's
   memory as it is first touched (this one, Firecracker) the faults of 2 MiB pages cost more
-  system time than the 4 KiB pages' they replace. ``simulate --condition 1 --dim 3``: 15.48 s against 19.03 s,
-  3.97 s of system time against 6.33 s (medians of 5 interleaved runs,
-  ``benchmarks/blas_threads.py --huge-pages``; docs/performance.md);
+  system time than the 4 KiB pages' they replace. ``simulate --condition 1 --dim 3``:
+  15.48 s against 19.03 s, 3.97 s of system time against 6.33 s (medians of 5 interleaved
+  runs, ``benchmarks/blas_threads.py --huge-pages``; docs/performance.md);
 
 and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
 solve's helper), :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
