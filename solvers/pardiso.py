@@ -5,7 +5,7 @@ its own, with its own symbolic analysis. Called through the ``PARDISO_64`` entry
 extension exports (``ctypes``), one handle keeps up to :data:`MAXFCT` numeric factors of
 matrices of one pattern in one order (PARDISO's ``maxfct``/``mnum``), analysed once: the step
 matrices of a heat march (one per step length and pump mode) differ in their values only. The
-3-D frame's four heat factors add 277 MB so against 387 MB with handles of their own, made in
+3-D frame's four heat factors add 277 MB against 387 MB with handles of their own, made in
 0.96 s against 1.23 s, the solutions the same to the bit (``benchmarks/shared_analysis.py``). Where
 the extension exports no ``PARDISO_64`` (a build that hides it), its class factors each
 matrix alone.
