@@ -3,31 +3,30 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
 
 * BLAS threads: :data:`BLAS_THREADS` (``GATETHERM_BLAS_THREADS`` overrides), through
   threadpoolctl;
-* glibc's mmap threshold fixed at 4 MiB: a freed large array goes back to the system at
-  once; glibc otherwise raises the threshold as arrays are freed and keeps later ones in
-  its heap. Peak memory of ``simulate --condition 1 --dim 3``: 1.58 GB without, 1.49 GB
-  with 4 MiB, 1.54 GB with 16 MiB; 1 MiB together with MKL's pool off
-  (``MKL_DISABLE_FAST_MM``) saved 0.02 GB more but cost 9 s of system time;
-* glibc's trim threshold at 64 MiB (128 KiB once the mmap threshold is set): the vectors of
-  the solvers, below the mmap threshold, no longer go back to the system as they are freed
-  and fault in anew as the next are made. ``simulate --condition 1 --dim 3``: page faults
-  0.93-0.97 million without, 0.65-0.66 million with 64 MiB or 1 GiB, 1-2 s less system time,
-  the same peak memory (2 runs each, interleaved);
+* glibc's malloc keeps what is freed for the next arrays (no mmap, no trim): on a virtual
+  machine whose host takes back the memory its guest frees (free page reporting: this one,
+  Firecracker), every page of a new array is faulted in anew at the host's cost, in system
+  time. Condition 1 at 20 × the 3-D nodes: 314.5 s wall, 133 s of it system time, 5.3 million
+  page faults, 10.16 GB, against 366.8 s, 202 s, 27.5 million and 9.58 GB with the mmap
+  threshold at 4 MiB (the setting before); at 1 × 13.72 s against 14.68 s
+  (docs/performance.md, "Memory kept for reuse"). What a phase has freed goes back to the
+  system where it ends (:func:`give_back`: before a fork, after a helper's set-up, before a
+  run's files), so that processes beside it do not hold it twice;
 * numpy's advice of transparent huge pages for its arrays of 4 MiB and more off, unless
-  numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: with the mmap threshold above, every large
-  array is memory new to the process, and on a virtual machine whose host backs the guest's
-  memory as it is first touched (this one, Firecracker) the faults of 2 MiB pages cost more
-  system time than the 4 KiB pages' they replace. ``simulate --condition 1 --dim 3``:
+  numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: on a virtual machine whose host backs the
+  guest's memory as it is first touched (this one) the faults of 2 MiB pages cost more system
+  time than the 4 KiB pages' they replace (measured with the mmap threshold at 4 MiB). ``simulate --condition 1 --dim 3``:
   15.48 s against 19.03 s, 3.97 s of system time against 6.33 s (medians of 5 interleaved
   runs, ``benchmarks/blas_threads.py --huge-pages``; docs/performance.md);
 
 and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
-solve's helper), :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
+solve's helper), :func:`fork`, :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
 (:func:`message`, :func:`send`, :func:`receive`: a pickle behind its length).
 """
 from __future__ import annotations
 
 import ctypes
+import functools
 import logging
 import os
 import pickle
@@ -43,7 +42,7 @@ THREADS_ENV = "GATETHERM_BLAS_THREADS"
 HUGE_PAGES_ENV = "NUMPY_MADVISE_HUGEPAGE"
 """numpy's switch of its huge-page advice: where it is set, :func:`configure` leaves the advice
 as numpy made it."""
-_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD, _M_MMAP_MAX = -1, -3, -4
 PR_SET_PDEATHSIG = 1
 """prctl(2) option: the signal a Linux process gets when its parent dies."""
 
@@ -57,6 +56,48 @@ def can_fork() -> bool:
 
     return (hasattr(os, "fork") and (os.cpu_count() or 1) > 1 and threading.active_count() == 1
             and multiprocessing.parent_process() is None)
+
+
+@functools.cache
+def _libc():
+    """glibc, or None (another C library: its malloc is left as it is)."""
+    try:
+        libc = ctypes.CDLL("libc.so.6")
+        return libc if hasattr(libc, "mallopt") and hasattr(libc, "malloc_trim") else None
+    except OSError:
+        return None
+
+
+def keep_freed(keep: bool) -> None:
+    """Whether glibc's malloc keeps the memory freed in this process for its next arrays
+    (:func:`configure` makes it so: no block mapped alone, the heap never trimmed), or returns
+    blocks of 4 MiB and more to the system when they are freed and trims its heap past 64 MiB
+    (a painting process's, which waits between pictures)."""
+    libc = _libc()
+    if libc is None:
+        log.debug("no glibc: malloc settings left as they are")
+    elif keep:
+        libc.mallopt(_M_MMAP_MAX, 0)
+        libc.mallopt(_M_TRIM_THRESHOLD, -1)
+    else:
+        libc.mallopt(_M_MMAP_MAX, 1 << 16)  # glibc's own
+        libc.mallopt(_M_MMAP_THRESHOLD, 4 << 20)
+        libc.mallopt(_M_TRIM_THRESHOLD, 64 << 20)
+
+
+def give_back() -> None:
+    """Return the memory this process has freed, and keeps for reuse since :func:`configure`,
+    to the system (glibc's ``malloc_trim``): where a phase ends whose arrays will not be made
+    again."""
+    if _libc() is not None:
+        _libc().malloc_trim(0)
+
+
+def fork() -> int:
+    """``os.fork()`` after :func:`give_back`: the child shares no freed pages, which either
+    process would otherwise copy as it reuses them."""
+    give_back()
+    return os.fork()
 
 
 def die_with_parent(sig: int) -> bool:
@@ -128,9 +169,9 @@ def configure() -> None:
     """Set up the running process for gatetherm's numerics, as every command does first.
 
     One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
-    sweeps and studies do not oversubscribe the cores; glibc's mmap threshold at 4 MiB, so
-    that freed large arrays go back to the system at once, and its trim threshold at 64 MiB,
-    so that freed small ones are made again without page faults; numpy's huge-page advice off
+    sweeps and studies do not oversubscribe the cores; glibc's malloc keeping freed memory,
+    large arrays too, for the next arrays (no page faults; :func:`give_back` returns it);
+    numpy's huge-page advice off
     unless ``NUMPY_MADVISE_HUGEPAGE`` is set (docs/performance.md gives the measurements).
     Optional in a script.
 
@@ -138,12 +179,7 @@ def configure() -> None:
     -------
     None
     """
-    try:
-        libc = ctypes.CDLL("libc.so.6")
-        libc.mallopt(_M_MMAP_THRESHOLD, 4 << 20)
-        libc.mallopt(_M_TRIM_THRESHOLD, 64 << 20)
-    except (OSError, AttributeError):  # not glibc
-        log.debug("no glibc: malloc settings left as they are")
+    keep_freed(True)
     if HUGE_PAGES_ENV not in os.environ:
         _huge_page_advice(False)
     from threadpoolctl import threadpool_limits

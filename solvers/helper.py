@@ -31,7 +31,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from gatetherm.process import die_with_parent, end_with_parent, receive, send
+from gatetherm.process import die_with_parent, end_with_parent, fork, give_back, receive, send
 from gatetherm.solvers.iterative import SolverError
 
 log = logging.getLogger(__name__)
@@ -85,7 +85,7 @@ def forked(make: Callable[[], Any], what: str) -> Pending:
         fcntl.fcntl(w, getattr(fcntl, "F_SETPIPE_SZ", 1031), 1 << 20)
     except (ImportError, OSError):  # not Linux, or above its limit: the process waits to be read
         pass
-    pid = os.fork()
+    pid = fork()
     if pid == 0:  # pragma: no cover - the child's coverage is not collected
         try:
             _close_others((w,))  # the caller's pipes: their readers see their end
@@ -137,6 +137,7 @@ def _serve(make: Callable[[], Callable], jobs: int, replies: int) -> None:
     try:
         t0 = time.perf_counter()
         solve, error = make(), None
+        give_back()  # the set-up's temporaries: not kept beside the caller
         log.debug("helper: solver made in %.2f s", time.perf_counter() - t0)
     except Exception as err:  # noqa: BLE001 - reported with every job
         solve, error = None, f"{type(err).__name__}: {err}"
@@ -197,7 +198,7 @@ class SolveHelper:
         if threading.current_thread() is threading.main_thread():  # Python's own setting (gmsh's start undoes
             signal.signal(signal.SIGPIPE, signal.SIG_IGN)  # it): a job sent to an ended helper raises, no signal
         (jobs_r, jobs_w), (replies_r, replies_w) = os.pipe(), os.pipe()
-        pid = os.fork()
+        pid = fork()
         if pid == 0:  # pragma: no cover - the child's coverage is not collected
             code = 1
             try:

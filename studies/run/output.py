@@ -11,6 +11,7 @@ import numpy as np
 from gatetherm import atomic_path, write_text_atomic
 from gatetherm.geometry.mesh import to_meshio
 from gatetherm.geometry.vtu import write_vtu
+from gatetherm.process import give_back
 from gatetherm.solvers.helper import Pending
 from gatetherm.solvers.model import Model, field_recovery, static_fields
 
@@ -185,6 +186,7 @@ def write_run(out: Path, run, metadata: dict[str, str], field_times, picture_tim
     helper process ends once it has solved these (:meth:`~gatetherm.solvers.linsolve.SPDSolver.retire`)."""
     from gatetherm.studies.run.timeseries import FORMAT, write_timeseries
 
+    give_back()  # the march's freed memory (its heat solvers'), not kept beside the helper and the painter
     write_timeseries(out / "timeseries.csv", run.series({"format": FORMAT, **metadata}))
     states = [(t, U) for t, U in run.result.states if t in field_times]
     pictured = dict(nearest_state(run, tp) for tp in picture_times)

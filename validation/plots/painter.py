@@ -22,7 +22,7 @@ import threading
 import time
 from pathlib import Path
 
-from gatetherm.process import can_fork, end_with_parent, message, receive, send
+from gatetherm.process import can_fork, end_with_parent, fork, keep_freed, message, receive, send
 
 log = logging.getLogger(__name__)
 
@@ -108,18 +108,19 @@ class Painter:
 
     def _start(self, workers: int) -> None:
         pairs = [(os.pipe(), os.pipe()) for _ in range(workers)]  # (jobs r, w), (replies r, w)
-        pid = os.fork()
+        pid = fork()
         if pid == 0:  # pragma: no cover - the child's coverage is not collected
             code, child = 1, None
             try:
                 end_with_parent()  # on SIGTERM the PNG being written (its temporary) is removed
+                keep_freed(False)  # a picture's memory (a 3-D renderer's) not held while it waits
                 for (jr, jw), (rr, rw) in pairs:
                     os.close(jw)
                     os.close(rr)
                 _warm()
                 mine = pairs[0]
                 if len(pairs) > 1:  # the second process: matplotlib imported already
-                    child = os.fork()
+                    child = fork()
                     if child == 0:
                         end_with_parent()
                     mine, other = (pairs[1], pairs[0]) if child == 0 else (pairs[0], pairs[1])
