@@ -142,7 +142,7 @@ def interleaved(names, rounds: int):
 
 def rusage_run(cmd, env=None) -> dict:
     """Run ``cmd`` to its end: wall and CPU seconds (``sys``: the system's part), peak resident memory
-    (GB), last JSON line."""
+    (GB), page faults (``faults``, minor), last JSON line."""
     t0 = time.perf_counter()
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     out = p.stdout.read()  # stderr too: one pipe cannot fill while the other is read
@@ -152,7 +152,7 @@ def rusage_run(cmd, env=None) -> dict:
         raise RuntimeError(f"{' '.join(cmd[:4])} failed: {out[-2000:]}")
     line = next((ln for ln in reversed(out.splitlines()) if ln.startswith("{")), "{}")
     return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "sys": usage.ru_stime, "rss_gb": usage.ru_maxrss / 1e6,
-            **json.loads(line)}
+            "faults": usage.ru_minflt, **json.loads(line)}
 
 
 def write_table(path: Path, columns: list, rows: list, notes: list[str]) -> None:

@@ -3,25 +3,23 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
 
 * BLAS threads: :data:`BLAS_THREADS` (``GATETHERM_BLAS_THREADS`` overrides), through
   threadpoolctl;
-* glibc's malloc keeps what is freed for the next arrays (no mmap, no trim): on a virtual
-  machine whose host takes back the memory its guest frees (free page reporting: this one,
-  Firecracker), every page of a new array is faulted in anew at the host's cost, in system
-  time. Condition 1 at 20 × the 3-D nodes: 314.5 s wall, 133 s of it system time, 5.3 million
-  page faults, 10.16 GB, against 366.8 s, 202 s, 27.5 million and 9.58 GB with the mmap
-  threshold at 4 MiB (the setting before); at 1 × 13.72 s against 14.68 s
-  (docs/performance.md, "Memory kept for reuse"). What a phase has freed goes back to the
-  system where it ends (:func:`give_back`: before a fork, after a helper's set-up, before a
-  run's files), so that processes beside it do not hold it twice;
+* glibc's malloc keeps what is freed for the next arrays (no block mapped alone, the heap never
+  trimmed: :func:`keep_freed`): on a virtual machine whose host takes back the memory its guest
+  frees (free page reporting: this one, Firecracker), each page of a new array is otherwise
+  faulted in anew, at the host's cost, in system time. What a phase has freed goes back to the
+  system where it ends (:func:`give_back`: before a fork, after a helper's set-up, before a run's
+  files), so that the processes beside it do not hold it. Measured by ``benchmarks/blas_threads.py
+  --malloc`` and ``benchmarks/scaling.py`` (docs/performance.md, "Freed memory kept for reuse");
 * numpy's advice of transparent huge pages for its arrays of 4 MiB and more off, unless
   numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: on a virtual machine whose host backs the
   guest's memory as it is first touched (this one) the faults of 2 MiB pages cost more system
-  time than the 4 KiB pages' they replace (measured with the mmap threshold at 4 MiB). ``simulate --condition 1 --dim 3``:
-  15.48 s against 19.03 s, 3.97 s of system time against 6.33 s (medians of 5 interleaved
-  runs, ``benchmarks/blas_threads.py --huge-pages``; docs/performance.md);
+  time than the 4 KiB pages' they replace. ``simulate --condition 1 --dim 3``: 15.48 s against
+  19.03 s, 3.97 s of system time against 6.33 s (medians of 5 interleaved runs,
+  ``benchmarks/blas_threads.py --huge-pages``, with the malloc settings before);
 
 and, for the child processes gatetherm starts (gmsh's, a sweep's workers, the painter's, a
-solve's helper), :func:`fork`, :func:`can_fork`, :func:`die_with_parent` and the messages of their pipes
-(:func:`message`, :func:`send`, :func:`receive`: a pickle behind its length).
+solve's helper), :func:`fork`, :func:`can_fork`, :func:`die_with_parent` and the messages of
+their pipes (:func:`message`, :func:`send`, :func:`receive`: a pickle behind its length).
 """
 from __future__ import annotations
 
@@ -170,10 +168,9 @@ def configure() -> None:
 
     One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
     sweeps and studies do not oversubscribe the cores; glibc's malloc keeping freed memory,
-    large arrays too, for the next arrays (no page faults; :func:`give_back` returns it);
-    numpy's huge-page advice off
-    unless ``NUMPY_MADVISE_HUGEPAGE`` is set (docs/performance.md gives the measurements).
-    Optional in a script.
+    large arrays too, for the next arrays (:func:`keep_freed`; :func:`give_back` returns it);
+    numpy's huge-page advice off unless ``NUMPY_MADVISE_HUGEPAGE`` is set (docs/performance.md
+    gives the measurements). Optional in a script.
 
     Returns
     -------

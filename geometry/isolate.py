@@ -35,7 +35,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry import sandbox
-from gatetherm.process import die_with_parent
+from gatetherm.process import die_with_parent, fork
 
 log = logging.getLogger(__name__)
 
@@ -179,7 +179,7 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
     if THREADS_STARTED["here"]:
         pid = _spawn(work, (out_w, log_w, go_r, theirs.fileno()), verbose)
     else:
-        pid = os.fork()
+        pid = fork()
         if pid == 0:  # pragma: no cover - the child's coverage is not collected
             mine.close()
             _child(work, out_w, log_w, theirs, go_r, verbose, parent)

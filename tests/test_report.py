@@ -165,12 +165,12 @@ def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypat
     """Absent files are "not measured yet"; a result file is one table of its columns and rows,
     captioned with its command, machine and date, its notes under it; a file that is not a
     table is said to be one; the digest follows the files (absent, then present)."""
-    from gatetherm.validation.report.registry import Context, section
+    from gatetherm.validation.report.registry import BENCHMARK_FILES, Context, section
     from gatetherm.validation.report.sections import speed
 
     monkeypatch.setattr(speed, "BENCHMARKS", tmp_path)
     res = speed.compute(Context(tmp_path, {}, 1))
-    assert res.tables == () and len(res.notes) == 6 and all("not measured yet" in n for n in res.notes)
+    assert res.tables == () and len(res.notes) == len(BENCHMARK_FILES) and all("not measured yet" in n for n in res.notes)
     assert "`python benchmarks/peer.py --rounds 3` writes it" in res.notes[0]
     (tmp_path / "peer.json").write_text(json.dumps(
         {"date": "2026-11-26", "machine": "2 cores", "command": "python benchmarks/peer.py --rounds 3",
@@ -182,7 +182,7 @@ def test_speed_section_shows_the_benchmark_files_as_they_are(tmp_path, monkeypat
     assert t.columns == ("case", "gatetherm s", "ratio") and t.rows == (("3-D heat", "1.235", "0.5"),
                                                                         ("3-D elastic", "2", "—"))
     assert t.title == "peer.json: measured by `python benchmarks/peer.py --rounds 3` on 2 cores, 2026-11-26"
-    assert t.note == "median of 3 rounds" and len(notes) == 5
+    assert t.note == "median of 3 rounds" and len(notes) == len(BENCHMARK_FILES) - 1
     assert notes[0].startswith("`benchmarks/results/scaling.json` is not a benchmark table (AttributeError: ")
     assert notes[0].endswith("rerun `python benchmarks/scaling.py`.")
     monkeypatch.setattr(b, "input_files", lambda patterns: {p: tmp_path / Path(p).name for p in patterns})

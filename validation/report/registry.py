@@ -65,6 +65,7 @@ BENCHMARK_FILES = {"peer.json": "python benchmarks/peer.py --rounds 3",
                    "backends.json": "python benchmarks/backends.py --rounds 3",
                    "blas_threads.json": "python benchmarks/blas_threads.py --rounds 3",
                    "huge_pages.json": "python benchmarks/blas_threads.py --huge-pages --rounds 5",
+                   "malloc.json": "python benchmarks/blas_threads.py --malloc --rounds 5",
                    "errormodel.json": "/tmp/venv_bench/bin/python benchmarks/errormodel.py --data FILE.csv"}
 """Result files of the benchmark scripts the speed section shows, with the command that measures
 each."""
