@@ -7,8 +7,9 @@ the settings before), interleaved.
 
     python benchmarks/blas_threads.py [--rounds 3] [--threads 1 2] [--huge-pages | --malloc] [--json FILE]
 
-Prints the medians of wall time, CPU time, its system part, peak memory and page faults per setting; the
-defaults of :func:`gatetherm.process.configure` are chosen from these tables (docs/performance.md).
+Prints the medians of wall time, CPU time, its system part, peak memory and page faults per
+setting; the defaults of :func:`gatetherm.process.configure` are chosen from these tables
+(docs/performance.md).
 """
 from __future__ import annotations
 

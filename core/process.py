@@ -9,7 +9,8 @@ frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.
   faulted in anew, at the host's cost, in system time. What a phase has freed goes back to the
   system where it ends (:func:`give_back`: before a fork, after a helper's set-up, before a run's
   files), so that the processes beside it do not hold it. Measured by ``benchmarks/blas_threads.py
-  --malloc`` and ``benchmarks/scaling.py`` (docs/performance.md, "Freed memory kept for reuse");
+  --malloc`` and ``benchmarks/scaling.py`` (docs/performance.md, "2026-12-06 late: freed memory
+  kept for reuse");
 * numpy's advice of transparent huge pages for its arrays of 4 MiB and more off, unless
   numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: on a virtual machine whose host backs the
   guest's memory as it is first touched (this one) the faults of 2 MiB pages cost more system
@@ -168,7 +169,7 @@ def configure() -> None:
 
     One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
     sweeps and studies do not oversubscribe the cores; glibc's malloc keeping freed memory,
-    large arrays too, for the next arrays (:func:`keep_freed`; :func:`give_back` returns it);
+    large arrays too, for the next arrays (``gatetherm.process.keep_freed``; ``give_back`` returns it);
     numpy's huge-page advice off unless ``NUMPY_MADVISE_HUGEPAGE`` is set (docs/performance.md
     gives the measurements). Optional in a script.
 
