@@ -56,8 +56,8 @@ def main() -> None:
         cmd = [sys.executable, "-c", COMMAND, "simulate", "--condition", "1", "--dim", "3",
                "--out", str(work / f"r{r}-{len(runs[n])}")]
         res = rusage_run(cmd, env={**env, **settings[n]})
-        runs[n].append(res)
         res["faults"] /= 1e6
+        runs[n].append(res)
         print(f"round {r + 1} {n}: wall {res['wall']:.1f} s, CPU {res['cpu']:.1f} s (system {res['sys']:.1f} s), "
               f"peak {res['rss_gb']:.2f} GB, {res['faults']:.2f} million page faults, load {os.getloadavg()[0]:.1f}",
               flush=True)

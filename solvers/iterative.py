@@ -238,8 +238,8 @@ class PCG:
         r = b - Ax
         goal, k = self.rtol * nb, 0
         if np.linalg.norm(r) > goal:
-            # the vectors of an iteration made once and updated in place: on a large mesh (20 × the
-            # 3-D frame's nodes) each new one is memory faulted in (glibc's mmap threshold, 4 MiB)
+            # the vectors of an iteration made once and updated in place, not made anew each time
+            # (on a large mesh each new one could be memory faulted in: gatetherm.process.keep_freed)
             z = self.amg(r)
             p, rz, w = z.copy(), float(r @ z), np.empty_like(r)
             for k in range(1, MAXITER + 1):

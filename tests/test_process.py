@@ -1,5 +1,6 @@
 """Process-wide settings of :func:`gatetherm.configure`: numpy's huge-page advice is off after it,
-unless numpy's own ``NUMPY_MADVISE_HUGEPAGE`` says how it should be."""
+unless numpy's own ``NUMPY_MADVISE_HUGEPAGE`` says how it should be; glibc's malloc keeps freed
+memory till :func:`gatetherm.process.give_back` returns it."""
 from __future__ import annotations
 
 import os
@@ -20,7 +21,6 @@ def test_configure_turns_numpys_huge_page_advice_off_unless_numpy_is_told(settin
     out = subprocess.run([sys.executable, "-c", ADVICE_AFTER_CONFIGURE], env=env, capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == advised
-
 
 
 KEPT_AFTER_CONFIGURE = """
