@@ -1,6 +1,6 @@
 """Parts of a 3-D run, each against the way it was made before, on the 3-D frame.
 
-    python benchmarks/assembly_parts.py [--rounds 5]
+    python benchmarks/assembly_parts.py [--rounds 5] [--factor 1] [--parts NAME ...]
 
 Each variant once, as a run calls it, in a new interpreter set up as a command is
 (``gt.configure()``): what a part costs there is mostly memory touched for the first time.
@@ -18,8 +18,12 @@ chunks of elements, facets of the elements touching the boundaries, against its 
 (whole arrays, every element's facets); the mesh's nodes by a mask against ``np.unique``; the METIS
 order with one refinement pass per level against METIS's default; shared facets of two boundaries
 by keys against a loop over tuples; the free displacement DOFs (those the mounting face does not
-hold) by a mask (``fem.complement``) against ``np.setdiff1d``.
-Prints the medians, their ratios, and that the results agree (docs/performance.md,
+hold) by a mask (``fem.complement``) against ``np.setdiff1d``. From 2026-12-06 evening: the
+elastic stiffness with its element matrices made a chunk of elements at a time
+(``p1.Pattern.blocks``) against all at once. ``--factor F`` meshes the frame with about F times
+the default nodes (as ``benchmarks/scaling.py``); ``--parts`` runs only the pairs named.
+Prints the medians, their ratios, each variant's peak memory above its start, and that the
+results agree (docs/performance.md,
 "2026-12-04" and "Against DOLFINx"; a METIS order is compared as a permutation only).
 """
 from __future__ import annotations
@@ -41,7 +45,8 @@ PAIRS = {"pattern": ("by rows", "searchsorted"),
          "mesh check": ("sorted keys", "np.unique"), "mesh read": ("whole arrays", "meshio"),
          "dof basis": ("one element", "every element"), "mesh check 12-06": ("chunks", "whole"),
          "mesh nodes": ("mask", "np.unique"), "METIS order": ("one pass", "ten passes"),
-         "shared facets": ("keys", "tuples"), "free DOFs": ("mask", "setdiff1d")}
+         "shared facets": ("keys", "tuples"), "free DOFs": ("mask", "setdiff1d"),
+         "stiffness": ("chunks", "at once")}
 
 
 def variants(fm, work: str):
@@ -76,12 +81,12 @@ def variants(fm, work: str):
         return np.searchsorted(rows + A.indices, i.astype(np.int64) * n + j)
 
     def six_matrices():  # stress._p1_recovery before, and Recovery.field's products
-        def s_entry(i, j):
-            def entry(_, b):
+        def s_form(i, j):
+            def form(_, b, G, vol, lam, mu):
                 sv = mu[:, None] * ((j == b) * G[:, :, i] + (i == b) * G[:, :, j]) + (lam[:, None] * G[:, :, b] if i == j else 0.0)
                 return np.broadcast_to((vol / k)[:, None, None] * sv[:, None, :], (len(vol), k, k))
-            return entry
-        S = {c: pattern.blocks(s_entry(*_INDEX[c]), 1, 3) for c in comps}
+            return form
+        S = {c: pattern.blocks(s_form(*_INDEX[c]), 1, 3, G, vol, lam, mu) for c in comps}
         t0 = time.perf_counter()
         out = {c: S[c] @ u for c in comps}
         return {**out, "product s": time.perf_counter() - t0,
@@ -131,6 +136,18 @@ def variants(fm, work: str):
         used[fm.cells.ravel()] = True
         return np.flatnonzero(used)
 
+    def stiffness_at_once():  # p1.stiffness before 2026-12-06 evening: all element matrices at once
+        dot, Gl, Gm = p1.conduction(G, vol, mu), (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
+        data = np.empty((pattern.nnz, 3, 3))
+        for a in range(3):
+            for b in range(3):
+                out = Gl[:, :, a][:, :, None] * G[:, :, b][:, None, :]
+                out += Gm[:, :, b][:, :, None] * G[:, :, a][:, None, :]
+                if a == b:
+                    out += dot
+                data[:, a, b] = np.bincount(pattern.inv, weights=out.ravel(), minlength=pattern.nnz)
+        return sp.bsr_matrix((data, pattern.indices, pattern.indptr), shape=(3 * n, 3 * n)).tocsr()
+
     msh, mesh, names = os.path.join(work, "frame.msh"), to_skfem(fm), list(fm.boundaries)
     vector, none = ElementVector(element(3, 1)), (np.zeros((3, 0)), np.zeros(0))
     held = (3 * np.unique(fm.boundaries["mounting_face"])[:, None] + np.arange(3)).ravel()
@@ -161,7 +178,9 @@ def variants(fm, work: str):
             ("shared facets", "keys"): lambda: np.full(1, 2.0) if _overlapping(fm, names) else np.ones(1),
             ("shared facets", "tuples"): shared_by_tuples,
             ("free DOFs", "mask"): lambda: complement(3 * n, held),
-            ("free DOFs", "setdiff1d"): lambda: np.setdiff1d(np.arange(3 * n), held)}
+            ("free DOFs", "setdiff1d"): lambda: np.setdiff1d(np.arange(3 * n), held),
+            ("stiffness", "chunks"): lambda: p1.stiffness(pattern, G, vol, lam, mu),
+            ("stiffness", "at once"): stiffness_at_once}
 
 
 def _part(mesh_file: str, part: str, variant: str, result_file: str) -> None:
@@ -172,15 +191,25 @@ def _part(mesh_file: str, part: str, variant: str, result_file: str) -> None:
     with open(mesh_file, "rb") as f:
         fm = pickle.load(f)  # written by this script's parent
     make = variants(fm, os.path.dirname(result_file))[(part, variant)]
+    with open("/proc/self/clear_refs", "w") as f:
+        f.write("5")  # the peak resident memory (VmHWM) starts again from now
+    before = _status("VmRSS")
     t0 = time.perf_counter()
     out = make()
     secs = time.perf_counter() - t0
+    grown = _status("VmHWM") - before  # the peak above the start
     if isinstance(out, str):  # a field file
         import meshio
 
         out = meshio.read(out).point_data["u"]
     with open(result_file, "wb") as f:
-        pickle.dump((secs, out), f)
+        pickle.dump((secs, out, grown), f)
+
+
+def _status(field: str) -> float:
+    """A memory figure of /proc/self/status, bytes."""
+    with open("/proc/self/status") as f:
+        return 1024.0 * next(int(line.split()[1]) for line in f if line.startswith(field + ":"))
 
 
 def _same(a, b) -> float:
@@ -191,9 +220,24 @@ def _same(a, b) -> float:
     return float(abs(a - b).max() / abs(b).max())
 
 
+def _config(factor: float, folder: str) -> str | None:
+    """A configuration file meshing the frame with about ``factor`` × the default nodes (None: 1)."""
+    if factor == 1.0:
+        return None
+    from gatetherm.geometry.frame import MeshParams
+
+    path = os.path.join(folder, "mesh.toml")
+    with open(path, "w") as f:
+        f.write(f"[mesh]\nsize_3d = {MeshParams().size_3d / factor ** (1 / 3)!r}\n")
+    return path
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--factor", type=float, default=1.0,
+                    help="the frame meshed with about this many times the default nodes (as benchmarks/scaling.py)")
+    ap.add_argument("--parts", nargs="+", choices=list(PAIRS), default=list(PAIRS), help="the pairs to run (all)")
     ap.add_argument("--part", nargs=4, help=argparse.SUPPRESS)  # one variant, in a new interpreter
     args = ap.parse_args()
     if args.part:
@@ -201,8 +245,10 @@ def main() -> None:
     import gatetherm as gt
     from gatetherm.geometry.mesh import save_mesh
 
-    fm = gt.gate_frame(dim=3).mesh
+    with tempfile.TemporaryDirectory() as folder:
+        fm = gt.gate_frame(dim=3, config=_config(args.factor, folder)).mesh
     times: dict = {}
+    peaks: dict = {}
     with tempfile.TemporaryDirectory() as tmp:
         mesh_file = os.path.join(tmp, "mesh.pkl")
         with open(mesh_file, "wb") as f:
@@ -211,23 +257,28 @@ def main() -> None:
         print(f"3-D frame: {len(fm.points)} nodes, {len(fm.cells)} elements", flush=True)
         results = {}
         for r in range(args.rounds):
-            for part, pair in PAIRS.items():
+            for part in args.parts:
+                pair = PAIRS[part]
                 for variant in (pair if r % 2 == 0 else pair[::-1]):
                     out = os.path.join(tmp, "result.pkl")
                     subprocess.run([sys.executable, __file__, "--part", mesh_file, part, variant, out], check=True)
                     with open(out, "rb") as f:
-                        secs, results[part, variant] = pickle.load(f)
+                        secs, results[part, variant], grown = pickle.load(f)
                     times.setdefault((part, variant), []).append(secs)
+                    peaks.setdefault((part, variant), []).append(grown / 1e9)
     print(f"medians of {args.rounds} rounds, each variant once in a new interpreter, s:")
-    for part, (new, old) in PAIRS.items():
+    for part in args.parts:
+        new, old = PAIRS[part]
         a, b = statistics.median(times[part, new]), statistics.median(times[part, old])
         print(f"  {part:16s} {new:19s} {a:6.3f}  {old:13s} {b:6.3f}  {a / b:5.2f} x  "
               f"(runs {', '.join(f'{t:.2f}' for t in times[part, new])} against "
               f"{', '.join(f'{t:.2f}' for t in times[part, old])}); largest relative difference "
-              f"{_same(results[part, new], results[part, old]):.1e}")
-    held = results["stress rhs", "six matrices"]
-    print(f"the six matrices of the stress projection held {held['GB']:.3f} GB; their products with one field "
-          f"took {held['product s']:.3f} s (the last round)")
+              f"{_same(results[part, new], results[part, old]):.1e}; peak above the start "
+              f"{statistics.median(peaks[part, new]):.3f} against {statistics.median(peaks[part, old]):.3f} GB")
+    held = results.get(("stress rhs", "six matrices"))
+    if held is not None:
+        print(f"the six matrices of the stress projection held {held['GB']:.3f} GB; their products with one field "
+              f"took {held['product s']:.3f} s (the last round)")
 
 
 if __name__ == "__main__":

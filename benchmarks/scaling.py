@@ -90,27 +90,28 @@ def exponent(nodes, seconds) -> float:
 def write(runs: dict, rounds: int, out: Path) -> None:
     """The table of the jobs run so far (medians, fitted exponents) printed and written to ``out``."""
     runs = {k: v for k, v in runs.items() if v}
-    columns = ["dim", "path", "nodes", "elastic DOFs", *PARTS, "total s", "wall s", "CPU s", "peak GB", "first peak um",
-               "swing um"]
+    columns = ["dim", "path", "nodes", "elastic DOFs", *PARTS, "total s", "wall s", "CPU s", "system s", "peak GB",
+               "first peak um", "swing um"]
     rows, notes = [], []
     for d, path in dict.fromkeys((d, path) for d, path, _ in runs):
         keys = [k for k in runs if k[:2] == (d, path)]
-        med = [{k: statistics.median(x[k] for x in runs[key]) for k in (*PARTS, "wall", "cpu", "rss_gb")}
+        med = [{k: statistics.median(x[k] for x in runs[key]) for k in (*PARTS, "wall", "cpu", "sys", "rss_gb")}
                | {k: runs[key][0][k] for k in ("nodes", "elastic_dofs", "first_peak_um", "swing_um")} for key in keys]
         for m in med:
             rows.append([d, path, m["nodes"], m["elastic_dofs"], *(round(m[k], 2) for k in PARTS),
-                         round(sum(m[k] for k in PARTS), 2), round(m["wall"], 1), round(m["cpu"], 1), round(m["rss_gb"], 2),
+                         round(sum(m[k] for k in PARTS), 2), round(m["wall"], 1), round(m["cpu"], 1), round(m["sys"], 1), round(m["rss_gb"], 2),
                          m["first_peak_um"], m["swing_um"]])
         if len(med) > 1:
             n = [m["nodes"] for m in med]
-            fits = {k: exponent(n, [m[k] for m in med]) for k in (*PARTS, "wall", "cpu", "rss_gb")}
+            fits = {k: exponent(n, [m[k] for m in med]) for k in (*PARTS, "wall", "cpu", "sys", "rss_gb")}
             rows.append([d, path, "exponent", "", *(f"{fits[k]:.2f}" for k in PARTS),
                          f"{exponent(n, [sum(m[k] for k in PARTS) for m in med]):.2f}",
-                         f"{fits['wall']:.2f}", f"{fits['cpu']:.2f}", f"{fits['rss_gb']:.2f}", "", ""])
+                         f"{fits['wall']:.2f}", f"{fits['cpu']:.2f}", f"{fits['sys']:.2f}", f"{fits['rss_gb']:.2f}", "", ""])
     notes.append(f"medians of {rounds} round(s); times in s; 'exponent': slope of log(part) against "
                  "log(nodes); condition 1 (5 h, 300 steps of 60 s), six output-time elastic solves, no files; "
                  "path: GATETHERM_SOLVER of the run; CPU s: the job process's user + system time (wait4), the figure "
-                 "to read when the shared cores are loaded")
+                 "to read when the shared cores are loaded; system s: its system part (on a virtual machine whose "
+                 "host takes back freed memory, mostly the first touch of new memory: docs/performance.md)")
     write_table(out, columns, rows, notes)
 
 

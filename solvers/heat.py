@@ -375,8 +375,8 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     s = None
     if order == 1 and problem.plane != "axisymmetric":  # the same matrices, vectorised (solvers/p1.py)
         s = simplices or p1.simplices(mesh)
-        M = s.pattern.scalar(p1.mass(s.G, s.vol, fields["rho_c"].values * th.values))
-        K = s.pattern.scalar(p1.conduction(s.G, s.vol, fields["k"].values * th.values))
+        M = s.pattern.scalar(p1.mass, s.G, s.vol, fields["rho_c"].values * th.values)
+        K = s.pattern.scalar(p1.conduction, s.G, s.vol, fields["k"].values * th.values)
         basis = dof_basis(mesh, e)
     else:
         basis = CellBasis(mesh, e, intorder=q)

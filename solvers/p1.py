@@ -6,14 +6,14 @@ frame's elastic stiffness: 10.7 s and a 1.9 GB peak of triplets through ``asm``)
 
 Every element matrix follows from the barycentric gradients; the mesh's node-pair
 pattern is found once (:class:`Pattern`), and each matrix is one ``np.bincount`` per
-component onto it. Vector DOFs are interleaved, ``dim * node + component``, as scikit-fem's
+component onto it, of the element entries made :data:`CHUNK` elements at a time. Vector DOFs are interleaved, ``dim * node + component``, as scikit-fem's
 ``ElementVector`` numbers them.
 """
 from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, partial
 from math import factorial
 
 import numpy as np
@@ -28,20 +28,34 @@ log = logging.getLogger(__name__)
 def gradients(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Barycentric gradients (E, d+1, d) and measures (E,) of the simplices ``cells``
     (E, d+1) of ``points`` (N, d): the rows of the inverse Jacobian by cofactors (cross
-    products in 3-D), a third of the time of a batched ``np.linalg.inv``."""
-    X = points[cells]
+    products in 3-D), a third of the time of a batched ``np.linalg.inv``; :data:`CHUNK`
+    elements at a time."""
+    G, vol = np.empty(cells.shape + (points.shape[1],)), np.empty(len(cells))
+    for s in range(0, len(cells), CHUNK):
+        G[s:s + CHUNK], vol[s:s + CHUNK] = _gradients(points[cells[s:s + CHUNK]])
+    return G, vol
+
+
+def _gradients(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     J = X[:, 1:] - X[:, :1]  # (E, d, d): rows x_i − x_0
-    if points.shape[1] == 3:
+    if X.shape[2] == 3:
         a, b, c = J[:, 0], J[:, 1], J[:, 2]
         cof = np.stack([np.cross(b, c), np.cross(c, a), np.cross(a, b)], axis=1)
         det = np.einsum("ij,ij->i", a, cof[:, 0])
     else:
         det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
         cof = np.stack([np.stack([J[:, 1, 1], -J[:, 1, 0]], -1), np.stack([-J[:, 0, 1], J[:, 0, 0]], -1)], axis=1)
-    G = np.empty(cells.shape + (points.shape[1],))
+    G = np.empty(X.shape[:1] + X.shape[1:])
     G[:, 1:] = cof / det[:, None, None]  # row i: the gradient of λ_i
     G[:, 0] = -G[:, 1:].sum(axis=1)
-    return G, np.abs(det) / factorial(points.shape[1])
+    return G, np.abs(det) / factorial(X.shape[2])
+
+
+CHUNK = 1 << 14
+"""Elements whose matrices are made at a time, into one array of every element's entries that
+each matrix component reuses: on the 3-D frame at 20 × the nodes the products of whole
+arrays had made the elastic set-up's temporaries 2.8 GB, each new to its process
+(``docs/performance.md``, "element matrices in chunks")."""
 
 
 class Pattern:
@@ -49,35 +63,48 @@ class Pattern:
 
     def __init__(self, cells: np.ndarray, n_nodes: int):
         k = cells.shape[1]
+        cells = cells.astype(np.int32 if n_nodes < 2 ** 31 else np.int64, copy=False)
         i = np.repeat(cells, k, axis=1).ravel()
         j = np.tile(cells, (1, k)).ravel()
         A = sp.csr_matrix((np.ones(len(i), dtype=np.int8), (i, j)), shape=(n_nodes, n_nodes))  # sorted, summed
         self.indices, self.indptr = A.indices.astype(np.int32), A.indptr.astype(np.int32)
         # each entry's position looked up in its row (about 0.6 × the time of one searchsorted over all,
-        # benchmarks/assembly_parts.py)
-        at = sp.csr_array((np.arange(A.nnz, dtype=float), A.indices, A.indptr), shape=A.shape)[i, j]
-        self.inv = at.astype(np.int32 if A.nnz < 2 ** 31 else np.int64)
+        # benchmarks/assembly_parts.py), a chunk of elements at a time
+        A = sp.csr_array((np.arange(A.nnz, dtype=float), A.indices, A.indptr), shape=A.shape)
+        self.inv = np.empty(len(i), dtype=np.int32 if A.nnz < 2 ** 31 else np.int64)
         """Position of every element entry (element-major, row-major within) in the pattern."""
+        step = CHUNK * k * k
+        for s in range(0, len(i), step):
+            self.inv[s:s + step] = A[i[s:s + step], j[s:s + step]]
         self.n, self.nnz, self.k = n_nodes, A.nnz, k
 
     def graph(self) -> sp.csr_matrix:
         """The node adjacency (the pattern as a matrix of ones)."""
         return sp.csr_matrix((np.ones(self.nnz), self.indices, self.indptr), shape=(self.n, self.n))
 
-    def _sum(self, Ke: np.ndarray) -> np.ndarray:
-        return np.bincount(self.inv, weights=np.ravel(Ke), minlength=self.nnz)
+    def _sum(self, at: np.ndarray, form, per_element, out: np.ndarray) -> np.ndarray:
+        """The pattern's values of the element matrices ``form(*rows)`` (e, k, k) of the arrays
+        ``per_element``, made :data:`CHUNK` elements at a time into ``out`` (every entry)."""
+        kk = self.k * self.k
+        for s in range(0, len(out) // kk, CHUNK):
+            out[s * kk:(s + CHUNK) * kk] = np.ravel(form(*(x[s:s + CHUNK] for x in per_element)))
+        return np.bincount(at, weights=out, minlength=self.nnz)
 
-    def scalar(self, Ke: np.ndarray) -> sp.csr_matrix:
-        """The matrix of element matrices ``Ke`` (E, k, k)."""
-        return sp.csr_matrix((self._sum(Ke), self.indices, self.indptr), shape=(self.n, self.n))
+    def scalar(self, form, *per_element: np.ndarray) -> sp.csr_matrix:
+        """The matrix of the element matrices ``form(*per_element)`` (E, k, k), made from the
+        rows (elements) of the arrays ``per_element`` a chunk at a time."""
+        data = self._sum(self.inv, form, per_element, np.empty(len(self.inv)))
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
 
-    def blocks(self, entry, rows: int, cols: int) -> sp.csr_matrix:
-        """A matrix of ``rows`` × ``cols`` blocks per node pair, ``entry(a, b)`` giving the
-        element entries (E, k, k) of block component (a, b); DOFs interleaved."""
+    def blocks(self, form, rows: int, cols: int, *per_element: np.ndarray) -> sp.csr_matrix:
+        """A matrix of ``rows`` × ``cols`` blocks per node pair, ``form(a, b, *per_element)``
+        (E, k, k) giving the element entries of block component (a, b) (made as :meth:`scalar`'s);
+        DOFs interleaved."""
+        at, entries = self.inv.astype(np.intp), np.empty(len(self.inv))  # each once for every component
         data = np.empty((self.nnz, rows, cols))
         for a in range(rows):
             for b in range(cols):
-                data[:, a, b] = self._sum(entry(a, b))
+                data[:, a, b] = self._sum(at, partial(form, a, b), per_element, entries)
         return sp.bsr_matrix((data, self.indices, self.indptr), shape=(rows * self.n, cols * self.n)).tocsr()
 
 
@@ -92,29 +119,31 @@ def conduction(G: np.ndarray, vol: np.ndarray, c: np.ndarray) -> np.ndarray:
     return (c * vol)[:, None, None] * np.matmul(G, G.transpose(0, 2, 1))
 
 
+def elastic(a: int, b: int, G: np.ndarray, vol: np.ndarray, lam: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """Component (a, b) of the element matrices of ``∫ λ div u div v + 2 μ ε(u):ε(v)``:
+    ``vol (λ G_ia G_jb + μ G_ib G_ja + μ δ_ab G_i·G_j)``, v test (i), u trial (j)."""
+    out = ((lam * vol)[:, None] * G[:, :, a])[:, :, None] * G[:, None, :, b]
+    out += ((mu * vol)[:, None] * G[:, :, b])[:, :, None] * G[:, None, :, a]
+    if a == b:
+        out += conduction(G, vol, mu)
+    return out
+
+
+def heat_strain(a: int, _: int, G: np.ndarray, vol: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Component (a, 0) of the element matrices of ``∫ b T div v``, T trial (j), v test (i):
+    ``b vol G_ia / (d+1)``."""
+    k = G.shape[1]
+    return np.broadcast_to(((b * vol / k)[:, None] * G[:, :, a])[:, :, None], G.shape[:2] + (k,))
+
+
 def stiffness(pattern: Pattern, G: np.ndarray, vol: np.ndarray, lam: np.ndarray, mu: np.ndarray) -> sp.csr_matrix:
-    """``∫ λ div u div v + 2 μ ε(u):ε(v)`` (λ, μ per element, thickness included):
-    ``K[d i + a, d j + b] = vol (λ G_ia G_jb + μ G_ib G_ja + μ δ_ab G_i·G_j)``, v test (i), u trial (j)."""
-    dim = G.shape[2]
-    dot = conduction(G, vol, mu)
-    Gl, Gm = (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
-
-    def entry(a, b):
-        out = Gl[:, :, a][:, :, None] * G[:, :, b][:, None, :]
-        out += Gm[:, :, b][:, :, None] * G[:, :, a][:, None, :]
-        if a == b:
-            out += dot
-        return out
-
-    return pattern.blocks(entry, dim, dim)
+    """``∫ λ div u div v + 2 μ ε(u):ε(v)`` (λ, μ per element, thickness included): :func:`elastic`."""
+    return pattern.blocks(elastic, G.shape[2], G.shape[2], G, vol, lam, mu)
 
 
 def thermal_load(pattern: Pattern, G: np.ndarray, vol: np.ndarray, b: np.ndarray) -> sp.csr_matrix:
-    """``∫ b T div v`` (T trial, P1 scalar; v test, P1 vector): ``B[d i + a, j] = b vol G_ia / (d+1)``."""
-    k = G.shape[1]
-    w = (b * vol / k)[:, None, None]
-    return pattern.blocks(lambda a, _: np.broadcast_to(w * G[:, :, a][:, :, None], G.shape[:2] + (k,)),
-                          G.shape[2], 1)
+    """``∫ b T div v`` (T trial, P1 scalar; v test, P1 vector): :func:`heat_strain`."""
+    return pattern.blocks(heat_strain, G.shape[2], 1, G, vol, b)
 
 
 def facet_terms(points: np.ndarray, facets: np.ndarray, w: np.ndarray, n: int) -> tuple[sp.csr_matrix, np.ndarray]:

@@ -223,11 +223,11 @@ def _p1_recovery(mesh, dim: int, comps, normal, lam, mu, b, elements, T_at, simp
         G, vol = p1.gradients(mesh.p.T, cells)
         lam, mu, b = lam[elements], mu[elements], b[elements]
         pattern, active, order = p1.Pattern(cells, mesh.nvertices), np.unique(cells), None
-    M = pattern.scalar(p1.mass(G, vol, np.ones(len(vol))))[active][:, active]
+    M = pattern.scalar(p1.mass, G, vol, np.ones(len(vol)))[active][:, active]
 
     S = ElementStress(cells, G, vol, lam, mu, tuple(comps), mesh.nvertices)
     if T_at is None:
-        Qn = pattern.scalar(p1.mass(G, vol, -b))  # the same for every normal component
+        Qn = pattern.scalar(p1.mass, G, vol, -b)  # the same for every normal component
         Q = {c: Qn for c in normal}
     else:
         sb = CellBasis(mesh, element(dim, 1), intorder=2, **({} if elements is None else {"elements": elements}))

@@ -32,8 +32,8 @@ def test_p1_matrices_equal_the_forms(dim, frame_2d, frame_3d):
     pattern = p1.Pattern(mesh.t.T, mesh.nvertices)
     th = t.values
     pairs = [
-        (pattern.scalar(p1.mass(G, vol, c.values * th)), asm(capacity, sb, rc=c.at(sb), t=t.at(sb))),
-        (pattern.scalar(p1.conduction(G, vol, k.values * th)), asm(conduction, sb, k=k.at(sb), t=t.at(sb))),
+        (pattern.scalar(p1.mass, G, vol, c.values * th), asm(capacity, sb, rc=c.at(sb), t=t.at(sb))),
+        (pattern.scalar(p1.conduction, G, vol, k.values * th), asm(conduction, sb, k=k.at(sb), t=t.at(sb))),
         (p1.stiffness(pattern, G, vol, lam * th, mu * th),
          asm(stiffness, vb, lam=Field(lam).at(vb), mu=Field(mu).at(vb), t=t.at(vb))),
         (p1.thermal_load(pattern, G, vol, b * th), asm(thermal_load, tb, vb, b=Field(b).at(vb), t=t.at(vb))),
