@@ -1,13 +1,13 @@
-"""Linear (P1) simplex matrices assembled all at once in numpy: capacity, conduction,
+"""Linear (P1) simplex matrices assembled vectorised in numpy: capacity, conduction,
 elastic stiffness and the thermal-load matrix, the same as scikit-fem's forms of
 :mod:`gatetherm.solvers.heat` and :mod:`gatetherm.solvers.elasticity` (to round-off,
 ``tests/test_p1.py``) at a fraction of the time and memory on a large mesh (the 3-D
 frame's elastic stiffness: 10.7 s and a 1.9 GB peak of triplets through ``asm``).
 
 Every element matrix follows from the barycentric gradients; the mesh's node-pair
-pattern is found once (:class:`Pattern`), and each matrix is one ``np.bincount`` per
-component onto it, of the element entries made :data:`CHUNK` elements at a time. Vector DOFs are interleaved, ``dim * node + component``, as scikit-fem's
-``ElementVector`` numbers them.
+pattern is found once (:class:`Pattern`), and each matrix component is summed onto it
+:data:`CHUNK` elements at a time. Vector DOFs are interleaved, ``dim * node + component``, as
+scikit-fem's ``ElementVector`` numbers them.
 """
 from __future__ import annotations
 
@@ -52,10 +52,9 @@ def _gradients(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 CHUNK = 1 << 14
-"""Elements whose matrices are made at a time, into one array of every element's entries that
-each matrix component reuses: on the 3-D frame at 20 × the nodes the products of whole
-arrays had made the elastic set-up's temporaries 2.8 GB, each new to its process
-(``docs/performance.md``, "element matrices in chunks")."""
+"""Elements whose matrices are made and summed (``np.add.at``) at a time: temporaries of a few
+MB on any mesh. On the 3-D frame at 20 × the nodes, whole arrays of element entries had made
+GBs of temporaries, each new to its process (``docs/performance.md``, "2026-12-06 night")."""
 
 
 class Pattern:
@@ -82,29 +81,29 @@ class Pattern:
         """The node adjacency (the pattern as a matrix of ones)."""
         return sp.csr_matrix((np.ones(self.nnz), self.indices, self.indptr), shape=(self.n, self.n))
 
-    def _sum(self, at: np.ndarray, form, per_element, out: np.ndarray) -> np.ndarray:
-        """The pattern's values of the element matrices ``form(*rows)`` (e, k, k) of the arrays
-        ``per_element``, made :data:`CHUNK` elements at a time into ``out`` (every entry)."""
+    def _sum(self, form, per_element, out: np.ndarray) -> np.ndarray:
+        """``out`` (nnz,) summed the entries of the element matrices ``form(*rows)`` (e, k, k) of
+        the arrays ``per_element``, made :data:`CHUNK` elements at a time."""
         kk = self.k * self.k
-        for s in range(0, len(out) // kk, CHUNK):
-            out[s * kk:(s + CHUNK) * kk] = np.ravel(form(*(x[s:s + CHUNK] for x in per_element)))
-        return np.bincount(at, weights=out, minlength=self.nnz)
+        out[:] = 0.0
+        for s in range(0, len(self.inv) // kk, CHUNK):
+            np.add.at(out, self.inv[s * kk:(s + CHUNK) * kk], np.ravel(form(*(x[s:s + CHUNK] for x in per_element))))
+        return out
 
     def scalar(self, form, *per_element: np.ndarray) -> sp.csr_matrix:
         """The matrix of the element matrices ``form(*per_element)`` (E, k, k), made from the
         rows (elements) of the arrays ``per_element`` a chunk at a time."""
-        data = self._sum(self.inv, form, per_element, np.empty(len(self.inv)))
+        data = self._sum(form, per_element, np.empty(self.nnz))
         return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
 
     def blocks(self, form, rows: int, cols: int, *per_element: np.ndarray) -> sp.csr_matrix:
         """A matrix of ``rows`` × ``cols`` blocks per node pair, ``form(a, b, *per_element)``
         (E, k, k) giving the element entries of block component (a, b) (made as :meth:`scalar`'s);
         DOFs interleaved."""
-        at, entries = self.inv.astype(np.intp), np.empty(len(self.inv))  # each once for every component
-        data = np.empty((self.nnz, rows, cols))
+        data, one = np.empty((self.nnz, rows, cols)), np.empty(self.nnz)
         for a in range(rows):
             for b in range(cols):
-                data[:, a, b] = self._sum(at, partial(form, a, b), per_element, entries)
+                data[:, a, b] = self._sum(partial(form, a, b), per_element, one)
         return sp.bsr_matrix((data, self.indices, self.indptr), shape=(rows * self.n, cols * self.n)).tocsr()
 
 
