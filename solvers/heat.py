@@ -362,6 +362,18 @@ def boundary_terms(mesh, name: str, e, q: int, thickness: Field) -> tuple[sp.csr
     return asm(film, fb, h=1.0, t=tf), asm(film_load, fb, h=1.0, t=tf)
 
 
+def bordered(A: sp.spmatrix, d) -> sp.csr_matrix:
+    """``[[A, 0], [0, diag(d)]]`` (CSR, no entry where ``d`` is 0): ``A``'s arrays extended, not
+    made anew through triplets as ``sp.block_diag`` makes them."""
+    A, d = A.tocsr(), np.asarray(d, dtype=float)
+    n, on = A.shape[0], np.flatnonzero(d)
+    indptr = np.r_[A.indptr, A.indptr[-1] + np.cumsum(d != 0)].astype(A.indptr.dtype)
+    if not on.size:  # the same entries: A's arrays shared
+        return sp.csr_matrix((A.data, A.indices, indptr), shape=(n + len(d),) * 2)
+    return sp.csr_matrix((np.r_[A.data, d[on]], np.r_[A.indices, n + on].astype(A.indices.dtype), indptr),
+                         shape=(n + len(d),) * 2)
+
+
 def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None,
                   simplices: p1.Simplices | None = None) -> HeatSystem:
     """Assemble the heat system of ``problem`` (a :class:`~gatetherm.solvers.problem.Problem`)
@@ -421,8 +433,6 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
             losses.append((fluid.hose_loss, fluid.ambient))
     n = n_solid + len(caps)
 
-    def grow(A):
-        return sp.block_diag([A, sp.csr_matrix((len(caps), len(caps)))]).tocsr() if caps else A.tocsr()
 
     pumped = []
     for fluid, (A_ww, c) in zip(problem.fluids, couplings):
@@ -436,8 +446,7 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         pumped.append(Pumped(wall, fluid.film_on, fluid.film_off, flow, fluid.conductance, i,
                              fluid.pump, fluid.supply))
         log.info("heat system: fluid %s on %s, wall area %.4g m²", fluid.name, fluid.boundary, c.sum())
-    M = sp.block_diag([M, sp.diags(caps)]).tocsr() if caps else M.tocsr()
-    K0 = grow(K)
+    M, K0 = bordered(M, caps), bordered(K, np.zeros(len(caps)))
     if any(ua for ua, _ in losses):
         K0 = (K0 + sp.diags(np.r_[np.zeros(n_solid), [ua for ua, _ in losses]])).tocsr()
     loads = [Load(np.r_[v, np.zeros(len(caps))], value, kind) for v, value, kind in loads]

@@ -131,6 +131,20 @@ def test_complement_equals_setdiff():
         assert got.dtype.kind == "i" and np.array_equal(got, np.setdiff1d(np.arange(n), taken))
 
 
+def test_bordered_equals_block_diag():
+    """``heat.bordered`` gives ``sp.block_diag([A, diag(d)])`` exactly: no border, a border of
+    zeros (no entries), and one with zeros and values."""
+    import scipy.sparse as sp
+
+    from gatetherm.solvers.heat import bordered
+
+    A = sp.random(30, 30, density=0.2, random_state=1, format="csr")
+    for d in ([], [0.0, 0.0], [2.0, 0.0, 3.0]):
+        got, want = bordered(A, d), sp.block_diag([A, sp.diags(d)]).tocsr() if d else A
+        want.eliminate_zeros()
+        assert got.shape == want.shape and got.nnz == want.nnz and abs(got - want).max() == 0.0
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_boundary_films_in_numpy_equal_the_facet_forms(dim, frame_2d, frame_3d):
     """The P1 facet mass and load of :func:`~gatetherm.solvers.heat.boundary_terms` equal
