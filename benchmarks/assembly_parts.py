@@ -18,13 +18,14 @@ chunks of elements, facets of the elements touching the boundaries, against its 
 (whole arrays, every element's facets); the mesh's nodes by a mask against ``np.unique``; the METIS
 order with one refinement pass per level against METIS's default; shared facets of two boundaries
 by keys against a loop over tuples; the free displacement DOFs (those the mounting face does not
-hold) by a mask (``fem.complement``) against ``np.setdiff1d``. From 2026-12-06 evening: the
+hold) by a mask (``fem.complement``) against ``np.setdiff1d``. From 2026-12-06 night: the
 elastic stiffness with its element matrices made a chunk of elements at a time
 (``p1.Pattern.blocks``) against all at once. ``--factor F`` meshes the frame with about F times
 the default nodes (as ``benchmarks/scaling.py``); ``--parts`` runs only the pairs named.
-Prints the medians, their ratios, each variant's peak memory above its start, and that the
-results agree (docs/performance.md,
-"2026-12-04" and "Against DOLFINx"; a METIS order is compared as a permutation only).
+Prints the medians, their ratios, each variant's new memory (its peak resident set above its
+start; freed memory the process keeps is reused first), and that the results agree
+(docs/performance.md, "2026-12-04", "2026-12-06 night" and "Against DOLFINx"; a METIS order is
+compared as a permutation only).
 """
 from __future__ import annotations
 
@@ -136,7 +137,7 @@ def variants(fm, work: str):
         used[fm.cells.ravel()] = True
         return np.flatnonzero(used)
 
-    def stiffness_at_once():  # p1.stiffness before 2026-12-06 evening: all element matrices at once
+    def stiffness_at_once():  # p1.stiffness before 2026-12-06 night: all element matrices at once
         dot, Gl, Gm = p1.conduction(G, vol, mu), (lam * vol)[:, None, None] * G, (mu * vol)[:, None, None] * G
         data = np.empty((pattern.nnz, 3, 3))
         for a in range(3):

@@ -433,7 +433,6 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
             losses.append((fluid.hose_loss, fluid.ambient))
     n = n_solid + len(caps)
 
-
     pumped = []
     for fluid, (A_ww, c) in zip(problem.fluids, couplings):
         o = lumped[fluid.name]

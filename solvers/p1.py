@@ -25,6 +25,12 @@ from gatetherm.solvers.linsolve import nd_order
 log = logging.getLogger(__name__)
 
 
+CHUNK = 1 << 14
+"""Elements whose matrices are made and summed (``np.add.at``) at a time: temporaries of a few
+MB on any mesh. On the 3-D frame at 20 × the nodes, whole arrays of element entries had made
+GBs of temporaries, each new to its process (``docs/performance.md``, "2026-12-06 night")."""
+
+
 def gradients(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Barycentric gradients (E, d+1, d) and measures (E,) of the simplices ``cells``
     (E, d+1) of ``points`` (N, d): the rows of the inverse Jacobian by cofactors (cross
@@ -45,16 +51,10 @@ def _gradients(X: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     else:
         det = J[:, 0, 0] * J[:, 1, 1] - J[:, 0, 1] * J[:, 1, 0]
         cof = np.stack([np.stack([J[:, 1, 1], -J[:, 1, 0]], -1), np.stack([-J[:, 0, 1], J[:, 0, 0]], -1)], axis=1)
-    G = np.empty(X.shape[:1] + X.shape[1:])
+    G = np.empty(X.shape)
     G[:, 1:] = cof / det[:, None, None]  # row i: the gradient of λ_i
     G[:, 0] = -G[:, 1:].sum(axis=1)
     return G, np.abs(det) / factorial(X.shape[2])
-
-
-CHUNK = 1 << 14
-"""Elements whose matrices are made and summed (``np.add.at``) at a time: temporaries of a few
-MB on any mesh. On the 3-D frame at 20 × the nodes, whole arrays of element entries had made
-GBs of temporaries, each new to its process (``docs/performance.md``, "2026-12-06 night")."""
 
 
 class Pattern:
@@ -82,8 +82,8 @@ class Pattern:
         return sp.csr_matrix((np.ones(self.nnz), self.indices, self.indptr), shape=(self.n, self.n))
 
     def _sum(self, form, per_element, out: np.ndarray) -> np.ndarray:
-        """``out`` (nnz,) summed the entries of the element matrices ``form(*rows)`` (e, k, k) of
-        the arrays ``per_element``, made :data:`CHUNK` elements at a time."""
+        """The element matrices ``form(*rows)`` (e, k, k) of the arrays ``per_element``, made
+        :data:`CHUNK` elements at a time, summed onto the pattern into ``out`` (nnz,)."""
         kk = self.k * self.k
         out[:] = 0.0
         for s in range(0, len(self.inv) // kk, CHUNK):
