@@ -41,6 +41,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from scaling import mesh_file as sized_frame  # noqa: E402  (benchmarks/ is not a package)
+
 PAIRS = {"pattern": ("by rows", "searchsorted"),
          "stress rhs": ("element by element", "six matrices"), "field file": ("raw", "meshio"),
          "mesh check": ("sorted keys", "np.unique"), "mesh read": ("whole arrays", "meshio"),
@@ -221,18 +224,6 @@ def _same(a, b) -> float:
     return float(abs(a - b).max() / abs(b).max())
 
 
-def _config(factor: float, folder: str) -> str | None:
-    """A configuration file meshing the frame with about ``factor`` × the default nodes (None: 1)."""
-    if factor == 1.0:
-        return None
-    from gatetherm.geometry.frame import MeshParams
-
-    path = os.path.join(folder, "mesh.toml")
-    with open(path, "w") as f:
-        f.write(f"[mesh]\nsize_3d = {MeshParams().size_3d / factor ** (1 / 3)!r}\n")
-    return path
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rounds", type=int, default=5)
@@ -247,7 +238,7 @@ def main() -> None:
     from gatetherm.geometry.mesh import save_mesh
 
     with tempfile.TemporaryDirectory() as folder:
-        fm = gt.gate_frame(dim=3, config=_config(args.factor, folder)).mesh
+        fm = gt.gate_frame(dim=3, config=sized_frame(3, args.factor, folder)[0]).mesh
     times: dict = {}
     peaks: dict = {}
     with tempfile.TemporaryDirectory() as tmp:

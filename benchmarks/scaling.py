@@ -45,9 +45,20 @@ BIG = 25.0
 f^0.93 of the factor f: 0.78 million at 20)."""
 
 
+def mesh_file(dim: int, factor: float, folder) -> tuple[Path, float]:
+    """A configuration file in ``folder`` meshing the ``dim``-D frame with about ``factor`` × the
+    default nodes (the element size divided by factor^(1/dim)), and that element size (m)."""
+    from gatetherm.geometry.frame import MeshParams
+
+    key = DEFAULT_SIZE[dim]
+    size = getattr(MeshParams(), key) / factor ** (1.0 / dim)
+    path = Path(folder) / "mesh.toml"
+    path.write_text(f"[mesh]\n{key} = {size!r}\n")
+    return path, size
+
+
 def job(dim: int, factor: float) -> dict:
     """Condition 1 on the refined mesh; part times (s) and node counts."""
-    from gatetherm.geometry.frame import MeshParams
     from gatetherm.process import configure
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.run.output import displacements
@@ -55,12 +66,10 @@ def job(dim: int, factor: float) -> dict:
     from gatetherm.studies.run.scenario import prepare
     from gatetherm.studies.run.simulate import delta_figures, run_model
 
-    key = DEFAULT_SIZE[dim]
-    size = getattr(MeshParams(), key) / factor ** (1.0 / dim)
     configure()  # the process settings of a command
     with tempfile.TemporaryDirectory() as tmp:
-        (Path(tmp) / "mesh.toml").write_text(f"[mesh]\n{key} = {size!r}\n")
-        cfg = load_config(Path(tmp) / "mesh.toml")
+        path, size = mesh_file(dim, factor, tmp)
+        cfg = load_config(path)
         t = time.perf_counter()
         case = frame_case(cfg, dim)  # meshed (gmsh, in a process of its own)
         mesh_s = time.perf_counter() - t

@@ -88,8 +88,9 @@ def give_back() -> None:
     """Return the memory this process has freed, and keeps for reuse since :func:`configure`,
     to the system (glibc's ``malloc_trim``): where a phase ends whose arrays will not be made
     again."""
-    if _libc() is not None:
-        _libc().malloc_trim(0)
+    libc = _libc()
+    if libc is not None:
+        libc.malloc_trim(0)
 
 
 def fork() -> int:

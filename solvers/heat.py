@@ -445,9 +445,7 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         pumped.append(Pumped(wall, fluid.film_on, fluid.film_off, flow, fluid.conductance, i,
                              fluid.pump, fluid.supply))
         log.info("heat system: fluid %s on %s, wall area %.4g m²", fluid.name, fluid.boundary, c.sum())
-    M, K0 = bordered(M, caps), bordered(K, np.zeros(len(caps)))
-    if any(ua for ua, _ in losses):
-        K0 = (K0 + sp.diags(np.r_[np.zeros(n_solid), [ua for ua, _ in losses]])).tocsr()
+    M, K0 = bordered(M, caps), bordered(K, [ua for ua, _ in losses])  # K0: the hoses' losses on its border
     loads = [Load(np.r_[v, np.zeros(len(caps))], value, kind) for v, value, kind in loads]
     for k, (ua, ambient) in enumerate(losses):
         if ua:
