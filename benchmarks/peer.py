@@ -167,9 +167,16 @@ def write_table(path: Path, columns: list, rows: list, notes: list[str]) -> None
         print(n)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps({"date": date.today().isoformat(), "machine": machine(),
-                                "command": " ".join(["python", f"benchmarks/{Path(sys.argv[0]).name}", *sys.argv[1:]]),
+                                "command": command_line(),
                                 "columns": columns, "rows": rows, "notes": notes}, indent=1) + "\n")
     print(f"wrote {path}")
+
+
+def command_line() -> str:
+    """This benchmark's command line, each absolute path argument by its file name only: what a
+    reader reruns beside their own copy of the file, with no path of this machine in it."""
+    args = [Path(a).name if a.startswith("/") else a for a in sys.argv[1:]]
+    return " ".join(["python", f"benchmarks/{Path(sys.argv[0]).name}", *args])
 
 
 def machine() -> str:
