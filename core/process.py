@@ -1,18 +1,17 @@
 """Process-wide settings a command makes before its numerics, each measured on the 3-D
 frame (``benchmarks/blas_threads.py``, ``benchmarks/peer.py``; docs/performance.md):
 
-* BLAS threads: :data:`BLAS_THREADS` (``GATETHERM_BLAS_THREADS`` overrides), through
-  threadpoolctl;
+* BLAS threads: half the cores, at least one (the solver option ``blas_threads``,
+  ``GATETHERM_BLAS_THREADS``, overrides), through threadpoolctl;
 * glibc's malloc keeps what is freed for the next arrays (no block mapped alone, the heap never
-  trimmed: :func:`keep_freed`): on a virtual machine whose host takes back the memory its guest
-  frees (free page reporting: this one, Firecracker), each page of a new array is otherwise
+  trimmed: :func:`keep_freed`) where the host takes back the memory its guest frees (free page
+  reporting: :func:`host_reclaims_freed_memory`), since each page of a new array is otherwise
   faulted in anew, at the host's cost, in system time. What a phase has freed goes back to the
   system where it ends (:func:`give_back`: before a fork, after a helper's set-up, before a run's
   files), so that the processes beside it do not hold it. Measured by ``benchmarks/blas_threads.py
-  --malloc`` and ``benchmarks/scaling.py`` (docs/performance.md, "2026-12-06 late: freed memory
-  kept for reuse");
-* numpy's advice of transparent huge pages for its arrays of 4 MiB and more off, unless
-  numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: on a virtual machine whose host backs the
+  --malloc`` and ``benchmarks/scaling.py`` (docs/performance.md, "Process settings");
+* numpy's advice of transparent huge pages for its arrays of 4 MiB and more off on a virtual
+  machine (:func:`virtual_machine`), unless numpy's own ``NUMPY_MADVISE_HUGEPAGE`` is set: on a virtual machine whose host backs the
   guest's memory as it is first touched (this one) the faults of 2 MiB pages cost more system
   time than the 4 KiB pages' they replace. ``simulate --condition 1 --dim 3``: 15.48 s against
   19.03 s, 3.97 s of system time against 6.33 s (medians of 5 interleaved runs,
@@ -35,9 +34,6 @@ from gatetherm import InputError
 
 log = logging.getLogger(__name__)
 
-BLAS_THREADS = 1
-"""BLAS threads of a command; see docs/performance.md for the measurement."""
-THREADS_ENV = "GATETHERM_BLAS_THREADS"
 HUGE_PAGES_ENV = "NUMPY_MADVISE_HUGEPAGE"
 """numpy's switch of its huge-page advice: where it is set, :func:`configure` leaves the advice
 as numpy made it."""
@@ -165,28 +161,69 @@ def _huge_page_advice(on: bool) -> bool | None:
     return bool(switch(on))
 
 
-def configure() -> None:
+def host_reclaims_freed_memory() -> bool:
+    """Whether this (virtual) machine reports the memory its processes free to its host, which
+    takes it back (free page reporting: ``page_reporting`` on the kernel's command line), so
+    that a page touched again is faulted in anew at the host's cost."""
+    try:
+        with open("/proc/cmdline") as f:
+            return "page_reporting" in f.read()
+    except OSError:
+        return False
+
+
+def virtual_machine() -> bool:
+    """Whether this process runs under a hypervisor (the CPU's ``hypervisor`` flag, Linux)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            return any(line.startswith("flags") and " hypervisor" in line for line in f)
+    except OSError:
+        return False
+
+
+def configure(options=None):
     """Set up the running process for gatetherm's numerics, as every command does first.
 
-    One BLAS thread (``GATETHERM_BLAS_THREADS`` overrides), so that the worker processes of
-    sweeps and studies do not oversubscribe the cores; glibc's malloc keeping freed memory,
-    large arrays too, for the next arrays (``gatetherm.process.keep_freed``; ``give_back`` returns it);
-    numpy's huge-page advice off unless ``NUMPY_MADVISE_HUGEPAGE`` is set (docs/performance.md
-    gives the measurements). Optional in a script.
+    Each setting adapts to the machine it runs on (docs/performance.md has the measurement
+    behind each):
+
+    * BLAS threads: the solver option ``blas_threads`` (``GATETHERM_BLAS_THREADS``), by default
+      half the machine's cores, at least one, so that a run's two busy processes (the heat march
+      and the elastic helper) and a sweep's workers do not oversubscribe the cores;
+    * glibc's malloc keeping freed memory, large arrays too, for the next arrays (:func:`keep_freed`;
+      :func:`give_back` returns it) where the host takes back what its guest frees
+      (:func:`host_reclaims_freed_memory`);
+    * numpy's huge-page advice off on a virtual machine (:func:`virtual_machine`), unless
+      ``NUMPY_MADVISE_HUGEPAGE`` is set.
+
+    Optional in a script.
+
+    Parameters
+    ----------
+    options : gatetherm.SolverOptions, optional
+        The solver options; they stay in force for the rest of the caller's context. Default:
+        those of the environment variables (:meth:`gatetherm.SolverOptions.from_environment`),
+        which a bad value of is refused here, before any numerics.
 
     Returns
     -------
-    None
+    gatetherm.SolverOptions
+        The options in force.
     """
-    keep_freed(True)
-    if HUGE_PAGES_ENV not in os.environ:
+    from gatetherm.options import SolverOptions, set_current
+
+    if options is None:
+        options = SolverOptions.from_environment()
+    elif not isinstance(options, SolverOptions):
+        raise TypeError(f"options: got {type(options).__name__}; give a gatetherm.SolverOptions")
+    else:
+        set_current(options)
+    keep_freed(host_reclaims_freed_memory())
+    if HUGE_PAGES_ENV not in os.environ and virtual_machine():
         _huge_page_advice(False)
     from threadpoolctl import threadpool_limits
 
-    threads = os.environ.get(THREADS_ENV, str(BLAS_THREADS))
-    if not threads.isdigit() or int(threads) < 1:
-        raise InputError(f"environment variable {THREADS_ENV}", f"{threads!r} is not a thread count",
-                         "give a whole number of at least 1, or unset it")
-    threads = int(threads)
+    threads = options.threads()
     threadpool_limits(threads, user_api="blas")
     log.debug("BLAS threads: %d", threads)
+    return options

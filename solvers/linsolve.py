@@ -13,7 +13,7 @@ workhorse. The backend is the first of :data:`BACKENDS` that is installed and wo
   reordering), or its minimum degree without pymetis. Always there.
 
 Which backend runs, and why a better one was skipped, is logged once (with the pip command);
-``GATETHERM_SPD_BACKEND`` forces one (``amg``: the iterative path for elasticity). Where a
+the solver option ``backend`` (``GATETHERM_SPD_BACKEND``) forces one (``amg``: the iterative path for elasticity). Where a
 factor would not fit in memory or would cost more than AMG-preconditioned conjugate gradients
 (:mod:`.iterative`) for the right-hand sides expected, :class:`SPDSolver` takes the iterative
 path instead (:mod:`.plan` predicts both); so does 3-D elasticity without pardiso or cholmod.
@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from gatetherm import options
 from gatetherm.solvers.helper import Pending, SolveHelper
 from gatetherm.solvers.iterative import PCG, SolverError
 from gatetherm.solvers.plan import plan
@@ -44,7 +45,7 @@ RTOL = 1e-8
 iterations at 4 × the nodes."""
 SETTINGS = {"direct_limit_3d": DIRECT_LIMIT_3D, "rtol": RTOL}
 """What the solution depends on, for digests of the numerical scheme."""
-BACKEND_ENV = "GATETHERM_SPD_BACKEND"
+BACKEND_ENV = options.ENVIRONMENT["backend"]
 HINTS = {"pardiso": "pip install py-mkl-pardiso (Linux x86_64, Windows)", "cholmod": "pip install cvxopt (GPL-3)",
          "metis": "pip install pymetis"}
 
@@ -158,10 +159,10 @@ def spd_factor(A: sp.spmatrix, order: np.ndarray | None = None, allow=tuple(BACK
                shared=None) -> tuple[Solve, str]:
     """Factor the SPD matrix ``A`` (in ``order``, from :func:`nd_order`, where the backend
     takes one) with the first backend of ``allow`` that works (only the one forced by
-    ``GATETHERM_SPD_BACKEND``, if that names one); ``(solve, backend name)``. ``shared``: a
+    the solver option ``backend``, if that names one); ``(solve, backend name)``. ``shared``: a
     :class:`~gatetherm.solvers.pardiso.Analyses` whose analysis a matrix of the same pattern
     shares (PARDISO)."""
-    forced = os.environ.get(BACKEND_ENV)
+    forced = options.current().backend
     names = [forced] if forced in allow else [] if forced in BACKENDS else list(allow)
     for name in names:
         try:
@@ -263,7 +264,7 @@ class SPDSolver:
 
         if self._solve is not None or self.background or not can_fork():
             return self.background
-        if os.environ.get(BACKEND_ENV) != "amg" or self.near_null is None:
+        if options.current().backend != "amg" or self.near_null is None:
             p = plan(*self.size, self.dim, self.dim, rhs)
             if p.path != "iterative":
                 return False
@@ -306,7 +307,7 @@ class SPDSolver:
     def _make(self, rhs: int) -> tuple[Solve, str]:
         small = self.dim == 2 or self.size[0] <= DIRECT_LIMIT_3D or self.near_null is None
         allow = ("pardiso", "cholmod") + (("superlu",) if small else ())
-        if os.environ.get(BACKEND_ENV) == "amg" and self.near_null is not None:
+        if options.current().backend == "amg" and self.near_null is not None:
             return PCG(self.A, self.near_null, self.block, RTOL), "iterative"
         return planned_solver(self.A, self.dim, rhs, self.what, self.dim, self.near_null, self.order, allow=allow,
                               amg_block=self.block)

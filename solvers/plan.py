@@ -6,9 +6,10 @@ one needing less memory), and logged in one line.
 The predictions are those of :mod:`gatetherm.geometry.sizing` (memory) and the time constants
 below, measured on the 3-D frame at 1, 2 and 4 times its default nodes (52 812 to 177 283,
 ``benchmarks/scaling.py``): a factor's flops grow as nodes^2.05 and its entries as
-nodes^1.46, a CG iteration as the matrix's entries. ``GATETHERM_SOLVER`` = ``direct`` or
-``iterative`` forces a path; ``GATETHERM_MEMORY_GB`` sets the budget (default: three quarters
-of this machine's memory).
+nodes^1.46, a CG iteration as the matrix's entries. The solver options
+(:class:`gatetherm.options.SolverOptions`: ``path`` = ``direct`` or ``iterative``, from the command
+line, a ``[solver]`` file or ``GATETHERM_SOLVER``) force a path; ``memory_gb``
+(``GATETHERM_MEMORY_GB``) sets the budget (default: three quarters of this machine's memory).
 """
 from __future__ import annotations
 
@@ -16,13 +17,13 @@ import logging
 import os
 from dataclasses import dataclass
 
-from gatetherm import InputError
+from gatetherm import options
 from gatetherm.geometry import sizing
 
 log = logging.getLogger(__name__)
 
-PATH_ENV = "GATETHERM_SOLVER"
-BUDGET_ENV = "GATETHERM_MEMORY_GB"
+PATH_ENV = options.ENVIRONMENT["path"]
+BUDGET_ENV = options.ENVIRONMENT["memory_gb"]
 PATHS = ("direct", "iterative")
 FLOP_RATE = 22e9
 """Flops per second of the numerical factorisation (PARDISO, one thread)."""
@@ -64,32 +65,21 @@ class Plan:
 
     def describe(self, what: str, rhs: int) -> str:
         costs = "; ".join(f"{p} {self.seconds[p]:.3g} s, {self.bytes[p] / 1e9:.3g} GB" for p in PATHS)
-        why = f"forced by {PATH_ENV}" if self.forced else f"budget {self.budget / 1e9:.3g} GB"
+        why = f"forced by the solver option path ({PATH_ENV})" if self.forced else f"budget {self.budget / 1e9:.3g} GB"
         return f"{what}: {self.path} ({rhs} right-hand side{'s' if rhs != 1 else ''}: {costs}; {why})"
 
 
 def budget() -> float:
-    """Memory the solvers may hold, bytes: ``GATETHERM_MEMORY_GB`` or 3/4 of this machine's."""
-    value = os.environ.get(BUDGET_ENV)
-    if value is None:
-        return 0.75 * sizing.memory_bytes()
-    try:
-        gb = float(value)
-    except ValueError:
-        gb = float("nan")
-    if not gb > 0:
-        raise InputError(BUDGET_ENV, f"got {value!r}, must be a number of gigabytes > 0", f"e.g. {BUDGET_ENV}=8")
-    return gb * 1e9
+    """Memory the solvers may hold, bytes: the solver option ``memory_gb``
+    (:func:`gatetherm.options.current`) or 3/4 of this machine's."""
+    gb = options.current().memory_gb
+    return 0.75 * sizing.memory_bytes() if gb is None else gb * 1e9
 
 
 def forced_path() -> str | None:
-    """The path ``GATETHERM_SOLVER`` forces, if any."""
-    value = os.environ.get(PATH_ENV)
-    if value in (None, "", "auto"):
-        return None
-    if value not in PATHS:
-        raise InputError(PATH_ENV, f"got {value!r}", f"one of {', '.join(PATHS)} or auto")
-    return value
+    """The path the solver option ``path`` forces, if any."""
+    path = options.current().path
+    return None if path == "auto" else path
 
 
 def predict(n: int, nnz: int, block: int, dim: int, rhs: int, factored: bool = False,

@@ -111,7 +111,7 @@ def test_plan_follows_the_budget_and_the_forced_path(heat_3d, monkeypatch, caplo
         _, path = planned_solver(A, 3, 1, "test system")
     assert path == "direct"
     line = [r.getMessage() for r in caplog.records if "test system" in r.getMessage()]
-    assert len(line) == 1 and "forced by GATETHERM_SOLVER" in line[0] and "iterative" in line[0]
+    assert len(line) == 1 and "forced by the solver option path (GATETHERM_SOLVER)" in line[0] and "iterative" in line[0]
     for env, value in ((plan.PATH_ENV, "fast"), (plan.BUDGET_ENV, "-1")):
         monkeypatch.setenv(env, value)
         with pytest.raises(InputError, match=env):

@@ -9,12 +9,15 @@ import sys
 
 import pytest
 
+from gatetherm.process import host_reclaims_freed_memory, virtual_machine
+
 ADVICE_AFTER_CONFIGURE = ("import gatetherm as gt; from gatetherm.process import _huge_page_advice as advice; "
                           "gt.configure(); print(advice(True))")
 
 
-@pytest.mark.parametrize("setting, advised", [(None, "False"), ("1", "True"), ("0", "False")])
+@pytest.mark.parametrize("setting, advised", [(None, str(not virtual_machine())), ("1", "True"), ("0", "False")])
 def test_configure_turns_numpys_huge_page_advice_off_unless_numpy_is_told(setting, advised):
+    """Off on a virtual machine (this one: the CPU's hypervisor flag), numpy's own elsewhere."""
     env = {k: v for k, v in os.environ.items() if k != "NUMPY_MADVISE_HUGEPAGE"}
     if setting is not None:
         env["NUMPY_MADVISE_HUGEPAGE"] = setting
@@ -46,10 +49,12 @@ print(freed, before - resident())
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc")
-@pytest.mark.parametrize("how, kept", [("configure", True), ("painter", False), ("plain", False)])
+@pytest.mark.parametrize("how, kept", [("configure", host_reclaims_freed_memory()), ("painter", False),
+                                       ("plain", False)])
 def test_configure_keeps_freed_arrays_till_given_back(how, kept):
-    """After configure a freed 64 MB array stays resident for the next arrays until give_back
-    returns it; a painting process (keep_freed(False)), like a plain one, returns it when freed."""
+    """After configure, on a machine whose host takes back freed memory (this one), a freed 64 MB
+    array stays resident for the next arrays until give_back returns it; a painting process
+    (keep_freed(False)), like a plain one, returns it when freed."""
     out = subprocess.run([sys.executable, "-c", KEPT_AFTER_CONFIGURE, how], capture_output=True, text=True, check=True)
     freed, given_back = map(int, out.stdout.split())
     assert freed < 2 if kept else freed >= 63  # MB back to the system when freed

@@ -11,6 +11,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.options import SolverOptions
 from gatetherm.process import configure
 from gatetherm.studies.run.case import Case, load_case
 from gatetherm.studies.run.frame_case import gate_frame
@@ -22,7 +23,7 @@ log = logging.getLogger(__name__)
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
-__all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "beam_coefficients", "condition", "configure", "gate_frame",
+__all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "SolverOptions", "beam_coefficients", "condition", "configure", "gate_frame",
            "load_case", "run", "schedule_file"]
 
 

@@ -88,6 +88,17 @@ def build_parser(only: str | None = None):
         "machine in a case file, beam theory, reduced models, compensation, sensor placement, diagnosis.",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
+    solver = parser.add_argument_group("solver options (docs/performance.md; each overrides the file's and the "
+                                       "environment's)")
+    solver.add_argument("--solver", choices=("auto", "direct", "iterative"),
+                        help="the path of every SPD system: sparse Cholesky or AMG-CG (default: auto, per system)")
+    solver.add_argument("--memory-gb", type=float, metavar="GB",
+                        help="memory the solvers may hold (default: 3/4 of the machine's)")
+    solver.add_argument("--spd-backend", choices=("auto", "pardiso", "cholmod", "superlu", "amg"),
+                        help="the direct path's factoriser (amg: the iterative path for elasticity)")
+    solver.add_argument("--blas-threads", type=int, metavar="N", help="BLAS threads (default: half the cores)")
+    solver.add_argument("--solver-options", metavar="FILE.toml",
+                        help="a TOML file whose [solver] table sets these options")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in (only,) if only else COMMAND_MODULES:
         importlib.import_module(f"gatetherm.cli.{name}").register(sub)
@@ -124,14 +135,21 @@ def _run(argv: list[str] | None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from gatetherm.options import SolverOptions
     from gatetherm.process import configure
     from gatetherm.studies.sweeps.runner import PointsFailed
 
     logging.captureWarnings(True)  # the numerical libraries' warnings: in the log, shown with -v
     logging.getLogger("py.warnings").setLevel(logging.INFO if args.verbose else logging.ERROR)
     try:
-        configure()
-        return int(args.func(args) or 0)
+        options = SolverOptions.from_environment()
+        if args.solver_options:
+            options = SolverOptions.from_file(args.solver_options, options)
+        options = options.merged(path=args.solver, memory_gb=args.memory_gb, backend=args.spd_backend,
+                                 blas_threads=args.blas_threads)
+        with options.use():
+            configure(options)
+            return int(args.func(args) or 0)
     except InputError as err:
         return _say(f"error: {err}", 2)
     except PointsFailed as err:
