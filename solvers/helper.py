@@ -32,7 +32,7 @@ from typing import Any, Callable
 import numpy as np
 
 from gatetherm.process import die_with_parent, end_with_parent, fork, give_back, receive, send
-from gatetherm.solvers.iterative import SolverError
+from gatetherm.solvers.errors import SolverError
 
 log = logging.getLogger(__name__)
 

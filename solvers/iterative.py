@@ -22,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from gatetherm.process import can_fork
+from gatetherm.solvers.errors import SolverError
 
 log = logging.getLogger(__name__)
 
@@ -43,10 +44,6 @@ def max_coarse(blocks: int) -> int:
     aggregates (3 564 unknowns) to 12, and conjugate gradients took 2.1 times the iterations of
     the 594 solved exactly (``benchmarks/amg_coarse.py``); up to 8 × no level changes."""
     return max(500, math.isqrt(blocks))
-
-
-class SolverError(RuntimeError):
-    """An iterative solve did not converge, or a matrix cannot be factorised."""
 
 
 def _nbytes(A) -> int:
