@@ -114,7 +114,8 @@ def part_at(mesh, names, xyz, tol: float = 1e-9) -> str | None:
     x = np.asarray(xyz, float)
     size = float(np.ptp(mesh.points, axis=0).max()) or 1.0
     for n in names:
-        simplices = mesh.cells[np.asarray(mesh.regions[n], int)] if n in mesh.regions else np.asarray(mesh.boundaries[n])
+        simplices = (mesh.cells[np.asarray(mesh.regions[n], int)] if n in mesh.regions
+                     else np.asarray(mesh.boundaries[n]))
         v = mesh.points[simplices]  # (S, k+1, dim)
         E = np.swapaxes(v[:, 1:] - v[:, :1], 1, 2)  # (S, dim, k): the edges from the first vertex
         lam = np.einsum("skd,sd->sk", np.linalg.pinv(E), x - v[:, 0])
