@@ -3,8 +3,9 @@
 In deviations from the initial temperature T0, ``x = U_free − T0`` (every unknown not held by a
 fixed temperature: solid nodes, fluids, hoses), and inputs ``u_j = value_j − offset_j`` (every
 value the problem's heat transfer reads: a film's or the faces' ambient, a fluid's supply, a
-hose's ambient, a fixed temperature (offset T0), a flux or a source density (offset 0)), the
-heat model of each pump mode p (every fluid's pump on or off) is the descriptor system
+hose's ambient, a fixed temperature (offset T0), a flux or a source density (offset 0); a
+temperature is an input even when constant, as a constant ``u``: a film to a constant room is a
+loss like any other), the heat model of each pump mode p (every fluid's pump on or off) is the descriptor system
 
     M ẋ = −K_p x + B_p u,    y = C x + D u + y0
 
@@ -112,8 +113,11 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
     K = {m: h.K(s).tocsr() for m, s in modes.items()}
     inputs, cols = [], {m: [] for m in modes}
     for (value, temp), vectors in groups.items():
-        if value.is_constant and (value.constant == T0 if temp else value.constant == 0.0):
-            continue  # at its offset: drives nothing
+        if value.is_constant and not temp and value.constant == 0.0:
+            continue  # a zero source or flux: drives nothing
+        # a temperature (a film's ambient, a fixed value) stays an input even when constant, even at
+        # T0: its column is the loss to it, which the Gramians, the room of an observer and the
+        # body's uniform state all need; a constant input is a constant u in every series
         inputs.append(Input(value.text or repr(value.constant), T0 if temp else 0.0))
         base = np.zeros(n)
         for v in vectors:
@@ -242,10 +246,13 @@ def _orthonormal_union(M, columns, count: int, tol: float = 1e-8) -> tuple[np.nd
 
 def _slowest(lhm: LinearHeatModel) -> float:
     """The slowest rate of every mode is close to the body cooling uniformly to its temperature
-    inputs with every pump off (the last mode); a body with none never settles."""
-    temp = [j for j, u in enumerate(lhm.inputs) if u.offset == lhm.T0]
-    B = lhm.B[lhm.modes[-1]]
-    loss = float(sum(B[:, j] for j in temp).sum()) if temp else 0.0
+    inputs with every pump off (the last mode); a body with none never settles. The loss is read
+    off the conductance matrix (``1ᵀ K 1``: what a uniform 1 K rise loses to films, fixed
+    temperatures and fluids' supplies), so it counts a loss whether its temperature is an input or not."""
+    K = lhm.K[lhm.modes[-1]]
+    loss = float(K @ np.ones(K.shape[0]) @ np.ones(K.shape[0]))
+    if not loss > 1e-10 * float(np.abs(K.diagonal()).sum()):  # conduction alone sums to round-off
+        loss = 0.0
     if not loss > 0:
         raise InputError("reduced model", "the case loses no heat to an ambient or a fixed temperature: it never "
                          "settles", "give a film, a fixed temperature or a fluid with a supply")

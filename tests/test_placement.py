@@ -315,7 +315,9 @@ def test_the_curve_stops_and_says_why(blocks):
     full = gt.place_sensors(case, 6, loads=5, held_out_loads=2, states=12)
     held = [c.held_out_mean_um for c in full.curve]
     assert not full.stopped and held == sorted(held, reverse=True)
-    assert held == pytest.approx([0.0648, 0.0490, 0.0383, 0.0341, 0.0289, 0.0260], abs=5e-4)  # achieved
+    # achieved; the bottom's film to a constant 20.0 is an input of the reduced model since issue 51
+    # (before: 0.0383, 0.0341, 0.0289, 0.0260 from 3 sensors, with a 12-state model no closer to FE)
+    assert held == pytest.approx([0.0648, 0.0490, 0.0400, 0.0347, 0.0309, 0.0283], abs=5e-4)
 
 
 def test_cli_writes_the_outputs_and_says_why_the_curve_stops(blocks, tmp_path, capsys):

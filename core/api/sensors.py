@@ -31,7 +31,8 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
         Loads to judge on (default: the paper's conditions 1-3 for a case driven by the frame's
         inputs, else ``held_out_loads`` generated ones of their own seed).
     **settings
-        ``boundaries`` (names whose nodes are the candidates; default the outer surface),
+        ``boundaries`` (names whose nodes are the candidates; default the outer surface; the
+        regions and boundaries of the case's ``[sensors] exclude`` are never candidates),
         ``spacing_m`` (thin the candidates to this spacing, m), ``exclude`` (boxes no sensor may
         lie in: ``(low corner, high corner)`` pairs, m), ``min_distance_m`` (least distance between
         two sensors, m), ``noise_K`` (standard deviation of each sensor's noise, K; default 0.05),
@@ -47,7 +48,8 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
         ``.sensors`` (name, node, coordinates in m, boundary), ``.model`` (the errormodel
         ``ErrorModel``), ``.curve`` (per count: form, leave-one-load-out and held-out MAE per target,
         µm), ``.failed`` (held-out MAE with one sensor lost, µm), ``.signals`` (the same family given
-        the case's θ_A, θ_B, θ_C mean, if it has them), ``.stopped`` (why the curve stops short).
+        the case's θ_A, θ_B, θ_C mean, if it has them), ``.stopped`` (why the curve stops short),
+        ``.candidates.excluded`` (per part that cannot carry a sensor, the candidate nodes it took away).
 
     Raises
     ------

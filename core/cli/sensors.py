@@ -112,6 +112,9 @@ def _report(placement, summary, check, out, seconds) -> None:
           f"screened) on a mesh of {summary['mesh_nodes']} nodes, placed in {seconds:.1f} s from "
           f"{len(placement.training)} training loads, judged on {len(placement.held_out)} held-out loads; wrote {out}/"
           "sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json")
+    if summary.get("excluded"):
+        print("excluded ([sensors] exclude, cannot carry a sensor): "
+              + ", ".join(f"{k} ({v} candidate nodes left out)" for k, v in summary["excluded"].items()))
     for c in placement.curve:
         errs = ", ".join(f"{k} {v:.3g}" for k, v in c.held_out_mae_um.items())
         where = "; ".join(f"{s.name} ({', '.join(f'{v:.3f}' for v in s.xyz)}) on {s.boundary}" for s in c.sensors)

@@ -20,11 +20,14 @@ faults go to ``sensors``; every run goes through the scenario path.
 from __future__ import annotations
 
 import dataclasses
+import logging
 from dataclasses import dataclass, field
 
 from gatetherm.solvers.effects import resolve
 from gatetherm.solvers.sensors import compose, faults_of
 from gatetherm.studies.run.case import Case
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -115,10 +118,33 @@ def parameter_pieces(case: Case, names=None, uncertain=()) -> list[Piece]:
                   q.doc, target=q.target, source=q) for q in (*own, *more) if names is None or q.name in names]
 
 
+def unmounted(case: Case, channels) -> dict[str, str]:
+    """The temperature channels whose probe lies on a part the case says cannot carry a
+    thermocouple (``[sensors] exclude``), with that part: {channel: part}."""
+    if not case.unmountable:
+        return {}
+    from gatetherm.studies.run.simulate import column
+    from gatetherm.studies.sensors.candidates import part_at
+
+    p, out = case.problem, {}
+    theta_C = {column(p, ("T", c))[0] for c in p.signals.theta_C}
+    for probe in (q for q in p.probes if "T" in q.quantities):
+        part = part_at(case.mesh, case.unmountable, probe.xyz)
+        if part is not None:
+            name = column(p, ("T", probe.name))[0]
+            out.update({c: part for c in (name, *(("theta_C_degC",) if name in theta_C else ())) if c in channels})
+    return out
+
+
 def sensor_pieces(channels, case: Case | None = None) -> list[Piece]:
-    """Faults of every channel (a lag only where the case sets none: two lags do not compose)."""
+    """Faults of every channel (a lag only where the case sets none: two lags do not compose),
+    none of a thermocouple on a part that cannot carry one (:func:`unmounted`)."""
     out = []
-    for c in channels:
+    skip = unmounted(case, channels) if case is not None else {}
+    for c, part in skip.items():
+        log.info("no sensor fault of %s: its probe lies on %s, which cannot carry a thermocouple ([sensors] "
+                 "exclude)", c, part)
+    for c in (c for c in channels if c not in skip):
         for f in faults_of(c).values():
             if f.name == "lag" and case is not None and "lag" in case.sensors.get(c, {}):
                 continue
@@ -129,7 +155,7 @@ def sensor_pieces(channels, case: Case | None = None) -> list[Piece]:
 
 def catalogue(case: Case, channels, uncertain=()) -> list[Piece]:
     """Every hypothesis, as ``--list-effects`` shows them (``uncertain``: further dimensions)."""
-    return effect_pieces(case) + parameter_pieces(case, uncertain=uncertain) + sensor_pieces(channels)
+    return effect_pieces(case) + parameter_pieces(case, uncertain=uncertain) + sensor_pieces(channels, case)
 
 
 PROPORTIONAL = (frozenset({"parameter:expansion", "sensor:sensor_gain@delta_um"}),)

@@ -37,7 +37,7 @@ from gatetherm.studies.run.tables import Table
 from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
-            "supports", "probes", "relative", "means", "signals", "time", "actuator") + case_mech.SECTIONS
+            "supports", "probes", "relative", "means", "signals", "time", "actuator", "sensors") + case_mech.SECTIONS
 SCHEME = ranges(TimeScheme)
 SECONDS = Range(0.0, lo_open=True, unit="s")
 KEYS = {
@@ -48,6 +48,7 @@ KEYS = {
     "sources.REGION": ("density", "power"),
     "time": ("end", "step", "output", "schedule", "fields", "scheme"),
     "time.scheme": ("theta", "restart", "restart_intervals"),
+    "sensors": ("exclude",),
     **case_mesh.KEYS,
     **case_tables.KEYS,
     **case_mech.KEYS,
@@ -114,6 +115,9 @@ class Case:
     """The files the case reads (itself, its mesh or geometry, its schedule): a run never overwrites them."""
     source: str = ""
     """Where the case came from, for metadata (a file path, or the generator and its model file)."""
+    unmountable: tuple[str, ...] = ()
+    """Regions and boundaries no thermocouple can be mounted on (``[sensors] exclude``: they rotate
+    or move): sensor placement and the diagnosis' sensor hypotheses leave them out."""
 
     @property
     def dim(self) -> int:
@@ -375,7 +379,22 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                                   f"schedule {time.schedule}" if time.schedule else "no schedule")
     return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
                 case_targets(problem, fm), actuator=case_tables.actuator(top), path=path, source=str(path),
+                unmountable=_unmountable(top, fm),
                 files=(path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else [])))
+
+
+def _unmountable(top: Table, fm: FrameMesh) -> tuple[str, ...]:
+    """``[sensors] exclude``: regions or boundaries of the mesh no thermocouple can go on."""
+    t = top.sub("sensors", KEYS["sensors"])
+    names = t.data.get("exclude", [])
+    names = [names] if isinstance(names, str) else names
+    valid = (*fm.regions, *fm.boundaries)
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        t.fail("exclude", f"{names!r} is not a list of names", 'e.g. exclude = ["spindle"]')
+    bad = [n for n in names if n not in valid]
+    if bad:
+        t.fail("exclude", f"'{bad[0]}' is not a region or boundary of the mesh", f"names: {', '.join(valid)}")
+    return tuple(dict.fromkeys(names))
 
 
 def case_targets(problem: Problem, fm: FrameMesh) -> Targets:

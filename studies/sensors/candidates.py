@@ -1,5 +1,6 @@
 """Where a thermocouple may go: mesh nodes of the outer surface or of named boundaries, thinned
-to a spacing, minus boxes that are not allowed.
+to a spacing, minus boxes that are not allowed and the parts that cannot carry one (a case's
+``[sensors] exclude``: regions and boundaries that rotate or move).
 
 The outer surface is every facet that belongs to one cell only (in a 2-D section: its outline;
 interfaces between regions are inside). Each candidate carries the name of the boundary it lies
@@ -9,7 +10,7 @@ end); else the first named boundary that holds it.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import combinations
 
 import numpy as np
@@ -43,6 +44,8 @@ class Candidates:
     """Their coordinates (candidates x dim), m."""
     boundary: tuple[str, ...]
     """The boundary each lies on."""
+    excluded: dict[str, int] = field(default_factory=dict)
+    """Per part that cannot carry a sensor (``[sensors] exclude``): the candidate nodes it took away."""
 
     def __len__(self) -> int:
         return len(self.nodes)
@@ -50,7 +53,7 @@ class Candidates:
     def subset(self, keep: np.ndarray) -> Candidates:
         """The candidates at the mask or indices ``keep``."""
         idx = np.flatnonzero(keep) if np.asarray(keep).dtype == bool else np.asarray(keep, int)
-        return Candidates(self.nodes[idx], self.xyz[idx], tuple(self.boundary[i] for i in idx))
+        return Candidates(self.nodes[idx], self.xyz[idx], tuple(self.boundary[i] for i in idx), self.excluded)
 
 
 def outer_facets(cells: np.ndarray) -> np.ndarray:
@@ -90,7 +93,41 @@ def thin(xyz: np.ndarray, spacing_m: float) -> np.ndarray:
     return np.array(keep, int)
 
 
-def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: str = "--candidates") -> Candidates:
+def unmountable_nodes(mesh, names) -> dict[str, np.ndarray]:
+    """The nodes of each of ``names`` (a region's: every node of its elements, its interfaces
+    included; a boundary's: every node of its facets), where no thermocouple can go."""
+    out = {}
+    for n in names:
+        if n in mesh.regions:
+            out[n] = np.unique(mesh.cells[np.asarray(mesh.regions[n], int)])
+        elif n in mesh.boundaries:
+            out[n] = np.unique(np.ravel(mesh.boundaries[n]))
+        else:
+            raise InputError(f"[sensors] exclude {n}", "is not a region or boundary of the mesh",
+                             f"names: {', '.join((*mesh.regions, *mesh.boundaries))}")
+    return out
+
+
+def part_at(mesh, names, xyz, tol: float = 1e-9) -> str | None:
+    """The first of ``names`` (regions, boundaries) that the point ``xyz`` (m) lies in or on (a
+    region: inside one of its elements, faces included; a boundary: on one of its facets), else None."""
+    x = np.asarray(xyz, float)
+    size = float(np.ptp(mesh.points, axis=0).max()) or 1.0
+    for n in names:
+        simplices = (mesh.cells[np.asarray(mesh.regions[n], int)] if n in mesh.regions
+                     else np.asarray(mesh.boundaries[n]))
+        v = mesh.points[simplices]  # (S, k+1, dim)
+        E = np.swapaxes(v[:, 1:] - v[:, :1], 1, 2)  # (S, dim, k): the edges from the first vertex
+        lam = np.einsum("skd,sd->sk", np.linalg.pinv(E), x - v[:, 0])
+        gap = np.linalg.norm(np.einsum("sdk,sk->sd", E, lam) - (x - v[:, 0]), axis=1)
+        inside = (lam >= -tol).all(axis=1) & (lam.sum(axis=1) <= 1 + tol) & (gap <= tol * size)
+        if inside.any():
+            return n
+    return None
+
+
+def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: str = "--candidates",
+               unmountable=()) -> Candidates:
     """The candidate nodes of ``mesh``.
 
     Parameters
@@ -103,6 +140,9 @@ def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: s
         Thin to this spacing, m (0: every node).
     exclude : sequence of Box
         Points inside any of these are not candidates.
+    unmountable : sequence of str
+        Regions and boundaries whose nodes are not candidates (:func:`unmountable_nodes`; a case's
+        ``[sensors] exclude``).
 
     Returns
     -------
@@ -121,7 +161,13 @@ def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: s
             raise InputError("--exclude", f"a box of {len(box.lo)}-D corners on a {mesh.dim}-D mesh",
                              f"give {2 * mesh.dim} numbers: the low corner, then the high one")
         nodes = nodes[~box.contains(mesh.points[nodes])]
+    excluded = {}
+    for name, held in unmountable_nodes(mesh, unmountable).items():
+        out = np.isin(nodes, held)
+        excluded[name] = int(out.sum())
+        nodes = nodes[~out]
     nodes = nodes[thin(mesh.points[nodes], spacing_m)]
     if not len(nodes):
-        raise InputError(where, "no candidate location is left", "name other boundaries, or fewer --exclude boxes")
-    return Candidates(nodes, mesh.points[nodes].copy(), boundary_names(mesh, nodes))
+        raise InputError(where, "no candidate location is left", "name other boundaries, or fewer --exclude boxes"
+                         + (" or [sensors] exclude names" if unmountable else ""))
+    return Candidates(nodes, mesh.points[nodes].copy(), boundary_names(mesh, nodes), excluded)

@@ -1,6 +1,7 @@
 """Where to put the thermocouples: :func:`place_sensors`, from the case's reduced model.
 
-1. Candidates (:mod:`.candidates`): outer-surface (or named-boundary) nodes, thinned, minus boxes.
+1. Candidates (:mod:`.candidates`): outer-surface (or named-boundary) nodes, thinned, minus boxes
+   and the parts the case says cannot carry a sensor (``[sensors] exclude``).
 2. Loads (:mod:`.loads`): training = the case's schedule (unless it is held out) and a generated
    family of duty cycles (or given schedules); held out = given schedules, or for a case driven
    by the paper frame's inputs (oil supply, pump, room) the paper's conditions 1-3, else a
@@ -158,7 +159,10 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
     if not targets:
         raise InputError(case.source or case.name, "has no relative displacement to predict",
                          "add a [relative] table (the tool against the workpiece)")
-    cand = find_candidates(case.mesh, s.boundaries, s.spacing_m, s.exclude)
+    cand = find_candidates(case.mesh, s.boundaries, s.spacing_m, s.exclude, unmountable=case.unmountable)
+    if case.unmountable:
+        log.info("no sensor on %s ([sensors] exclude): %s candidate nodes left out", ", ".join(case.unmountable),
+                 cand.excluded)
     train, held, ranges = _loads(case, s, schedules, held_out)
     t0 = time.perf_counter()
     cache = cache or ScenarioCache()

@@ -104,6 +104,7 @@ class Placement:
                 "stopped": self.stopped, "notes": list(self.notes),
                 "one_sensor_failed": self.failed, "signals": self.signals,
                 "candidates": len(self.candidates), "shortlist": int(len(self.shortlist)),
+                "excluded": dict(self.candidates.excluded),
                 "training_loads": [x.label for x in self.training], "held_out_loads": [x.label for x in self.held_out],
                 "input_ranges": [dataclasses.asdict(r) for r in self.ranges],
                 "settings": _plain({**dataclasses.asdict(s), "fit": settings_of(s.fit)}) if s is not None else {},
@@ -133,11 +134,19 @@ def sensors_toml(p: Placement) -> str:
     """The ``[probes]`` tables of the chosen points, to paste into a case file."""
     lines = [f"# Thermocouples chosen by 'gatetherm sensors' for {p.case}: {len(p.sensors)} of {len(p.candidates)} "
              f"candidates, {p.curve[-1].form} error model (model.json), held-out MAE "
-             + ", ".join(f"{k} {v:.3g} um" for k, v in p.curve[-1].held_out_mae_um.items()), ""]
+             + ", ".join(f"{k} {v:.3g} um" for k, v in p.curve[-1].held_out_mae_um.items())]
+    if p.candidates.excluded:
+        lines.append(f"# none on {excluded_text(p.candidates.excluded)} ([sensors] exclude)")
+    lines.append("")
     for s in p.sensors:
         lines += [f"[probes.{s.name}]", f"point = [{', '.join(repr(float(v)) for v in s.xyz)}]   # node {s.node}, "
                   f"on boundary \"{s.boundary}\"", 'quantities = ["T"]', ""]
     return "\n".join(lines)
+
+
+def excluded_text(excluded: dict[str, int]) -> str:
+    """``spindle (24 candidate nodes), …``: the parts no sensor may go on."""
+    return ", ".join(f"{k} ({v} candidate node{'s' * (v != 1)})" for k, v in excluded.items())
 
 
 def curve_csv(p: Placement) -> str:
