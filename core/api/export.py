@@ -10,7 +10,7 @@ from gatetherm.api.run import Case, Schedule
 
 
 def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *, schedule: Schedule | None = None,
-               title: str | None = None) -> dict:
+               title: str | None = None, run: bool = False) -> dict:
     """Write ``out/job.inp``, a CalculiX 2.20 deck of ``case``'s state at ``time``, and
     ``out/gatetherm.json``, gatetherm's own displacements there (run ``ccx job`` in ``out``).
 
@@ -37,6 +37,8 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
         The duty cycle (default the case's own).
     title : str, optional
         The deck's heading.
+    run : bool
+        Also run ``ccx job`` there (InputError if ``ccx`` is not installed) and add its results.
 
     Returns
     -------
@@ -45,9 +47,11 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
         probe, m), ``relative_m`` (its relative displacements, m), ``probes`` (each probe's node
         set, 1-based nodes and weights), ``element``, ``vertices``, ``nodes``, ``elements``,
         ``order``, ``time_s``. Compare with CalculiX's ``job.dat`` through
-        :func:`gatetherm.studies.run.ccx.probes_from_dat` and ``relative_from_dat``.
+        :func:`gatetherm.studies.run.ccx.probes_from_dat` and ``relative_from_dat``. With
+        ``run``: ``calculix``, CalculiX's ``probes_m`` and ``relative_m`` and ``worst`` (the
+        largest probe difference over gatetherm's largest displacement).
     """
-    from gatetherm.studies.run.ccx import check_time, export_state
+    from gatetherm.studies.run.ccx import check_time, export_state, run_ccx
 
     schedule = case.schedule if schedule is None else schedule
     t = check_time(schedule, float(schedule.times[-1]) if time is None else float(time))
@@ -56,4 +60,6 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
     out.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out / "job.inp", inp)
     write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")
+    if run:
+        info = {**info, "calculix": run_ccx(out, info)}
     return info

@@ -6,7 +6,7 @@ from gatetherm import InputError
 from gatetherm.cli.options import add_model_options, refuse_model_options
 
 #: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
-OUTPUTS = ("job.inp", "gatetherm.json")
+OUTPUTS = ("job.inp", "gatetherm.json", "ccx.log")
 
 DESCRIPTION = (
     "Write DIR/job.inp for CalculiX 2.20 (run 'ccx job' in DIR) and DIR/gatetherm.json with gatetherm's own "
@@ -34,6 +34,8 @@ def register(sub) -> None:
     p.add_argument("--condition", type=int, metavar="N", help="the paper's condition N (with --time)")
     p.add_argument("--time", type=float, metavar="MIN", help="time of the state, minutes (default: the run's end)")
     add_model_options(p)
+    p.add_argument("--run", action="store_true", help="also run 'ccx job' in DIR (CalculiX installed) and print "
+                   "CalculiX's relative displacements beside gatetherm's and the largest probe difference")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.set_defaults(func=run)
 
@@ -53,9 +55,15 @@ def run(args) -> int:
     schedule = case.schedule
     t = check_time(schedule, float(schedule.times[-1]) if args.time is None else args.time * 60.0)
     with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files)) as out:
-        info = gt.export_ccx(case, out, t, schedule=schedule, title=f"gatetherm {what}, t = {t / 60:g} min")
-    print(f"wrote {args.out}/job.inp ({info['element']}, {info['nodes']} nodes) and gatetherm.json; "
-          f"run: cd {args.out} && ccx job")
+        info = gt.export_ccx(case, out, t, schedule=schedule, title=f"gatetherm {what}, t = {t / 60:g} min",
+                             run=args.run)
+    print(f"wrote {args.out}/job.inp ({info['element']}, {info['nodes']} nodes) and gatetherm.json"
+          + ("" if args.run else f"; run: cd {args.out} && ccx job"))
+    ccx = info.get("calculix")
     for name, v in info["relative_m"].items():
-        print(f"gatetherm {name}: {v * 1e6:.6g} um")
+        print(f"gatetherm {name}: {v * 1e6:.6g} um" + (f", CalculiX {ccx['relative_m'][name] * 1e6:.6g} um "
+                                                      f"({ccx['relative_m'][name] / v - 1:+.1e})" if ccx and v else ""))
+    if ccx:
+        print(f"CalculiX against gatetherm at the probes: largest difference {ccx['worst']:.1e} of the largest "
+              "displacement")
     return 0

@@ -265,3 +265,29 @@ def relative_from_dat(dat: str, info: dict) -> dict[str, float]:
     """The relative displacements (m) of ``info`` (:func:`export_state`) from CalculiX's ``job.dat``."""
     u = probes_from_dat(dat, info)
     return {name: float(u[r["a"]][r["axis"]] - u[r["b"]][r["axis"]]) for name, r in info["relative"].items()}
+
+
+def run_ccx(folder, info: dict, timeout: float = 3600.0) -> dict:
+    """Run ``ccx job`` in ``folder`` (the deck of ``info``) and read its displacements back:
+    {"probes_m": {probe: [ux, uy(, uz)]}, "relative_m": {name: m}, "worst": the largest
+    difference of a probe displacement from gatetherm's over gatetherm's largest}."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    exe = shutil.which("ccx")
+    if exe is None:
+        raise InputError("--run", "CalculiX (ccx) is not installed", "install it (Debian: apt-get install "
+                         "calculix-ccx) or run 'ccx job' in the folder yourself")
+    folder = Path(folder)
+    run = subprocess.run([exe, "job"], cwd=folder, capture_output=True, text=True, timeout=timeout)
+    (folder / "ccx.log").write_text(run.stdout + run.stderr)
+    if run.returncode != 0 or "ERROR" in run.stdout or not (folder / "job.dat").exists():
+        raise RuntimeError(f"ccx failed (exit {run.returncode}); see {folder / 'ccx.log'}")
+    dat = (folder / "job.dat").read_text()
+    u = probes_from_dat(dat, info)
+    g = {k: np.asarray(v) for k, v in info["probes_m"].items()}
+    scale = max((np.abs(v).max() for v in g.values()), default=0.0)
+    worst = max((np.abs(u[k][:len(v)] - v).max() for k, v in g.items()), default=0.0) / scale if scale else 0.0
+    return {"probes_m": {k: [float(x) for x in v[:len(g[k])]] for k, v in u.items()},
+            "relative_m": relative_from_dat(dat, info), "worst": float(worst)}
