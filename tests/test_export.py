@@ -217,6 +217,98 @@ point = [0.075, 0.025]
         assert worst(calculix(d2, info2), info2) < 5e-3  # the same convention: a force on the whole ring
 
 
+def test_axisymmetric_solid_disc_on_its_axis(tmp_path):
+    """A solid disc r ≤ 100 mm, 50 mm thick (CAX6, nodes on the axis), its rim at 40 °C and top
+    at 30 °C, gravity and 1 MPa on the top, held axially below: the centre does not move
+    radially; CalculiX's elements on the axis differ by O(h) (1.3e-3 at 10 mm, 6.2e-4 at 5 mm,
+    3.0e-4 at 2.5 mm under the heating alone)."""
+    geo = RECTANGLE.replace('"left"', '"axis"').replace('"right"', '"outside"')
+    case = """
+[case]
+order = 2
+plane = "axisymmetric"
+[mesh]
+file = "body.geo"
+[materials.body]
+k = 45.0
+E = 2.1e11
+nu = 0.3
+alpha = 1.2e-5
+rho = 7850.0
+[initial]
+temperature = 20.0
+[thermal.outside]
+temperature = 40.0
+[thermal.top]
+temperature = 30.0
+[gravity]
+acceleration = [0, -9.81]
+[loads.top]
+pressure = 1e6
+[supports.bottom]
+type = "normal"
+[probes.rim]
+point = [0.1, 0.05]
+[probes.centre]
+point = [0.0, 0.05]
+[probes.inner]
+point = [0.0337, 0.0211]
+"""
+    d, info, text = export(tmp_path, case, geo, x0=0, L=0.1, H=0.05, h=0.01)
+    assert abs(info["probes_m"]["centre"][0]) < 1e-4 * abs(info["probes_m"]["rim"][0])  # achieved 6e-6
+    if CCX:
+        assert worst(calculix(d, info), info) == pytest.approx(1.3e-3, abs=2e-4)  # band: 5e-3 (0.5 %)
+
+
+def test_prescribed_displacement_is_written_on_boundary(tmp_path):
+    """The plate of :func:`test_plane_strain_block_under_pressure` pulled 10 µm at its right edge
+    instead (*BOUNDARY with the value): the corner moves 10 µm, uniform strain."""
+    case = """
+[case]
+plane = "strain"
+[mesh]
+file = "body.geo"
+[materials.body]
+E = 2.1e11
+nu = 0.3
+[supports.left]
+type = "normal"
+[supports.bottom]
+type = "normal"
+[supports.right]
+type = "displacement"
+value = [1e-5, "free"]
+[probes.corner]
+point = [0.2, 0.1]
+[probes.middle]
+point = [0.1, 0.05]
+"""
+    d, info, text = export(tmp_path, case, RECTANGLE, x0=0, L=0.2, H=0.1, h=0.05)
+    held = text.split("*BOUNDARY\n")[1].split("*")[0].strip().splitlines()
+    assert sum(ln.endswith(", 1, 1, 1e-05") for ln in held) >= 3
+    assert info["probes_m"]["corner"][0] == pytest.approx(1e-5, rel=1e-12)
+    assert info["probes_m"]["middle"][0] == pytest.approx(5e-6, rel=1e-9)
+    if CCX:
+        assert worst(calculix(d, info), info) < 1e-6
+
+
+@pytest.mark.parametrize("case,where", [
+    ('[mesh]\nfile = "two_blocks.geo"\n[materials.left]\nk = 50.0\n[materials.right]\nk = 15.0\n'
+     '[thermal.hot]\ntemperature = 100.0\n[thermal.cold]\ntemperature = 0.0\n', "materials"),
+    ('[mesh]\nfile = "two_blocks.geo"\n[materials.left]\nE = 2e11\nnu = 0.3\nalpha = 1e-5\n[materials.right]\n'
+     'E = 2e11\nnu = 0.3\nalpha = 1e-5\n[temperature.regions]\nleft = 30.0\nright = 40.0\n[supports.hot]\n'
+     'type = "clamped"\n', "temperature"),
+    ('[mesh]\nfile = "two_blocks.geo"\n[materials.left]\nE = 2e11\nnu = 0.3\n[materials.right]\nE = 2e11\n'
+     'nu = 0.3\n[loads."left/right"]\npressure = 1e6\n[supports.hot]\ntype = "clamped"\n', "loads.left/right"),
+], ids=["no displacement", "temperature jump", "inner pressure"])
+def test_more_refusals_name_their_table(tmp_path, case, where):
+    shutil.copy(DATA / "two_blocks.geo", tmp_path)
+    (tmp_path / "case.toml").write_text(case)
+    with pytest.raises(gt.InputError) as err:
+        gt.export_ccx(gt.load_case(tmp_path / "case.toml"), tmp_path / "x")
+    assert f"{where}: " in str(err.value) and "\n" not in str(err.value)
+
+
 BLOCKS = """
 [mesh]
 file = "two_blocks.geo"
@@ -311,7 +403,7 @@ axis = "x"
 FLOOR = '[supports.floor]\ntype = "clamped"\n'
 
 
-@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("order", [1, pytest.param(2, marks=pytest.mark.slow)])
 def test_column_on_bed_3d_contact_gravity_and_pressure(tmp_path, order):
     """A steel column on a cast-iron bed (3-D, C3D4 / C3D10), a contact conductance between them,
     the head at 45 °C, gravity and 2 MPa on a side face (*DLOAD P on tetrahedron faces), the
@@ -328,15 +420,15 @@ def test_column_on_bed_3d_contact_gravity_and_pressure(tmp_path, order):
         assert relative_from_dat((d / "job.dat").read_text(), info)["drift"] == pytest.approx(drift, rel=1e-12)
 
 
-@pytest.mark.parametrize("what,case,where", [
-    ("no supports", COLUMN.format(order=1, supports=""), "supports"),
-    ("joint stiffness", COLUMN.format(order=1, supports=FLOOR).replace("conductance = 3000.0",
+@pytest.mark.parametrize("case,where", [
+    (COLUMN.format(order=1, supports=""), "supports"),
+    (COLUMN.format(order=1, supports=FLOOR).replace("conductance = 3000.0",
                                                                         "conductance = 3000.0\nstiffness = [1e12, 1e11]"),
      "contacts.bolted.stiffness"),
-    ("foundation", COLUMN.format(order=1, supports='[supports.floor]\ntype = "foundation"\nstiffness = 1e10\n'),
+    (COLUMN.format(order=1, supports='[supports.floor]\ntype = "foundation"\nstiffness = 1e10\n'),
      "supports.floor"),
-])
-def test_what_a_deck_cannot_hold_is_refused_in_one_line(tmp_path, capsys, what, case, where):
+], ids=["no supports", "joint stiffness", "foundation"])
+def test_what_a_deck_cannot_hold_is_refused_in_one_line(tmp_path, capsys, case, where):
     shutil.copy(DATA / "column_on_bed.geo", tmp_path)
     (tmp_path / "case.toml").write_text(case)
     assert main(["export", "ccx", str(tmp_path / "case.toml"), "--out", str(tmp_path / "x")]) == 2

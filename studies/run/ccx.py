@@ -283,7 +283,7 @@ def run_ccx(folder, info: dict, timeout: float = 3600.0) -> dict:
     run = subprocess.run([exe, "job"], cwd=folder, capture_output=True, text=True, timeout=timeout)
     (folder / "ccx.log").write_text(run.stdout + run.stderr)
     if run.returncode != 0 or "ERROR" in run.stdout or not (folder / "job.dat").exists():
-        raise RuntimeError(f"ccx failed (exit {run.returncode}); see {folder / 'ccx.log'}")
+        raise ChildProcessError(f"ccx failed (exit {run.returncode}); see {folder / 'ccx.log'}")
     dat = (folder / "job.dat").read_text()
     u = probes_from_dat(dat, info)
     g = {k: np.asarray(v) for k, v in info["probes_m"].items()}
