@@ -96,7 +96,7 @@ def _temperatures(model: Model, U, basis, cells) -> np.ndarray | None:
         if np.any(np.isfinite(T[nodes]) & (T[nodes] != value)):
             raise InputError("temperature", f"the temperature per region jumps at nodes region {region} shares: "
                              "CalculiX's nodal temperatures cannot hold the jump",
-                             "split the regions by a [contacts] table, or prescribe a continuous field")
+                             "prescribe a continuous [temperature] field, or solve for the temperature")
         T[nodes] = value
     return np.nan_to_num(T, nan=p.T_ref)
 
@@ -162,8 +162,7 @@ def job_inp(model: Model, U: np.ndarray | None, title: str, env=None) -> tuple[s
     for n, c, m in equations:
         L += ["*EQUATION", "2", f"{n + 1}, {c + 1}, 1.0, {m + 1}, {c + 1}, -1.0"]
     probes = {}
-    for pr in p.probes:
-        idx, w = interpolation(basis, pr.xyz)
+    for pr, (idx, w) in zip(p.probes, interpolation(basis, [pr.xyz for pr in p.probes])):
         probes[pr.name] = {"set": probe_set(pr.name), "nodes": [int(i) + 1 for i in idx], "weights": w.tolist()}
         L += [f"*NSET, NSET={probe_set(pr.name)}", *_lines(idx + 1)]
     if T is not None:

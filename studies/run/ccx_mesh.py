@@ -20,6 +20,9 @@ the equivalent material, :func:`gatetherm.studies.run.ccx.plane_strain_equivalen
 _PAIRS = {3: ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)), 2: ((0, 1), (1, 2), (2, 0))}
 """Corner pairs of CalculiX's mid-side nodes: C3D10 nodes 5-10, CPS6/CPE6/CAX6 nodes 4-6."""
 
+CHUNK = 20_000
+"""Elements matched at a time (memory: 60 distances of 3 coordinates each per element)."""
+
 _FACE = {3: {3: 1, 2: 2, 0: 3, 1: 4}, 2: {2: 1, 0: 2, 1: 3}}
 """CalculiX face number by the corner a face leaves out (C3D4: 1-2-3, 1-4-2, 2-4-3, 3-4-1;
 triangles: 1-2, 2-3, 3-1)."""
@@ -55,11 +58,13 @@ def connectivity(basis) -> np.ndarray:
         t[neg] = t[neg][:, [0, 2, 1]]
     if basis.elem.maxdeg == 1:
         return t
-    ed = basis.element_dofs.T
-    locs = basis.doflocs.T[ed]  # (elements, local DOFs, dim)
-    mids = np.stack([(X[t[:, a]] + X[t[:, b]]) / 2 for a, b in _PAIRS[dim]], axis=1)
-    d = np.linalg.norm(locs[:, None, :, :] - mids[:, :, None, :], axis=-1)
-    return np.hstack([t, np.take_along_axis(ed, d.argmin(axis=2), axis=1)])
+    ed, out = basis.element_dofs.T, []
+    for s in range(0, len(t), CHUNK):  # (elements, mid-sides, local DOFs) distances, a chunk at a time
+        tc, ec = t[s:s + CHUNK], ed[s:s + CHUNK]
+        mids = np.stack([(X[tc[:, a]] + X[tc[:, b]]) / 2 for a, b in _PAIRS[dim]], axis=1)
+        d = np.linalg.norm(basis.doflocs.T[ec][:, None, :, :] - mids[:, :, None, :], axis=-1)
+        out.append(np.hstack([tc, np.take_along_axis(ec, d.argmin(axis=2), axis=1)]))
+    return np.vstack(out)
 
 
 def faces(mesh, cells: np.ndarray, boundary: str, where: str) -> list[tuple[int, int]]:
@@ -79,6 +84,8 @@ def twin_groups(basis, contacts) -> list[np.ndarray]:
     """Nodes at one place on the two (or more) sides of split interfaces, as groups (0-based)."""
     from gatetherm.solvers.contact import jump
 
+    if not contacts:
+        return []
     parent = np.arange(basis.N)
 
     def root(i):
@@ -103,9 +110,15 @@ def twin_groups(basis, contacts) -> list[np.ndarray]:
     return [np.array(sorted(g)) for g in groups.values()]
 
 
-def interpolation(basis, xyz) -> tuple[np.ndarray, np.ndarray]:
-    """The nodes (0-based) and weights whose sum is the field at ``xyz``: the element's shape
-    functions there (one node, weight 1, where the point is a node)."""
-    w = basis.probes(np.asarray(xyz, float)[:, None]).tocsr()
-    keep = np.abs(w.data) > 1e-12
-    return w.indices[keep].astype(int), w.data[keep]
+def interpolation(basis, points) -> list[tuple[np.ndarray, np.ndarray]]:
+    """For each point (m), the nodes (0-based) and weights whose sum is the field there: the
+    element's shape functions (one node, weight 1, where the point is a node)."""
+    if not len(points):
+        return []
+    W = basis.probes(np.asarray(points, float).T).tocsr()
+    out = []
+    for i in range(W.shape[0]):
+        row = W[i]
+        keep = np.abs(row.data) > 1e-12
+        out.append((row.indices[keep].astype(int), row.data[keep]))
+    return out
