@@ -56,7 +56,9 @@ def worst(ccx: dict, info: dict) -> float:
     """The largest difference of CalculiX's probe displacements from gatetherm's, relative to the largest."""
     g = {k: np.asarray(v) for k, v in info["probes_m"].items()}
     scale = max(np.abs(v).max() for v in g.values())
-    return max(np.abs(ccx[k][:len(v)] - v).max() for k, v in g.items()) / scale
+    w = max(np.abs(ccx[k][:len(v)] - v).max() for k, v in g.items()) / scale
+    print(f"CalculiX against gatetherm: {w:.2e}")
+    return w
 
 
 CANTILEVER = """
@@ -95,7 +97,22 @@ def test_plane_stress_cantilever_under_gravity(tmp_path):
     assert len(between["nodes"]) == 6 and sum(between["weights"]) == pytest.approx(1.0, abs=1e-12)
     assert info["probes"]["tip"]["weights"] == [pytest.approx(1.0, abs=1e-12)]  # a node
     if CCX:
-        assert worst(calculix(d, info), info) < 1e-5  # achieved 5e-8 (ccx prints 7 digits)
+        assert worst(calculix(d, info), info) < 1e-6  # achieved 1.2e-8 (ccx prints 7 digits); band: 5e-3
+
+
+@needs_ccx
+@pytest.mark.parametrize("thickness,stiffer", [(0.02, -0.0161), (0.001, -5.6e-5)])
+def test_calculix_cps_elements_are_a_slab_not_plane_stress(tmp_path, thickness, stiffer):
+    """Why plane stress is written as CPE with the equivalent material: the same cantilever
+    deck with CalculiX's own CPS6 and the true material deflects less than plane stress by
+    1.6 % at 20 mm thick (25 mm deep), 6e-5 at 1 mm: a slab of the thickness, plane stress
+    only as it goes to 0."""
+    d, info, text = export(tmp_path, CANTILEVER.replace("thickness = 0.02", f"thickness = {thickness}")
+                           + "[gravity]\nacceleration = [0, -9.81]\n", RECTANGLE, x0=0, L=1.0, H=0.025, h=0.0125)
+    text = text.replace("TYPE=CPE6", "TYPE=CPS6").replace(f"{2.1e11 * 1.6 / 1.69:.13g}, {0.3 / 1.3:.13g}", "2.1e11, 0.3")
+    (d / "job.inp").write_text(text)
+    cps = calculix(d, info)["tip"][1] / info["probes_m"]["tip"][1] - 1
+    assert cps == pytest.approx(stiffer, rel=0.05)
 
 
 def test_plane_stress_point_force_and_a_probe_between_nodes(tmp_path):
@@ -107,7 +124,7 @@ def test_plane_stress_point_force_and_a_probe_between_nodes(tmp_path):
     beam = 100.0 / (3 * 2.1e11 * 0.02 * 0.025 ** 3 / 12)
     assert -info["probes_m"]["tip"][1] / beam - 1 == pytest.approx(-0.00016, abs=1e-4)  # band: 1 %
     if CCX:
-        assert worst(calculix(d, info), info) < 1e-5
+        assert worst(calculix(d, info), info) < 1e-6  # achieved 2.4e-8; band: 5e-3
 
 
 def test_plane_stress_uniform_heating_of_a_free_standing_plate(tmp_path):
@@ -140,7 +157,7 @@ point = [0.2, 0.1]
     ux, uy = info["probes_m"]["corner"]
     assert ux == pytest.approx(1.2e-5 * 10 * 0.2, rel=1e-9) and uy == pytest.approx(1.2e-5 * 10 * 0.1, rel=1e-9)
     if CCX:
-        assert worst(calculix(d, info), info) < 1e-6
+        assert worst(calculix(d, info), info) < 1e-6  # achieved 4e-16; band: 5e-3
 
 
 def test_plane_strain_block_under_pressure(tmp_path):
@@ -171,7 +188,7 @@ point = [0.2, 0.1]
     assert uy == pytest.approx(-10e6 * 0.1 * (1 - 0.09) / 2.1e11, rel=1e-9)
     assert ux == pytest.approx(10e6 * 0.2 * 0.3 * 1.3 / 2.1e11, rel=1e-9)
     if CCX:
-        assert worst(calculix(d, info), info) < 1e-6
+        assert worst(calculix(d, info), info) < 1e-6  # achieved 7.7e-8; band: 5e-3
 
 
 def test_axisymmetric_ring_under_bore_pressure_and_heating(tmp_path):
@@ -214,7 +231,8 @@ point = [0.075, 0.025]
         assert worst(calculix(d, info), info) == pytest.approx(1.27e-4, abs=2e-5)  # band: 5e-3 (0.5 %)
         d2, info2, _ = export(tmp_path, case.replace("[loads.bore]\npressure = 10e6\n", "[loads.corner]\n"
                                                      "force = [1e5, 0]\n"))
-        assert worst(calculix(d2, info2), info2) < 5e-3  # the same convention: a force on the whole ring
+        assert worst(calculix(d2, info2), info2) == pytest.approx(1.27e-4, abs=2e-5)  # the same convention: a
+        # force on the whole ring (per radian would be 2π off); band: 5e-3
 
 
 def test_axisymmetric_solid_disc_on_its_axis(tmp_path):
@@ -289,7 +307,7 @@ point = [0.1, 0.05]
     assert info["probes_m"]["corner"][0] == pytest.approx(1e-5, rel=1e-12)
     assert info["probes_m"]["middle"][0] == pytest.approx(5e-6, rel=1e-9)
     if CCX:
-        assert worst(calculix(d, info), info) < 1e-6
+        assert worst(calculix(d, info), info) < 1e-6  # achieved 2.1e-8; band: 5e-3
 
 
 @pytest.mark.parametrize("case,where", [
@@ -357,8 +375,8 @@ def test_conductive_contact_is_tied_and_its_jump_is_in_the_temperatures(tmp_path
     assert np.ptp(T[on]) == pytest.approx(Q / (2000 * 0.02), rel=1e-9)  # the jump, to round-off (T is linear)
     held = sum(1 for n in on if nodes[n, 0] == 0.0)
     assert text.count("*EQUATION") == 2 * (len(first) - held)
-    if CCX:
-        assert worst(calculix(d, info), info) < 1e-5  # gatetherm bonds by a stiff layer (10⁶ E/h)
+    if CCX:  # gatetherm bonds by a stiff layer (10⁶ E/h)
+        assert worst(calculix(d, info), info) == pytest.approx(4.2e-7, abs=2e-7)  # band: 5e-3
 
 
 COLUMN = """
@@ -414,7 +432,7 @@ def test_column_on_bed_3d_contact_gravity_and_pressure(tmp_path, order):
     assert len(info["probes"]["inside"]["nodes"]) == 4 * order + (order == 2) * 2  # 4 or 10 nodes
     if CCX:
         ccx = calculix(d, info)
-        assert worst(ccx, info) < 1e-4  # achieved 2e-5 at P2: gatetherm bonds by a stiff layer (10⁶ E/h)
+        assert worst(ccx, info) == pytest.approx(4.2e-7 if order == 1 else 1.74e-5, rel=0.3)  # band: 5e-3 (0.5 %)
         drift = ccx["tip"][0] - ccx["inside"][0]
         assert drift == pytest.approx(info["relative_m"]["drift"], rel=1e-4)
         assert relative_from_dat((d / "job.dat").read_text(), info)["drift"] == pytest.approx(drift, rel=1e-12)
