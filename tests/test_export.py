@@ -109,7 +109,8 @@ def test_calculix_cps_elements_are_a_slab_not_plane_stress(tmp_path, thickness, 
     only as it goes to 0."""
     d, info, text = export(tmp_path, CANTILEVER.replace("thickness = 0.02", f"thickness = {thickness}")
                            + "[gravity]\nacceleration = [0, -9.81]\n", RECTANGLE, x0=0, L=1.0, H=0.025, h=0.0125)
-    text = text.replace("TYPE=CPE6", "TYPE=CPS6").replace(f"{2.1e11 * 1.6 / 1.69:.13g}, {0.3 / 1.3:.13g}", "2.1e11, 0.3")
+    equivalent = f"{2.1e11 * 1.6 / 1.69:.13g}, {0.3 / 1.3:.13g}"
+    text = text.replace("TYPE=CPE6", "TYPE=CPS6").replace(equivalent, "2.1e11, 0.3")
     (d / "job.inp").write_text(text)
     cps = calculix(d, info)["tip"][1] / info["probes_m"]["tip"][1] - 1
     assert cps == pytest.approx(stiffer, rel=0.05)
@@ -371,7 +372,7 @@ def test_conductive_contact_is_tied_and_its_jump_is_in_the_temperatures(tmp_path
     on = np.flatnonzero(np.isclose(nodes[:, 0], 0.1))
     _, first = np.unique(nodes[on].round(9), axis=0, return_index=True)
     assert len(on) == 2 * len(first)  # every interface node has its twin
-    Q = 100.0 / (0.1 / (50 * 0.02) + 1 / (2000 * 0.02) + 0.1 / (15 * 0.03))  # W per m of height; the layer on left's side
+    Q = 100.0 / (0.1 / (50 * 0.02) + 1 / (2000 * 0.02) + 0.1 / (15 * 0.03))  # W per m of height (layer: left's t)
     assert np.ptp(T[on]) == pytest.approx(Q / (2000 * 0.02), rel=1e-9)  # the jump, to round-off (T is linear)
     held = sum(1 for n in on if nodes[n, 0] == 0.0)
     assert text.count("*EQUATION") == 2 * (len(first) - held)
@@ -441,7 +442,7 @@ def test_column_on_bed_3d_contact_gravity_and_pressure(tmp_path, order):
 @pytest.mark.parametrize("case,where", [
     (COLUMN.format(order=1, supports=""), "supports"),
     (COLUMN.format(order=1, supports=FLOOR).replace("conductance = 3000.0",
-                                                                        "conductance = 3000.0\nstiffness = [1e12, 1e11]"),
+                                                     "conductance = 3000.0\nstiffness = [1e12, 1e11]"),
      "contacts.bolted.stiffness"),
     (COLUMN.format(order=1, supports='[supports.floor]\ntype = "foundation"\nstiffness = 1e10\n'),
      "supports.floor"),
@@ -478,7 +479,8 @@ def exported(tmp_path_factory):
 def test_deck_holds_mesh_materials_supports_temperatures_and_probe_prints(exported):
     text = (exported / "job.inp").read_text()
     nodes = text.split("*NODE\n")[1].split("*ELEMENT")[0].strip().splitlines()
-    elements = [ln for block in text.split("*ELEMENT, TYPE=C3D4")[1:] for ln in block.split("*")[0].strip().splitlines()[1:]]
+    elements = [ln for block in text.split("*ELEMENT, TYPE=C3D4")[1:]
+                for ln in block.split("*")[0].strip().splitlines()[1:]]
     temps = text.split("*TEMPERATURE\n")[1].split("*")[0].strip().splitlines()
     assert len(temps) == len(nodes) > 1000 and len(elements) > 3 * len(nodes)
     assert text.count("*MATERIAL") == 7 and "*EXPANSION, ZERO=20\n" in text

@@ -57,7 +57,8 @@ PLANE_STRESS_NOTE = (
 def plane_strain_equivalent(mat) -> tuple[float, float, float]:
     """(E', ν', α') of the plane strain material whose in-plane response is the plane stress
     response of ``mat`` (Pa, 1, 1/K)."""
-    return mat.E * (1 + 2 * mat.nu) / (1 + mat.nu) ** 2, mat.nu / (1 + mat.nu), mat.alpha * (1 + mat.nu) / (1 + 2 * mat.nu)
+    E, nu, alpha = mat.E, mat.nu, mat.alpha
+    return E * (1 + 2 * nu) / (1 + nu) ** 2, nu / (1 + nu), alpha * (1 + nu) / (1 + 2 * nu)
 
 
 def refuse(problem) -> None:
@@ -129,7 +130,8 @@ def job_inp(model: Model, U: np.ndarray | None, title: str, env=None) -> tuple[s
     cells = connectivity(basis)
     nodes = basis.doflocs.T
     T = _temperatures(model, U, basis, cells)
-    L = [f"** {title}", *(PLANE_STRESS_NOTE if dim == 2 and p.plane == "stress" else ()), "*HEADING", title[:80], "*NODE"]
+    note = PLANE_STRESS_NOTE if dim == 2 and p.plane == "stress" else ()
+    L = [f"** {title}", *note, "*HEADING", title[:80], "*NODE"]
     L += [f"{i + 1}, " + ", ".join(num(c) for c in (*x, *[0.0] * (3 - dim))) for i, x in enumerate(nodes)]
     etype = element_type(dim, p.plane, p.order)  # plane stress: CPE and the equivalent material
     for region, idx in mesh.subdomains.items():
@@ -246,9 +248,10 @@ def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
     rel = {r.name: {"a": r.a, "b": r.b, "axis": r.axis} for r in model.problem.relative}
     return inp, {"title": title, "time_s": t, "element": element_type(model.dim, model.problem.plane,
                                                                          model.problem.order),
-                 "probes_m": at, "relative_m": {n: at[r["a"]][r["axis"]] - at[r["b"]][r["axis"]] for n, r in rel.items()},
+                 "probes_m": at,
+                 "relative_m": {n: at[r["a"]][r["axis"]] - at[r["b"]][r["axis"]] for n, r in rel.items()},
                  "relative": rel, "probes": probes, "probe_sets": {k: v["set"] for k, v in probes.items()},
-                 "vertices": int(model.mesh.nvertices), "nodes": len(inp.split("*NODE\n")[1].split("*")[0].splitlines()),
+                 "vertices": int(model.mesh.nvertices), "nodes": int(model.elastic.basis.N // model.dim),
                  "elements": int(model.mesh.nelements), "order": model.problem.order}
 
 

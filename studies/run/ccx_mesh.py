@@ -50,7 +50,8 @@ def connectivity(basis) -> np.ndarray:
     t = mesh.t.T.copy()
     X = mesh.p.T
     if dim == 3:
-        neg = np.einsum("ij,ij->i", np.cross(X[t[:, 1]] - X[t[:, 0]], X[t[:, 2]] - X[t[:, 0]]), X[t[:, 3]] - X[t[:, 0]]) < 0
+        a, b, c = (X[t[:, k]] - X[t[:, 0]] for k in (1, 2, 3))
+        neg = np.einsum("ij,ij->i", np.cross(a, b), c) < 0
         t[neg] = t[neg][:, [1, 0, 2, 3]]
     else:
         a, b = X[t[:, 1]] - X[t[:, 0]], X[t[:, 2]] - X[t[:, 0]]
