@@ -1,27 +1,45 @@
 """Export a thermoelastic state to CalculiX (``ccx`` 2.20), an independent FE code.
 
-``job.inp`` holds the mesh (C3D4, or C3D10 for quadratic elements), a material per
-region, the supports, the temperature field at one time as ``*TEMPERATURE`` over
-``*INITIAL CONDITIONS`` at the stress-free temperature, one static step, and a node set
-per probe with ``*NODE PRINT`` of ``U``, so that ``ccx job`` prints the probes'
-displacements to ``job.dat`` (:func:`read_dat` reads them back).
+``job.inp`` holds the mesh (3-D: C3D4, C3D10 at P2; 2-D: CPE3/CPE6 plane strain, and plane
+stress as plane strain with the equivalent material (:func:`plane_strain_equivalent`:
+CalculiX's CPS3/CPS6 are a slab of the section's thickness, plane stress only as it goes to
+0), CAX3/CAX6 axisymmetric, x = r, y = z; nodes and orientation:
+:mod:`~gatetherm.studies.run.ccx_mesh`), a material per region (with ``*DENSITY`` under
+gravity; the 2-D thickness on ``*SOLID SECTION``, none for CAX), the fixed and prescribed
+displacements (``*BOUNDARY``), the temperature field at one time (``*TEMPERATURE`` over
+``*INITIAL CONDITIONS`` at the stress-free temperature), the mechanical loads at that time
+(gravity ``*DLOAD GRAV``, a pressure ``*DLOAD Pn`` on the element faces, tractions, forces on a
+boundary and point forces as ``*CLOAD`` of gatetherm's consistent nodal forces), the bonded
+sides of every contact tied node to node (``*EQUATION``) and one static step with
+``*NODE PRINT`` of ``U`` on a node set per probe. A probe that is not a node prints the nodes
+of its element; :func:`probes_from_dat` interpolates them with the element's shape functions,
+as gatetherm does. A contact's conductance is in the temperatures (the jump across the
+interface is written on the twin nodes); ccx solves no heat.
+
+Refused, one line each (``InputError``): a case without displacement (no E, ν), without any
+fixed support (an empty ``*BOUNDARY``), an elastic foundation, a contact with a joint
+stiffness, a pressure on an inner boundary, a temperature per region that jumps on nodes the
+regions share.
 """
 from __future__ import annotations
 
+import dataclasses
 import re
 
 import numpy as np
+from skfem import CellBasis
 
 from gatetherm import InputError
 from gatetherm.solvers.model import Model, prescribed_at
+from gatetherm.studies.run.ccx_mesh import connectivity, element_type, faces, interpolation, set_name, twin_groups
 
-_PAIRS = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
-"""Edges of a tetrahedron in the order of C3D10's mid-side nodes 5-10 (and scikit-fem's)."""
+_set = set_name
 
 
-def _set(name: str) -> str:
-    """A CalculiX set name (letters, digits, underscores, at most 80 characters)."""
-    return re.sub(r"\W", "_", name).upper()[:80]
+def num(x) -> str:
+    """A number as CalculiX reads it: at most 20 characters (ccx cuts longer fields, so that
+    repr's ``8.703947368421051e-06`` would read as 8.70…), 13 significant digits."""
+    return f"{float(x):.13g}"
 
 
 def _lines(values, per_line: int = 16) -> list[str]:
@@ -29,91 +47,167 @@ def _lines(values, per_line: int = 16) -> list[str]:
     return [", ".join(str(v) for v in values[i:i + per_line]) for i in range(0, len(values), per_line)]
 
 
-def job_inp(model: Model, U: np.ndarray | None, title: str) -> str:
-    """The input deck for the heat state ``U`` (None: the problem's prescribed temperature)."""
-    p = model.problem
-    if model.dim != 3:
-        raise InputError("--dim", "CalculiX export is for 3-D models", "use --dim 3")
-    if any(s.stiffness is not None for s in p.supports):
-        raise InputError("supports", "an elastic foundation has no CalculiX counterpart here",
-                         "export a model with fixed supports")
-    if model.terms is not None or p.contacts or not p.thermal:
-        raise InputError("loads", "the export writes the thermal load only (no mechanical loads, joints or purely "
-                         "mechanical cases)", "export a case without [gravity], [loads], [contacts] and displacement "
-                         "supports")
-    fm, order = model.fmesh, p.order
-    cells = fm.cells.copy()
-    X = fm.points[cells]
-    neg = np.einsum("ij,ij->i", np.cross(X[:, 1] - X[:, 0], X[:, 2] - X[:, 0]), X[:, 3] - X[:, 0]) < 0
-    cells[neg] = cells[neg][:, [1, 0, 2, 3]]  # C3D4: positive volume
-    from skfem import CellBasis
+PLANE_STRESS_NOTE = (
+    "** plane stress is written as plane strain (CPE3/CPE6) of the same thickness with the equivalent material",
+    "** E' = E (1 + 2 nu) / (1 + nu)^2, nu' = nu / (1 + nu), alpha' = alpha (1 + nu) / (1 + 2 nu): the same in-plane",
+    "** displacements and stresses. CalculiX's CPS3/CPS6 are a slab of the section's thickness, plane stress only",
+    "** as the thickness goes to 0 (docs/cli.md, gatetherm export).")
 
+
+def plane_strain_equivalent(mat) -> tuple[float, float, float]:
+    """(E', ν', α') of the plane strain material whose in-plane response is the plane stress
+    response of ``mat`` (Pa, 1, 1/K)."""
+    E, nu, alpha = mat.E, mat.nu, mat.alpha
+    return E * (1 + 2 * nu) / (1 + nu) ** 2, nu / (1 + nu), alpha * (1 + nu) / (1 + 2 * nu)
+
+
+def refuse(problem) -> None:
+    """InputError for what a deck cannot hold (see the module's docstring), before any run."""
+    p = problem
+    if not p.elastic:
+        raise InputError("materials", "the case solves no displacement: there is nothing for CalculiX to compare",
+                         "give E and nu of every region")
+    soft = next((s for s in p.supports if s.stiffness is not None), None)
+    if soft is not None:
+        raise InputError(f"supports.{soft.boundary}", "an elastic foundation is not exported to CalculiX",
+                         "export with the boundary fixed (type = \"clamped\" or \"normal\")")
+    if not p.supports:
+        raise InputError("supports", "the case holds no displacement: CalculiX would get an empty *BOUNDARY",
+                         "add a [supports] table that fixes the body")
+    joint = next((c for c in p.contacts if c.stiffness is not None), None)
+    if joint is not None:
+        raise InputError(f"contacts.{joint.name}.stiffness", "an elastic joint layer has no CalculiX counterpart "
+                         "in the export (ccx has no zero-thickness layer element)",
+                         "export with the contact bonded (drop stiffness); its conductance is kept")
+
+
+def _temperatures(model: Model, U, basis, cells) -> np.ndarray | None:
+    """Nodal temperatures (°C): the heat state, or the prescribed field (None without one)."""
+    p = model.problem
+    if not p.thermal:
+        return None
+    if U is not None:
+        return U[:model.heat.n_solid]
+    if not p.prescribed_regions:
+        return prescribed_at(model, basis.doflocs)
+    T = np.full(basis.N, np.nan)
+    for region, idx in model.mesh.subdomains.items():
+        nodes = np.unique(cells[idx])
+        value = p.prescribed_regions.get(region, 0.0)
+        if np.any(np.isfinite(T[nodes]) & (T[nodes] != value)):
+            raise InputError("temperature", f"the temperature per region jumps at nodes region {region} shares: "
+                             "CalculiX's nodal temperatures cannot hold the jump",
+                             "prescribe a continuous [temperature] field, or solve for the temperature")
+        T[nodes] = value
+    return np.nan_to_num(T, nan=p.T_ref)
+
+
+def _nodal_forces(model: Model, env) -> np.ndarray:
+    """gatetherm's consistent nodal forces (N, elastic DOFs) of the tractions, boundary forces
+    and point forces at the inputs ``env``."""
+    from gatetherm.solvers.loads import mechanical_terms
+
+    p = model.problem
+    q = dataclasses.replace(p, gravity=(), supports=(), loads=tuple(x for x in p.loads if x.kind != "pressure"))
+    terms = mechanical_terms(q, model.mesh, model.elastic.basis, model.fields, model.fmesh.sensors, None)
+    return np.zeros(model.elastic.basis.N) if terms is None else terms.F @ terms.at(env)
+
+
+def job_inp(model: Model, U: np.ndarray | None, title: str, env=None) -> tuple[str, dict]:
+    """The input deck for the heat state ``U`` (None: the problem's prescribed temperature,
+    or none) and the loads at the inputs ``env``; and the probes' nodes and weights
+    ({probe: {"set", "nodes" (1-based), "weights"}})."""
+    from gatetherm.solvers.elasticity import support_dofs
     from gatetherm.solvers.fem import element
 
-    basis = model.heat.basis if model.heat is not None else CellBasis(model.mesh, element(3, order))
-    nodes = basis.doflocs.T  # vertices first (the mesh's numbering), then mid-edges for P2
-    T = U[:model.heat.n_solid] if U is not None else prescribed_at(model, nodes.T)
-    if order == 2:
-        edge_dof = {tuple(sorted(basis.mesh.t[[a, c], e])): basis.element_dofs[4 + k, e]
-                    for e in range(basis.mesh.nelements) for k, (a, c) in enumerate(_PAIRS)}
-        mids = np.array([[edge_dof[tuple(sorted((c[a], c[b])))] for a, b in _PAIRS] for c in cells])
-        cells = np.hstack([cells, mids])
-    L = [f"** {title}", "*HEADING", title[:80], "*NODE"]
-    L += [f"{i + 1}, {float(x[0])!r}, {float(x[1])!r}, {float(x[2])!r}" for i, x in enumerate(nodes)]
-    for region, idx in fm.regions.items():
-        L.append(f"*ELEMENT, TYPE={'C3D10' if order == 2 else 'C3D4'}, ELSET={_set(region)}")
+    refuse(model.problem)
+    p, env = model.problem, env or {}
+    dim, mesh = model.dim, model.mesh
+    basis = model.heat.basis if model.heat is not None else CellBasis(mesh, element(dim, p.order))
+    vb = model.elastic.basis
+    if vb.N != dim * basis.N:
+        raise RuntimeError("the elastic basis does not interleave the scalar basis's DOFs")
+    cells = connectivity(basis)
+    nodes = basis.doflocs.T
+    T = _temperatures(model, U, basis, cells)
+    note = PLANE_STRESS_NOTE if dim == 2 and p.plane == "stress" else ()
+    L = [f"** {title}", *note, "*HEADING", title[:80], "*NODE"]
+    L += [f"{i + 1}, " + ", ".join(num(c) for c in (*x, *[0.0] * (3 - dim))) for i, x in enumerate(nodes)]
+    etype = element_type(dim, p.plane, p.order)  # plane stress: CPE and the equivalent material
+    for region, idx in mesh.subdomains.items():
+        L.append(f"*ELEMENT, TYPE={etype}, ELSET={_set(region)}")
         L += [f"{e + 1}, " + ", ".join(str(n + 1) for n in cells[e]) for e in idx]
     for region, mat in p.materials.items():
-        L += [f"*MATERIAL, NAME={_set(region)}", "*ELASTIC", f"{mat.E!r}, {mat.nu!r}",
-              f"*EXPANSION, ZERO={p.T_ref!r}", f"{mat.alpha!r}",
-              f"*SOLID SECTION, ELSET={_set(region)}, MATERIAL={_set(region)}"]
-    bnodes = {}
+        E, nu, alpha = plane_strain_equivalent(mat) if dim == 2 and p.plane == "stress" else (mat.E, mat.nu, mat.alpha)
+        L += [f"*MATERIAL, NAME={_set(region)}", "*ELASTIC", f"{num(E)}, {num(nu)}"]
+        if T is not None:
+            L += [f"*EXPANSION, ZERO={num(p.T_ref)}", num(alpha)]
+        if p.gravity:
+            L += ["*DENSITY", num(mat.rho)]
+        L.append(f"*SOLID SECTION, ELSET={_set(region)}, MATERIAL={_set(region)}")
+        if dim == 2 and not p.axisymmetric:
+            L.append(num(p.thickness.get(region, 1.0)))
+    fixed: dict[tuple[int, int], float] = {}  # (node, component): displacement, m; a later support wins
     for s in p.supports:
-        facet_nodes = np.unique(fm.boundaries[s.boundary])
-        bnodes[s.boundary] = facet_nodes if order == 1 else np.unique(np.r_[facet_nodes,
-                                                                            _facet_mids(cells, facet_nodes)])
-    for name, keep in bnodes.items():
-        L += [f"*NSET, NSET=B_{_set(name)}", *_lines(keep + 1)]
-    probe_node = {}
-    for pr in p.probes:
-        d = np.linalg.norm(nodes - np.asarray(pr.xyz), axis=1)
-        i = int(np.argmin(d))
-        if d[i] > 1e-9 * max(np.ptp(nodes, axis=0).max(), 1.0):
-            raise InputError(f"probe {pr.name}", "is not a node of the mesh", "put probes on mesh points")
-        probe_node[pr.name] = i
-        L += [f"*NSET, NSET=P_{_set(pr.name)}", str(i + 1)]
-    L += ["*INITIAL CONDITIONS, TYPE=TEMPERATURE"] + [f"{i + 1}, {p.T_ref!r}" for i in range(len(nodes))]
+        for k, c in enumerate(s.components):
+            value = float(s.values[k](env)) if s.values else 0.0
+            for d in support_dofs(vb, mesh, s.boundary, (c,), model.fmesh.lines):
+                fixed[(int(d) // dim, c)] = value
+    equations = []
+    for group in twin_groups(basis, p.contacts):
+        for c in range(dim):
+            held = [fixed[(int(n), c)] for n in group if (int(n), c) in fixed]
+            if held:  # held on one side: on all, no equation
+                fixed.update({(int(n), c): held[-1] for n in group})
+            else:
+                equations += [(int(n), c, int(group[0])) for n in group[1:]]
+    for n, c, m in equations:
+        L += ["*EQUATION", "2", f"{n + 1}, {c + 1}, 1.0, {m + 1}, {c + 1}, -1.0"]
+    probes = {}
+    for pr, (idx, w) in zip(p.probes, interpolation(basis, [pr.xyz for pr in p.probes])):
+        probes[pr.name] = {"set": probe_set(pr.name), "nodes": [int(i) + 1 for i in idx], "weights": w.tolist()}
+        L += [f"*NSET, NSET={probe_set(pr.name)}", *_lines(idx + 1)]
+    if T is not None:
+        L += ["*INITIAL CONDITIONS, TYPE=TEMPERATURE"] + [f"{i + 1}, {num(p.T_ref)}" for i in range(len(nodes))]
     L += ["*STEP", "*STATIC", "*BOUNDARY"]
-    for s in p.supports:
-        L += [f"B_{_set(s.boundary)}, {c + 1}, {c + 1}" for c in s.components]
-    L += ["*TEMPERATURE"] + [f"{i + 1}, {float(v)!r}" for i, v in enumerate(T)]
-    for name in probe_node:
-        L += [f"*NODE PRINT, NSET=P_{_set(name)}", "U"]
+    L += [f"{n + 1}, {c + 1}, {c + 1}" + (f", {num(v)}" if v else "") for (n, c), v in sorted(fixed.items())]
+    if T is not None:
+        L += ["*TEMPERATURE"] + [f"{i + 1}, {num(v)}" for i, v in enumerate(T)]
+    g = np.array([float(v(env)) for v in p.gravity] + [0.0] * (3 - len(p.gravity)))
+    if np.any(g):
+        G = float(np.linalg.norm(g))
+        L += ["*DLOAD"] + [f"{_set(r)}, GRAV, {num(G)}, " + ", ".join(num(x) for x in g / G)
+                           for r in mesh.subdomains]
+    for load in p.loads:
+        if load.kind == "pressure" and float(load.values[0](env)) != 0.0:
+            value = float(load.values[0](env))
+            L += ["*DLOAD"] + [f"{e + 1}, P{k}, {num(value)}"
+                               for e, k in faces(mesh, cells, load.boundary, f"loads.{load.boundary}")]
+    f = _nodal_forces(model, env)
+    nz = np.flatnonzero(f)
+    if len(nz):
+        L += ["*CLOAD"] + [f"{d // dim + 1}, {d % dim + 1}, {num(f[d])}" for d in nz]
+    for name in probes:
+        L += [f"*NODE PRINT, NSET={probe_set(name)}", "U"]
     L += ["*END STEP"]
-    return "\n".join(L) + "\n"
+    return "\n".join(L) + "\n", probes
 
 
-def _facet_mids(cells: np.ndarray, facet_nodes: np.ndarray) -> np.ndarray:
-    """Mid-side nodes of the C3D10 cells whose both edge ends lie on a boundary."""
-    on = np.isin(cells[:, :4], facet_nodes)
-    out = [cells[on[:, a] & on[:, b], 4 + k] for k, (a, b) in enumerate(_PAIRS)]
-    return np.concatenate(out)
-
-
-def read_dat(text: str) -> dict[str, np.ndarray]:
-    """Displacements (m) per probe node set from ``job.dat``: {probe set: (ux, uy, uz)}."""
-    out, current = {}, None
+def read_dat(text: str) -> dict[str, dict[int, np.ndarray]]:
+    """Displacements (m) per node set from ``job.dat``: {set: {node: (ux, uy, uz)}}."""
+    out: dict[str, dict[int, np.ndarray]] = {}
+    current = None
     for line in text.splitlines():
         m = re.match(r"\s*displacements \(vx,vy,vz\) for set (\S+)", line)
         if m:
-            current = m.group(1)
+            current = out.setdefault(m.group(1), {})
             continue
         parts = line.split()
-        if current and len(parts) == 4:
-            try:
-                out[current] = np.array([float(v) for v in parts[1:]])
-            except ValueError:
-                pass
+        if current is None or not parts:
+            continue
+        try:
+            current[int(parts[0])] = np.array([float(v) for v in parts[1:4]])
+        except ValueError:
             current = None
     return out
 
@@ -132,26 +226,70 @@ def check_time(schedule, t: float) -> float:
 
 
 def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
-    """Run ``case`` through ``schedule`` and export the state
-    at ``t`` (s, a step of the run): (``job.inp`` text, ``gatetherm.json`` content: gatetherm's
-    relative displacements in m, the probe sets they compare and the mesh size)."""
+    """Run ``case`` through ``schedule`` and export the state at ``t`` (s, a step of the run):
+    (``job.inp`` text, ``gatetherm.json`` content: gatetherm's displacement at every probe and
+    its relative displacements in m, the probes' nodes and weights, the mesh size)."""
+    from gatetherm.solvers.heat import environment
+    from gatetherm.solvers.model import static_displacement
     from gatetherm.studies.run.scenario import run_scenario
 
     t = check_time(schedule, t)
+    refuse(case.problem)  # before the run
+    env = environment(schedule.drive, t)
     run = run_scenario(case, schedule, keep_times=[t])
-    (_, U), = [s for s in run.result.states if abs(s[0] - t) < 1e-6]
     model = run.model
-    u = {}
-    if U is not None:
-        u = {k[1]: float(v) for k, v in zip(model.readout.keys, model.read(U)) if k[0] == "relative"}
-    probes = {pr.name: probe_set(pr.name) for pr in model.problem.probes}
-    rel = {r.name: {"a": probes[r.a], "b": probes[r.b], "axis": r.axis} for r in model.problem.relative}
-    return job_inp(model, U, title), {"title": title, "time_s": t, "relative_m": u, "relative": rel,
-                                      "probe_sets": probes, "vertices": len(model.fmesh.points),
-                                      "elements": len(model.fmesh.cells), "order": model.problem.order}
+    U = next((s[1] for s in run.result.states if abs(s[0] - t) < 1e-6), None)
+    if model.heat is not None and U is None:
+        U = run.result.states[-1][1]  # a steady run keeps its one state
+    u = model.displacement_field(U, env) if U is not None else static_displacement(model, env)
+    at = {pr.name: [float(model.elastic.point_functional(pr.xyz, c) @ u) for c in range(model.dim)]
+          for pr in model.problem.probes}
+    inp, probes = job_inp(model, U, title, env)
+    rel = {r.name: {"a": r.a, "b": r.b, "axis": r.axis} for r in model.problem.relative}
+    return inp, {"title": title, "time_s": t, "element": element_type(model.dim, model.problem.plane,
+                                                                         model.problem.order),
+                 "probes_m": at,
+                 "relative_m": {n: at[r["a"]][r["axis"]] - at[r["b"]][r["axis"]] for n, r in rel.items()},
+                 "relative": rel, "probes": probes, "probe_sets": {k: v["set"] for k, v in probes.items()},
+                 "vertices": int(model.mesh.nvertices), "nodes": int(model.elastic.basis.N // model.dim),
+                 "elements": int(model.mesh.nelements), "order": model.problem.order}
+
+
+def probes_from_dat(dat: str, info: dict) -> dict[str, np.ndarray]:
+    """Each probe's displacement (m, x y z) from CalculiX's ``job.dat``: its nodes'
+    displacements weighted by the shape functions in ``info`` (:func:`export_state`)."""
+    d = read_dat(dat)
+    return {name: sum(w * d[pr["set"]][n] for n, w in zip(pr["nodes"], pr["weights"]))
+            for name, pr in info["probes"].items()}
 
 
 def relative_from_dat(dat: str, info: dict) -> dict[str, float]:
     """The relative displacements (m) of ``info`` (:func:`export_state`) from CalculiX's ``job.dat``."""
-    d = read_dat(dat)
-    return {name: float(d[r["a"]][r["axis"]] - d[r["b"]][r["axis"]]) for name, r in info["relative"].items()}
+    u = probes_from_dat(dat, info)
+    return {name: float(u[r["a"]][r["axis"]] - u[r["b"]][r["axis"]]) for name, r in info["relative"].items()}
+
+
+def run_ccx(folder, info: dict, timeout: float = 3600.0) -> dict:
+    """Run ``ccx job`` in ``folder`` (the deck of ``info``) and read its displacements back:
+    {"probes_m": {probe: [ux, uy(, uz)]}, "relative_m": {name: m}, "worst": the largest
+    difference of a probe displacement from gatetherm's over gatetherm's largest}."""
+    import shutil
+    import subprocess
+    from pathlib import Path
+
+    exe = shutil.which("ccx")
+    if exe is None:
+        raise InputError("--run", "CalculiX (ccx) is not installed", "install it (Debian: apt-get install "
+                         "calculix-ccx) or run 'ccx job' in the folder yourself")
+    folder = Path(folder)
+    run = subprocess.run([exe, "job"], cwd=folder, capture_output=True, text=True, timeout=timeout)
+    (folder / "ccx.log").write_text(run.stdout + run.stderr)
+    if run.returncode != 0 or "ERROR" in run.stdout or not (folder / "job.dat").exists():
+        raise ChildProcessError(f"ccx failed (exit {run.returncode}); see {folder / 'ccx.log'}")
+    dat = (folder / "job.dat").read_text()
+    u = probes_from_dat(dat, info)
+    g = {k: np.asarray(v) for k, v in info["probes_m"].items()}
+    scale = max((np.abs(v).max() for v in g.values()), default=0.0)
+    worst = max((np.abs(u[k][:len(v)] - v).max() for k, v in g.items()), default=0.0) / scale if scale else 0.0
+    return {"probes_m": {k: [float(x) for x in v[:len(g[k])]] for k, v in u.items()},
+            "relative_m": relative_from_dat(dat, info), "worst": float(worst)}
