@@ -252,3 +252,18 @@ def test_cli_predict_refuses_a_file_without_a_model_column(tmp_path, capsys):
     assert cli("errormodel", "predict", tmp_path / "model.json", "--data", data, "--out", tmp_path / "p") == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"column {used}: missing; the model reads it" in err, err
+
+
+def test_cli_resolution_sets_the_noise_rule(tmp_path, capsys):
+    """--resolution-K: the sensors' noise the coefficients are fitted for, printed as the noise it adds."""
+    data = _write(tmp_path, synthetic(n=400))
+    args = ("errormodel", "fit", "--data", data, "--targets", "d_um", "--form", "static", "--out", tmp_path / "f")
+    assert cli(*args, "--resolution-K", "-1") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "resolution_K: -1.0 is not >= 0" in err, err
+    assert cli(*args, "--resolution-K", "0") == 0
+    assert "sensor noise 0 um" in capsys.readouterr().out
+    assert cli(*args) == 0  # 0.05 K: the noise is 0.05 K x sqrt(K_1^2 + K_3^2)
+    m = load_model(tmp_path / "f" / "model.json").target("d_um")
+    assert m.noise_um == pytest.approx(0.05 * np.hypot(*m.coefficients[:2]), rel=1e-9) and len(m.terms) == 2
+    assert m.noise_um == pytest.approx(0.096, abs=0.005)  # achieved 0.0960
