@@ -80,6 +80,8 @@ def test_sensor_noise_costs_at_most_20_percent_of_the_accuracy(machine):
     clean, with_noise, noise_um = errors(FitParams())
     assert clean == pytest.approx(0.151, abs=0.005) and noise_um == pytest.approx(0.132, abs=0.005)
     assert with_noise / clean == pytest.approx(1.186, abs=0.01)  # band: <= 1.2
+    clean, with_noise, _ = errors(LAGS)  # closer without noise, so noise costs more: x3.5, yet less in um
+    assert clean == pytest.approx(0.041, abs=0.005) and with_noise == pytest.approx(0.145, abs=0.01)
     clean, with_noise, _ = errors(OLD_RULE)  # the old rule: exact on clean data, useless with noise
     assert clean == pytest.approx(0.030, abs=0.005) and with_noise == pytest.approx(61.5, abs=2.0)
 
