@@ -108,7 +108,8 @@ def test_every_method_reports_its_held_out_benefit(machine):
     data = noisy(measured, 7)
     model = fit_error_model(own, ["delta_um"], THETAS)  # the noise-aware default
     got = {name: compensate(data, case, s).summary["benefit"] for name, s in
-           (("paper", Settings("paper")), ("mlr", Settings("mlr")), ("errormodel", Settings("errormodel", model=model)))}
+           (("paper", Settings("paper")), ("mlr", Settings("mlr")),
+            ("errormodel", Settings("errormodel", model=model)))}
     assert {b["verdict"] for b in got.values()} == {"better"} and not any(b["forced"] for b in got.values())
     assert [b["uncompensated_um"] for b in got.values()] == [pytest.approx(8.776, abs=0.01)] * 3
     assert got["paper"]["held_out_um"] == pytest.approx(0.648, abs=0.03)  # K fitted on the first 70 % only
@@ -147,3 +148,22 @@ def test_cli_forced_writes_the_warning_and_says_when_the_benefit_is_unknown(mach
     assert main([str(a) for a in argv]) == 0
     summary = json.loads((tmp_path / "comp" / "summary.json").read_text())
     assert summary["benefit"]["verdict"] == "unchecked" and "--fit-span 0:0.7" in summary["warning"]
+
+
+def test_mlr_fitted_on_the_model_is_refused_where_the_machine_differs(machine):
+    """300 W the case does not know of heat the bed (a hydraulic unit): the regression fitted on the
+    model's own run would leave δ worse than no compensation; the paper method with K fitted on the
+    record is named instead."""
+    case = machine[0]
+    run = gt.run(case, effects={"heat_source@bed": 300.0}, keep=())
+    data = TimeSeries({n: run[n] for n in COLUMNS}, {"format": FORMAT})
+    with pytest.raises(InputError) as err:
+        compensate(data, case, Settings("mlr"))
+    text = str(err.value)
+    held, unc, better = (float(v) for v in re.findall(r"([\d.]+) um", text))
+    assert text.startswith("--method mlr: mlr would leave δ") and "--method paper --k-source fit" in text
+    assert held == pytest.approx(31.64, abs=0.5) and unc == pytest.approx(24.50, abs=0.2) and better < 0.5
+    forced = compensate(data, case, Settings("mlr", force=True)).summary
+    assert forced["benefit"]["verdict"] == "worse" and "applied because forced" in forced["warning"]
+    paper = compensate(data, case, Settings("paper")).summary["benefit"]
+    assert paper["held_out_um"] == pytest.approx(better, abs=0.01) and paper["verdict"] == "better"
