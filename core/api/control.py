@@ -36,7 +36,7 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
     Compensation
         ``.loop`` (the compensated δ, the strokes, the updates), ``.summary`` (bands, updates;
         ``benefit``: ``held_out_um`` and ``uncompensated_um``, the largest |δ| on the held-out span with
-        and without it, um, ``verdict`` better, worse or unchecked, ``forced``; ``warning`` where forced
+        and without it, um, ``verdict`` better, no-gain, worse or unchecked, ``forced``; ``warning`` where forced
         or unchecked).
     """
     from gatetherm.studies.control.methods import Settings, compensate as methods_compensate

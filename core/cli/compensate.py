@@ -36,7 +36,8 @@ held-out last ``--held-out`` (30 %) of the record, what the method fits fitted o
 it (gatetherm.studies.control.benefit). A correction that would leave δ there worse than no
 compensation is refused in one line naming the figures and a better choice (exit 2), unless
 ``--force``: then it is written with a warning, printed and in summary.json (``benefit``,
-``warning``). Every summary.json has ``benefit``.
+``warning``); so is one within the 0.1-um resolution of no compensation (``no-gain``) or one that
+cannot be checked. Every summary.json has ``benefit``.
 """
 from __future__ import annotations
 

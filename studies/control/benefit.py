@@ -10,9 +10,11 @@ its causal Kalman filter, an error model fitted on another record) is checked as
 model fitted on this same record up to inside the span is not checked (``unchecked``): its
 held-out benefit cannot be known from this record.
 
-Verdict: ``worse`` when ``held_out_um > uncompensated_um``, else ``better``. A worse correction is
-refused (:func:`guard`, one line naming the figures and a better choice) unless forced; forced, it
-runs with a warning in the log and in the summary.
+Verdict, with the displacement sensor's resolution r (:data:`RESOLUTION_UM`, 0.1 um): ``worse`` when
+``held_out_um > uncompensated_um + r``, ``no-gain`` within r of it (a difference no sensor can see),
+else ``better``. A worse correction is refused (:func:`guard`, one line naming the figures and a
+better choice) unless forced; forced, it runs with a warning in the log and in the summary. A
+correction of no measurable gain, or one that could not be checked, runs with a warning.
 """
 from __future__ import annotations
 
@@ -29,7 +31,10 @@ log = logging.getLogger(__name__)
 
 HELD_OUT = 0.3
 """Default held-out fraction: the last 30 % of the record."""
-VERDICTS = ("better", "worse", "unchecked")
+VERDICTS = ("better", "no-gain", "worse", "unchecked")
+RESOLUTION_UM = 0.1
+"""Resolution of a displacement reading, um (the paper's differential transformer): smaller
+differences between the compensated and uncompensated δ are no gain and no loss."""
 
 
 @dataclass(frozen=True)
@@ -60,7 +65,7 @@ class Benefit:
         last = f"the held-out last {self.fraction * 100:.0f} %"
         if self.held_out_um is None:
             return f"{method}: benefit unchecked on {last} ({self.basis})"
-        rel = ">" if self.verdict == "worse" else "<="
+        rel = {"worse": ">", "no-gain": "≈"}.get(self.verdict, "<")
         return (f"{method} would leave δ {self.held_out_um:.2f} um {rel} {self.uncompensated_um:.2f} um "
                 f"uncompensated on {last}")
 
@@ -88,7 +93,8 @@ def benefit(loop, fraction: float, basis: str) -> Benefit:
     if late.sum() < 2 or not np.isfinite(comp).all():
         return Benefit(None, unc, fraction, start, "unchecked", f"{basis}; too few held-out samples")
     held = float(np.max(comp))
-    return Benefit(held, unc, fraction, start, "worse" if held > unc else "better", basis)
+    verdict = "worse" if held > unc + RESOLUTION_UM else "no-gain" if held >= unc - RESOLUTION_UM else "better"
+    return Benefit(held, unc, fraction, start, verdict, basis)
 
 
 def unchecked(loop, fraction: float, why: str) -> Benefit:
@@ -100,9 +106,10 @@ def unchecked(loop, fraction: float, why: str) -> Benefit:
 def guard(b: Benefit, method: str, force: bool, better: str) -> tuple[Benefit, str | None]:
     """Refuse a worse correction (InputError, one line: the figures, ``better`` (the better choice)
     and ``--force``), or, with ``force``, pass it marked forced with a warning sentence; an unchecked
-    one passes with a warning. Returns the benefit and the warning (None if none)."""
-    if b.verdict == "unchecked":
-        warning = f"{b.sentence(method)}: its correction may make δ worse"
+    one and one of no measurable gain pass with a warning. Returns the benefit and the warning (None if none)."""
+    if b.verdict in ("unchecked", "no-gain"):
+        warning = f"{b.sentence(method)}: " + ("its correction may make δ worse" if b.verdict == "unchecked" else
+                                               f"no gain beyond the {RESOLUTION_UM:g} um resolution")
         log.warning("%s", warning)
         return b, warning
     if b.verdict != "worse":
