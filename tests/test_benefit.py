@@ -167,3 +167,23 @@ def test_mlr_fitted_on_the_model_is_refused_where_the_machine_differs(machine):
     assert forced["benefit"]["verdict"] == "worse" and "applied because forced" in forced["warning"]
     paper = compensate(data, case, Settings("paper")).summary["benefit"]
     assert paper["held_out_um"] == pytest.approx(better, abs=0.01) and paper["verdict"] == "better"
+
+
+@pytest.mark.parametrize("left_um, verdict", [(2.0, "better"), (9.95, "no-gain"), (10.05, "no-gain"),
+                                               (10.2, "worse")])
+def test_the_verdict_counts_the_displacement_resolution(left_um, verdict):
+    """δ ramps to 10 µm; the compensation leaves ``left_um`` at the end: within 0.1 µm of 10 µm is no gain."""
+    from types import SimpleNamespace
+
+    from gatetherm.studies.control.benefit import benefit, guard
+
+    t = np.linspace(0.0, 10.0, 11)
+    loop = SimpleNamespace(t_s=t, delta_um=t.copy(), delta_comp_um=t * left_um / 10.0)
+    b = benefit(loop, 0.3, "as applied")
+    assert (b.held_out_um, b.uncompensated_um, b.start_s, b.verdict) == (pytest.approx(left_um), 10.0, 7.0, verdict)
+    if verdict == "worse":
+        with pytest.raises(InputError, match=r"^--method m: m would leave δ 10.20 um > 10.00 um uncompensated .*; "
+                                             r"leave the axis uncompensated, or --force"):
+            guard(b, "m", False, "leave the axis uncompensated")
+    b, warning = guard(b, "m", True, "")
+    assert (warning is None) == (verdict == "better") and b.forced == (verdict == "worse")
