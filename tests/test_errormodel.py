@@ -78,7 +78,7 @@ def test_fit_recovers_sensors_coefficients_and_time_constant():
 def test_static_fit_is_exact_without_noise():
     ts = synthetic(noise_um=0.0)
     d = 0.3 + 1.25 * (ts["s2_degC"] - ts["s2_degC"][0]) - 0.5 * (ts["s5_degC"] - ts["s5_degC"][0])
-    model = fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS, params=FitParams(form="static"))
+    model = fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS, params=FitParams(form="static", resolution_K=0.0))  # exact readings
     m = model.target("d_um")
     assert dict(zip(m.sensors, m.coefficients)) == pytest.approx({"s2_degC": 1.25, "s5_degC": -0.5}, abs=1e-9)
     assert m.residual["max_abs_um"] < 1e-9
@@ -90,7 +90,7 @@ def test_paper_form_finds_its_three_sensors():
     ts = synthetic(noise_um=0.0)
     th = {s: ts[s] - ts[s][0] for s in SENSORS}
     d = 2.0 * (th["s4_degC"] - th["s2_degC"]) - 0.7 * th["s6_degC"]
-    m = fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS, params=FitParams(form="paper")).target("d_um")
+    m = fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS, params=FitParams(form="paper", resolution_K=0.0)).target("d_um")
     diff, third = m.terms
     assert (diff.column, diff.other, third.column) == ("s4_degC", "s2_degC", "s6_degC")
     assert m.coefficients == pytest.approx((2.0, -0.7), abs=1e-9)
@@ -101,7 +101,7 @@ def test_a_difference_is_one_term_for_two_sensors():
     ts = synthetic(noise_um=0.0)
     d = 2.0 * ((ts["s4_degC"] - ts["s4_degC"][0]) - (ts["s2_degC"] - ts["s2_degC"][0]))
     m = fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS,
-                        params=FitParams(form="static", differences=True)).target("d_um")
+                        params=FitParams(form="static", differences=True, resolution_K=0.0)).target("d_um")
     (term,) = m.terms
     assert (term.kind, {term.column, term.other}) == ("difference", {"s2_degC", "s4_degC"})
     assert abs(m.coefficients[0]) == pytest.approx(2.0, abs=1e-9) and m.sensors == (term.column, term.other)
@@ -178,7 +178,7 @@ def test_replay_with_the_papers_correction():
     ts = synthetic(noise_um=0.0)
     th = {s: ts[s] - ts[s][0] for s in SENSORS}
     ts = ts.with_columns(d_um=2.0 * (th["s4_degC"] - th["s2_degC"]) - 0.7 * th["s6_degC"])
-    model = fit_error_model(ts, ["d_um"], SENSORS, params=FitParams(form="paper"))
+    model = fit_error_model(ts, ["d_um"], SENSORS, params=FitParams(form="paper", resolution_K=0.0))  # exact
     with_r = replay(model, ts, "d_um", CompensatorParams(), correction=True)
     plain = replay(model, ts, "d_um", CompensatorParams())
     late = with_r.t_s > 600
@@ -252,3 +252,18 @@ def test_cli_predict_refuses_a_file_without_a_model_column(tmp_path, capsys):
     assert cli("errormodel", "predict", tmp_path / "model.json", "--data", data, "--out", tmp_path / "p") == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"column {used}: missing; the model reads it" in err, err
+
+
+def test_cli_resolution_sets_the_noise_rule(tmp_path, capsys):
+    """--resolution-K: the sensors' noise the coefficients are fitted for, printed as the noise it adds."""
+    data = _write(tmp_path, synthetic(n=400))
+    args = ("errormodel", "fit", "--data", data, "--targets", "d_um", "--form", "static", "--out", tmp_path / "f")
+    assert cli(*args, "--resolution-K", "-1") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "resolution_K: -1.0 is not >= 0" in err, err
+    assert cli(*args, "--resolution-K", "0") == 0
+    assert "sensor noise 0 um" in capsys.readouterr().out
+    assert cli(*args) == 0  # 0.05 K: the noise is 0.05 K x sqrt(K_1^2 + K_3^2)
+    m = load_model(tmp_path / "f" / "model.json").target("d_um")
+    assert m.noise_um == pytest.approx(0.05 * np.hypot(*m.coefficients[:2]), rel=1e-9) and len(m.terms) == 2
+    assert m.noise_um == pytest.approx(0.096, abs=0.005)  # achieved 0.0960

@@ -89,13 +89,13 @@ def compare(ts, rom, mlr, K, params: CompensatorParams = CompensatorParams(),
     residual bands, updates, threshold, rom forecast error."""
     from gatetherm.studies.control.methods import Settings, compensate as method
 
-    paper = method(ts, None, Settings("paper", params, *K), actuator).summary
+    paper = method(ts, None, Settings("paper", params, *K, force=True), actuator).summary  # compared, never refused
     out = {"swing_um": paper["swing_um"], "paper_um": paper["residual_band_um"],
            "mlr_um": band(close_loop(ts, external_prediction(ts, regression_forecast(mlr, ts), params), params,
                                      actuator), params)["residual_band_um"]}
     for mode in ("fixed", "event"):
         s = method(ts, None, Settings("rom", params, control=PredictiveParams(mode=mode, max_updates=BUDGET),
-                                      sensors=THETAS), actuator, rom=rom).summary
+                                      sensors=THETAS, force=True), actuator, rom=rom).summary
         out["rom_5min_um" if mode == "fixed" else "rom_event_um"] = s["residual_band_um"]
         if mode == "event":
             out.update(rom_updates=s["updates"], threshold_um=s["threshold_um"],

@@ -30,6 +30,14 @@ DIR/rom.key records).
 The actuator is the case's ``[actuator]`` (the frame's: the paper's piezo), ideal without one or
 with ``--no-actuator``. The mlr regression is fitted on the model's own schedule (the frame's:
 condition 1).
+
+Never silently worse: before anything is written, the correction's benefit is measured on the
+held-out last ``--held-out`` (30 %) of the record, what the method fits fitted on the part before
+it (gatetherm.studies.control.benefit). A correction that would leave δ there worse than no
+compensation is refused in one line naming the figures and a better choice (exit 2), unless
+``--force``: then it is written with a warning, printed and in summary.json (``benefit``,
+``warning``); so is one within the 0.1-um resolution of no compensation (``no-gain``) or one that
+cannot be checked. Every summary.json has ``benefit``.
 """
 from __future__ import annotations
 
@@ -96,6 +104,11 @@ def register(subparsers) -> None:
                    "--method (the --data file needs only time_s, the model's columns and --target)")
     p.add_argument("--target", metavar="COL", help="--model: the compensated channel (default: the model's only one)")
     p.add_argument("--correction", action="store_true", help="--model of the paper's form: on-line R_i, R_C (eqs 30-38)")
+    p.add_argument("--held-out", type=float, default=0.3, metavar="FRACTION",
+                   help="the last part of the record on which the correction's benefit is checked, what the method "
+                   "fits fitted before it (default 0.3)")
+    p.add_argument("--force", action="store_true", help="apply a correction that would leave delta worse than no "
+                   "compensation on the held-out span (default: refuse it), with a warning in summary.json")
     p.set_defaults(func=run)
 
 
@@ -116,8 +129,11 @@ def _settings(args):
 
         model = load_model(args.model)
         loop_target(model, args.target)
+    if not (math.isfinite(args.held_out) and 0 < args.held_out < 1):
+        raise InputError("--held-out", f"{args.held_out:g} is not a fraction in (0, 1)", "e.g. --held-out 0.3")
     return Settings("errormodel" if model else args.method, params, args.Ki, args.Kc, args.k_source, args.states,
-                    control, sensors=sensors, model=model, target=args.target, correction=args.correction)
+                    control, sensors=sensors, model=model, target=args.target, correction=args.correction,
+                    force=args.force, held_out=args.held_out)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -200,4 +216,9 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
           f"prediction error band {_um(summary['prediction_error_band_um'])}, "
           f"residual band {_um(summary['residual_band_um'])} "
           f"({_um(summary['residual_at_updates_um'])} at the update instants), {summary['updates']} updates")
+    b = summary["benefit"]
+    print(f"held-out last {b['fraction'] * 100:.0f} %: {_um(b['held_out_um'])} compensated, "
+          f"{_um(b['uncompensated_um'])} uncompensated ({b['verdict']}; {b['basis']})")
+    if "warning" in summary:
+        print(f"warning: {summary['warning']}")
     return 0

@@ -60,6 +60,10 @@ def register(subparsers) -> None:
     f.add_argument("--differences", action="store_true", help="also offer sensor differences theta_a - theta_b")
     f.add_argument("--fit-span", default="0:1", metavar="START:END",
                    help="fitting span as fractions of the run's duration (default 0:1, all)")
+    f.add_argument("--resolution-K", type=float, default=FitParams.resolution_K, metavar="K",
+                   help="the temperature sensors' resolution, also their noise's standard deviation (default 0.05 K, "
+                   "a thermocouple): a term spanning less than 10 of these gets no weight, and the coefficients are "
+                   "fitted for readings with this noise (docs/errormodel.md)")
     f.set_defaults(func=run_fit)
     q = sub.add_parser("predict", help="apply DIR/model.json to a data file")
     q.add_argument("model", metavar="MODEL.json", help="from 'gatetherm errormodel fit'")
@@ -77,7 +81,7 @@ def run_fit(args) -> int:
     inputs = _names(args.inputs, "--inputs", "spindle_rpm") or ()
     ts = read_timeseries(args.data, required=("time_s", *targets, *(candidates or ()), *inputs))
     params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
-                       differences=args.differences)
+                       differences=args.differences, resolution_K=args.resolution_K)
     span = fraction_span(ts.time_s, *_span(args.fit_span))
     with output_dir(args.out, FIT_OUTPUTS, keep=(args.data,)) as out:
         model = fit_error_model(ts, targets, candidates, inputs, params, span, source=str(args.data))
@@ -86,7 +90,8 @@ def run_fit(args) -> int:
     for m in model.targets:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
         print(f"{m.target}: {m.form}; sensors {', '.join(m.sensors)}; time constants {taus}; "
-              f"held-out MAE {m.held_out_mae_um:.3g} um, fit RMS {m.residual['rms_um']:.3g} um")
+              f"held-out MAE {m.held_out_mae_um:.3g} um, fit RMS {m.residual['rms_um']:.3g} um, "
+              f"sensor noise {m.noise_um:.2g} um")
         if m.form == "paper":
             best = "; ".join(f"{' and '.join(s['terms'])}: {s['cv_mae_um']:.3g} um" for s in m.selection[:3])
             print(f"  best triples, held-out MAE: {best}")

@@ -11,6 +11,10 @@
 
 The actuator is the case's (``[actuator]``; the paper frame's piezo), or ideal (None): the
 correction sent to the machine's control as an offset.
+
+Before a correction is returned, its benefit on the record's held-out last 30 % is measured
+(:mod:`.benefit`): one that would leave δ worse than no compensation is refused with one line
+naming a better choice, or, with ``force``, applied with a warning in the summary.
 """
 from __future__ import annotations
 
@@ -20,8 +24,11 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from gatetherm import InputError
 from gatetherm.solvers.expr import Value
+from gatetherm.studies.control import benefit as held
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import (NEEDED, ClosedLoop, CompensatorParams, close_loop, compensate as
                                                    paper_loop, external_prediction, summarize)
@@ -62,6 +69,10 @@ class Settings:
     """errormodel: the compensated channel (default: the model's only one)."""
     correction: bool = False
     """errormodel of the paper's form: the on-line R_i, R_C of eqs 30–38."""
+    force: bool = False
+    """Apply a correction that would leave δ worse on the held-out span (with a warning) instead of refusing it."""
+    held_out: float = held.HELD_OUT
+    """Fraction of the record, at its end, on which the benefit is checked, dimensionless."""
 
 
 @dataclass(frozen=True)
@@ -132,7 +143,9 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
     s, params = settings, settings.params
     if s.method not in METHODS:
         raise InputError("--method", f"unknown method {s.method!r}", f"choose from {', '.join(METHODS)}")
+    held.span_start(ts.time_s, s.held_out)  # a bad fraction fails before any work
     every = f"update every {params.update_interval_s / 60:g} min"
+    checked = None  # the loop of the benefit check where it differs from the applied one, and its basis
     if s.method == "errormodel":
         from gatetherm.studies.errormodel.replay import loop_target, replay
 
@@ -143,13 +156,18 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         extra = {"target": target, "correction": s.correction}
         label = head = f"error model, {target} ({s.model.target(target).form} form" \
             f"{', on-line R' if s.correction else ''}), {every}"
-        return Compensation(loop, {**summarize(loop, params.settle_s), "method": s.method, **extra,
-                                   "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
-                                   "actuator": dataclasses.asdict(actuator) if actuator else None}, label, head, extra)
+        checked = _model_check(s.model, loop, s.held_out, source)
+        return _checked(ts, loop, checked, s, actuator, extra, label, head)
     validate_complete(ts, NEEDED)
     if s.method == "paper":
         ki, kc, source = coefficients(case, ts, s, cache)
         loop = paper_loop(ts, ki, kc, params, actuator)
+        if source == "fit":
+            checked = _refitted(lambda: paper_loop(ts, *fit_coefficients(held.before(ts, s.held_out)), params,
+                                                   actuator), f"K_i, K_C fitted on the first "
+                                f"{100 * (1 - s.held_out):.0f} % of the record")
+        else:
+            checked = loop, f"as applied (K_i, K_C from {source}, nothing fitted on the record)"
         extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source}
         label = f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source}), {every}"
         head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source})"
@@ -159,6 +177,9 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         train = run_scenario(case, cache=cache).series({})
         mlr = fit_regression(train, THETAS)
         loop = close_loop(ts, external_prediction(ts, regression_forecast(mlr, ts), params), params, actuator)
+        checked = _refitted(lambda: close_loop(ts, external_prediction(ts, regression_forecast(
+            fit_regression(held.before(train, s.held_out), THETAS), ts), params), params, actuator),
+            f"regression fitted on the first {100 * (1 - s.held_out):.0f} % of the model's run")
         extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))}}
         label = f"regression on theta_A, theta_B, theta_C ({case.schedule.label} of the model), 1-sample forecast, " \
             + every
@@ -166,10 +187,64 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
     else:
         loop, extra, label = _rom_loop(ts, case, s, actuator, rom, rom_dir, cache, source, rom_source)
         head = f"rom ({label})"
-    summary = {**summarize(loop, params.settle_s), "method": s.method, **extra,
-               "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(params),
-               "actuator": dataclasses.asdict(actuator) if actuator else None}
+        checked = loop, "as applied (the reduced model and its causal Kalman filter fit nothing on the record)"
+    check_loop, basis = checked
+    b = held.unchecked(loop, s.held_out, basis) if check_loop is None else held.benefit(check_loop, s.held_out, basis)
+    return _checked(ts, loop, b, s, actuator, extra, label, head)
+
+
+def _refitted(make, basis: str):
+    """(the loop of the benefit check, its basis), or (None, why) where the refit on the shorter record fails."""
+    try:
+        return make(), basis
+    except InputError as err:
+        return None, f"{basis} failed: {err}"
+
+
+def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head) -> Compensation:
+    """The compensation with its held-out benefit, refused (InputError) where it would make δ worse
+    unless forced (:func:`.benefit.guard`)."""
+    name = "error model" if s.method == "errormodel" else s.method
+    better = _better(ts, s, actuator) if b.verdict == "worse" and not s.force else ""
+    b, warning = held.guard(b, name, s.force, better)
+    summary = {**summarize(loop, s.params.settle_s), "method": s.method, **extra,
+               "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(s.params),
+               "actuator": dataclasses.asdict(actuator) if actuator else None, "benefit": b.as_dict(),
+               **({"warning": warning} if warning else {})}
     return Compensation(loop, summary, label, head, extra)
+
+
+def _better(ts, s: Settings, actuator) -> str:
+    """The better choice named by a refusal: the paper method with K fitted on the record before the
+    held-out span where that beats no compensation there, else no compensation."""
+    if s.method != "paper" and all(n in ts for n in NEEDED):
+        try:
+            loop = paper_loop(ts, *fit_coefficients(held.before(ts, s.held_out)), s.params, actuator)
+        except InputError:
+            loop = None
+        if loop is not None:
+            b = held.benefit(loop, s.held_out, "")
+            if b.verdict == "better":
+                return f"use --method paper --k-source fit (δ {b.held_out_um:.2f} um there)"
+    return "leave the axis uncompensated"
+
+
+def _model_check(model, loop, fraction: float, source: str) -> held.Benefit:
+    """An error model's benefit: as applied, unless it was fitted on this record into the held-out span."""
+    fitted_on = str(model.fit_span.get("source", ""))
+    start = held.span_start(loop.t_s, fraction)
+    same = bool(fitted_on) and _same_file(fitted_on, source)
+    if same and float(model.fit_span.get("end_s", -np.inf)) >= start:
+        return held.unchecked(loop, fraction, f"the error model was fitted on this record ({fitted_on}) into its "
+                              f"last {fraction * 100:.0f} %; refit it with --fit-span 0:{1 - fraction:g}")
+    return held.benefit(loop, fraction, f"as applied (the error model was fitted on {fitted_on or 'other data'})")
+
+
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return Path(a).resolve() == Path(b).resolve()
+    except (OSError, ValueError):
+        return a == b
 
 
 def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache, source: str, where: str | None):

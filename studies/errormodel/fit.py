@@ -17,6 +17,17 @@ to the budget, then the smallest model on the path within ``min_gain`` of the be
 ``form="auto"`` fits ``static`` and ``dynamic`` and keeps ``dynamic`` only if its held-out error is
 lower by at least ``min_gain``. The fit is deterministic: no random numbers; ties go to the
 candidate listed first. The coefficients come from least squares on all valid rows of the span.
+
+What the sensors' noise allows (docs/errormodel.md, "Sensor noise"), with ``resolution_K`` the
+thermocouples' resolution, taken as the standard deviation of their noise:
+
+* a temperature term (rise, difference, lagged rise) whose values span less than
+  :data:`SPAN_RESOLUTIONS` resolutions in the fitting span is not offered: it gets no weight;
+* every least squares, in the held-out folds and the final fit, minimises the expected squared
+  error on readings with that noise, ``|y - X c|^2 + n sum_k sigma_k^2 c_k^2`` (sigma_k the noise
+  of term k: :func:`~gatetherm.studies.errormodel.terms.noise_sd`), so that each coefficient is
+  bounded by what the noise makes identifiable; ``noise_um``, the noise the sensors then add to
+  the prediction (``sqrt(sum sigma_k^2 c_k^2)``), is recorded per target.
 """
 from __future__ import annotations
 
@@ -31,12 +42,14 @@ from gatetherm import InputError
 from gatetherm.studies.errormodel import select
 from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, residual_stats
 from gatetherm.studies.errormodel.paper import fit_paper_form
-from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps
+from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps, noise_sd
 
 log = logging.getLogger(__name__)
 
 FIT_FORMS = ("auto", "static", "dynamic", "paper")
 SQRT2 = float(np.sqrt(2.0))
+#: A temperature term spanning fewer resolutions than this in the fitting span is not offered.
+SPAN_RESOLUTIONS = 10
 
 
 @dataclass(frozen=True)
@@ -63,9 +76,11 @@ class FitParams:
     """``auto``, ``static``, ``dynamic`` or ``paper`` (module docstring)."""
     refine: bool = True
     """Refine the selected time constants continuously and drop terms that do not earn ``min_gain``."""
-    resolution_K: float = 0.01
-    """Temperature resolution, K: a rise or difference that spans less than 10 x this in the fitting
-    span is not offered (it carries no information, and its coefficient would amplify noise)."""
+    resolution_K: float = 0.05
+    """Resolution of the temperature sensors, K, also taken as the standard deviation of their noise
+    (a thermocouple's 0.05 K): a term spanning less than :data:`SPAN_RESOLUTIONS` times this in the
+    fitting span is not offered, and the coefficients are fitted for readings with this noise
+    (module docstring); 0 = exact, noise-free readings."""
     max_gap_s: float = 300.0
     """Longest gap in a used column that is bridged by linear interpolation, s; rows in longer gaps
     are left out of the fit and not predicted."""
@@ -81,6 +96,8 @@ class FitParams:
                if not (np.isfinite(v) and v > 0)]
         if bad:
             raise InputError("exponents, time constants, max_gap_s", f"{bad[0]} is not > 0", "use positive values")
+        if not (np.isfinite(self.resolution_K) and self.resolution_K >= 0):
+            raise InputError("resolution_K", f"{self.resolution_K} is not >= 0", "e.g. 0.05 (K, a thermocouple)")
         if not 0 <= self.min_gain < 1:
             raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
 
@@ -175,12 +192,19 @@ def _base_terms(candidates, inputs, cols, in_span, params: FitParams) -> list[Te
     return base
 
 
+def _variances(terms, t: np.ndarray, params: FitParams) -> np.ndarray:
+    """Noise variance of the intercept (0) and of each term's values (K^2; 0 for inputs)."""
+    step = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    return np.array([0.0] + [noise_sd(term, params.resolution_K, step) ** 2 for term in terms])
+
+
 def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:
     """Terms offered to the forward selection and their combination vectors (column 0 = ones);
     ``B`` are the base columns on the fitting rows."""
     terms, cands, p = [], [], len(base) + 1
+    min_span = SPAN_RESOLUTIONS * params.resolution_K
     for j, b in enumerate(base):
-        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B[:, j + 1], params.resolution_K)):
+        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B[:, j + 1], min_span)):
             w = np.zeros(p)
             w[j + 1] = 1.0
             terms.append(b)
@@ -191,7 +215,7 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
         for i, k in [(i, k) for n, i in enumerate(plain) for k in plain[n + 1:]]:
             w = np.zeros(p)
             w[i + 1], w[k + 1] = 1.0, -1.0
-            if not select.informative(B @ w, params.resolution_K):
+            if not select.informative(B @ w, min_span):
                 continue
             terms.append(Term("difference", base[i].column, other=base[k].column))
             cands.append(select.Candidate(len(cands), w, frozenset((base[i].column, base[k].column)), False))
@@ -204,9 +228,9 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams)
     if rows.sum() < 4 * max(params.folds):
         raise InputError(f"target {name}", f"only {rows.sum()} valid samples in the fitting span",
                          f"give at least {4 * max(params.folds)}")
-    cv = select.CrossValidation(B[rows], y_all[rows], params.folds)
+    cv = select.CrossValidation(B[rows], y_all[rows], params.folds, penalty=_variances(base, t, params))
     if params.form == "paper":
-        return fit_paper_form(cv, name, base, B, y_all, rows, params.resolution_K)
+        return fit_paper_form(cv, name, base, B, y_all, rows, SPAN_RESOLUTIONS * params.resolution_K)
     forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
     has_dynamic = any(b.tau_s is not None for b in base)
     fits, selection = {}, []
@@ -226,9 +250,11 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams)
         else "static"
     terms, cv_mae = fits[form]
     X = np.column_stack([np.ones(t.size)] + [evaluate(term, t, cols, reference) for term in terms])
-    c = np.linalg.lstsq(X[rows], y_all[rows], rcond=None)[0]
+    var = _variances(terms, t, params)
+    c = select.noisy_least_squares(X[rows], y_all[rows], var)
     return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
-                       residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection))
+                       residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection),
+                       float(np.sqrt(var @ c**2)))
 
 
 def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
@@ -247,8 +273,13 @@ def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
 
     def sse(log_tau):
         X = design(log_tau)
-        r = X @ np.linalg.lstsq(X, y, rcond=None)[0] - y
-        return float(r @ r)
+        now = list(terms)
+        for j, lt in zip(lagged, log_tau):
+            now[j] = dataclasses.replace(terms[j], tau_s=float(np.exp(lt)))
+        v = _variances(now, t, params)
+        c = select.noisy_least_squares(X, y, v)
+        r = X @ c - y
+        return float(r @ r + y.size * (v @ c**2))
 
     out = list(terms)
     if lagged:
@@ -262,7 +293,8 @@ def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
                for i, a in enumerate(out) for b in out[i + 1:] if a.tau_s and b.tau_s):
             return out, np.inf
     X = np.column_stack([np.ones(y.size)] + [evaluate(term, t, cols, reference)[rows] for term in out])
-    return out, select.CrossValidation(X, y, params.folds).error(np.eye(X.shape[1]))
+    cv = select.CrossValidation(X, y, params.folds, penalty=_variances(out, t, params))
+    return out, cv.error(np.eye(X.shape[1]))
 
 
 def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):

@@ -53,6 +53,9 @@ class TargetModel:
     """Mean absolute error of the blocked cross-validation inside the fitting span, um."""
     selection: tuple[dict, ...] = ()
     """The forward-selection path: per step ``terms`` (labels), ``sensors`` (count), ``cv_mae_um``."""
+    noise_um: float | None = None
+    """Standard deviation the temperature sensors' noise adds to the prediction, um:
+    ``sqrt(sum_k (c_k sigma_k)^2)`` at the fit's sensor resolution (None: not recorded)."""
 
     @property
     def sensors(self) -> tuple[str, ...]:
@@ -186,7 +189,7 @@ def to_dict(model: ErrorModel) -> dict:
     targets = {m.target: {"form": m.form, "sensors": list(m.sensors), "intercept_um": m.intercept_um,
                           "terms": [term(t, b) for t, b in zip(m.terms, m.coefficients)],
                           "residual": m.residual, "held_out_mae_um": m.held_out_mae_um,
-                          "selection": list(m.selection)} for m in model.targets}
+                          "selection": list(m.selection), "noise_um": m.noise_um} for m in model.targets}
     return {"format": FORMAT, "fit_span": model.fit_span, "reference_degC": model.reference_degC,
             "max_gap_s": model.max_gap_s, "settings": model.settings, "targets": targets}
 
@@ -205,7 +208,8 @@ def from_dict(data: dict, where: str = "model") -> ErrorModel:
                 raise InputError(f"{where}: targets.{name}.form", f"unknown {d['form']!r}", f"use {', '.join(FORMS)}")
             targets.append(TargetModel(name, d["form"], terms, tuple(float(t["coefficient"]) for t in d["terms"]),
                                        float(d.get("intercept_um", 0.0)), d.get("residual", {}),
-                                       d.get("held_out_mae_um"), tuple(d.get("selection", ()))))
+                                       d.get("held_out_mae_um"), tuple(d.get("selection", ())),
+                                       d.get("noise_um")))
         ref = {str(k): float(v) for k, v in data["reference_degC"].items()}
         model = ErrorModel(tuple(targets), ref, dict(data.get("fit_span", {})), float(data.get("max_gap_s", 300.0)),
                            dict(data.get("settings", {})))

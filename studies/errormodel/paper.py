@@ -11,9 +11,9 @@ from gatetherm.studies.errormodel.terms import Term
 
 
 def fit_paper_form(cv: select.CrossValidation, name: str, base: list[Term], B: np.ndarray, y_all: np.ndarray,
-                   rows: np.ndarray, resolution_K: float) -> TargetModel:
+                   rows: np.ndarray, min_span_K: float) -> TargetModel:
     """The paper's form for target ``name``: every triple of the plain sensors among the ``base``
-    terms (a < b, c neither; a difference spanning less than 10 ``resolution_K`` left out) scored
+    terms (a < b, c neither; a difference or third sensor spanning less than ``min_span_K`` left out) scored
     by ``cv``; the best, fitted on ``rows`` (``B``: the base columns after a column of ones), with
     the ten best triples as its selection."""
     plain = [j for j, b in enumerate(base) if b.kind == "sensor" and b.tau_s is None]
@@ -25,15 +25,17 @@ def fit_paper_form(cv: select.CrossValidation, name: str, base: list[Term], B: n
         return w
 
     pairs = [(a, b) for n, a in enumerate(plain) for b in plain[n + 1:]
-             if select.informative(B[rows] @ W(a, b, a)[:, 0], resolution_K)]
-    triples = [(a, b, c) for a, b in pairs for c in plain if c not in (a, b)]
+             if select.informative(B[rows] @ W(a, b, a)[:, 0], min_span_K)]
+    triples = [(a, b, c) for a, b in pairs for c in plain
+               if c not in (a, b) and select.informative(B[rows, c + 1], min_span_K)]
     if not triples:
         raise InputError("candidates", "the paper's form needs at least 3 temperature columns", "name 3 or more")
     ranked = select.exhaustive(cv, ((abc, W(*abc)) for abc in triples))
     cv_mae, (a, b, c) = ranked[0]
     X = B[:, [a + 1, b + 1, c + 1]]
     X = np.column_stack([X[:, 0] - X[:, 1], X[:, 2]])
-    k = np.linalg.lstsq(X[rows], y_all[rows], rcond=None)[0]
+    var = np.array([cv.D[a + 1] + cv.D[b + 1], cv.D[c + 1]])  # the noise of theta_a - theta_b and theta_c
+    k = select.noisy_least_squares(X[rows], y_all[rows], var)
     if k[0] < 0:  # orient the difference so that K_i > 0
         a, b, k[0] = b, a, -k[0]
         X[:, 0] *= -1
@@ -41,4 +43,5 @@ def fit_paper_form(cv: select.CrossValidation, name: str, base: list[Term], B: n
     selection = tuple({"form": "paper", "terms": [f"{base[i].column}-{base[j].column}", base[m].column],
                        "sensors": 3, "cv_mae_um": e} for e, (i, j, m) in ranked[:10])
     return TargetModel(name, "paper", terms, (float(k[0]), float(k[1])), 0.0,
-                       residual_stats(X[rows] @ k - y_all[rows]), float(cv_mae), selection)
+                       residual_stats(X[rows] @ k - y_all[rows]), float(cv_mae), selection,
+                       float(np.sqrt(var @ k**2)))

@@ -19,6 +19,12 @@ formed once; any model's are ``W^T G W``, so a cross-validated error costs a few
   parameters unless more predict measurably better.
 * :func:`exhaustive`: every model of a fixed shape (the paper's ``K_i (theta_a - theta_b) -
   K_C theta_c``: all pairs a, b and third sensors c).
+
+Sensor noise (``penalty``): each base column ``j`` may carry independent noise of variance
+``d_j`` (a thermocouple's: its resolution squared). The coefficients then minimise the expected
+squared error on noisy readings, ``|y - Z W c|^2 + n c^T W^T diag(d) W c`` (:func:`noisy_least_squares`,
+ridge regression scaled by the noise variance, the intercept unpenalised), in every fold as in the
+final fit: a coefficient is only as large as the noise lets it be identified.
 """
 from __future__ import annotations
 
@@ -31,10 +37,12 @@ import numpy as np
 class CrossValidation:
     """Blocked cross-validation of least squares on combinations of the base columns ``Z`` (n x p)."""
 
-    def __init__(self, Z: np.ndarray, y: np.ndarray, folds=(4, 5, 6, 7, 8), blocks=None):
+    def __init__(self, Z: np.ndarray, y: np.ndarray, folds=(4, 5, 6, 7, 8), blocks=None, penalty=None):
         """``blocks``: explicit ``(start, stop)`` row ranges that partition the rows once (e.g. one
-        per separate run, leave-one-run-out) instead of the equal blocks of ``folds``."""
+        per separate run, leave-one-run-out) instead of the equal blocks of ``folds``. ``penalty``:
+        the noise variance of each base column (module docstring); None = noise-free."""
         self.Z, self.y, n = Z, y, len(y)
+        self.D = np.zeros(Z.shape[1]) if penalty is None else np.asarray(penalty, float)
         if blocks is not None:
             self.blocks, self.partitions = [(int(lo), int(hi)) for lo, hi in blocks], 1
             if sorted(self.blocks)[0][0] != 0 or sum(hi - lo for lo, hi in self.blocks) != n or len(self.blocks) < 2:
@@ -50,17 +58,18 @@ class CrossValidation:
         self.Gb = np.array([Z[lo:hi].T @ Z[lo:hi] for lo, hi in self.blocks])
         self.rb = np.array([Z[lo:hi].T @ y[lo:hi] for lo, hi in self.blocks])
         self._Zf = np.asfortranarray(Z)  # columns gathered fast by error_of
+        self.n_fit = np.array([n - (hi - lo) for lo, hi in self.blocks], float)  # rows each fold fits on
 
     def error(self, W: np.ndarray) -> float:
         """Held-out mean absolute error (unit of y) of the model with regressors ``Z @ W``; inf if singular."""
         W = np.asarray(W)
         if W.ndim == 2 and W.size and np.all((W == 0) | (W == 1)) and np.all(W.sum(axis=0) == 1):
             return self.error_of(np.argmax(W, axis=0))  # the columns are base columns
-        A, b = W.T @ self.G @ W, W.T @ self.r
+        A, b, P = W.T @ self.G @ W, W.T @ self.r, W.T @ (self.D[:, None] * W)
         total = 0.0
         try:
-            for (lo, hi), Gb, rb in zip(self.blocks, self.Gb, self.rb):
-                c = np.linalg.solve(A - W.T @ Gb @ W, b - W.T @ rb)
+            for (lo, hi), Gb, rb, m in zip(self.blocks, self.Gb, self.rb, self.n_fit):
+                c = np.linalg.solve(A - W.T @ Gb @ W + m * P, b - W.T @ rb)
                 total += np.abs(self.Z[lo:hi] @ (W @ c) - self.y[lo:hi]).sum()
         except np.linalg.LinAlgError:
             return np.inf
@@ -72,8 +81,10 @@ class CrossValidation:
         indexed out of the Gram matrices and solved at once."""
         cols = list(columns)
         A, b = self.G[np.ix_(cols, cols)], self.r[cols]
+        P = self.n_fit[:, None, None] * np.diag(self.D[cols])[None]
         try:
-            C = np.linalg.solve(A[None] - self.Gb[:, cols][:, :, cols], (b[None] - self.rb[:, cols])[..., None])[..., 0]
+            C = np.linalg.solve(A[None] - self.Gb[:, cols][:, :, cols] + P,
+                                (b[None] - self.rb[:, cols])[..., None])[..., 0]
         except np.linalg.LinAlgError:
             return np.inf
         Zs = self._Zf[:, cols]
@@ -137,6 +148,15 @@ def exhaustive(cv: CrossValidation, models) -> list[tuple[float, tuple]]:
     return sorted((cv.error(W), key) for key, W in models)
 
 
-def informative(values: np.ndarray, resolution: float) -> bool:
-    """True if ``values`` span at least 10 ``resolution`` (a signal below that carries no information)."""
-    return bool(np.ptp(values) >= 10 * resolution)
+def noisy_least_squares(X: np.ndarray, y: np.ndarray, variance=None) -> np.ndarray:
+    """Coefficients minimising ``|y - X c|^2 + n sum_j variance_j c_j^2`` (module docstring;
+    ``variance`` per column of ``X``, 0 for the intercept; None or all 0: plain least squares)."""
+    if variance is None or not np.any(variance):
+        return np.linalg.lstsq(X, y, rcond=None)[0]
+    rows = np.diag(np.sqrt(len(y) * np.asarray(variance, float)))
+    return np.linalg.lstsq(np.vstack([X, rows]), np.r_[y, np.zeros(X.shape[1])], rcond=None)[0]
+
+
+def informative(values: np.ndarray, min_span: float) -> bool:
+    """True if ``values`` span at least ``min_span`` (a signal below that carries no information)."""
+    return bool(np.ptp(values) >= min_span)

@@ -108,6 +108,20 @@ def evaluate(term: Term, t_s: np.ndarray, columns, reference_degC: dict[str, flo
     return s if term.tau_s is None else lag(t_s, s, term.tau_s)
 
 
+def noise_sd(term: Term, sensor_K: float, step_s: float) -> float:
+    """Standard deviation of the term's values when each temperature reading carries independent
+    white noise of ``sensor_K`` (K): ``sensor_K`` for a rise, sqrt(2) times that for a difference,
+    reduced by a lag of step ``step_s`` (s) to ``sqrt((1 - a) / (1 + a))`` of it, ``a = exp(-h / tau)``
+    (the stationary variance of a first-order lag of white noise); 0 for an input (a commanded value)."""
+    if term.kind == "input":
+        return 0.0
+    sd = sensor_K * (np.sqrt(2.0) if term.kind == "difference" else 1.0)
+    if term.tau_s is not None:
+        a = np.exp(-step_s / term.tau_s)
+        sd *= np.sqrt((1.0 - a) / (1.0 + a))
+    return float(sd)
+
+
 @dataclass(frozen=True)
 class GapReport:
     """What :func:`fill_gaps` did to one column."""
