@@ -1,0 +1,67 @@
+"""A machine other than the shipped two, as a new user writes it (tests/data/headstock_diag.*): a
+lathe headstock's 2-D section, a spindle in a front and a rear bearing in a housing on a bed
+(issue 51). The free-body check of its assembly: a contact that transmits force connects the
+parts at P1 and at P2; a part that nothing holds is still refused by name."""
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import gatetherm as gt
+from gatetherm.cli import main
+from gatetherm.solvers.elasticity import _held_by
+
+DATA = Path(__file__).resolve().parent / "data"
+CASE = DATA / "headstock_diag.toml"
+REAR = '[contacts.rear]\nbetween = ["bearing_rear", "spindle"]\nconductance = 2000.0\n'
+
+
+def steady(tmp_path: Path, order: int, extra: str) -> Path:
+    """The headstock in steady state at ``order``, with ``extra`` tables."""
+    shutil.copy(DATA / "headstock_diag.geo", tmp_path)
+    text = CASE.read_text().split("[time]")[0].replace("order = 1", f"order = {order}")
+    (tmp_path / "case.toml").write_text(text + extra)
+    return tmp_path / "case.toml"
+
+
+@pytest.mark.parametrize("order, delta, change", [(1, -21.0331, 0.0964), (2, -21.2105, 0.1011)])
+def test_a_bonded_contact_holds_the_assembly(tmp_path, order, delta, change):
+    """A conductance on the interface bearing_rear/spindle, no stiffness: the code bonds the two
+    sides (a joint BOND·E/h stiff), so the spindle moves with the bearing and the bed's clamped
+    feet hold it all. Before issue 51 the check scaled the joint's round-off energy of the rigid
+    modes to O(1), of either sign, and refused the held assembly at P2 (translation x and y)."""
+    case = gt.load_case(steady(tmp_path, order, REAR))
+    d = gt.run(case).columns["delta_um"][-1]
+    assert d == pytest.approx(delta, abs=2e-3)  # the case's own δ, µm (P1, P2 of one mesh)
+    bonded = gt.run(gt.load_case(steady(tmp_path, order, ""))).columns["delta_um"][-1]
+    # the contact's resistance (2000 W/(m² K)) warms the spindle less than a perfect interface
+    assert d - bonded == pytest.approx(change, abs=2e-3)  # band: 0 < change < 0.5 µm
+
+
+def test_a_part_on_slides_is_refused_by_name(tmp_path, capsys):
+    """Both bearings as frictionless slides (tangential stiffness 0) along the spindle: nothing holds
+    the spindle along its axis, and the check names it and that mode only."""
+    slides = "".join(f'[contacts.{b}]\nbetween = ["bearing_{b}", "spindle"]\nconductance = 2000.0\n'
+                     f"stiffness = [1e12, 0.0]\n" for b in ("rear", "front"))
+    for order in (1, 2):
+        path = steady(tmp_path, order, slides)
+        assert main(["run", str(path), "--out", str(tmp_path / "o"), "--no-pictures"]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Traceback" not in err
+        assert "supports: the part made of region spindle is free to move (translation x)" in err, err
+
+
+def test_round_off_of_a_joint_holds_nothing():
+    """A spring matrix whose rigid-mode energy is round-off (of either sign) adds nothing; one that
+    holds a mode adds it at O(1), whatever the spring's stiffness."""
+    R = np.eye(4)[:, :2]
+    joint = 1e19 * np.array([[1.0, -1.0, 0, 0], [-1.0, 1.0, 0, 0], [0, 0, 1.0, -1.0], [0, 0, -1.0, 1.0]])
+    R2 = np.array([[1.0, 0], [1.0, 0], [0, 1.0], [0, 1.0]])  # both sides move together
+    noisy = joint + np.diag([0, 0, 0, 1e-16 * 1e19]) * np.array([-1.0])  # an entry of round-off
+    assert np.abs(_held_by(noisy, R2)).max() < 1e-15
+    assert np.linalg.eigvalsh(_held_by(noisy, R2)).min() >= 0.0
+    held = _held_by(1e3 * np.eye(4), R)
+    assert np.allclose(held, np.eye(2))
