@@ -1,7 +1,8 @@
 """A machine other than the shipped two, as a new user writes it (tests/data/headstock_diag.*): a
 lathe headstock's 2-D section, a spindle in a front and a rear bearing in a housing on a bed
 (issue 51). The free-body check of its assembly: a contact that transmits force connects the
-parts at P1 and at P2; a part that nothing holds is still refused by name."""
+parts at P1 and at P2; a part that nothing holds is still refused by name. Its diagnosis: a
+hypothesis the model refuses is dropped, never the whole diagnosis."""
 from __future__ import annotations
 
 import shutil
@@ -11,8 +12,17 @@ import numpy as np
 import pytest
 
 import gatetherm as gt
+from gatetherm import InputError
 from gatetherm.cli import main
 from gatetherm.solvers.elasticity import _held_by
+from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
+from gatetherm.studies.diagnosis.hypotheses import configure
+from gatetherm.studies.diagnosis.replay import Replayer
+from gatetherm.studies.diagnosis.report import report_markdown
+from gatetherm.studies.run.scenario import run_scenario
+from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
+from gatetherm.validation.case_diagnosis import hidden
+from gatetherm.validation.truth import recorded
 
 DATA = Path(__file__).resolve().parent / "data"
 CASE = DATA / "headstock_diag.toml"
@@ -23,6 +33,7 @@ def steady(tmp_path: Path, order: int, extra: str) -> Path:
     """The headstock in steady state at ``order``, with ``extra`` tables."""
     shutil.copy(DATA / "headstock_diag.geo", tmp_path)
     text = CASE.read_text().split("[time]")[0].replace("order = 1", f"order = {order}")
+    text = text.replace('"60 * spindle"', "60.0").replace('"25 * spindle"', "25.0")  # full speed
     (tmp_path / "case.toml").write_text(text + extra)
     return tmp_path / "case.toml"
 
@@ -65,3 +76,36 @@ def test_round_off_of_a_joint_holds_nothing():
     assert np.linalg.eigvalsh(_held_by(noisy, R2)).min() >= 0.0
     held = _held_by(1e3 * np.eye(4), R)
     assert np.allclose(held, np.eye(2))
+
+
+def measured(case, labels: dict, seed: int = 3):
+    """The rig's record of the headstock with the hidden pieces ``labels`` (a P1 run: the fast tests'
+    inverse crime; the slow acceptance test records a P2 run)."""
+    schedule = case.schedule
+    cols = run_scenario(configure(case, hidden(case, labels)), schedule).columns
+    return recorded(cols, ("time_s", *schedule.drive.columns, *OUTPUT_COLUMNS), OUTPUT_COLUMNS, seed,
+                    {"source": "test"})
+
+
+def test_a_hypothesis_the_model_refuses_is_dropped_and_the_diagnosis_goes_on(monkeypatch):
+    """The joint resistance of bearing_rear/spindle made to fail as a free body did before issue 51:
+    the diagnosis drops it with the model's reason, lists it, and names the hidden rear bearing."""
+    case = gt.load_case(CASE)
+    ts = measured(case, {"source_bearing_rear": 1.6})
+    joint, real = "joint_resistance@bearing_rear/spindle", Replayer.run
+
+    def run(self, c=None):
+        if c is not None and joint in c.effects:
+            raise InputError("supports", "the part made of regions bed, spindle, bearing_rear is free to move "
+                             "(translation x, translation y)", "hold it")
+        return real(self, c)
+
+    monkeypatch.setattr(Replayer, "run", run)
+    d = diagnose(case, ts, Settings(effects=(joint, "heat_source@housing"), parameters=("source_bearing_rear",),
+                                    sensors=False, p2_check=False))
+    s = d.summary()
+    assert d.verdict == "explained" and [r.piece.label for r in d.pieces] == ["source_bearing_rear"]
+    assert d.pieces[0].value == pytest.approx(1.6, abs=0.02)  # band: ± 10 %
+    assert s["dropped"] == [{"name": joint, "kind": "effect", "why": "supports: the part made of regions bed, "
+                             "spindle, bearing_rear is free to move (translation x, translation y); hold it"}]
+    assert "**Dropped: the model refuses them**" in report_markdown(d, "m.csv", "headstock_diag.toml", {})
