@@ -102,7 +102,7 @@ def test_a_hypothesis_the_model_refuses_is_dropped_and_the_diagnosis_goes_on(mon
         return real(self, c)
 
     monkeypatch.setattr(Replayer, "run", run)
-    d = diagnose(case, ts, Settings(effects=(joint, "heat_source@housing"), parameters=("source_bearing_rear",),
+    d = diagnose(case, ts, Settings(effects=(joint,), parameters=("source_bearing_rear",),
                                     sensors=False, p2_check=False))
     s = d.summary()
     assert d.verdict == "explained" and [r.piece.label for r in d.pieces] == ["source_bearing_rear"]

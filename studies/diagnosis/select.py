@@ -84,11 +84,15 @@ class Selection:
 
 
 def _drop(dropped: dict, refused: Refused, ran=()) -> None:
-    """The hypotheses of a refused run that were not in the set that ran (``ran``) leave the search."""
-    for p in refused.pieces:
-        if p not in ran and p not in dropped:
-            dropped[p] = str(refused.error)
-            log.warning("hypothesis %s dropped: the model refuses it (%s)", p.label, refused.error)
+    """The hypothesis of a refused run that was not in the set that ran (``ran``) leaves the search;
+    where two or more new ones are refused together, only that set is skipped."""
+    new = [p for p in refused.pieces if p not in ran]
+    if len(new) != 1:
+        log.info("the model refuses %s together: that set is skipped", " + ".join(p.label for p in new))
+        return
+    if new[0] not in dropped:
+        dropped[new[0]] = str(refused.error)
+        log.warning("hypothesis %s dropped: the model refuses it (%s)", new[0].label, refused.error)
 
 
 def _best_first(trials):
