@@ -16,10 +16,8 @@ import gatetherm as gt
 from gatetherm import InputError
 from gatetherm.cli import main
 from gatetherm.solvers.elasticity import _held_by
-from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
 from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.diagnosis.replay import Replayer
-from gatetherm.studies.diagnosis.report import report_markdown
 from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, write_timeseries
 from gatetherm.validation.case_diagnosis import hidden
@@ -88,11 +86,12 @@ def measured(case, labels: dict, seed: int = 3):
                     {"source": "test"})
 
 
-def test_a_hypothesis_the_model_refuses_is_dropped_and_the_diagnosis_goes_on(monkeypatch):
+def test_a_hypothesis_the_model_refuses_is_dropped_and_the_diagnosis_goes_on(monkeypatch, tmp_path, capsys):
     """The joint resistance of bearing_rear/spindle made to fail as a free body did before issue 51:
-    the diagnosis drops it with the model's reason, lists it, and names the hidden rear bearing."""
+    the diagnosis drops it with the model's reason, says so (output, diagnosis.json, report.md), and
+    names the hidden rear bearing."""
     case = gt.load_case(CASE)
-    ts = measured(case, {"source_bearing_rear": 1.6})
+    write_timeseries(tmp_path / "m.csv", measured(case, {"source_bearing_rear": 1.6}))
     joint, real = "joint_resistance@bearing_rear/spindle", Replayer.run
 
     def run(self, c=None):
@@ -102,14 +101,17 @@ def test_a_hypothesis_the_model_refuses_is_dropped_and_the_diagnosis_goes_on(mon
         return real(self, c)
 
     monkeypatch.setattr(Replayer, "run", run)
-    d = diagnose(case, ts, Settings(effects=(joint,), parameters=("source_bearing_rear",),
-                                    sensors=False, p2_check=False))
-    s = d.summary()
-    assert d.verdict == "explained" and [r.piece.label for r in d.pieces] == ["source_bearing_rear"]
-    assert d.pieces[0].value == pytest.approx(1.6, abs=0.02)  # band: ± 10 %
-    assert s["dropped"] == [{"name": joint, "kind": "effect", "why": "supports: the part made of regions bed, "
-                             "spindle, bearing_rear is free to move (translation x, translation y); hold it"}]
-    assert "**Dropped: the model refuses them**" in report_markdown(d, "m.csv", "headstock_diag.toml", {})
+    assert main(["diagnose", "--case", str(CASE), "--data", str(tmp_path / "m.csv"), "--out", str(tmp_path / "d"),
+                 "--effects", joint, "--parameters", "source_bearing_rear", "--no-sensors", "--keep-order"]) == 0
+    why = "supports: the part made of regions bed, spindle, bearing_rear is free to move (translation x, " \
+          "translation y); hold it"
+    assert f"  dropped, the model refuses it: {joint} ({why})" in capsys.readouterr().out
+    d = json.loads((tmp_path / "d" / "diagnosis.json").read_text())
+    assert d["verdict"] == "explained" and [p["name"] for p in d["pieces"]] == ["source_bearing_rear"]
+    assert d["fitted"]["source_bearing_rear.factor"] == pytest.approx(1.6, abs=0.02)  # band: ± 10 %
+    assert d["dropped"] == [{"name": joint, "kind": "effect", "why": why}]
+    assert f"**Dropped: the model refuses them** (their runs fail, the diagnosis went on without them): " \
+           f"{joint} ({why})." in (tmp_path / "d" / "report.md").read_text()
 
 
 @pytest.mark.slow
