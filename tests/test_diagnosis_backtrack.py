@@ -64,6 +64,8 @@ def test_a_refused_hypothesis_is_dropped_with_its_reason_and_the_search_goes_on(
     assert sel.dropped[FREE] == ("supports: the part made of region spindle is free to move (translation x); "
                                  "hold it")
     assert obj.refused == 1  # tried once, never again
+    err = Refused([FREE], InputError("supports", "free", "hold it"))  # unexpected elsewhere: still one line
+    assert isinstance(err, InputError) and str(err) == "supports: free; hold it" and err.pieces == (FREE,)
 
 
 def test_rejected_stand_ins_send_the_selection_back_to_the_next_candidates():

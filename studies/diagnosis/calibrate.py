@@ -60,14 +60,18 @@ def coordinate(p: Piece):
     return (lambda v: (v - p.lo) / (p.hi - p.lo)), (lambda x: float(p.lo + x * (p.hi - p.lo)))
 
 
-class Refused(Exception):
+class Refused(InputError):
     """A model run that the model refuses for the hypotheses in it (an
     :class:`~gatetherm.InputError` of the model: a part left free to move, a singular system):
-    the search drops them (:mod:`select`) and goes on, never the whole diagnosis."""
+    the search drops them (:mod:`select`) and goes on, never the whole diagnosis. Where no step
+    of the search expects it, it is still the model's one-line error."""
 
     def __init__(self, pieces, error: InputError):
-        super().__init__(str(error))
+        super().__init__(error.field, error.problem, error.fix)
         self.pieces, self.error = tuple(pieces), error
+
+    def __reduce__(self):  # across processes: the model's error itself
+        return InputError, (self.field, self.problem, self.fix)
 
 
 @dataclass(frozen=True)
