@@ -189,13 +189,27 @@ def free_modes(vb: CellBasis, fixed: np.ndarray, springs=(), pieces=None,
     R = R / np.linalg.norm(R, axis=0)
     G = R[fixed].T @ R[fixed]
     for K in springs:
-        F = R.T @ (K @ R)
-        scale = np.abs(F).max()
-        G = G + (F / scale if scale > 0 else F)
+        G = G + _held_by(K, R)
     w, V = np.linalg.eigh(G)
     loose = V[:, w < 1e-10 * max(w.max(), 1.0)]
     m = len(names)
     return [(int(i) // m, names[int(i) % m]) for i in np.argmax(np.abs(loose), axis=0)]
+
+
+def _held_by(K, R: np.ndarray) -> np.ndarray:
+    """The energy ``Rᵀ K R`` of the rigid modes ``R`` in the spring matrix ``K`` (a foundation or
+    a joint), in units of the energy its diagonal alone would give them (``Rᵀ diag(K) R``): O(1)
+    for a mode the spring holds, round-off for one it carries along (a rigid motion of both sides
+    of a joint). Scaled by its own largest entry instead, a joint's round-off became O(1) with
+    either sign, and a held assembly was refused at P2 (issue 51)."""
+    F = R.T @ (K @ R)
+    diag = np.asarray(abs(K.diagonal()) if hasattr(K, "diagonal") else np.abs(np.diag(K)), dtype=float)
+    scale = float(((R * R).T @ diag).max())
+    if scale <= 0.0:
+        return np.zeros_like(F)
+    F = (F + F.T) / (2.0 * scale)
+    w, V = np.linalg.eigh(F)  # a spring only holds: no round-off of either sign
+    return (V * np.clip(w, 0.0, None)) @ V.T
 
 
 def _refuse_loose(vb: CellBasis, mesh, loose, pieces) -> None:

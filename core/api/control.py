@@ -68,8 +68,9 @@ def diagnose(case: Case, measured, **settings):
     Diagnosis
         ``.verdict``, ``.pieces`` (each with its fitted value), ``.groups`` (what the data cannot
         tell from a named piece, and what would), ``.stand_ins`` (pieces that make the model fit
-        but fail a model-form check), ``.cause`` (what kind of cause would fit what stays
-        unexplained), ``.summary()``; docs/diagnosis.md.
+        but fail a model-form check), ``.dropped`` (hypotheses whose model run the model refused,
+        with its one-line reason: dropped, the diagnosis went on), ``.cause`` (what kind of cause
+        would fit what stays unexplained), ``.summary()``; docs/diagnosis.md.
     """
     from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose as run_diagnosis
     from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries

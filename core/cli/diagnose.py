@@ -150,6 +150,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  cannot be told apart: {g.sentence()}")
     for p, v, why in diag.stand_ins:
         print(f"  stand-in, not a cause: {p.label} {p.param} = {v:.4g} {p.unit} ({why})")
+    for p, why in diag.dropped:
+        print(f"  dropped, the model refuses it: {p.label} ({why})")
     if diag.cause:
         print(f"  what kind of cause would fit: {diag.cause}")
     if s["best_rejected"]:

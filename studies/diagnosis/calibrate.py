@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares, minimize_scalar
 
+from gatetherm import InputError
 from gatetherm.solvers.sensors import ORDER, apply_fault, linear_basis
 from gatetherm.studies.diagnosis.hypotheses import Piece, configure, model_side
 from gatetherm.studies.diagnosis.locate import significant
@@ -57,6 +58,20 @@ def coordinate(p: Piece):
         a, b = np.log(p.lo), np.log(p.hi)
         return (lambda v: (np.log(v) - a) / (b - a)), (lambda x: float(np.exp(a + x * (b - a))))
     return (lambda v: (v - p.lo) / (p.hi - p.lo)), (lambda x: float(p.lo + x * (p.hi - p.lo)))
+
+
+class Refused(InputError):
+    """A model run that the model refuses for the hypotheses in it (an
+    :class:`~gatetherm.InputError` of the model: a part left free to move, a singular system):
+    the search drops them (:mod:`select`) and goes on, never the whole diagnosis. Where no step
+    of the search expects it, it is still the model's one-line error."""
+
+    def __init__(self, pieces, error: InputError):
+        super().__init__(error.field, error.problem, error.fix)
+        self.pieces, self.error = tuple(pieces), error
+
+    def __reduce__(self):  # across processes: the model's error itself
+        return InputError, (self.field, self.problem, self.fix)
 
 
 @dataclass(frozen=True)
@@ -96,12 +111,22 @@ class Objective:
         key = model_side({p: v for p, v in values.items()  # a neutral value changes nothing
                           if p.neutral is None or abs(v - p.neutral) > 1e-9 * abs(p.neutral)})
         if key not in self._memo:
-            self._memo[key] = self.replayer.run(configure(self.replayer.config, dict(key)))
-        return self._memo[key]
+            try:
+                self._memo[key] = self.replayer.run(configure(self.replayer.config, dict(key)))
+            except InputError as err:
+                if not key:  # the case itself: its own bad input, not a hypothesis's
+                    raise
+                log.info("model run refused with %s: %s", " + ".join(p.label for p, _ in key), err)
+                self._memo[key] = err
+        found = self._memo[key]
+        if isinstance(found, InputError):
+            raise Refused([p for p, _ in key], found)
+        return found
 
     def solo_runs(self, piece: Piece) -> list[tuple[float, dict]]:
         """Runs made so far with ``piece`` alone, as (value, columns)."""
-        return [(k[0][1], cols) for k, cols in self._memo.items() if len(k) == 1 and k[0][0] == piece]
+        return [(k[0][1], cols) for k, cols in self._memo.items()
+                if len(k) == 1 and k[0][0] == piece and not isinstance(cols, InputError)]
 
     def residuals(self, values: dict, cols: dict | None = None, solve: bool = True) -> tuple[dict, dict]:
         """(measured − model per channel, values) with the sensor faults of ``values`` applied to

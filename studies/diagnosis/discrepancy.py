@@ -11,7 +11,11 @@
    held-out rest, each channel group weighing the same (:mod:`calibrate`, :mod:`select`).
 4. *Check*: the model-form checks (:mod:`checks`): the chosen set must hold on each input
    phase when fitted on the others, with the same values, plausible ones, and a sensor fault
-   needs evidence of a sensor; a piece that fails is a stand-in, not a cause, and is not named.
+   needs evidence of a sensor; a piece that fails is a stand-in, not a cause, and is not named:
+   the selection runs again without the stand-ins, so the next candidates get their turn
+   (:func:`~select.select_confirmed`). A hypothesis whose model run the model refuses (a part
+   left free to move, a singular system) is dropped with its reason and listed, and the
+   diagnosis goes on.
 5. *Group*: hypotheses the data cannot tell from a named piece are one group with it, with
    the measurement that would separate them (:mod:`identify`); a physical piece is named
    before an equivalent sensor fault.
@@ -43,7 +47,7 @@ from gatetherm.studies.diagnosis.identify import Group, groups, physical_first
 from gatetherm.studies.diagnosis.locate import Finding, Phase, input_phases, locate, noise_sd, phases
 from gatetherm.studies.diagnosis.pattern import kind_of_cause, unexplained
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
-from gatetherm.studies.diagnosis.select import Round, Selection, physical_in_place, select
+from gatetherm.studies.diagnosis.select import Round, Selection, physical_in_place, select, select_confirmed
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.timeseries import TimeSeries
 
@@ -149,6 +153,9 @@ class Diagnosis:
     order: int = 1
     """Element order of the replayed model (2 for a P1 case whose discretisation error showed in the data:
     :attr:`Settings.refine`)."""
+    dropped: tuple[tuple[Piece, str], ...] = ()
+    """Hypotheses whose model run the model refused (a part left free to move, a singular system):
+    (piece, the model's one-line reason); out of the search, the diagnosis went on without them."""
 
     @property
     def too_coarse(self) -> list[str]:
@@ -194,6 +201,7 @@ class Diagnosis:
             "stand_ins": [{"name": p.label, "kind": p.kind, "value": float(v), "why": why}
                           for p, v, why in self.stand_ins],
             "groups": [g.entry() for g in self.groups],
+            "dropped": [{"name": p.label, "kind": p.kind, "why": why} for p, why in self.dropped],
             "unexplained": unexplained(self.remaining if self.pieces else self.findings),
             "kind_of_cause": self.cause,
         }
@@ -301,10 +309,14 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     obj = Objective(rep, ts, channels, scale, train)
     chk, stand, grp = None, {}, []
     if discrepant:
-        sel = select(obj, pool, settings.margin_min, settings.max_pieces, settings.screen_top)
-        named, stand, chk = confirm(obj, physical_in_place(sel), run_phases, settings.margin_min, sel.base.score)
+        sel, named, chk = select_confirmed(
+            lambda cands, dropped: select(obj, cands, settings.margin_min, settings.max_pieces, settings.screen_top,
+                                          dropped=dropped),
+            lambda s: confirm(obj, physical_in_place(s), run_phases, settings.margin_min, s.base.score), pool)
+        stand = sel.stand_ins
         solo = {p: s.values[p] for p, s in sel.rounds[0].trials} if sel.rounds else {}
-        named, grp = physical_first(named, groups(obj, named, pool, sel.alternatives, solo, settings.margin_min))
+        usable = [p for p in pool if p not in sel.dropped]
+        named, grp = physical_first(named, groups(obj, named, usable, sel.alternatives, solo, settings.margin_min))
         final = sel.final if named == sel.final.values else obj.scored(named)
     else:
         base = obj.scored({})
@@ -325,7 +337,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
                      remaining, res0, after, runs, time.perf_counter() - t0, rep.has_ambient, settings.margin_min,
                      rep.dim, inputs, check, chk, tuple((p, v, why) for p, (v, why) in stand.items()), tuple(grp),
-                     cause, rep.config.problem.order)
+                     cause, rep.config.problem.order, tuple(sel.dropped.items()))
 
 
 def _located(ts: TimeSeries, cols: dict, channels, t: np.ndarray, run_phases) -> tuple[dict, list[Finding], bool]:

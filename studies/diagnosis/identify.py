@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gatetherm.studies.diagnosis.calibrate import Objective, refit
+from gatetherm.studies.diagnosis.calibrate import Objective, Refused, refit
 from gatetherm.studies.diagnosis.hypotheses import Piece
 from gatetherm.studies.diagnosis.replay import NOT_COMPARED, RESOLUTION, label, resolution, unit
 from gatetherm.studies.diagnosis.surrogate import Surrogate
@@ -93,8 +93,12 @@ def groups(obj: Objective, values: dict, pool, alternatives: dict, solo: dict, m
             vq = contribution(obj, {**rest, q: solo[q]}, q, sur.columns)
             ang = _angle(vp, vq)
             if q in alternatives.get(p, ()) or ang < ANGLE_DEG:
-                swapped = refit(obj, {**rest, q: solo[q]}, free=[q], max_nfev=6)
-                if obj.scored(swapped).score - obj.scored(values).score < margin:
+                try:
+                    swapped = refit(obj, {**rest, q: solo[q]}, free=[q], max_nfev=6)
+                    worse = obj.scored(swapped).score - obj.scored(values).score
+                except Refused:  # the model refuses q with the rest: no equivalent
+                    continue
+                if worse < margin:
                     members.append(q)
                     vals[q], angles[q] = swapped[q], ang
         if members:

@@ -66,6 +66,9 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
     if d.stand_ins:
         L += ["", "**Stand-ins, not causes** (they make the model fit, but fail a model-form check; section 6): "
               + "; ".join(f"{p.label} {p.param} = {_num(v)} {p.unit} ({why})" for p, v, why in d.stand_ins) + "."]
+    if d.dropped:
+        L += ["", "**Dropped: the model refuses them** (their runs fail, the diagnosis went on without them): "
+              + "; ".join(f"{p.label} ({why})" for p, why in d.dropped) + "."]
     if d.best_rejected:
         L += ["", f"Best rejected: {d.best_rejected[0].label} (score gain {_num(d.margin)} < margin {d.margin_min:g})."]
     if d.removed:

@@ -21,6 +21,12 @@ piece not chosen is put in place of each chosen one on the surrogate; where that
 within the margin, the closest are refitted for real, and if they still do, the data
 cannot tell the two apart: the chosen piece lists them as alternatives (a proportional
 partner, such as α for a gain of the δ sensor, is refitted for real whatever the surrogate says).
+
+A hypothesis whose model run the model refuses (an InputError of the model: a part it leaves
+free to move, a singular system; :class:`~calibrate.Refused`) leaves the search with its
+reason (:attr:`Selection.dropped`): it is one hypothesis that cannot be, never the end of the
+diagnosis. :func:`select_confirmed` runs the selection again without the pieces the model-form
+checks reject as stand-ins, so that the next candidates get their turn.
 """
 from __future__ import annotations
 
@@ -31,7 +37,7 @@ from itertools import combinations
 
 import numpy as np
 
-from gatetherm.studies.diagnosis.calibrate import Objective, Scored, fit_one, refit
+from gatetherm.studies.diagnosis.calibrate import Objective, Refused, Scored, fit_one, refit
 from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece
 from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.diagnosis.surrogate import Surrogate, screen
@@ -70,34 +76,64 @@ class Selection:
     """{(piece, alternative): the chosen set refitted with the alternative in the piece's place}."""
     best_rejected: tuple[Piece, Scored] | None = None
     """The best addition that did not clear the margin in the last round."""
+    dropped: dict = field(default_factory=dict)
+    """{piece: why}: hypotheses whose model run the model refused, out of the search."""
+    stand_ins: dict = field(default_factory=dict)
+    """{piece: (value, why)}: pieces the model-form checks rejected, out of the search
+    (:func:`select_confirmed`)."""
+
+
+def _drop(dropped: dict, refused: Refused, ran=()) -> None:
+    """The hypothesis of a refused run that was not in the set that ran (``ran``) leaves the search;
+    where two or more new ones are refused together, only that set is skipped."""
+    new = [p for p in refused.pieces if p not in ran]
+    if len(new) != 1:
+        log.info("the model refuses %s together: that set is skipped", " + ".join(p.label for p in new))
+        return
+    if new[0] not in dropped:
+        dropped[new[0]] = str(refused.error)
+        log.warning("hypothesis %s dropped: the model refuses it (%s)", new[0].label, refused.error)
 
 
 def _best_first(trials):
     return sorted(trials, key=lambda t: (t[1].approx, t[1].score))
 
 
-def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: dict, pair_top: int = 3) -> Round:
+def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: dict, pair_top: int = 3,
+           dropped: dict | None = None) -> Round:
     """Every single addition (fitted for real in the first round, else on the surrogate with
     the best ``top`` refitted for real), then every pair of additions on the surrogate
     (starting from the single fits), the best ``pair_top`` pairs refitted for real (three
     since the frame's dimensions joined the pool: with two, a dimension's pair, which the
-    surrogate ranks too well, took the place of the hidden pair in a compound case)."""
-    ctx = current.values
+    surrogate ranks too well, took the place of the hidden pair in a compound case). A piece
+    whose run the model refuses goes to ``dropped`` and out of the round."""
+    ctx, dropped = current.values, {} if dropped is None else dropped
+
+    def tried(fit):  # a Scored, or None where the model refuses the set (its new pieces dropped)
+        try:
+            return fit()
+        except Refused as err:
+            _drop(dropped, err, ctx)
+            return None
+
     if not ctx:
-        singles = [(p, obj.scored(fit_one(obj, {}, p))) for p in pool]
+        singles = [(p, tried(lambda p=p: obj.scored(fit_one(obj, {}, p)))) for p in pool]
+        singles = [(p, s) for p, s in singles if s is not None]
         fits.update({frozenset([p]): s for p, s in singles})
     sur = Surrogate(obj, ctx)
     if ctx:
         screened = sorted(((p, screen(sur, ctx, {p: None})) for p in pool if sur.usable(p)),
                           key=lambda ps: ps[1].score)
-        singles = [(p, obj.scored(fit_one(obj, ctx, p))) for p in pool if not sur.usable(p)]
+        singles = [(p, tried(lambda p=p: obj.scored(fit_one(obj, ctx, p)))) for p in pool if not sur.usable(p)]
         for i, (p, s) in enumerate(screened):
-            singles.append((p, _real(obj, s, fits) if i < top else s))
+            singles.append((p, tried(lambda s=s: _real(obj, s, fits)) if i < top else s))
+        singles = [(p, s) for p, s in singles if s is not None and p not in dropped]
     singles = _best_first(singles)
     lead = [(p, s) for p, s in singles if sur.usable(p)]
     pairs = sorted((((p, q), screen(sur, ctx, {p: sp.values[p], q: sq.values[q]}))
                     for (p, sp), (q, sq) in combinations(lead, 2)), key=lambda t: t[1].score)
-    pairs = [(pq, _real(obj, s, fits) if i < pair_top else s) for i, (pq, s) in enumerate(pairs)]
+    pairs = [(pq, tried(lambda s=s: _real(obj, s, fits)) if i < pair_top else s) for i, (pq, s) in enumerate(pairs)]
+    pairs = [(pq, s) for pq, s in pairs if s is not None and not set(pq) & set(dropped)]
     return Round(tuple(singles), tuple(_best_first(pairs)), (), current.score)
 
 
@@ -108,9 +144,11 @@ def _real(obj: Objective, screened: Scored, fits: dict) -> Scored:
 
 
 def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: int = 4, top: int = 3,
-           swaps: int = 2) -> Selection:
+           swaps: int = 2, dropped: dict | None = None) -> Selection:
+    """Forward selection from the baseline over ``candidates`` (the module docstring);
+    ``dropped``: pieces the model refused before (kept out, and listed)."""
     base = obj.scored({})
-    sel = Selection(base, base, [])
+    sel = Selection(base, base, [], dropped=dict(dropped or {}))
     fits: dict[frozenset, Scored] = {}
     current = base
     for _ in range(swaps + 1):
@@ -127,15 +165,56 @@ def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: i
     return sel
 
 
+def select_confirmed(pick, judge, candidates: list[Piece], tries: int = 3):
+    """Forward selection that goes back when the model-form checks reject its pieces.
+
+    ``pick(pool, dropped)`` selects from ``pool`` (:func:`select`, ``dropped`` the pieces the
+    model refused so far); ``judge(selection)`` gives ``(named, stand_ins, checks)`` of the chosen
+    set (:func:`~gatetherm.studies.diagnosis.checks.confirm`: ``named`` {piece: value} that hold,
+    ``stand_ins`` {piece: (value, why)} that do not). While the judge rejects stand-ins, they
+    leave the candidates and the selection runs again on the rest (the model runs made so far
+    are kept), ``tries`` selections at most: a pair of stand-ins chosen first no longer hides the
+    piece that alone explains the data (issue 51). A later selection that names nothing does not
+    replace an earlier one that named pieces.
+
+    Returns
+    -------
+    (Selection, dict, checks)
+        The selection kept (every stand-in rejected on the way in its :attr:`Selection.stand_ins`,
+        every refused piece in :attr:`Selection.dropped`), its named pieces and their checks.
+    """
+    pool, rejected, dropped, best = list(candidates), {}, {}, None
+    for i in range(tries):
+        sel = pick(pool, dropped)
+        dropped = sel.dropped
+        named, stand, chk = judge(sel)
+        rejected.update(stand)
+        if best is None or named or not best[1]:
+            best = (sel, named, chk)
+        if not stand:
+            break
+        pool = [p for p in pool if p not in stand and p not in dropped]
+        if i + 1 < tries:
+            log.info("model-form checks rejected %s as stand-ins: selecting again from the %d other candidates",
+                     " + ".join(p.label for p in stand), len(pool))
+    sel, named, chk = best
+    sel.stand_ins = {p: v for p, v in rejected.items() if p not in named}
+    sel.dropped = dropped
+    return sel, named, chk
+
+
 def _forward(obj: Objective, sel: Selection, current: Scored, candidates, margin: float, max_pieces: int, top: int,
              fits: dict) -> Scored:
     """Rounds of additions: the best pair when it gains the margin over the best single
     addition (and there is room for two), else the best single one when it gains the margin."""
     while len(current.values) < max_pieces and not current.explains:
-        pool = [p for p in candidates if p not in current.values and p not in sel.removed]
+        pool = [p for p in candidates if p not in current.values and p not in sel.removed and p not in sel.dropped]
         if not pool:
             break
-        rnd = _round(obj, current, pool, top, fits)
+        rnd = _round(obj, current, pool, top, fits, dropped=sel.dropped)
+        if not rnd.trials:
+            log.info("round %d: every addition was refused by the model", len(sel.rounds) + 1)
+            break
         p, one = rnd.trials[0]
         gain = current.score - one.score
         pair = rnd.pairs[0] if rnd.pairs and not rnd.pairs[0][1].approx else None
@@ -169,9 +248,13 @@ def _replacements(obj: Objective, current: Scored, pool) -> list[tuple[Piece, Pi
 
 def _swap(obj: Objective, sel: Selection, current: Scored, candidates, margin: float, top: int = 2) -> Scored | None:
     """Replace one chosen piece by one not chosen, if that (refitted) lowers the score by the margin."""
-    pool = [q for q in candidates if q not in current.values and q not in sel.removed]
+    pool = [q for q in candidates if q not in current.values and q not in sel.removed and q not in sel.dropped]
     for p, q, s in _replacements(obj, current, pool)[:top]:
-        real = obj.scored(refit(obj, s.values, max_nfev=5))
+        try:
+            real = obj.scored(refit(obj, s.values, max_nfev=5))
+        except Refused as err:
+            _drop(sel.dropped, err, current.values)
+            continue
         if current.score - real.score >= margin:
             log.info("swap: %s for %s (gain %.1f)", q.label, p.label, current.score - real.score)
             sel.removed.append(p)
@@ -196,7 +279,13 @@ def _removal(obj: Objective, sel: Selection, current: Scored, fits: dict, margin
         for p in current.values:
             rest = frozenset(current.values) - {p}
             if rest not in fits:
-                fits[rest] = obj.scored(refit(obj, {q: current.values[q] for q in rest}) if rest else {})
+                try:
+                    fits[rest] = obj.scored(refit(obj, {q: current.values[q] for q in rest}) if rest else {})
+                except Refused:  # the others alone are refused: p is needed
+                    fits[rest] = None
+            if fits[rest] is None:
+                costs.append((True, np.inf, p, None))
+                continue
             small = _contribution(obj, current.values, p) < 1.0
             costs.append((not small, fits[rest].score - current.score, p, fits[rest]))
         needed, cost, p, without = min(costs, key=lambda c: c[:2])
@@ -218,7 +307,7 @@ def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, mos
     first, whatever the surrogate says (it adds changes made on the baseline model, so it misses
     the product of α with the effect of another chosen piece)."""
     final = sel.final
-    pool = [q for q in candidates if q not in final.values]
+    pool = [q for q in candidates if q not in final.values and q not in sel.dropped]
     tried: dict[Piece, int] = {}
 
     def partners(p: Piece, q: Piece) -> bool:
@@ -228,7 +317,11 @@ def _alternatives(obj: Objective, sel: Selection, candidates, margin: float, mos
         if (s.score - final.score >= margin and not partners(p, q)) or tried.get(p, 0) >= most:
             continue
         tried[p] = tried.get(p, 0) + 1
-        swapped = obj.scored(refit(obj, s.values, max_nfev=max_nfev))
+        try:
+            swapped = obj.scored(refit(obj, s.values, max_nfev=max_nfev))
+        except Refused as err:
+            _drop(sel.dropped, err, final.values)
+            continue
         if swapped.score - final.score < margin:
             sel.alternatives.setdefault(p, []).append(q)
             sel.in_place[p, q] = swapped.values
