@@ -194,12 +194,85 @@ def test_save_writes_matplotlibs_pixels(tmp_path):
         assert (np.asarray(ours)[..., 3] == 255).all() == (alpha == 1.0)
 
 
+def _labels(ax) -> list[str]:
+    return [line.get_label() for line in ax.lines if not line.get_label().startswith("_")]
+
+
 def test_compensation(cframe):
+    """The paper's method with the C-frame's actuator: four panels, the stroke named as the piezo
+    model's, R_i and R_C, every axis with its unit."""
     comp = gt.compensate(cframe, method="paper")
     ax = gt.plot.compensation(comp, axes=axes(4))
     assert np.array_equal(ax[0].lines[0].get_ydata(), cframe["delta_um"])
     assert np.array_equal(ax[2].lines[0].get_ydata(), comp.loop.delta_comp_um)
     assert np.array_equal(ax[2].lines[1].get_ydata(), comp.loop.stroke_um)
+    assert _labels(ax[2]) == ["compensated δ", "actuator stroke (piezo model)"] and _labels(ax[3]) == ["R_i", "R_C"]
+    assert [a.get_ylabel() for a in ax] == ["δ [µm]", "δ − δ_et [µm]", "compensated δ [µm]", "correction factor [1]"]
+    assert ax[3].get_xlabel() == "time [h]" and ax[0].get_title() == comp.label
+
+
+def test_compensation_without_actuator_or_factors_draws_neither(cframe):
+    """mlr without an actuator (the rom and errormodel methods have no R_i, R_C either): three
+    panels, the fourth given removed; no stroke, no actuator named, no empty R panel."""
+    comp = gt.compensate(cframe, method="mlr", actuator=None)
+    given = axes(4)
+    ax = gt.plot.compensation(comp, axes=given)
+    assert len(ax) == 3 and len(given[0].figure.axes) == 3
+    assert _labels(ax[2]) == ["compensated δ"]
+    text = " ".join(label for a in ax for label in (*_labels(a), a.get_ylabel(), a.get_title()))
+    assert "piezo" not in text and "actuator" not in text and "R_i" not in text and "cutting" not in text
+    assert all(a.get_ylabel().endswith("[µm]") for a in ax) and ax[2].get_xlabel() == "time [h]"
+
+
+def test_response_names_the_cases_own_signals(cframe):
+    """The C-frame's δ is the table top against the tool along y; θ_A … its probes: no "tips F"."""
+    a1, a2 = gt.plot.response(cframe, axes=axes(2))
+    assert _labels(a2) == ["δ = u_y(table_top) − u_y(tool)"]
+    assert _labels(a1) == ["θ_A (probe TF)", "θ_B (probe TB)", "θ_C (probe TS)"]
+    assert a1.get_ylabel() == "temperature rise [K]" and a2.get_ylabel() == "δ [µm] (+ = approach)"
+
+
+def test_a_steady_picture_is_titled_steady_state(tmp_path):
+    """A steady thermoelastic bar (no [time]): its pictures say so, not "t = 0"."""
+    from test_order_check import free_bar
+
+    from gatetherm.validation.plots.run import state_title
+
+    run = gt.run(free_bar(tmp_path, 40.0))
+    assert gt.plot.deformed(run, ax=axes()).get_title().startswith("case, steady state\ndisplacement magnified")
+    assert gt.plot.field(run, "T", ax=axes()).get_title() == "case, steady state"
+    assert state_title("lathe", None) == "lathe, steady state" and state_title("lathe", 1800.0) == "lathe, t = 30 min"
+
+
+def test_drift_inputs_have_their_units_and_no_empty_panel():
+    """A pump alone: on the panel's own axis, labelled 1 = on; a spindle's power in W beside a
+    room temperature; no inputs: no empty 0-1 panel, the time axis on the temperatures'."""
+    from gatetherm.validation.plots.drift import plot_drift
+
+    t = np.arange(0.0, 7200.0, 60.0)
+    d, T = {"delta_um": np.sin(t / 900)}, {"T_bed_degC": np.cos(t / 900)}
+    ax = plot_drift(t, d, T, {"pump": (t > 1800).astype(float)}, None, "lathe", axes=axes(3))
+    assert ax[2].get_ylabel() == "pump [1 = on, 0 = off]" and len(ax[2].figure.axes) == 3
+    ax = plot_drift(t, d, T, {"ambient_degC": 20 + 0 * t, "spindle_W": 60 + 0 * t}, None, "lathe", axes=axes(3))
+    assert ax[2].get_ylabel() == "input temperature [°C]" and ax[2].figure.axes[-1].get_ylabel() == "spindle_W [W]"
+    ax = plot_drift(t, d, T, {}, None, "lathe", axes=axes(3))
+    assert not ax[2].get_visible() and ax[1].get_xlabel() == "time [min]"
+    assert [a.get_ylabel() for a in ax[:2]] == ["displacement drift [µm]", "temperature drift [K]"]
+
+
+def test_sweep_axes_carry_their_units():
+    """A case study's swept film and its result: both axes with units, the hue's legend too."""
+    rows = [{"thermal.free.film": f, "materials.spindle.alpha": a, "delta_final_um": f * a * 1e5}
+            for f in (6.0, 10.0) for a in (1.15e-5, 1.25e-5)]
+    ax = gt.plot.sweep(rows, "thermal.free.film", "delta_final_um", "materials.spindle.alpha", ax=axes())
+    assert ax.get_xlabel() == "thermal.free.film [W/(m² K)]" and ax.get_ylabel() == "delta_final_um [µm]"
+    assert _labels(ax) == ["materials.spindle.alpha = 1.15e-05 1/K", "materials.spindle.alpha = 1.25e-05 1/K"]
+    from gatetherm.validation.plots.labels import axis_label
+
+    assert [axis_label(k) for k in ("sources.spindle.power", "effect.heat_source@arm", "swing_um", "Ki_F_fe",
+                                    "derived.beta", "geometry.l4", "mesh.parameters.h")] == [
+        "sources.spindle.power [W]", "effect.heat_source@arm [W]", "swing_um [µm]", "Ki_F_fe [µm/K]",
+        "derived.beta [1]", "geometry.l4 [m]", "mesh.parameters.h"]
 
 
 def test_prediction(cframe):

@@ -190,7 +190,8 @@ def test_a_tiny_element_size_is_refused_before_meshing(tmp_path, capsys):
     assert err.startswith(f"gatetherm: error: {tmp_path / 'case.toml'}: mesh.size: 1e-05 m gives about 2.3e+10 "
                           "triangles needing"), err
     assert "raise it to at least" in err and err.count("\n") == 1
-    assert took < 5.0  # achieved ~1 s (the child's import of gmsh, parsing, no meshing)
+    assert took < 60.0  # achieved 2.1-3.0 s at a load average of 17 (gmsh imported, the script
+    #                     parsed); meshing it would take hours
 
 
 def _endless(tmp_path: Path) -> Path:
@@ -204,26 +205,51 @@ def _children(pid: int) -> list[int]:
     return [int(x) for x in path.read_text().split()] if path.exists() else []
 
 
+def _sandboxed_child(pid: int) -> int | None:
+    """The child of ``pid`` that runs under a seccomp filter: gmsh's process once it is in its
+    sandbox, about to read the script (the painter's process, started first, has none)."""
+    for child in _children(pid):
+        try:
+            status = Path(f"/proc/{child}/status").read_text()
+        except OSError:  # ended meanwhile
+            continue
+        if any(line.split() == ["Seccomp:", "2"] for line in status.splitlines()):
+            return child
+    return None
+
+
+#: The command, with the fallback that ends a command ignoring its signal after
+#: ``_Signals.GRACE_S`` (5 s) pushed out of reach: the run must end by unwinding from the signal.
+CLI = "from gatetherm import cli; cli._Signals.GRACE_S = 3600.0; cli.console()"
+
+
 @pytest.mark.parametrize("sig, code, said", [(signal.SIGTERM, 143, "terminated"), (signal.SIGINT, 130, "interrupted")])
-def test_a_signal_ends_a_run_inside_gmsh_within_2_s(tmp_path, sig, code, said):
-    """An endless .geo loop: the run ends with the usual line and code, no output, no child left."""
+def test_a_signal_ends_a_run_inside_gmsh_at_once(tmp_path, sig, code, said):
+    """An endless .geo loop: the run ends with the usual line and code, no output, no child left.
+
+    The signal is sent once gmsh's process is in its sandbox (its seccomp filter is visible in
+    /proc), never after a guessed sleep: on a busy machine the first child is the painter's and
+    gmsh's starts seconds later (at a load average of 20: the painter's 0.8 s after the start,
+    gmsh's 4.6 s), so a signal a second after "a child" hit the command still importing, not
+    gmsh. No tight wall-clock margin: without the fallback timer, a signal the run did not
+    unwind from would leave gmsh's loop to its 30-s read limit, 20 s beyond the 10 s allowed."""
     case = _endless(tmp_path)
-    proc = subprocess.Popen([sys.executable, "-m", "gatetherm.cli", "run", str(case), "--out",
-                             str(tmp_path / "out")], stderr=subprocess.PIPE, text=True,
+    proc = subprocess.Popen([sys.executable, "-c", CLI, "run", str(case), "--out", str(tmp_path / "out")],
+                            stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    deadline = time.monotonic() + 60
-    while not _children(proc.pid) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    child = _children(proc.pid)
-    assert child, "gmsh's process did not start"
-    time.sleep(1.0)  # inside the loop
+    deadline = time.monotonic() + 300  # a hang guard, no margin: the loaded machine takes seconds
+    while (gmsh := _sandboxed_child(proc.pid)) is None and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert gmsh is not None, f"gmsh's process did not enter its sandbox: {proc.poll()}"
+    children = _children(proc.pid)
     t0 = time.monotonic()
     proc.send_signal(sig)
-    _, err = proc.communicate(timeout=10)
+    _, err = proc.communicate(timeout=300)
     took = time.monotonic() - t0
-    assert proc.returncode == code and err == f"gatetherm: {said}\n", err
-    assert took < 2.0  # achieved ~0.1-0.5 s
-    assert not (tmp_path / "out").exists() and not Path(f"/proc/{child[0]}").exists()
+    assert proc.returncode == code and err == f"gatetherm: {said}\n", (proc.returncode, err)
+    assert took < 10.0  # achieved 0.1-0.5 s; a run that went on would end at gmsh's 30-s read limit
+    assert not (tmp_path / "out").exists()
+    assert gmsh in children and not [c for c in children if Path(f"/proc/{c}").exists()]
 
 
 def test_the_result_comes_back_through_the_pipe_checked():

@@ -206,7 +206,10 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     from gatetherm.validation.plots import save
     from gatetherm.validation.plots.compensation import plot_compensation, plot_piezo_loops  # outer layer
     write_timeseries(out_dir / "compensated.csv", out)
-    save(plot_compensation(loop), out_dir / "compensation.png")
+    from gatetherm.validation.plots.labels import signal_labels
+
+    save(plot_compensation(loop, title=f"{what}: {settings.method}, {comp.label}",
+                           delta=signal_labels(case.problem).get("delta_um", "δ")), out_dir / "compensation.png")
     if actuator:
         save(plot_piezo_loops(actuator), out_dir / "piezo_loops.png")
     write_text_atomic(out_dir / "summary.json", text)

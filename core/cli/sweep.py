@@ -18,7 +18,8 @@ OUTPUTS = ("table.csv", "study.json", "*_vs_*.png")
 
 def register(sub) -> None:
     p = sub.add_parser("sweep", help="run a parametric study (grid of parameters); table and plots",
-                       description="Evaluate every point of the grid in STUDY.toml (see "
+                       description="Evaluate every point of the grid in STUDY.toml (its tables and keys: docs/sweep.md; "
+                       "a case file's keys with [study] case = \"case.toml\", the paper frame's: "
                        "studies/data/example_sweep.toml); resumes where a stopped run left off.")
     p.add_argument("study", metavar="STUDY.toml", help="study file")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")

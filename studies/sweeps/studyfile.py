@@ -1,6 +1,8 @@
 """The study file (STUDY.toml) of ``gatetherm sweep``: ``[study]`` (name, and ``case`` for a case
 file, or ``dim``, ``config``, ``compute``, ``fit_frame`` for the paper's frame), ``[set]``,
-``[grid]`` and ``[[plot]]`` tables into a :class:`~gatetherm.studies.sweeps.sweep.Study`."""
+``[grid]`` and ``[[plot]]`` tables into a :class:`~gatetherm.studies.sweeps.sweep.Study`.
+Every table and key is documented in docs/sweep.md (``tests/test_sweep_docs.py`` holds the page
+to :data:`KEYS` and :data:`FREE`)."""
 from __future__ import annotations
 
 import tomllib
@@ -13,6 +15,15 @@ from gatetherm.files import read_text
 if TYPE_CHECKING:
     from gatetherm.studies.run.config import Config
     from gatetherm.studies.sweeps.sweep import Study
+
+
+KEYS = {"study": ("name", "case", "dim", "config", "compute", "fit_frame"), "plot": ("x", "y", "hue")}
+"""The keys of the study file's tables that have fixed keys (``[[plot]]``: each of them)."""
+FREE = {"set": "KEY", "grid": "KEY"}
+"""The tables whose keys are the parameters a point sets (a case file's dotted key, ``effect.…``,
+or the frame's), by the placeholder docs/sweep.md names them with."""
+TABLES = ("study", "set", "grid", "plot")
+"""The study file's tables, in the order docs/sweep.md documents them."""
 
 
 def _flatten(table: dict, prefix: str = "") -> dict[str, Any]:
@@ -52,7 +63,7 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None,
     from gatetherm.studies.run.config import load_config
     from gatetherm.studies.sweeps.sweep import COMPUTE, Study
 
-    known = {"study": dict, "set": dict, "grid": dict, "plot": list}
+    known = {t: list if t == "plot" else dict for t in TABLES}
     for key, value in data.items():
         if key not in known:
             raise InputError(key, "unknown table", f"known tables: {', '.join(sorted(known))}")
@@ -60,7 +71,7 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None,
             raise InputError(key, f"expected {'[[plot]] tables' if key == 'plot' else f'a [{key}] table'}")
     head = dict(data.get("study", {}))
     for key in head:
-        if key not in ("name", "dim", "config", "compute", "fit_frame", "case"):
+        if key not in KEYS["study"]:
             raise InputError(f"study.{key}", "unknown key",
                              "known keys: name, case (a case file), or dim, config, compute, fit_frame (the frame)")
     if case is not None:
@@ -129,7 +140,7 @@ def _plots(data: dict, columns: set) -> list:
         if not isinstance(spec, dict) or "x" not in spec or "y" not in spec:
             raise InputError(f"plot[{i + 1}]", "needs x and y", "write [[plot]] with x, y and hue")
         for key, value in spec.items():
-            if key not in ("x", "y", "hue"):
+            if key not in KEYS["plot"]:
                 raise InputError(f"plot[{i + 1}].{key}", "unknown key", "known keys: x, y, hue")
             if value not in columns:
                 raise InputError(f"plot[{i + 1}].{key}", f"{value!r} is not a table column",

@@ -44,7 +44,10 @@ def _panels(axes):
 
 def _title(run, t: float | None = None) -> str:
     name = getattr(getattr(run, "case", None), "name", "")
-    return name if t is None else f"{name}, t = {t / 3600:.3g} h"
+    if t is None:
+        return name
+    when = "steady state" if len(getattr(run, "time", ())) <= 1 else f"t = {t / 3600:.3g} h"
+    return f"{name}, {when}" if name else when
 
 
 def series(run, *columns: str, ax=None, hours: bool = True):
@@ -114,9 +117,10 @@ def response(run, axes=None):
     numpy.ndarray of matplotlib.axes.Axes
         The two panels.
     """
+    from gatetherm.validation.plots.labels import signal_labels
     from gatetherm.validation.plots.run import plot_response
 
-    return plot_response(run.columns, _title(run), axes, _panels(axes))
+    return plot_response(run.columns, _title(run), axes, _panels(axes), signal_labels(run.case.problem))
 
 
 def fluids(run, ax=None):
@@ -188,22 +192,25 @@ def deformed(run, t: float | None = None, ax=None):
 
 def compensation(result, axes=None):
     """A compensation (:func:`gatetherm.compensate`): δ and its prediction, the prediction error,
-    the compensated δ with the actuator's stroke, and the correction factors, against time.
+    the compensated δ (with the actuator's stroke where it drove one), and the correction factors
+    R_i, R_C where the method has them (the paper's), against time.
 
     Parameters
     ----------
     result : Compensation
         What :func:`gatetherm.compensate` returns.
-    axes : four matplotlib.axes.Axes, optional
-        Where to draw (default: a new figure of four panels).
+    axes : four (or three) matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure of four panels, three without R_i, R_C; a panel left
+        over is removed).
 
     Returns
     -------
     numpy.ndarray of matplotlib.axes.Axes
+        The panels drawn on, titled with what was done (``result.label``).
     """
     from gatetherm.validation.plots.compensation import plot_compensation
 
-    return plot_compensation(result.loop, axes, _panels(axes))
+    return plot_compensation(result.loop, axes, _panels(axes), title=result.label)
 
 
 def prediction(model, data, axes=None):

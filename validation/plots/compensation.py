@@ -11,24 +11,38 @@ from gatetherm.studies.control.compensator import ClosedLoop
 from gatetherm.validation.plots import figure
 
 
-def plot_compensation(loop: ClosedLoop, axes=None, fig=None):
-    """Four panels against time: delta and prediction, prediction error, compensated delta, R;
-    on ``axes`` (four), or four panels of ``fig`` or of a new figure. Returns the Axes."""
-    axes = figure((7.5, 9.0), 4, 1, fig, sharex=True) if axes is None else axes
-    t_h = loop.t_s / 3600.0
+def plot_compensation(loop: ClosedLoop, axes=None, fig=None, title: str = "", delta: str = "δ"):
+    """Panels against time: δ and its prediction, the prediction error, the compensated δ (with
+    the actuator's stroke where the loop drove one: a piezo model), and the correction factors
+    R_i, R_C where the method has them (the paper's; none for the others: three panels). On
+    ``axes`` (four, or three; a fourth left over is removed), or panels of ``fig`` or of a new
+    figure; ``delta``: what δ is on this machine (a :func:`~gatetherm.validation.plots.labels.signal_labels`
+    entry). Returns the Axes drawn on."""
     pr = loop.prediction
-    axes[0].plot(t_h, loop.delta_um, label=r"measured $\delta$ (uncompensated)")
-    axes[0].plot(t_h, loop.delta_pred_um, "--", label=r"predicted $\delta_{et}$")
-    axes[0].set_ylabel(r"$\delta$ / µm")
+    has_R = bool(np.isfinite(np.asarray(pr.R_i, float)).any())
+    n = 4 if has_R else 3
+    if axes is None:
+        axes = figure((7.5, 9.0 if has_R else 7.0), n, 1, fig, sharex=True)
+    else:
+        for extra in list(axes)[n:]:
+            extra.remove()
+        axes = axes[:n]
+    t_h = loop.t_s / 3600.0
+    axes[0].plot(t_h, loop.delta_um, label=f"{delta} (uncompensated)")
+    axes[0].plot(t_h, loop.delta_pred_um, "--", label="predicted δ_et")
+    axes[0].set_ylabel("δ [µm]")
     axes[1].plot(t_h, loop.delta_um - loop.delta_pred_um, color="C3")
-    axes[1].set_ylabel(r"$\delta - \delta_{et}$ / µm")
-    axes[2].plot(t_h, loop.delta_comp_um, color="C2", label=r"compensated $\delta$")
-    axes[2].step(t_h, loop.stroke_um, where="post", color="0.5", lw=0.8, label="piezo at cutting area")
-    axes[2].set_ylabel("µm")
-    axes[3].plot(pr.t_s / 3600.0, pr.R_i, label=r"$R_i$")
-    axes[3].plot(pr.t_s / 3600.0, pr.R_C, label=r"$R_C$")
-    axes[3].set_ylabel("correction factor")
-    axes[3].set_xlabel("time / h")
+    axes[1].set_ylabel("δ − δ_et [µm]")
+    axes[2].plot(t_h, loop.delta_comp_um, color="C2", label="compensated δ")
+    if np.isfinite(np.asarray(loop.voltage_V, float)).any():  # an actuator model drove it
+        axes[2].step(t_h, loop.stroke_um, where="post", color="0.5", lw=0.8, label="actuator stroke (piezo model)")
+    axes[2].set_ylabel("compensated δ [µm]")
+    if has_R:
+        axes[3].plot(pr.t_s / 3600.0, pr.R_i, label="R_i")
+        axes[3].plot(pr.t_s / 3600.0, pr.R_C, label="R_C")
+        axes[3].set_ylabel("correction factor [1]")
+    axes[-1].set_xlabel("time [h]")
+    axes[0].set_title(title, fontsize="medium")
     if pr.peak_index is not None:
         for ax in axes:
             ax.axvline(pr.t_s[pr.peak_index] / 3600.0, color="0.6", lw=0.7, ls=":")

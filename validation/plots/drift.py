@@ -3,7 +3,16 @@ inputs against time, the input phases shaded."""
 from __future__ import annotations
 
 from gatetherm.validation.plots import figure
+from gatetherm.validation.plots.labels import unit
 from gatetherm.validation.plots.run import shade as shade_phases
+
+
+def _input_label(name: str) -> str:
+    """An input's axis label with its unit: a pump is on at 1, off at 0."""
+    if name == "pump" or name.endswith("_pump"):
+        return f"{name} [1 = on, 0 = off]"
+    u = unit(name)
+    return f"{name} [{u}]" if u else f"{name} [as in the file]"
 
 
 def plot_drift(t_s, displacement: dict, temperature: dict, inputs: dict, shade, title: str = "", axes=None):
@@ -27,15 +36,20 @@ def plot_drift(t_s, displacement: dict, temperature: dict, inputs: dict, shade, 
     temps = [n for n in inputs if n.endswith("_degC")]
     for n in temps:
         axes[2].plot(t, inputs[n], label=n)
-    axes[2].set_ylabel("input temperature [°C]" if temps else "")
     others = [n for n in inputs if n not in temps]
-    if others:
-        right = axes[2].twinx()
+    if temps:
+        axes[2].set_ylabel("input temperature [°C]")
+    if others:  # beside the temperatures on a right axis, else on the panel's own
+        right = axes[2].twinx() if temps else axes[2]
         for i, n in enumerate(others):
             right.step(t, inputs[n], where="post", color=f"C{len(temps) + i}", ls="--", label=n)
-        right.set_ylabel(", ".join(others))
-        right.legend(fontsize="x-small", loc="upper right")
-    axes[2].set_xlabel(f"time [{'h' if hours else 'min'}]")
+        right.set_ylabel(", ".join(_input_label(n) for n in others))
+        if temps:
+            right.legend(fontsize="x-small", loc="upper right")
+    if not inputs:  # no empty 0-1 panel: the time axis on the temperatures'
+        axes[2].set_visible(False)
+        axes[1].tick_params(labelbottom=True)
+    axes[2 if inputs else 1].set_xlabel(f"time [{'h' if hours else 'min'}]")
     for ax in axes:
         handles = ax.get_legend_handles_labels()[0]
         if handles:

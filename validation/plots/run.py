@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gatetherm.validation.plots import figure
+from gatetherm.validation.plots.labels import signal_labels
 
 THETAS = (("theta_A_degC", "θ_A"), ("theta_B_degC", "θ_B"), ("theta_C_degC", "θ_C"))
 """The response's temperature signals and their labels."""
@@ -47,17 +48,19 @@ def plot_fluids(cols: dict, problem, title: str = "", ax=None):
     return ax
 
 
-def plot_response(cols: dict, title: str = "", axes=None, fig=None):
+def plot_response(cols: dict, title: str = "", axes=None, fig=None, labels=None):
     """Figs. 11–13 analogue: θ_A, θ_B, θ_C rises (top) and δ (bottom) against time, pump
-    phases shaded. Returns the two Axes."""
-    return plot_responses({"": cols}, title, axes, fig)
+    phases shaded; ``labels``: the signals' legend entries (:func:`~gatetherm.validation.plots.labels.signal_labels`
+    of the case). Returns the two Axes."""
+    return plot_responses({"": cols}, title, axes, fig, labels)
 
 
-def plot_responses(runs: dict, title: str = "", axes=None, fig=None):
+def plot_responses(runs: dict, title: str = "", axes=None, fig=None, labels=None):
     """Figs. 11–13 analogue for one or more runs of the same schedule ({label: columns}: solid
     lines for the first, dashed for the second, …): θ_A, θ_B, θ_C rises and δ against time,
     pump phases shaded; on ``axes`` (two), or two panels of ``fig`` or of a new figure.
-    Returns the two Axes."""
+    ``labels``: legend entries by column (default: θ_A, θ_B, θ_C, δ). Returns the two Axes."""
+    labels = labels or {}
     axes = figure((7.5, 6.5), 2, 1, fig, sharex=True) if axes is None else axes
     a1, a2 = axes
     first = next(iter(runs.values()))
@@ -68,8 +71,8 @@ def plot_responses(runs: dict, title: str = "", axes=None, fig=None):
     for k, (name, cols) in enumerate(runs.items()):
         t, ls, tag = cols["time_s"] / 60.0, ("-", "--", ":")[k % 3], f" {name}" if name else ""
         for i, (key, lab) in enumerate(THETAS):
-            a1.plot(t, cols[key] - cols[key][0], ls=ls, color=f"C{i}", label=lab + tag)
-        a2.plot(t, cols["delta_um"], ls=ls, color="k", label="δ at the tips F" + tag)
+            a1.plot(t, cols[key] - cols[key][0], ls=ls, color=f"C{i}", label=labels.get(key, lab) + tag)
+        a2.plot(t, cols["delta_um"], ls=ls, color="k", label=labels.get("delta_um", "δ") + tag)
         if "delta_E_um" in cols and k == 0:
             a2.plot(t, cols["delta_E_um"], ls=":", color="0.4", lw=0.9, label="δ at E (beam theory point)" + tag)
     a1.set(ylabel="temperature rise [K]", title=title)
@@ -98,6 +101,13 @@ def plot_channels(cols: dict, title: str = "", axes=None, fig=None):
     axes[0].set_title(title)
     axes[1].set(xlabel="time [h]")
     return axes
+
+
+def state_title(title: str, t: float | None) -> str:
+    """The title of a picture of one state: ``title, t = … min``, or ``title, steady state`` for
+    a steady run (``t`` None)."""
+    when = "steady state" if t is None else f"t = {t / 60:.0f} min"
+    return f"{title}, {when}" if title else when
 
 
 def has_response(cols: dict) -> bool:
@@ -149,14 +159,14 @@ def write_pictures(run, out, title: str, picture_s: float | None, solved: dict |
     transient = len(cols["time_s"]) > 1
     wanted = (lambda name: True) if only is None else only.__contains__
     if picture_s is not None and run.model.elastic is not None and wanted("deformed.png"):  # the largest first
-        caption = caption or (lambda t: f"{title}, t = {t / 60:.0f} min")
+        caption = caption or (lambda t: state_title(title, t if transient else None))
         jobs["deformed.png"] = render_deformed, deformed(run, picture_s, caption, solved)
     if transient:
         jobs["channels.png"] = plot_channels, (cols, title)
     if transient and run.model.problem.fluids:
         jobs["oil_temperatures.png"] = plot_fluids, (cols, run.model.problem, title)
     if has_response(cols):
-        jobs["response.png"] = plot_response, (cols, title)
+        jobs["response.png"] = plot_response, (cols, title, None, None, signal_labels(run.model.problem))
     order = PAINTING_ORDER[3 if run.model.dim == 3 else 2]
     jobs = dict(sorted(((k, v) for k, v in jobs.items() if wanted(k)), key=lambda job: order.index(job[0])))
     painter = Painter(0) if painter is None else painter

@@ -5,6 +5,7 @@ import numpy as np
 from matplotlib.ticker import NullFormatter, ScalarFormatter
 
 from gatetherm.validation.plots import figure
+from gatetherm.validation.plots.labels import axis_label, unit
 
 SIZE = (6.0, 4.2)
 """Size of a one-panel sweep plot, inches."""
@@ -17,11 +18,18 @@ def _num(v) -> float:
         return np.nan
 
 
+def _value(key: str, value) -> str:
+    """A legend entry ``key = value unit``."""
+    u = unit(key)
+    return f"{key} = {value}" + (f" {u}" if u and u != "1" else "")
+
+
 def plot_xy(rows: list[dict], x: str, y: str, hue: str | None = None, title: str = "", logx: bool = False,
             hline: float | None = None, lines_by=(), ax=None):
     """Lines with markers of ``y`` over ``x`` (rows without a number left out): one colour per
     ``hue`` value, one line per combination of the ``lines_by`` columns (other swept
-    parameters; line styles tell them apart, the legend names them). Returns the Axes."""
+    parameters; line styles tell them apart, the legend names them); each axis labelled with its
+    column's unit (:func:`~gatetherm.validation.plots.labels.unit`). Returns the Axes."""
     ax = figure(SIZE) if ax is None else ax
     hues = list(dict.fromkeys(r.get(hue) for r in rows)) if hue else [None]
     others = list(dict.fromkeys(tuple(r.get(k) for k in lines_by) for r in rows))
@@ -32,7 +40,7 @@ def plot_xy(rows: list[dict], x: str, y: str, hue: str | None = None, title: str
             pts = [p for p in sorted((_num(r.get(x)), _num(r.get(y))) for r in grp) if np.isfinite(p).all()]
             if not pts:
                 continue
-            label = ", ".join([f"{hue} = {h}"] * bool(hue) + [f"{k} = {v}" for k, v in zip(lines_by, o)])
+            label = ", ".join([_value(hue, h)] * bool(hue) + [_value(k, v) for k, v in zip(lines_by, o)])
             ax.plot(*zip(*pts), "o", ls=styles[j % len(styles)], ms=3.5, color=f"C{i % 10}", label=label or None)
     if hline is not None:
         ax.axhline(hline, color="0.4", lw=0.8, ls="--")
@@ -41,8 +49,8 @@ def plot_xy(rows: list[dict], x: str, y: str, hue: str | None = None, title: str
         ax.set_xticks(sorted({p for r in rows if np.isfinite(p := _num(r.get(x)))}))
         ax.xaxis.set_major_formatter(ScalarFormatter())
         ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(axis_label(x))
+    ax.set_ylabel(axis_label(y))
     ax.set_title(title, fontsize="medium")
     ax.grid(True, lw=0.3)
     if hue or lines_by:

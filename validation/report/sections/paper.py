@@ -17,6 +17,7 @@ def compute(ctx) -> Result:
     from gatetherm.validation.paper_table import run_condition, table_rows
     from gatetherm.validation.plots import save
     from gatetherm.validation.plots.field import draw_deformed
+    from gatetherm.validation.plots.labels import signal_labels
     from gatetherm.validation.plots.run import plot_fluids, plot_responses
 
     dims, load = ctx.scope["dims"], os.getloadavg()[0]
@@ -34,7 +35,8 @@ def compute(ctx) -> Result:
         figures.append(Figure(f"fig10_oil_c{c}.png", f"Fig. 10 analogue, condition {c}: supply oil, oil in the "
                               "tank and tank wall; grey: pump on"))
         save(plot_responses({f"{d}-D": runs[(c, d)].columns for d in dims},
-                            f"condition {c}: θ rises and δ" + (" (solid 2-D, dashed 3-D)" if len(dims) > 1 else "")),
+                            f"condition {c}: θ rises and δ" + (" (solid 2-D, dashed 3-D)" if len(dims) > 1 else ""),
+                            labels=signal_labels(run.model.problem)),
              ctx.work / f"response_c{c}.png")
         figures.append(Figure(f"response_c{c}.png", f"Figs. 11–13 analogue, condition {c}: θ_A, θ_B, θ_C rises "
                               "and δ against time, pump phases shaded"))
