@@ -301,26 +301,30 @@ def test_out_is_checked_before_the_run(tmp_path, capsys, monkeypatch, where, nee
 
 
 def test_a_second_run_into_a_locked_directory_is_refused(tmp_path, capsys):
-    with output_dir(tmp_path / "o") as out:
-        (out / "timeseries.csv").write_text("the first run's\n")
+    out = tmp_path / "o"
+    with output_dir(out) as stage:
+        (stage / "timeseries.csv").write_text("the first run's\n")
         refused(capsys, 1, ["simulate", "--condition", "1", "--out", out],
                 f"gatetherm: error: {out}: another gatetherm run (pid {os.getpid()}) is writing into this directory")
-        assert (out / "timeseries.csv").read_text() == "the first run's\n"
-    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["timeseries.csv"]  # the lock is gone
-
+        assert (stage / "timeseries.csv").read_text() == "the first run's\n"
+    assert sorted(p.name for p in out.iterdir()) == ["timeseries.csv"]  # committed; the lock is gone
 
 
 def test_an_interrupted_run_leaves_no_temporary(tmp_path):
     """A writer cut short (a terminated worker) leaves its temporary; the run's output
-    directory removes it as the interruption passes, and keeps the finished files."""
+    directory removes it and the stage as the interruption passes, and keeps the files a
+    command keeps across runs (a sweep's points, written into the directory itself)."""
     from gatetherm import _new_temporary
 
-    with pytest.raises(KeyboardInterrupt), output_dir(tmp_path / "o") as out:
+    out = tmp_path / "o"
+    with pytest.raises(KeyboardInterrupt), output_dir(out) as stage:
+        (stage / "table.csv").write_text("never committed")
         (out / "points").mkdir()
         (out / "points" / "a.json").write_text("{}")
         _new_temporary(out / "points" / "b.json")
         raise KeyboardInterrupt
     assert sorted(str(p.relative_to(out)) for p in out.rglob("*")) == ["points", "points/a.json"]
+
 
 def test_unwritable_output_and_unreadable_input(tmp_path, capsys, monkeypatch):
     """A read-only output directory (exit 1, before the run) and a model file without read
@@ -399,9 +403,10 @@ def test_a_run_never_overwrites_its_input_files(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml"]
 
 
-def test_disk_full_ends_in_one_line_and_keeps_the_finished_files(tmp_path, capsys, monkeypatch):
-    """The disk fills while the fields are written: exit 1, one line naming the file; the
-    time series written before is complete, no partial file under a final name, no temporary."""
+def test_disk_full_ends_in_one_line_and_leaves_nothing(tmp_path, capsys, monkeypatch):
+    """The disk fills while the fields are written: exit 1, one line naming the file (its
+    name in --out, not the stage's); nothing of the failed run is left (the directory it
+    created is removed again), so no partial file under a final name and no temporary."""
     from gatetherm.studies.run import output
 
     def full(path, *args, **kwargs):
@@ -414,8 +419,7 @@ def test_disk_full_ends_in_one_line_and_keeps_the_finished_files(tmp_path, capsy
     out = tmp_path / "o"
     refused(capsys, 1, ["simulate", "--condition", "1", "--config", cfg, "--no-pictures", "--out", out],
             f"gatetherm: error: {out}/fields/fields_0000min.vtu: No space left on device")
-    assert len(read_timeseries(out / "timeseries.csv")) == 301
-    assert sorted(p.name for p in out.rglob("*") if p.is_file()) == ["timeseries.csv"]
+    assert not out.exists()
 
 
 # ---- sweeps ------------------------------------------------------------------------------------

@@ -175,7 +175,7 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     replaced = [name for name in WRITTEN if name in ts]
     if replaced:
         log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
-    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=out_dir,
+    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=Path(args.out),
                       source=what, rom_source=args.rom)
     summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
                "config": case.source, "dim": case.dim, **({"model": args.model} if args.model else {})}
@@ -194,7 +194,7 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     if actuator:
         save(plot_piezo_loops(actuator), out_dir / "piezo_loops.png")
     write_text_atomic(out_dir / "summary.json", text)
-    print(f"wrote {out_dir}/compensated.csv, compensation.png, "
+    print(f"wrote {args.out}/compensated.csv, compensation.png, "
           f"{'piezo_loops.png, ' if actuator else ''}summary.json")
     print(f"{what}: {comp.head}; swing {summary['swing_um']:.2f} um, "
           f"prediction error band {_um(summary['prediction_error_band_um'])}, "

@@ -82,7 +82,7 @@ def run_fit(args) -> int:
     with output_dir(args.out, FIT_OUTPUTS, keep=(args.data,)) as out:
         model = fit_error_model(ts, targets, candidates, inputs, params, span, source=str(args.data))
         save_model(out / "model.json", model)
-    print(f"wrote {out}/model.json (fitted on {span[0]:g} .. {span[1]:g} s, {model.fit_span['samples']} samples)")
+    print(f"wrote {args.out}/model.json (fitted on {span[0]:g} .. {span[1]:g} s, {model.fit_span['samples']} samples)")
     for m in model.targets:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
         print(f"{m.target}: {m.form}; sensors {', '.join(m.sensors)}; time constants {taus}; "
@@ -122,7 +122,7 @@ def run_predict(args) -> int:
         write_timeseries(out / "prediction.csv", TimeSeries(cols, source))
         save(plot_model_prediction(model, ts), out / "prediction.png")
         write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
-    print(f"wrote {out}/prediction.csv, prediction.png, summary.json")
+    print(f"wrote {args.out}/prediction.csv, prediction.png, summary.json")
     for name, g in gaps.items():
         print(f"{name}: {g.filled} missing samples filled (longest gap {g.longest_s:.0f} s), "
               f"{g.unpredicted} in gaps over {model.max_gap_s:.0f} s not predicted")

@@ -103,7 +103,7 @@ def run(args) -> int:
         seconds = time.perf_counter() - t0
         check = gt.check_placement(case, placement) if args.check else None
         summary = gt.write_placement(out, placement, case, check, {"seconds_total": round(seconds, 2)})
-    _report(placement, summary, check, out, seconds)
+    _report(placement, summary, check, args.out, seconds)
     return 0
 
 

@@ -40,7 +40,7 @@ def run(args) -> int:
             res = gt.run(case, schedule, effects, keep=picture_keep(schedule, every),
                          on_step=Progress(f"condition {args.condition or 'file'}"), fields_every=every)
             s = res.write(out, pictures=not args.no_pictures, fields_every=every, painter=painter, release=True)
-    print(f"wrote {out}/timeseries.csv, summary.json, fields/ and plots")
+    print(f"wrote {args.out}/timeseries.csv, summary.json, fields/ and plots")
     print("first peak {first_peak_um} µm at {first_peak_min} min, swing {swing_um} µm, wall time {w} s"
           .format(**{k: (round(v, 2) if isinstance(v, float) else v) for k, v in s.items()}, w=s["wall_time_s"]))
     return 0
