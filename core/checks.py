@@ -168,3 +168,82 @@ def check_linear_system(where: str, modes, C, D=None, inputs=None, outputs=None)
         eig = np.linalg.eigvals(np.asarray(A, float))
         if not eig.real.max() < -1e-9 * np.abs(eig).max():  # a zero eigenvalue is zero only to round-off
             fail(f"A_{mode} is not stable (an eigenvalue with real part {eig.real.max():.3g} >= 0)")
+
+
+class NonFiniteError(InputError):
+    """A number that would be written to a file, or was read from one, is NaN or infinite:
+    ``str(err)`` names the file and the quantity (its path in the data) on one line."""
+
+
+def first_nonfinite(data, path: str = "") -> tuple[str, float] | None:
+    """``(path, value)`` of the first NaN or infinite float in nested dicts, lists and tuples
+    (``path`` as ``a.b[2].c``), or None."""
+    stack = [(path, data)]
+    while stack:
+        where, value = stack.pop()
+        if isinstance(value, (float, np.floating)) and not math.isfinite(value):
+            return where or "the value", float(value)
+        if isinstance(value, dict):
+            stack.extend((f"{where}.{k}" if where else str(k), v) for k, v in reversed(list(value.items())))
+        elif isinstance(value, (list, tuple)):
+            stack.extend((f"{where}[{i}]", v) for i, v in reversed(list(enumerate(value))))
+    return None
+
+
+def json_text(data, what: str, **dumps) -> str:
+    """``data`` as JSON text (and a final newline) for the file ``what``; :class:`NonFiniteError`
+    naming the quantity if a number in it is NaN or infinite (JSON has no such numbers, and a
+    reader would take a default for them)."""
+    import json
+
+    bad = first_nonfinite(data)
+    if bad is not None:
+        raise NonFiniteError(f"{what}: {bad[0]}", f"is {bad[1]}, not a finite number; nothing was written",
+                             "report it with the command and its input files")
+    return json.dumps(data, allow_nan=False, **dumps) + "\n"
+
+
+MAX_JSON_DEPTH = 32
+"""Deepest nesting of lists and objects a JSON input file may have."""
+
+
+def parse_json(text: str, where: str, fix: str):
+    """The data of the JSON text of the file ``where``: InputError (one line) for text that is
+    not JSON, for NaN, Infinity or a number too large for a float, and for nesting deeper than
+    :data:`MAX_JSON_DEPTH`."""
+    import json
+
+    def constant(name):
+        raise InputError(where, f"holds {name}, not a finite number", fix)
+
+    def number(text):
+        value = float(text)
+        if not math.isfinite(value):
+            raise InputError(where, f"holds {text}, not a finite number", fix)
+        return value
+
+    def integer(text):
+        if len(text.lstrip("-")) > 18:
+            raise InputError(where, f"holds the integer {text[:12]}... of {len(text)} digits", fix)
+        return int(text)
+
+    try:
+        data = json.loads(text, parse_constant=constant, parse_float=number, parse_int=integer)
+    except RecursionError:
+        data = None
+        too_deep = True
+    except ValueError as err:
+        if isinstance(err, InputError):
+            raise
+        raise InputError(where, f"not JSON ({err})", fix) from None
+    else:
+        too_deep = False
+        stack = [(data, 1)]
+        while stack and not too_deep:
+            value, depth = stack.pop()
+            if isinstance(value, (dict, list)):
+                too_deep = depth > MAX_JSON_DEPTH
+                stack.extend((v, depth + 1) for v in (value.values() if isinstance(value, dict) else value))
+    if too_deep:
+        raise InputError(where, f"nested deeper than {MAX_JSON_DEPTH} levels", fix)
+    return data

@@ -9,6 +9,7 @@ import errno
 import json
 import math
 import os
+import re
 import typing
 from pathlib import Path
 
@@ -492,3 +493,92 @@ def test_a_failed_point_is_one_line_naming_the_field(tmp_path, capsys, monkeypat
             "gatetherm: error: 1 of 2 points failed (point {'geometry.l4': 0.3}: thermal.h_air: got -1")
     assert [row.split(",")[1] for row in (tmp_path / "o" / "table.csv").read_text().splitlines()[1:]] == \
         ["ok", "pending"]
+
+
+# ---- error-model files, leakage, non-finite numbers (issue 55) ---------------------------------
+
+def _record(path: Path) -> Path:
+    """A machine's record: d_um = 2 theta_1 + noise, two sensors, 400 samples a minute apart."""
+    from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
+
+    rng = np.random.default_rng(0)
+    t = 60.0 * np.arange(400)
+    s1, s2 = 22 + np.cumsum(rng.normal(0, 0.05, t.size)), 22 + np.cumsum(rng.normal(0, 0.05, t.size))
+    write_timeseries(path, TimeSeries({"time_s": t, "s1_degC": s1, "s2_degC": s2, "rpm": 0 * t,
+                                       "d_um": 2.0 * (s1 - s1[0]) + rng.normal(0, 0.05, t.size)}, {"format": "x"}))
+    return path
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fitted")
+    data = _record(d / "data.csv")
+    assert main(["errormodel", "fit", "--data", str(data), "--targets", "d_um", "--out", str(d)]) == 0
+    return data, json.loads((d / "model.json").read_text())
+
+
+@pytest.mark.parametrize("option", ["--candidates", "--inputs"])
+def test_a_target_is_never_read_by_its_own_model(tmp_path, capsys, fitted, option):
+    """The leak of issue 55: d_um predicted from itself (held-out error 1e-15) is refused before
+    the data file is read, and the library refuses it too."""
+    from gatetherm.studies.errormodel.fit import fit_error_model
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    data, _ = fitted
+    refused(capsys, 2, ["errormodel", "fit", "--data", tmp_path / "none.csv", "--targets", "d_um", option,
+                        "d_um,s1_degC", "--out", tmp_path / "o"],
+            f"gatetherm: error: {option} d_um: is a target (--targets): a model cannot read the column it predicts; "
+            f"drop d_um from {option}")
+    kwargs = {"candidates": ["s1_degC", "d_um"]} if option == "--candidates" else {"inputs": ["d_um"]}
+    with pytest.raises(InputError, match="d_um: is a target"):
+        fit_error_model(read_timeseries(data, required=("time_s",)), ["d_um"], **kwargs)
+    assert not (tmp_path / "o").exists()
+
+
+def _coefficient(model: dict, text: str) -> str:
+    """The model file with its first coefficient written as ``text``."""
+    return re.sub(r'"coefficient": [^,}]+', f'"coefficient": {text}', json.dumps(model), count=1)
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda d: {**d, "targets": {}}, "model.json: targets: is empty: the model predicts nothing"),
+    (lambda d: _coefficient(d, "NaN"), "holds NaN, not a finite"),
+    (lambda d: _coefficient(d, "1e999"), "holds 1e999, not a fin"),
+    (lambda d: _coefficient(d, '"nan"'),
+     "model.json: targets.d_um.terms[0].coefficient: is nan, not a finite number"),
+    (lambda d: _coefficient(d, "1" * 400),
+     "holds the integer 111111111111... of 400 digits"),
+    (lambda d: "[" * 100_000 + "]" * 100_000, "model.json: nested deeper than 32 levels"),
+    (lambda d: {**d, "targets": {"d_um": {**d["targets"]["d_um"], "terms": [
+        {"kind": "sensor", "column": "d_um", "coefficient": 1.0}]}}, "reference_degC": {"d_um": 0.0}},
+     "model.json: targets.d_um: reads its own target column"),
+], ids=["no targets", "NaN", "1e999", "'nan'", "400 digits", "nested 100000 deep", "reads its target"])
+def test_error_model_files_are_refused_in_one_line(tmp_path, capsys, fitted, edit, needle):
+    data, model = fitted
+    text = edit(model)
+    path = _write(tmp_path / "model.json", text if isinstance(text, str) else json.dumps(text))
+    refused(capsys, 2, ["errormodel", "predict", path, "--data", data, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def test_json_writers_name_a_non_finite_quantity(tmp_path):
+    from gatetherm.checks import NonFiniteError, json_text
+    from gatetherm.studies.run.output import write_json
+
+    with pytest.raises(NonFiniteError, match=r"^summary.json: probes.tip\[1\]: is nan, not a finite number; "
+                                             "nothing was written"):
+        write_json(tmp_path / "summary.json", {"probes": {"tip": [1.0, float("nan")]}})
+    assert json_text({"a": [1.5, None]}, "x.json") == '{"a": [1.5, null]}\n'
+    assert not list(tmp_path.iterdir())
+
+
+def test_fit_with_differences_on_the_shipped_record_writes_finite_numbers(tmp_path, capsys):
+    """errormodel fit --differences gave ``ValueError: Out of range float values ...: inf``: a
+    forward step whose every addition made the model singular (a difference of two sensors
+    already in it) was put on the path with an infinite error. Such additions are skipped."""
+    data = _record(tmp_path / "data.csv")
+    assert main(["errormodel", "fit", "--data", str(data), "--targets", "d_um", "--differences",
+                 "--out", str(tmp_path / "o")]) == 0
+    model = json.loads((tmp_path / "o" / "model.json").read_text())
+    errors = [s["cv_mae_um"] for s in model["targets"]["d_um"]["selection"]]
+    assert all(map(math.isfinite, errors)) and min(errors) == pytest.approx(0.04, abs=0.01)  # band: noise 0.05 um

@@ -35,12 +35,12 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import logging
 import math
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.cli.options import add_model_options, refuse_model_options
 
 log = logging.getLogger(__name__)
@@ -179,7 +179,7 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
                       source=what, rom_source=args.rom)
     summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
                "config": case.source, "dim": case.dim, **({"model": args.model} if args.model else {})}
-    text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
+    text = json_text(summary, "summary.json", indent=2)
     loop = comp.loop
     out = ts.with_columns(u_piezo_um=loop.stroke_um, delta_pred_um=loop.delta_pred_um,
                           delta_comp_um=loop.delta_comp_um)

@@ -2,9 +2,9 @@
 gatetherm against an independent FE code."""
 from __future__ import annotations
 
-import json
 
 from gatetherm import InputError, write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.cli.options import add_model_options, refuse_model_options
 
 #: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
@@ -46,7 +46,7 @@ def run(args) -> int:
     with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files)) as out:
         inp, info = export_state(case, schedule, t, f"gatetherm {what}, t = {t / 60:g} min")
         write_text_atomic(out / "job.inp", inp)
-        write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")
+        write_text_atomic(out / "gatetherm.json", json_text(info, "gatetherm.json", indent=2))
     print(f"wrote {args.out}/job.inp ({info['vertices']} vertices) and gatetherm.json; run: cd {args.out} && ccx job")
     for name, v in info["relative_m"].items():
         print(f"gatetherm {name}: {v * 1e6:.6g} um")
