@@ -17,9 +17,9 @@ from gatetherm import InputError
 from gatetherm.geometry.build import _extract
 from gatetherm.geometry.geoscan import scan
 from gatetherm.geometry.groups import GroupRule, fragment, interfaces, physical, regions
-from gatetherm.geometry.isolate import READ_LIMIT_S, run_isolated
+from gatetherm.geometry.isolate import READ_LIMIT_S, quiet, run_isolated
 from gatetherm.geometry.mesh import FrameMesh, check_mesh, from_arrays, to_arrays
-from gatetherm.geometry.sizing import check_estimate, model_estimate
+from gatetherm.geometry.sizing import check_count, check_estimate, model_estimate
 
 log = logging.getLogger(__name__)
 
@@ -122,12 +122,15 @@ def _read(gmsh, spec: MeshSpec) -> int:
     try:
         if spec.path.suffix.lower() == SCRIPT:
             signal.alarm(READ_LIMIT_S)  # an endless loop: the child ends on SIGALRM (isolate._result)
+            verbosity = gmsh.option.getNumber("General.Verbosity")
+            gmsh.option.setNumber("General.Verbosity", min(verbosity, 1))  # the script's Printf: not shown
             gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)
+            gmsh.option.setNumber("General.Verbosity", verbosity)
         else:
             gmsh.model.occ.importShapes(str(spec.path))
             gmsh.model.occ.synchronize()
     except Exception as err:  # gmsh reports a bad file as a plain Exception
-        raise InputError(str(spec.path), f"gmsh cannot read it ({err})", "check the file in gmsh") from None
+        raise InputError(str(spec.path), f"gmsh cannot read it ({quiet(str(err))})", "check the file in gmsh") from None
     finally:
         signal.alarm(0)
     dim = max((d for d, _ in gmsh.model.getEntities()), default=0)
@@ -142,7 +145,7 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
     try:
         fragment(gmsh, dim)
     except Exception as err:  # noqa: BLE001 - OpenCASCADE's own failure
-        raise InputError(str(spec.path), f"its solids cannot be made conformal ({err})",
+        raise InputError(str(spec.path), f"its solids cannot be made conformal ({quiet(str(err), script=False)})",
                          "check the CAD model") from None
     regions(gmsh, spec.groups, dim)
     interfaces(gmsh, dim)
@@ -159,7 +162,10 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
     try:
         gmsh.model.mesh.generate(dim)
     except Exception as err:  # noqa: BLE001
-        raise InputError(str(spec.path), f"gmsh cannot mesh it ({err})", "check the geometry in gmsh") from None
+        raise InputError(str(spec.path), f"gmsh cannot mesh it ({quiet(str(err), script=False)})", "check the geometry in gmsh") from None
+    elements = sum(len(t) for e in gmsh.model.getEntities(dim) for t in gmsh.model.mesh.getElements(*e)[1])
+    key, value = _size_key(spec, tag, size, mine)
+    check_count(elements, dim, key, value, "" if "factor" in key else " m", counted=True)
     groups = {d: {names[(d, t)]: [int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(d, t)]
                   for dd, t in names if dd == d} for d in range(dim + 1)}
     owner: dict[int, str] = {}

@@ -582,3 +582,60 @@ def test_fit_with_differences_on_the_shipped_record_writes_finite_numbers(tmp_pa
     model = json.loads((tmp_path / "o" / "model.json").read_text())
     errors = [s["cv_mae_um"] for s in model["targets"]["d_um"]["selection"]]
     assert all(map(math.isfinite, errors)) and min(errors) == pytest.approx(0.04, abs=0.01)  # band: noise 0.05 um
+
+
+# ---- gmsh's reading of a case is quiet (issue 55) ----------------------------------------------
+
+PLATE_GEO = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 1, 1};
+Physical Surface("plate") = {1};
+Physical Curve("edge") = {1};
+"""
+PLATE_CASE = '[mesh]\nfile = "a.geo"\nsize = SIZE\n[materials.plate]\nk = 50.0\n[thermal.edge]\ntemperature = 100.0\n'
+
+
+@pytest.mark.parametrize("script, needle", [
+    ('Error(StrCat("leak: ", GetEnv("GT_SECRET")));\n',
+     "a.geo: gmsh cannot read it (gmsh's message is not repeated: it names no line; open the file in gmsh to read it)"),
+    ('Printf(StrCat("leak: ", GetEnv("GT_SECRET")));\nError("stop");\n', "gmsh's message is not repeated"),
+    ('x = GT_SECRET_IS_hunter2 + ;\n', "a.geo: gmsh cannot read it (a.geo, line 5: Unknown variable); check the file"),
+    ('Error(StrCat("leak: ", GetString("GT_SECRET")));\n', "gmsh's message is not repeated"),
+], ids=["Error of GetEnv", "Printf of GetEnv", "a syntax error quoting the text", "GetString"])
+def test_a_geo_never_echoes_the_environment_or_its_own_text(tmp_path, capsys, monkeypatch, script, needle):
+    """A .geo's messages are not repeated beyond the file name and line; the script's process
+    has no environment to read (GetEnv gives ''), also in the -v log."""
+    monkeypatch.setenv("GT_SECRET", "hunter2")
+    _write(tmp_path / "a.geo", PLATE_GEO + script)
+    case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", "0.25"))
+    err = refused(capsys, 2, ["-v", "run", case, "--out", tmp_path / "o"], needle)
+    assert "hunter2" not in err and "leak" not in err
+
+
+def test_the_child_reading_a_geo_has_no_environment(tmp_path, monkeypatch):
+    """The script writes what GetEnv gives into a Physical name, which comes back in the mesh:
+    empty, for a variable set in gatetherm's environment."""
+    from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+
+    monkeypatch.setenv("GT_SECRET", "hunter2")
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    geo = PLATE_GEO.replace('"edge"', 'StrCat("e", GetEnv("GT_SECRET"), GetEnv("OMP_NUM_THREADS"))')
+    fm = mesh_geometry(MeshSpec(_write(tmp_path / "a.geo", geo), size=0.25))
+    assert sorted(fm.boundaries) == ["e1"]
+
+
+@pytest.mark.parametrize("size, needle", [
+    ("1e-300", "mesh.size: 1e-300 m gives more triangles than can be counted, more than the budget of 5e+07 "
+               "elements; give a size of about a tenth of the smallest part"),
+    ("1e-4", "mesh.size: 0.0001 m gives about 2.3e+08 triangles, more than the budget of 5e+07 elements; raise it "
+             "to at least 0.00021 m"),
+], ids=["1e-300", "1e-4"])
+def test_an_element_size_beyond_the_element_budget_is_refused(tmp_path, capsys, monkeypatch, size, needle):
+    """[mesh] size = 1e-300 gave ZeroDivisionError in gmsh's process; every size whose estimate
+    exceeds the budget is refused in one line before gmsh meshes (memory set ample here)."""
+    from gatetherm.geometry import sizing
+
+    monkeypatch.setattr(sizing, "memory_bytes", lambda: 1e15)
+    _write(tmp_path / "a.geo", PLATE_GEO)
+    case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", size))
+    refused(capsys, 2, ["run", case, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
