@@ -247,3 +247,35 @@ def parse_json(text: str, where: str, fix: str):
     if too_deep:
         raise InputError(where, f"nested deeper than {MAX_JSON_DEPTH} levels", fix)
     return data
+
+
+def argument(name: str, value, kinds, expected: str, fix: str = ""):
+    """``value`` if it is an instance of ``kinds`` (a bool only where ``bool`` is among them),
+    else a one-line :class:`TypeError` naming the argument ``name``, what it ``expected`` and the
+    ``fix``: a public function's type check, before any numerics."""
+    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
+    if isinstance(value, kinds) and not (isinstance(value, (bool, np.bool_)) and bool not in kinds):
+        return value
+    raise TypeError(f"{name}: got {type(value).__name__} {_short(value)}, expected {expected}" + (f"; {fix}" if fix
+                                                                                                  else ""))
+
+
+def number_argument(name: str, value, rng: Range = FINITE, fix: str = "") -> float:
+    """``value`` as a float if it is a number (not a bool: :class:`TypeError`) in ``rng``, else
+    :class:`~gatetherm.InputError` naming the argument ``name``, the range and the ``fix``."""
+    argument(name, value, numbers.Real, "a number", fix)
+    rng.check(name, value, fix)
+    return float(value)
+
+
+def whole_argument(name: str, value, rng: Range, fix: str = "") -> int:
+    """``value`` as an int if it is a whole number (an int, or a float with no fraction: not a
+    bool, :class:`TypeError`) in ``rng``; else InputError naming ``name``, the range, the fix."""
+    argument(name, value, numbers.Real, "a whole number", fix)
+    dataclasses.replace(rng, whole=True).check(name, value, fix)
+    return int(value)
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

@@ -5,7 +5,8 @@ import os
 from pathlib import Path
 from typing import Mapping
 
-from gatetherm.api.run import Case
+from gatetherm.api.run import Case, _case
+from gatetherm.checks import Range, whole_argument
 
 
 def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, **settings):
@@ -59,6 +60,8 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
     from gatetherm.studies.sensors.candidates import Box
     from gatetherm.studies.sensors.place import PlacementSettings, place_sensors as place
 
+    _case(case)
+    count = whole_argument("count", count, Range(1, 50), "e.g. 3")
     fit = {k: settings.pop(k) for k in ("form", "max_inputs", "min_gain") if k in settings}
     if isinstance(settings.get("ranges"), Mapping):
         settings["ranges"] = tuple((k, float(lo), float(hi)) for k, (lo, hi) in settings["ranges"].items())
