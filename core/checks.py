@@ -102,6 +102,9 @@ NONNEGATIVE = Range(0.0)
 FINITE = Range()
 CELSIUS = Range(ABSOLUTE_ZERO_C, MAX_CELSIUS, lo_open=True, unit="°C")
 """A temperature: above absolute zero and at most :data:`MAX_CELSIUS`."""
+ACCELERATION = Range(-1e4, 1e4, unit="m/s²")
+"""A component of ``[gravity]``: up to about 1 000 g (a machine on a shaker table, not a
+number that makes every displacement overflow)."""
 
 
 def admissible(default: Range | None = None, **ranges: Range):

@@ -6,7 +6,10 @@ from pathlib import Path
 from typing import Mapping
 
 from gatetherm.api.run import Case, _case
-from gatetherm.checks import Range, whole_argument
+from gatetherm.checks import Range, number_argument, whole_argument
+
+SPAN = Range(-1e9, 1e9)
+"""What a bound of ``ranges`` may be, in the input's unit (°C, W, 1/min …)."""
 
 
 def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, **settings):
@@ -64,7 +67,8 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
     count = whole_argument("count", count, Range(1, 50), "e.g. 3")
     fit = {k: settings.pop(k) for k in ("form", "max_inputs", "min_gain") if k in settings}
     if isinstance(settings.get("ranges"), Mapping):
-        settings["ranges"] = tuple((k, float(lo), float(hi)) for k, (lo, hi) in settings["ranges"].items())
+        settings["ranges"] = tuple((k, *(number_argument(f"ranges[{k!r}]", v, SPAN, "give LO, HI in the input's unit")
+                                         for v in (lo, hi))) for k, (lo, hi) in settings["ranges"].items())
     if "exclude" in settings:
         settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
     if "boundaries" in settings:
