@@ -639,3 +639,41 @@ def test_an_element_size_beyond_the_element_budget_is_refused(tmp_path, capsys, 
     case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", size))
     refused(capsys, 2, ["run", case, "--out", tmp_path / "o"], needle)
     assert not (tmp_path / "o").exists()
+
+
+# ---- the older audit's and the newest commands' arguments (issue 55) ----------------------------
+
+@pytest.mark.parametrize("argv, needle", [
+    (["sensors", "--seed", "-1"], "gatetherm sensors: error: argument --seed: got -1, must be a whole number in [0, "),
+    (["sensors", "--exclude=0,0,nan,1"], "gatetherm: error: --exclude: got nan, must be a finite number"),
+    (["sensors", "--range", "spindle_W=0:1e300"],
+     "gatetherm: error: --range spindle_W: got 1e+300, must be a number in [-1e+09, 1e+09]"),
+    (["sensors", "--range", "spindle_W=5:1"], "gatetherm: error: --range spindle_W=5:1: its low end is above its high"),
+    (["simulate", "--condition", "0"], "gatetherm: error: --condition: no condition 0; choose one of 1, 2, 3"),
+    (["export", "ccx", "--condition", "0"], "gatetherm: error: --condition: no condition 0"),
+    (["compensate", "--model", "m.json", "--data", "d.csv", "--method", "rom"],
+     "gatetherm: error: --model/--method: --model replays a fitted error model: --method rom would be ignored"),
+], ids=["seed -1", "exclude nan", "range 1e300", "range reversed", "simulate condition 0", "export condition 0",
+        "model with method"])
+def test_command_arguments_are_refused_in_one_line(tmp_path, capsys, argv, needle):
+    refused(capsys, 2, [*argv, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_case_diagnosis_study_of_an_unfit_case_is_one_line(tmp_path, capsys):
+    """validate case-diagnosis --case t4.toml: AttributeError ('function' object has no
+    attribute 'columns') deep in the study; a steady case without signals is refused at once."""
+    t4 = Path(__file__).parents[1] / "validation" / "nafems" / "t4.toml"
+    refused(capsys, 2, ["validate", "case-diagnosis", "--case", t4, "--out", tmp_path / "o"],
+            f"gatetherm: error: --case {t4}: the study replays a transient case from its schedule file")
+    assert not (tmp_path / "o").exists()
+
+
+def test_gravity_out_of_range_names_gravity(tmp_path, capsys):
+    """[gravity] of 1e300 ended in a message about a stress column; now the key is named."""
+    example = Path(__file__).parents[1] / "validation" / "examples" / "c_frame"
+    for f in example.iterdir():
+        _write(tmp_path / f.name, f.read_bytes())
+    case = _write(tmp_path / "case.toml", (example / "case.toml").read_text() + "\n[gravity]\nacceleration = [0, -1e300]\n")
+    refused(capsys, 2, ["run", case, "--out", tmp_path / "o"],
+            f"gatetherm: error: {case}: gravity.acceleration[2]: got -1e+300, must be a number in [-10000, 10000] m/s²")

@@ -110,6 +110,9 @@ def _settings(args):
     control = PredictiveParams(mode=args.updates, max_updates=args.max_updates, interval_s=params.update_interval_s)
     sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
     model = None
+    if args.model is not None and args.method != "paper":
+        raise InputError("--model/--method", f"--model replays a fitted error model: --method {args.method} would "
+                         "be ignored", "drop --method, or drop --model")
     if args.model is not None:  # a bad model file or --target fails before --out is touched
         from gatetherm.studies.errormodel.model import load_model
         from gatetherm.studies.errormodel.replay import loop_target
