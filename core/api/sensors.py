@@ -71,6 +71,9 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
                                          for v in (lo, hi))) for k, (lo, hi) in settings["ranges"].items())
     if "exclude" in settings:
         settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
+        for i, box in enumerate(settings["exclude"]):
+            for v in (*box.lo, *box.hi):
+                number_argument(f"exclude[{i}]", v, fix="give a box's low and high corners, m")
     if "boundaries" in settings:
         b = settings["boundaries"]
         settings["boundaries"] = (b,) if isinstance(b, str) else tuple(b)
