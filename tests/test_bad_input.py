@@ -677,3 +677,16 @@ def test_gravity_out_of_range_names_gravity(tmp_path, capsys):
     case = _write(tmp_path / "case.toml", (example / "case.toml").read_text() + "\n[gravity]\nacceleration = [0, -1e300]\n")
     refused(capsys, 2, ["run", case, "--out", tmp_path / "o"],
             f"gatetherm: error: {case}: gravity.acceleration[2]: got -1e+300, must be a number in [-10000, 10000] m/s²")
+
+
+def test_a_geometry_of_more_parts_than_the_budget_is_refused(tmp_path, capsys):
+    """1 000 touching cubes gave no output in 300 s (fragmenting them); over the part budget
+    a geometry is refused in one line before."""
+    from gatetherm.geometry.gmshfile import MAX_PARTS
+
+    n = MAX_PARTS + 1
+    geo = 'SetFactory("OpenCASCADE");\nFor i In {1:%d}\n  Rectangle(i) = {2 * i, 0, 0, 1, 1};\nEndFor\n' % n
+    _write(tmp_path / "a.geo", geo + 'Physical Surface("plate") = {1:%d};\nPhysical Curve("edge") = {1};\n' % n)
+    case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", "0.5"))
+    refused(capsys, 2, ["run", case, "--out", tmp_path / "o"],
+            f"a.geo: has {n} surfaces, more than the budget of {MAX_PARTS} parts")
