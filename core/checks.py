@@ -102,6 +102,9 @@ NONNEGATIVE = Range(0.0)
 FINITE = Range()
 CELSIUS = Range(ABSOLUTE_ZERO_C, MAX_CELSIUS, lo_open=True, unit="°C")
 """A temperature: above absolute zero and at most :data:`MAX_CELSIUS`."""
+ACCELERATION = Range(-1e4, 1e4, unit="m/s²")
+"""A component of ``[gravity]``: up to about 1 000 g (a machine on a shaker table, not a
+number that makes every displacement overflow)."""
 
 
 def admissible(default: Range | None = None, **ranges: Range):
@@ -168,3 +171,114 @@ def check_linear_system(where: str, modes, C, D=None, inputs=None, outputs=None)
         eig = np.linalg.eigvals(np.asarray(A, float))
         if not eig.real.max() < -1e-9 * np.abs(eig).max():  # a zero eigenvalue is zero only to round-off
             fail(f"A_{mode} is not stable (an eigenvalue with real part {eig.real.max():.3g} >= 0)")
+
+
+class NonFiniteError(InputError):
+    """A number that would be written to a file, or was read from one, is NaN or infinite:
+    ``str(err)`` names the file and the quantity (its path in the data) on one line."""
+
+
+def first_nonfinite(data, path: str = "") -> tuple[str, float] | None:
+    """``(path, value)`` of the first NaN or infinite float in nested dicts, lists and tuples
+    (``path`` as ``a.b[2].c``), or None."""
+    stack = [(path, data)]
+    while stack:
+        where, value = stack.pop()
+        if isinstance(value, (float, np.floating)) and not math.isfinite(value):
+            return where or "the value", float(value)
+        if isinstance(value, dict):
+            stack.extend((f"{where}.{k}" if where else str(k), v) for k, v in reversed(list(value.items())))
+        elif isinstance(value, (list, tuple)):
+            stack.extend((f"{where}[{i}]", v) for i, v in reversed(list(enumerate(value))))
+    return None
+
+
+def json_text(data, what: str, **dumps) -> str:
+    """``data`` as JSON text (and a final newline) for the file ``what``; :class:`NonFiniteError`
+    naming the quantity if a number in it is NaN or infinite (JSON has no such numbers, and a
+    reader would take a default for them)."""
+    import json
+
+    bad = first_nonfinite(data)
+    if bad is not None:
+        raise NonFiniteError(f"{what}: {bad[0]}", f"is {bad[1]}, not a finite number; nothing was written",
+                             "report it with the command and its input files")
+    return json.dumps(data, allow_nan=False, **dumps) + "\n"
+
+
+MAX_JSON_DEPTH = 32
+"""Deepest nesting of lists and objects a JSON input file may have."""
+
+
+def parse_json(text: str, where: str, fix: str):
+    """The data of the JSON text of the file ``where``: InputError (one line) for text that is
+    not JSON, for NaN, Infinity or a number too large for a float, and for nesting deeper than
+    :data:`MAX_JSON_DEPTH`."""
+    import json
+
+    def constant(name):
+        raise InputError(where, f"holds {name}, not a finite number", fix)
+
+    def number(text):
+        value = float(text)
+        if not math.isfinite(value):
+            raise InputError(where, f"holds {text}, not a finite number", fix)
+        return value
+
+    def integer(text):
+        if len(text.lstrip("-")) > 18:
+            raise InputError(where, f"holds the integer {text[:12]}... of {len(text)} digits", fix)
+        return int(text)
+
+    try:
+        data = json.loads(text, parse_constant=constant, parse_float=number, parse_int=integer)
+    except RecursionError:
+        data = None
+        too_deep = True
+    except ValueError as err:
+        if isinstance(err, InputError):
+            raise
+        raise InputError(where, f"not JSON ({err})", fix) from None
+    else:
+        too_deep = False
+        stack = [(data, 1)]
+        while stack and not too_deep:
+            value, depth = stack.pop()
+            if isinstance(value, (dict, list)):
+                too_deep = depth > MAX_JSON_DEPTH
+                stack.extend((v, depth + 1) for v in (value.values() if isinstance(value, dict) else value))
+    if too_deep:
+        raise InputError(where, f"nested deeper than {MAX_JSON_DEPTH} levels", fix)
+    return data
+
+
+def argument(name: str, value, kinds, expected: str, fix: str = ""):
+    """``value`` if it is an instance of ``kinds`` (a bool only where ``bool`` is among them),
+    else a one-line :class:`TypeError` naming the argument ``name``, what it ``expected`` and the
+    ``fix``: a public function's type check, before any numerics."""
+    kinds = kinds if isinstance(kinds, tuple) else (kinds,)
+    if isinstance(value, kinds) and not (isinstance(value, (bool, np.bool_)) and bool not in kinds):
+        return value
+    raise TypeError(f"{name}: got {type(value).__name__} {_short(value)}, expected {expected}" + (f"; {fix}" if fix
+                                                                                                  else ""))
+
+
+def number_argument(name: str, value, rng: Range = FINITE, fix: str = "") -> float:
+    """``value`` as a float if it is a number (not a bool: :class:`TypeError`) in ``rng``, else
+    :class:`~gatetherm.InputError` naming the argument ``name``, the range and the ``fix``."""
+    argument(name, value, numbers.Real, "a number", fix)
+    rng.check(name, value, fix)
+    return float(value)
+
+
+def whole_argument(name: str, value, rng: Range, fix: str = "") -> int:
+    """``value`` as an int if it is a whole number (an int, or a float with no fraction: not a
+    bool, :class:`TypeError`) in ``rng``; else InputError naming ``name``, the range, the fix."""
+    argument(name, value, numbers.Real, "a whole number", fix)
+    dataclasses.replace(rng, whole=True).check(name, value, fix)
+    return int(value)
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

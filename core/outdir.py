@@ -1,17 +1,21 @@
-"""The output directory of a run, made ready before anything is computed.
+"""The output directory of a run: a transaction, made ready before anything is computed.
 
 :func:`output_dir` checks that the directory can be created and written (not a file, no
 file above it, not read-only), takes a lock on it so that a second run into it is refused
-at once, and removes what a previous run left there: temporaries of a killed run (named
-:data:`gatetherm.TEMP_PREFIX`...) and the files the command owns (its output set), so that
-the directory then holds exactly the files of this run. Every command that writes files
-runs inside it.
+at once, and yields a *stage*: a hidden folder inside it (named :data:`gatetherm.TEMP_PREFIX`...)
+that the command writes its files into. Only when the command succeeds do the staged files
+replace the previous run's (the files the command owns, its output set, that this run did not
+write again are removed then), so that the directory holds exactly the files of this run. A
+refusal, an error, Ctrl-C or SIGTERM removes the stage and leaves the previous results as they
+were; a kill -9 leaves them too, and its stage is removed by the next command into the
+directory. Every command that writes files runs inside it.
 """
 from __future__ import annotations
 
 import contextlib
 import logging
 import os
+import shutil
 from pathlib import Path
 
 from gatetherm import TEMP_PREFIX, InputError, _new_temporary
@@ -76,16 +80,44 @@ def _unlock(out: Path, fd: int | None) -> None:
         os.close(fd)
 
 
-def _clean(out: Path, owns, keep) -> None:
-    stale = [*out.glob(f"{TEMP_PREFIX}*"), *out.glob(f"*/{TEMP_PREFIX}*"), *(p for g in owns for p in out.glob(g))]
-    keep = {Path(k).resolve() for k in keep if k is not None}
+def _clean(out: Path) -> None:
+    """Remove the temporaries (files and stages) that a killed or failed run left in ``out``."""
     removed = 0
-    for p in stale:
-        if (p.is_file() or p.is_symlink()) and p.resolve() not in keep:
+    for p in [*out.glob(f"{TEMP_PREFIX}*"), *out.glob(f"*/{TEMP_PREFIX}*")]:
+        if p.is_dir() and not p.is_symlink():
+            shutil.rmtree(p, ignore_errors=True)
+            removed += 1
+        elif p.is_file() or p.is_symlink():
+            with contextlib.suppress(FileNotFoundError):
+                p.unlink()
+            removed += 1
+    if removed:
+        log.info("%s: removed %d temporaries of a previous run", out, removed)
+
+
+def _stage(out: Path, stage: Path) -> None:
+    """Remove what killed runs left in ``out``, then make the new run's empty ``stage``."""
+    _clean(out)
+    stage.mkdir()
+
+
+def _commit(stage: Path, out: Path, owns, keep) -> None:
+    """Move the staged files into ``out`` (each by an atomic rename), then remove the files of
+    the output set ``owns`` that this run did not write; keep the input files ``keep``."""
+    keep = {Path(k).resolve() for k in keep if k is not None}
+    staged = sorted(p.relative_to(stage) for p in stage.rglob("*") if not p.is_dir())
+    for rel in staged:
+        (out / rel).parent.mkdir(parents=True, exist_ok=True)
+        os.replace(stage / rel, out / rel)
+    written = {(out / rel).resolve() for rel in staged}
+    removed = 0
+    for p in (p for g in owns for p in out.glob(g)):
+        if (p.is_file() or p.is_symlink()) and p.resolve() not in written | keep:
             p.unlink()
             removed += 1
     if removed:
-        log.info("%s: removed %d files of a previous run", out, removed)
+        log.info("%s: removed %d files of the previous run", out, removed)
+    shutil.rmtree(stage, ignore_errors=True)
 
 
 def _refuse_overwriting(out: Path, owns, keep, option: str) -> None:
@@ -101,14 +133,18 @@ def _refuse_overwriting(out: Path, owns, keep, option: str) -> None:
 
 @contextlib.contextmanager
 def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out"):
-    """Yield ``path`` as a :class:`~pathlib.Path`, ready for this run's files: created if
-    needed, writable, locked against other runs, with stale temporaries and the files
-    matching the glob patterns ``owns`` (the command's output set, relative to ``path``)
-    removed. The run's input files ``keep`` (None entries are skipped) are never removed or
-    overwritten: one that is among the files the command writes is refused. A directory
-    this call created is removed again if the run fails before writing anything into it;
-    temporaries left by a failed or interrupted run are removed at once. Raises InputError
-    (``option`` names a file) or :class:`OutputError` (cannot write, locked)."""
+    """Yield the stage of a run into ``path``: a new empty folder inside ``path`` (a
+    :class:`~pathlib.Path`) to write this run's files into. ``path`` is created if needed,
+    checked to be writable and locked against other runs; the temporaries of a killed run are
+    removed. When the block ends without an exception, the staged files replace those in
+    ``path`` and the files matching the glob patterns ``owns`` (the command's output set,
+    relative to ``path``) that this run did not write are removed; on any exception (a
+    refusal, Ctrl-C) the stage is removed and ``path`` keeps the previous run's files. The
+    run's input files ``keep`` (None entries are skipped) are never removed or overwritten:
+    one that is among the files the command writes is refused. A directory this call created
+    is removed again if the run fails. Files a command keeps across runs (a cache, a sweep's
+    points) are written into ``path`` itself, not the stage. Raises InputError (``option``
+    names a file) or :class:`OutputError` (cannot write, locked)."""
     out = Path(path)
     created = _check_path(out, option)
     _refuse_overwriting(out, owns, keep, option)
@@ -120,17 +156,32 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
         raise
     except OSError as err:
         raise OutputError(f"{out}: cannot write into this directory ({err.strerror or err})") from None
+    stage = out / f"{TEMP_PREFIX}stage.{os.urandom(4).hex()}"
     try:
-        _clean(out, owns, keep)
-        yield out
-    except BaseException:
+        _stage(out, stage)
+        yield stage
+        _refuse_staged_inputs(stage, out, keep, option)
+        _commit(stage, out, owns, keep)
+    except BaseException as err:
         with contextlib.suppress(OSError):
-            _clean(out, (), ())  # temporaries of writers cut short (a worker terminated mid-write)
+            _clean(out)  # the stage, and temporaries of writers cut short (a worker terminated mid-write)
         _unlock(out, fd)
         fd = None
         for d in reversed(created):
             with contextlib.suppress(OSError):
                 d.rmdir()  # only if empty
+        if isinstance(err, OSError) and err.errno is not None and str(err.filename or "").startswith(f"{stage}/"):
+            where = out / Path(err.filename).relative_to(stage)  # the file's name in the directory, not the stage's
+            raise OSError(err.errno, err.strerror, str(where)) from err
         raise
     finally:
         _unlock(out, fd)
+
+
+def _refuse_staged_inputs(stage: Path, out: Path, keep, option: str) -> None:
+    """InputError if a staged file would replace an input file of the run."""
+    keep = {Path(k).resolve() for k in keep if k is not None}
+    for p in stage.rglob("*"):
+        if not p.is_dir() and (out / p.relative_to(stage)).resolve() in keep:
+            raise InputError(option, f"the run would overwrite its input '{out / p.relative_to(stage)}'",
+                             "choose another output directory, or move the input out of it")

@@ -91,9 +91,23 @@ def give_back() -> None:
 
 def fork() -> int:
     """``os.fork()`` after :func:`give_back`: the child shares no freed pages, which either
-    process would otherwise copy as it reuses them."""
+    process would otherwise copy as it reuses them. SIGINT and SIGTERM are held back across the
+    fork; the child starts with their default actions (end quietly), so that a signal that
+    reaches it while Python sets it up (the parent ending its helpers at once) is no traceback
+    from the parent's handler; a child that wants them sets its own."""
+    import signal
+    import threading
+
     give_back()
-    return os.fork()
+    held = {signal.SIGINT, signal.SIGTERM}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    pid = os.fork()
+    if pid == 0 and threading.current_thread() is threading.main_thread():
+        for sig in held:
+            if signal.getsignal(sig) is not signal.SIG_IGN:
+                signal.signal(sig, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    return pid
 
 
 def die_with_parent(sig: int) -> bool:

@@ -17,9 +17,9 @@ from gatetherm import InputError
 from gatetherm.geometry.build import _extract
 from gatetherm.geometry.geoscan import scan
 from gatetherm.geometry.groups import GroupRule, fragment, interfaces, physical, regions
-from gatetherm.geometry.isolate import READ_LIMIT_S, run_isolated
+from gatetherm.geometry.isolate import READ_LIMIT_S, quiet, run_isolated
 from gatetherm.geometry.mesh import FrameMesh, check_mesh, from_arrays, to_arrays
-from gatetherm.geometry.sizing import check_estimate, model_estimate
+from gatetherm.geometry.sizing import check_count, check_estimate, model_estimate
 
 log = logging.getLogger(__name__)
 
@@ -116,18 +116,26 @@ def _size_key(spec: MeshSpec, tag: int | None, size: float, mine: dict[int, int]
     return (f"mesh.refine[{mine[tag]}].size" if tag in mine else f"{spec.path.name}: Field[{tag}].SizeMin"), size
 
 
+MAX_PARTS = 200
+"""Budget of solids (surfaces in 2-D) of a geometry: more are refused before they are made
+conformal (an assembly of 1 000 touching cubes gave no output in 300 s)."""
+
+
 def _read(gmsh, spec: MeshSpec) -> int:
     for k, v in spec.parameters.items():
         gmsh.parser.setNumber(k, [float(v)])
     try:
         if spec.path.suffix.lower() == SCRIPT:
             signal.alarm(READ_LIMIT_S)  # an endless loop: the child ends on SIGALRM (isolate._result)
+            verbosity = gmsh.option.getNumber("General.Verbosity")
+            gmsh.option.setNumber("General.Verbosity", min(verbosity, 1))  # the script's Printf: not shown
             gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)
+            gmsh.option.setNumber("General.Verbosity", verbosity)
         else:
             gmsh.model.occ.importShapes(str(spec.path))
             gmsh.model.occ.synchronize()
     except Exception as err:  # gmsh reports a bad file as a plain Exception
-        raise InputError(str(spec.path), f"gmsh cannot read it ({err})", "check the file in gmsh") from None
+        raise InputError(str(spec.path), f"gmsh cannot read it ({quiet(str(err))})", "check the file in gmsh") from None
     finally:
         signal.alarm(0)
     dim = max((d for d, _ in gmsh.model.getEntities()), default=0)
@@ -139,10 +147,15 @@ def _read(gmsh, spec: MeshSpec) -> int:
 def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
     """Read, name, check the size of and mesh the geometry (in the sandboxed child)."""
     dim = _read(gmsh, spec)
+    parts = len(gmsh.model.getEntities(dim))
+    if parts > MAX_PARTS:
+        raise InputError(str(spec.path), f"has {parts} {'surfaces' if dim == 2 else 'volumes'}, more than the budget of "
+                         f"{MAX_PARTS} parts (making them conformal takes hours)",
+                         "merge parts in the CAD model, or mesh a sub-assembly")
     try:
         fragment(gmsh, dim)
     except Exception as err:  # noqa: BLE001 - OpenCASCADE's own failure
-        raise InputError(str(spec.path), f"its solids cannot be made conformal ({err})",
+        raise InputError(str(spec.path), f"its solids cannot be made conformal ({quiet(str(err), script=False)})",
                          "check the CAD model") from None
     regions(gmsh, spec.groups, dim)
     interfaces(gmsh, dim)
@@ -159,7 +172,10 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
     try:
         gmsh.model.mesh.generate(dim)
     except Exception as err:  # noqa: BLE001
-        raise InputError(str(spec.path), f"gmsh cannot mesh it ({err})", "check the geometry in gmsh") from None
+        raise InputError(str(spec.path), f"gmsh cannot mesh it ({quiet(str(err), script=False)})", "check the geometry in gmsh") from None
+    elements = sum(len(t) for e in gmsh.model.getEntities(dim) for t in gmsh.model.mesh.getElements(*e)[1])
+    key, value = _size_key(spec, tag, size, mine)
+    check_count(elements, dim, key, value, "" if "factor" in key else " m", counted=True)
     groups = {d: {names[(d, t)]: [int(e) for e in gmsh.model.getEntitiesForPhysicalGroup(d, t)]
                   for dd, t in names if dd == d} for d in range(dim + 1)}
     owner: dict[int, str] = {}

@@ -21,6 +21,7 @@ import json
 import logging
 import os
 import pickle
+import re
 import select
 import signal
 import socket
@@ -145,6 +146,7 @@ def _child(work, out: int, logfd: int, sock: socket.socket, go: int, verbose: bo
                 os.close(listener)
             if os.read(go, 1) != b"1":
                 os._exit(0)
+            scrub_environment()
             try:
                 data = pack(*work(gmsh))
             except InputError as err:
@@ -157,6 +159,41 @@ def _child(work, out: int, logfd: int, sock: socket.socket, go: int, verbose: bo
             os._exit(0)
     finally:
         os._exit(1)
+
+
+KEPT_ENVIRONMENT = ("OMP_", "OPENBLAS_", "MKL_", "GOTO_", "LANG", "LC_", "TZ")
+"""Prefixes of the environment variables gmsh's process keeps while it reads a user's file
+(threads and locale); every other one is removed, so that a script's ``GetEnv`` reads nothing."""
+_PLACE = re.compile(r"'([^']*)', line (\d+)")
+_WORDS = re.compile(r"[A-Za-z][A-Za-z ]{0,60}")
+
+
+def scrub_environment() -> None:
+    """Remove the environment variables but :data:`KEPT_ENVIRONMENT` from this process (the C
+    library's environment too), before a user's script runs in it: a ``.geo`` cannot read a
+    secret of the environment (``GetEnv("TOKEN")``) into a message."""
+    for key in list(os.environ):
+        if not key.startswith(KEPT_ENVIRONMENT):
+            del os.environ[key]
+
+
+def quiet(message: str, script: bool = True) -> str:
+    """What gatetherm repeats of a message of gmsh's: the place it names (file name and line)
+    and gmsh's words for the kind of error, without the quoted, bracketed or parenthesised
+    text (the user's). While a ``script`` runs, a message without a place is not repeated: an
+    ``Error`` of the script's own could say anything, a variable's value included; after it
+    (meshing), gmsh's words are."""
+    place = _PLACE.search(message)
+    if place is None and script:
+        return "gmsh's message is not repeated: it names no line; open the file in gmsh to read it"
+    rest = re.sub(r"'[^']*'|\"[^\"]*\"|\([^)]*\)|\[[^\]]*\]|\{[^}]*\}", "",
+                  message[place.end():] if place else message.removeprefix("Error").lstrip(" :"))
+    rest = " ".join(rest.split()).lstrip(" :")
+    words = _WORDS.match(rest)
+    kind = words.group(0).strip() if words and words.end() == len(rest.rstrip()) else ""
+    if place is None:
+        return kind or "gmsh's message is not repeated; open the file in gmsh to read it"
+    return f"{Path(place.group(1)).name}, line {place.group(2)}" + (f": {kind}" if kind else "")
 
 
 def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tuple[dict, dict[str, np.ndarray]]:
@@ -221,7 +258,8 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
                     else:
                         *full, partial = (partial + chunk).split(b"\n")
                         lines.extend(x.decode(errors="replace").strip() for x in full if x.strip())
-                        if verbose and full and time.monotonic() - last >= PROGRESS_S:
+                        if verbose and full and time.monotonic() - last >= PROGRESS_S and \
+                                not lines[-1].startswith("Error"):  # said in the one line, quietly
                             last = time.monotonic()
                             log.info("gmsh: %s", lines[-1].removeprefix("Info").lstrip(" :"))
         _, status = os.waitpid(pid, 0)
@@ -272,7 +310,7 @@ def _unreported(mode: bytes, label: str, script, scan) -> None:
 
 def _result(data: bytes, status: int, label: str, lines) -> tuple[dict, dict[str, np.ndarray]]:
     errors = [x for x in lines if x.startswith("Error")]
-    said = f": {errors[-1]}" if errors else ""
+    said = f": {quiet(errors[-1])}" if errors else ""
     if not data:
         if os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGALRM:
             raise InputError(label, f"gmsh was still reading it after {READ_LIMIT_S} s (an endless loop in the "

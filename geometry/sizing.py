@@ -47,6 +47,15 @@ FALLBACK_MEMORY = 8e9
 """Memory assumed where the operating system does not report it, bytes."""
 CELL = {2: math.sqrt(3) / 4, 3: 1 / (6 * math.sqrt(2))}
 """Area (volume) of an equilateral triangle (regular tetrahedron) of unit edge."""
+MAX_ELEMENTS = 50e6
+"""Budget of elements a mesh may have (estimated before gmsh meshes, counted after): 50 million,
+about 6 times the 3-D frame's at 20 times its default nodes (``benchmarks/scaling.py``)."""
+
+
+def _count(measure: float, h: float, dim: int) -> float:
+    """Elements of size ``h`` in ``measure`` (area, volume); inf where ``h ** dim`` underflows."""
+    cell = CELL[dim] * h ** dim
+    return measure / cell if cell > 0 else math.inf
 
 
 def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
@@ -59,7 +68,7 @@ def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
 
     total = sum(map(measure, part_boxes(p, dim).values())) - measure(tank_box(p, dim))
     s = m.size if dim == 2 else m.size_3d
-    return total / (CELL[dim] * s ** dim)
+    return _count(total, s, dim)
 
 
 def _measure(gmsh, d: int, t: int) -> float:
@@ -93,7 +102,7 @@ def model_estimate(gmsh, dim: int) -> list[tuple[float, int | None, float]]:
         pts = [p for p in gmsh.model.getBoundary([(dim, t)], recursive=True) if p[0] == 0]
         lc = [s for s in gmsh.model.mesh.getSizes(pts) if s > 0] if pts and opt("Mesh.MeshSizeFromPoints") else []
         h = min(clip(math.exp(np.mean(np.log(lc))) if lc else float(np.linalg.norm(box[1] - box[0]))), far)
-        base += _measure(gmsh, dim, t) / (CELL[dim] * h ** dim)
+        base += _count(_measure(gmsh, dim, t), h, dim)
         h_base = min(h_base, h)
     out = [(base, None, h_base)]
     total = sum(_measure(gmsh, dim, t) for t in solids)
@@ -108,12 +117,13 @@ def model_estimate(gmsh, dim: int) -> list[tuple[float, int | None, float]]:
         n = 0.0
         for d, e in near:
             if d == dim:  # inside a solid: all at SizeMin, then the ramp outside its boundary
-                n += _measure(gmsh, d, e) / (CELL[dim] * smin ** dim)
+                n += _count(_measure(gmsh, d, e), smin, dim)
                 near += [(b, abs(t)) for b, t in gmsh.model.getBoundary([(d, e)], oriented=False)]
                 continue
             shell = {1: 2.0 * np.ones_like(r), 2: 2 * np.pi * r, 3: 4 * np.pi * r ** 2}[dim - d]
-            n += float(np.sum(_measure(gmsh, d, e) * shell / (CELL[dim] * h ** dim)) * (r[1] - r[0]))
-        out.append((min(n, total / (CELL[dim] * smin ** dim)), int(tag), float(f.getNumber(tag, "SizeMin"))))
+            with np.errstate(divide="ignore", over="ignore"):  # inf where h ** dim underflows
+                n += float(np.sum(_measure(gmsh, d, e) * shell / (CELL[dim] * h ** dim)) * (r[1] - r[0]))
+        out.append((min(n, _count(total, smin, dim)), int(tag), float(f.getNumber(tag, "SizeMin"))))
     return out
 
 
@@ -164,16 +174,34 @@ def check_estimate(elements: float, dim: int, key: str, size: float) -> dict[str
     """Raise InputError naming ``key`` (an element size of ``size`` m, or a factor on the
     sizes) if a mesh of about ``elements`` elements of dimension ``dim`` needs more memory
     than the machine has on both solver paths (:func:`path_memory`); the fix gives the
-    smallest admissible value (elements ∝ size^-dim). Else the predicted peak of each path."""
+    smallest admissible value (elements ∝ size^-dim). Also refused: more than
+    :data:`MAX_ELEMENTS` (a size so small that the count is not even a number included). Else
+    the predicted peak of each path."""
+    unit = "" if "factor" in key else " m"
+    if not math.isfinite(elements):
+        check_count(elements, dim, key, size, unit)
     need, have = path_memory(elements * NODES_PER_ELEMENT[dim], dim), memory_bytes()
     low = min(need.values())
-    unit = "" if "factor" in key else " m"
     if low > have:
         raise InputError(key, f"{size:g}{unit} gives about {elements:.2g} "
                          f"{'triangles' if dim == 2 else 'tetrahedra'} needing ~{low / 1e9:.3g} GB, more than the "
                          f"{have / 1e9:.3g} GB of memory of this machine",
                          f"raise it to at least {size * (low / have) ** (1 / dim):.2g}{unit}")
+    check_count(elements, dim, key, size, unit)
     return need
+
+
+def check_count(elements: float, dim: int, key: str, size: float, unit: str = " m", counted: bool = False) -> None:
+    """InputError naming ``key`` if ``elements`` (estimated, or ``counted``) exceed :data:`MAX_ELEMENTS`."""
+    if elements <= MAX_ELEMENTS:
+        return
+    kind = "triangles" if dim == 2 else "tetrahedra"
+    got = f"{elements:.2g} {kind}" if math.isfinite(elements) else f"more {kind} than can be counted"
+    fix = (f"raise it to at least {size * (elements / MAX_ELEMENTS) ** (1 / dim):.2g}{unit}"
+           if math.isfinite(elements) and size > 0 else "give a size of about a tenth of the smallest part")
+    about = "" if counted or not math.isfinite(elements) else "about "
+    raise InputError(key, f"{size:g}{unit} gives {about}{got}, more than the budget of "
+                     f"{MAX_ELEMENTS:.3g} elements", fix)
 
 
 def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:

@@ -207,6 +207,7 @@ class SolveHelper:
                 _serve(make, jobs_r, replies_w)
                 code = 0  # its answers' files are the caller's to read and remove
             finally:
+                signal.signal(signal.SIGTERM, signal.SIG_IGN)  # a SIGTERM here: no SystemExit out of the child
                 if code:
                     shutil.rmtree(self._dir, ignore_errors=True)
                 os._exit(code)

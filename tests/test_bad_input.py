@@ -9,6 +9,7 @@ import errno
 import json
 import math
 import os
+import re
 import typing
 from pathlib import Path
 
@@ -301,26 +302,30 @@ def test_out_is_checked_before_the_run(tmp_path, capsys, monkeypatch, where, nee
 
 
 def test_a_second_run_into_a_locked_directory_is_refused(tmp_path, capsys):
-    with output_dir(tmp_path / "o") as out:
-        (out / "timeseries.csv").write_text("the first run's\n")
+    out = tmp_path / "o"
+    with output_dir(out) as stage:
+        (stage / "timeseries.csv").write_text("the first run's\n")
         refused(capsys, 1, ["simulate", "--condition", "1", "--out", out],
                 f"gatetherm: error: {out}: another gatetherm run (pid {os.getpid()}) is writing into this directory")
-        assert (out / "timeseries.csv").read_text() == "the first run's\n"
-    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["timeseries.csv"]  # the lock is gone
-
+        assert (stage / "timeseries.csv").read_text() == "the first run's\n"
+    assert sorted(p.name for p in out.iterdir()) == ["timeseries.csv"]  # committed; the lock is gone
 
 
 def test_an_interrupted_run_leaves_no_temporary(tmp_path):
     """A writer cut short (a terminated worker) leaves its temporary; the run's output
-    directory removes it as the interruption passes, and keeps the finished files."""
+    directory removes it and the stage as the interruption passes, and keeps the files a
+    command keeps across runs (a sweep's points, written into the directory itself)."""
     from gatetherm import _new_temporary
 
-    with pytest.raises(KeyboardInterrupt), output_dir(tmp_path / "o") as out:
+    out = tmp_path / "o"
+    with pytest.raises(KeyboardInterrupt), output_dir(out) as stage:
+        (stage / "table.csv").write_text("never committed")
         (out / "points").mkdir()
         (out / "points" / "a.json").write_text("{}")
         _new_temporary(out / "points" / "b.json")
         raise KeyboardInterrupt
     assert sorted(str(p.relative_to(out)) for p in out.rglob("*")) == ["points", "points/a.json"]
+
 
 def test_unwritable_output_and_unreadable_input(tmp_path, capsys, monkeypatch):
     """A read-only output directory (exit 1, before the run) and a model file without read
@@ -399,9 +404,10 @@ def test_a_run_never_overwrites_its_input_files(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.toml"]
 
 
-def test_disk_full_ends_in_one_line_and_keeps_the_finished_files(tmp_path, capsys, monkeypatch):
-    """The disk fills while the fields are written: exit 1, one line naming the file; the
-    time series written before is complete, no partial file under a final name, no temporary."""
+def test_disk_full_ends_in_one_line_and_leaves_nothing(tmp_path, capsys, monkeypatch):
+    """The disk fills while the fields are written: exit 1, one line naming the file (its
+    name in --out, not the stage's); nothing of the failed run is left (the directory it
+    created is removed again), so no partial file under a final name and no temporary."""
     from gatetherm.studies.run import output
 
     def full(path, *args, **kwargs):
@@ -414,8 +420,7 @@ def test_disk_full_ends_in_one_line_and_keeps_the_finished_files(tmp_path, capsy
     out = tmp_path / "o"
     refused(capsys, 1, ["simulate", "--condition", "1", "--config", cfg, "--no-pictures", "--out", out],
             f"gatetherm: error: {out}/fields/fields_0000min.vtu: No space left on device")
-    assert len(read_timeseries(out / "timeseries.csv")) == 301
-    assert sorted(p.name for p in out.rglob("*") if p.is_file()) == ["timeseries.csv"]
+    assert not out.exists()
 
 
 # ---- sweeps ------------------------------------------------------------------------------------
@@ -488,3 +493,200 @@ def test_a_failed_point_is_one_line_naming_the_field(tmp_path, capsys, monkeypat
             "gatetherm: error: 1 of 2 points failed (point {'geometry.l4': 0.3}: thermal.h_air: got -1")
     assert [row.split(",")[1] for row in (tmp_path / "o" / "table.csv").read_text().splitlines()[1:]] == \
         ["ok", "pending"]
+
+
+# ---- error-model files, leakage, non-finite numbers (issue 55) ---------------------------------
+
+def _record(path: Path) -> Path:
+    """A machine's record: d_um = 2 theta_1 + noise, two sensors, 400 samples a minute apart."""
+    from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
+
+    rng = np.random.default_rng(0)
+    t = 60.0 * np.arange(400)
+    s1, s2 = 22 + np.cumsum(rng.normal(0, 0.05, t.size)), 22 + np.cumsum(rng.normal(0, 0.05, t.size))
+    write_timeseries(path, TimeSeries({"time_s": t, "s1_degC": s1, "s2_degC": s2, "rpm": 0 * t,
+                                       "d_um": 2.0 * (s1 - s1[0]) + rng.normal(0, 0.05, t.size)}, {"format": "x"}))
+    return path
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory):
+    d = tmp_path_factory.mktemp("fitted")
+    data = _record(d / "data.csv")
+    assert main(["errormodel", "fit", "--data", str(data), "--targets", "d_um", "--out", str(d)]) == 0
+    return data, json.loads((d / "model.json").read_text())
+
+
+@pytest.mark.parametrize("option", ["--candidates", "--inputs"])
+def test_a_target_is_never_read_by_its_own_model(tmp_path, capsys, fitted, option):
+    """The leak of issue 55: d_um predicted from itself (held-out error 1e-15) is refused before
+    the data file is read, and the library refuses it too."""
+    from gatetherm.studies.errormodel.fit import fit_error_model
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    data, _ = fitted
+    refused(capsys, 2, ["errormodel", "fit", "--data", tmp_path / "none.csv", "--targets", "d_um", option,
+                        "d_um,s1_degC", "--out", tmp_path / "o"],
+            f"gatetherm: error: {option} d_um: is a target (--targets): a model cannot read the column it predicts; "
+            f"drop d_um from {option}")
+    kwargs = {"candidates": ["s1_degC", "d_um"]} if option == "--candidates" else {"inputs": ["d_um"]}
+    with pytest.raises(InputError, match="d_um: is a target"):
+        fit_error_model(read_timeseries(data, required=("time_s",)), ["d_um"], **kwargs)
+    assert not (tmp_path / "o").exists()
+
+
+def _coefficient(model: dict, text: str) -> str:
+    """The model file with its first coefficient written as ``text``."""
+    return re.sub(r'"coefficient": [^,}]+', f'"coefficient": {text}', json.dumps(model), count=1)
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda d: {**d, "targets": {}}, "model.json: targets: is empty: the model predicts nothing"),
+    (lambda d: _coefficient(d, "NaN"), "holds NaN, not a finite"),
+    (lambda d: _coefficient(d, "1e999"), "holds 1e999, not a fin"),
+    (lambda d: _coefficient(d, '"nan"'),
+     "model.json: targets.d_um.terms[0].coefficient: is nan, not a finite number"),
+    (lambda d: _coefficient(d, "1" * 400),
+     "holds the integer 111111111111... of 400 digits"),
+    (lambda d: "[" * 100_000 + "]" * 100_000, "model.json: nested deeper than 32 levels"),
+    (lambda d: {**d, "targets": {"d_um": {**d["targets"]["d_um"], "terms": [
+        {"kind": "sensor", "column": "d_um", "coefficient": 1.0}]}}, "reference_degC": {"d_um": 0.0}},
+     "model.json: targets.d_um: reads its own target column"),
+], ids=["no targets", "NaN", "1e999", "'nan'", "400 digits", "nested 100000 deep", "reads its target"])
+def test_error_model_files_are_refused_in_one_line(tmp_path, capsys, fitted, edit, needle):
+    data, model = fitted
+    text = edit(model)
+    path = _write(tmp_path / "model.json", text if isinstance(text, str) else json.dumps(text))
+    refused(capsys, 2, ["errormodel", "predict", path, "--data", data, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def test_json_writers_name_a_non_finite_quantity(tmp_path):
+    from gatetherm.checks import NonFiniteError, json_text
+    from gatetherm.studies.run.output import write_json
+
+    with pytest.raises(NonFiniteError, match=r"^summary.json: probes.tip\[1\]: is nan, not a finite number; "
+                                             "nothing was written"):
+        write_json(tmp_path / "summary.json", {"probes": {"tip": [1.0, float("nan")]}})
+    assert json_text({"a": [1.5, None]}, "x.json") == '{"a": [1.5, null]}\n'
+    assert not list(tmp_path.iterdir())
+
+
+def test_fit_with_differences_on_the_shipped_record_writes_finite_numbers(tmp_path, capsys):
+    """errormodel fit --differences gave ``ValueError: Out of range float values ...: inf``: a
+    forward step whose every addition made the model singular (a difference of two sensors
+    already in it) was put on the path with an infinite error. Such additions are skipped."""
+    data = _record(tmp_path / "data.csv")
+    assert main(["errormodel", "fit", "--data", str(data), "--targets", "d_um", "--differences",
+                 "--out", str(tmp_path / "o")]) == 0
+    model = json.loads((tmp_path / "o" / "model.json").read_text())
+    errors = [s["cv_mae_um"] for s in model["targets"]["d_um"]["selection"]]
+    assert all(map(math.isfinite, errors)) and min(errors) == pytest.approx(0.04, abs=0.01)  # band: noise 0.05 um
+
+
+# ---- gmsh's reading of a case is quiet (issue 55) ----------------------------------------------
+
+PLATE_GEO = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 1, 1};
+Physical Surface("plate") = {1};
+Physical Curve("edge") = {1};
+"""
+PLATE_CASE = '[mesh]\nfile = "a.geo"\nsize = SIZE\n[materials.plate]\nk = 50.0\n[thermal.edge]\ntemperature = 100.0\n'
+
+
+@pytest.mark.parametrize("script, needle", [
+    ('Error(StrCat("leak: ", GetEnv("GT_SECRET")));\n',
+     "a.geo: gmsh cannot read it (gmsh's message is not repeated: it names no line; open the file in gmsh to read it)"),
+    ('Printf(StrCat("leak: ", GetEnv("GT_SECRET")));\nError("stop");\n', "gmsh's message is not repeated"),
+    ('x = GT_SECRET_IS_hunter2 + ;\n', "a.geo: gmsh cannot read it (a.geo, line 5: Unknown variable); check the file"),
+    ('Error(StrCat("leak: ", GetString("GT_SECRET")));\n', "gmsh's message is not repeated"),
+], ids=["Error of GetEnv", "Printf of GetEnv", "a syntax error quoting the text", "GetString"])
+def test_a_geo_never_echoes_the_environment_or_its_own_text(tmp_path, capsys, monkeypatch, script, needle):
+    """A .geo's messages are not repeated beyond the file name and line; the script's process
+    has no environment to read (GetEnv gives ''), also in the -v log."""
+    monkeypatch.setenv("GT_SECRET", "hunter2")
+    _write(tmp_path / "a.geo", PLATE_GEO + script)
+    case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", "0.25"))
+    err = refused(capsys, 2, ["-v", "run", case, "--out", tmp_path / "o"], needle)
+    assert "hunter2" not in err and "leak" not in err
+
+
+def test_the_child_reading_a_geo_has_no_environment(tmp_path, monkeypatch):
+    """The script writes what GetEnv gives into a Physical name, which comes back in the mesh:
+    empty, for a variable set in gatetherm's environment."""
+    from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+
+    monkeypatch.setenv("GT_SECRET", "hunter2")
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    geo = PLATE_GEO.replace('"edge"', 'StrCat("e", GetEnv("GT_SECRET"), GetEnv("OMP_NUM_THREADS"))')
+    fm = mesh_geometry(MeshSpec(_write(tmp_path / "a.geo", geo), size=0.25))
+    assert sorted(fm.boundaries) == ["e1"]
+
+
+@pytest.mark.parametrize("size, needle", [
+    ("1e-300", "mesh.size: 1e-300 m gives more triangles than can be counted, more than the budget of 5e+07 "
+               "elements; give a size of about a tenth of the smallest part"),
+    ("1e-4", "mesh.size: 0.0001 m gives about 2.3e+08 triangles, more than the budget of 5e+07 elements; raise it "
+             "to at least 0.00021 m"),
+], ids=["1e-300", "1e-4"])
+def test_an_element_size_beyond_the_element_budget_is_refused(tmp_path, capsys, monkeypatch, size, needle):
+    """[mesh] size = 1e-300 gave ZeroDivisionError in gmsh's process; every size whose estimate
+    exceeds the budget is refused in one line before gmsh meshes (memory set ample here)."""
+    from gatetherm.geometry import sizing
+
+    monkeypatch.setattr(sizing, "memory_bytes", lambda: 1e15)
+    _write(tmp_path / "a.geo", PLATE_GEO)
+    case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", size))
+    refused(capsys, 2, ["run", case, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+# ---- the older audit's and the newest commands' arguments (issue 55) ----------------------------
+
+@pytest.mark.parametrize("argv, needle", [
+    (["sensors", "--seed", "-1"], "gatetherm sensors: error: argument --seed: got -1, must be a whole number in [0, "),
+    (["sensors", "--exclude=0,0,nan,1"], "gatetherm: error: --exclude: got nan, must be a finite number"),
+    (["sensors", "--range", "spindle_W=0:1e300"],
+     "gatetherm: error: --range spindle_W: got 1e+300, must be a number in [-1e+09, 1e+09]"),
+    (["sensors", "--range", "spindle_W=5:1"], "gatetherm: error: --range spindle_W=5:1: its low end is above its high"),
+    (["simulate", "--condition", "0"], "gatetherm: error: --condition: no condition 0; choose one of 1, 2, 3"),
+    (["export", "ccx", "--condition", "0"], "gatetherm: error: --condition: no condition 0"),
+    (["compensate", "--model", "m.json", "--data", "d.csv", "--method", "rom"],
+     "gatetherm: error: --model/--method: --model replays a fitted error model: --method rom would be ignored"),
+], ids=["seed -1", "exclude nan", "range 1e300", "range reversed", "simulate condition 0", "export condition 0",
+        "model with method"])
+def test_command_arguments_are_refused_in_one_line(tmp_path, capsys, argv, needle):
+    refused(capsys, 2, [*argv, "--out", tmp_path / "o"], needle)
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_case_diagnosis_study_of_an_unfit_case_is_one_line(tmp_path, capsys):
+    """validate case-diagnosis --case t4.toml: AttributeError ('function' object has no
+    attribute 'columns') deep in the study; a steady case without signals is refused at once."""
+    t4 = Path(__file__).parents[1] / "validation" / "nafems" / "t4.toml"
+    refused(capsys, 2, ["validate", "case-diagnosis", "--case", t4, "--out", tmp_path / "o"],
+            f"gatetherm: error: --case {t4}: the study replays a transient case from its schedule file")
+    assert not (tmp_path / "o").exists()
+
+
+def test_gravity_out_of_range_names_gravity(tmp_path, capsys):
+    """[gravity] of 1e300 ended in a message about a stress column; now the key is named."""
+    example = Path(__file__).parents[1] / "validation" / "examples" / "c_frame"
+    for f in example.iterdir():
+        _write(tmp_path / f.name, f.read_bytes())
+    case = _write(tmp_path / "case.toml", (example / "case.toml").read_text() + "\n[gravity]\nacceleration = [0, -1e300]\n")
+    refused(capsys, 2, ["run", case, "--out", tmp_path / "o"],
+            f"gatetherm: error: {case}: gravity.acceleration[2]: got -1e+300, must be a number in [-10000, 10000] m/s²")
+
+
+def test_a_geometry_of_more_parts_than_the_budget_is_refused(tmp_path, capsys):
+    """1 000 touching cubes gave no output in 300 s (fragmenting them); over the part budget
+    a geometry is refused in one line before."""
+    from gatetherm.geometry.gmshfile import MAX_PARTS
+
+    n = MAX_PARTS + 1
+    geo = 'SetFactory("OpenCASCADE");\nFor i In {1:%d}\n  Rectangle(i) = {2 * i, 0, 0, 1, 1};\nEndFor\n' % n
+    _write(tmp_path / "a.geo", geo + 'Physical Surface("plate") = {1:%d};\nPhysical Curve("edge") = {1};\n' % n)
+    case = _write(tmp_path / "case.toml", PLATE_CASE.replace("SIZE", "0.5"))
+    refused(capsys, 2, ["run", case, "--out", tmp_path / "o"],
+            f"a.geo: has {n} surfaces, more than the budget of {MAX_PARTS} parts")

@@ -12,7 +12,6 @@ import time
 from pathlib import Path
 
 from gatetherm.cli import main
-from gatetherm.studies.run.timeseries import read_timeseries
 
 GATETHERM = [sys.executable, "-m", "gatetherm.cli"]
 INTERRUPTED = {130, -signal.SIGINT}
@@ -74,17 +73,22 @@ def alive(pid: int) -> bool:
 
 
 def test_killed_runs_and_reruns_into_the_same_directory(tmp_path):
-    """kill -9 and SIGTERM while a run writes its field files (more than the rerun writes);
-    each rerun leaves exactly its own files."""
+    """kill -9 and SIGTERM while a rerun writes its field files (more than the first run wrote,
+    into its hidden stage): the first run's files are kept as they were; the next rerun leaves
+    exactly its own files (issue 55: the output directory is a transaction)."""
     cfg = tmp_path / "c.toml"
     cfg.write_text(COARSE)
     run = ["simulate", "--condition", "1", "--config", str(cfg), "--no-pictures", "--out"]
+    first = {}
+    for sig in (signal.SIGKILL, signal.SIGTERM):
+        assert main([*run, str(tmp_path / sig.name)]) == 0
+        first[sig] = {f: (tmp_path / sig.name / f).read_bytes() for f in files(tmp_path / sig.name)}
     procs = {sig: subprocess.Popen([*GATETHERM, *run, str(tmp_path / sig.name), "--fields-every", "1"],
                                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
              for sig in (signal.SIGKILL, signal.SIGTERM)}
     for sig, proc in procs.items():
         out = tmp_path / sig.name
-        wait_for(lambda: len(list(out.glob("fields/fields_*.vtu"))) >= 10, proc)
+        wait_for(lambda: len(list(out.glob(".gatetherm-tmp.stage.*/fields/fields_*.vtu"))) >= 10, proc)
         proc.send_signal(sig)
     assert procs[signal.SIGKILL].wait() == -signal.SIGKILL and ".gatetherm.lock" in files(tmp_path / "SIGKILL")
     assert (procs[signal.SIGTERM].wait(), procs[signal.SIGTERM].stderr.read()) == (143, "gatetherm: terminated\n")
@@ -92,8 +96,10 @@ def test_killed_runs_and_reruns_into_the_same_directory(tmp_path):
              "summary.json", "timeseries.csv"]
     for sig in procs:
         out = tmp_path / sig.name
-        killed = files(out)
-        assert "summary.json" not in killed and sum(f.startswith("fields/fields_") for f in killed) >= 10
+        kept = {f: (out / f).read_bytes() for f in files(out) if not f.startswith(".gatetherm")}
+        assert kept == first[sig], sig.name
+        if sig == signal.SIGTERM:
+            assert files(out) == rerun
         assert main([*run, str(out)]) == 0
         assert files(out) == rerun, sig.name
 
@@ -183,9 +189,9 @@ def test_ctrl_c_to_a_sweep_and_its_workers(tmp_path):
     assert not [f for f in files(out) if f.startswith(".gatetherm") or "/.gatetherm" in f]
 
 
-def test_a_full_disk_ends_in_one_line_and_keeps_the_finished_files(tmp_path):
-    """A file-size limit stands in for a full disk: the time series (27 kB) is written, the first
-    field (60 kB) is not: exit 1, one line, no partial file under a final name, no temporary."""
+def test_a_full_disk_ends_in_one_line_and_leaves_nothing(tmp_path):
+    """A file-size limit stands in for a full disk: the time series (27 kB) is written into the
+    stage, the first field (60 kB) is not: exit 1, one line naming the file in --out, nothing left."""
     (tmp_path / "c.toml").write_text(COARSE)
     (tmp_path / "s.csv").write_text("time_s,oil_degC,pump\n0,40,1\n3600,40,1\n")
     out = tmp_path / "o"
@@ -198,4 +204,4 @@ def test_a_full_disk_ends_in_one_line_and_keeps_the_finished_files(tmp_path):
                         str(tmp_path / "c.toml"), "--no-pictures", "--out", str(out)], preexec_fn=limit,
                        capture_output=True, text=True)
     assert (r.returncode, r.stderr) == (1, f"gatetherm: error: {out}/fields/fields_0000min.vtu: File too large\n")
-    assert files(out) == ["timeseries.csv"] and len(read_timeseries(out / "timeseries.csv")) == 61
+    assert not out.exists()  # nothing of the failed run: the directory it made is removed again (issue 55)

@@ -26,7 +26,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from gatetherm import write_text_atomic
+from gatetherm import InputError, write_text_atomic
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
 from gatetherm.studies.diagnosis.hypotheses import catalogue, configure
 from gatetherm.studies.run.case import Case, load_case
@@ -95,6 +95,10 @@ def run_study(out: Path, case_path: Path = C_FRAME, seed: int = 10, scenarios=tu
         if name not in scenarios:
             continue
         case = load_case(case_path, factor)
+        if case.time is None or not case.problem.signals.complete or not hasattr(case.schedule.drive, "columns"):
+            raise InputError(f"--case {case_path}", "the study replays a transient case from its schedule file and "
+                             "compares theta_A, theta_B, theta_C and delta: it needs [time] with a schedule and "
+                             "[signals] mapping them", "give a case like validation/examples/c_frame/case.toml")
         truth = case if factor == MESH_FACTOR else load_case(case_path, MESH_FACTOR)
         values = hidden(truth, labels)
         ts = measured_run(truth, values, seed + i, name)

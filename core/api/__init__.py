@@ -17,6 +17,29 @@ The paper's frame is a case like any other: ``gt.gate_frame(dim=2)``.
 The functions live by task in this package's modules: :mod:`gatetherm.api.run` (cases,
 schedules, runs), :mod:`gatetherm.api.reduction`, :mod:`gatetherm.api.control` (compensation,
 diagnosis), :mod:`gatetherm.api.sensors` and :mod:`gatetherm.api.export`; every public name is offered here.
+
+### Errors
+
+Every public function checks its arguments where it is called, before any numerics, and says
+in one line (``str(err)``) which argument is wrong and how to fix it:
+
+- :class:`TypeError` for an argument of the wrong type: ``gt.run("case.toml")`` gives
+  ``case: got str 'case.toml', expected a Case; make one with gt.load_case(path) or
+  gt.gate_frame()``; the same for ``schedule``, ``effects``, ``keep``, ``on_step``, ``ax``, a
+  bool where a number belongs (``gt.condition(True)``) …
+- :class:`gatetherm.InputError` (a ``ValueError``) for a value out of its range or one that
+  would mislead: ``gt.gate_frame(dim=4)`` gives ``dim: got 4, must be 2 or 3; …``;
+  ``gt.condition(1, step_s=7)`` (7 s does not divide the 5 h: the run would end at 17 997 s),
+  ``gt.reduce(case, states=0)`` or a steady case, ``gt.load_case(path, mesh_factor=nan)``,
+  ``keep=[nan]``, ``fields_every=0``, ``run.field("T", t=nan)``, ``gt.plot.deformed`` of a
+  heat-only run, ``gt.plot.save(ax, path, dpi=1e6)``, ``run.write(folder)`` that would overwrite
+  a file the case reads. The same class reports bad input files (case files, schedules, model
+  files), naming the file, the key or line and the fix; a number that would be written to a
+  file as NaN or infinity is :class:`gatetherm.checks.NonFiniteError`, a kind of InputError
+  naming the quantity.
+- ``OSError`` for a file that cannot be written (a full disk), naming the file.
+
+Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm.api.control import compensate, diagnose
 from gatetherm.api.export import export_ccx

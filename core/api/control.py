@@ -1,7 +1,8 @@
 """Compensation and diagnosis of a run or a measurement (:mod:`gatetherm.api`)."""
 from __future__ import annotations
 
-from gatetherm.api.run import Case, Run
+from gatetherm.api.run import PATH, Case, Run, _case
+from gatetherm.checks import argument
 
 
 def compensate(series, case: Case | None = None, method: str = "paper", *, actuator="case", **settings):
@@ -41,6 +42,7 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
     """
     from gatetherm.studies.control.methods import Settings, compensate as methods_compensate
 
+    argument("case", case, (Case, type(None)), "a Case or None", "make one with gt.load_case(path) or gt.gate_frame()")
     if isinstance(series, Run):
         case = case or series.case
         series = series.scenario.series({"source": "gatetherm.api.compensate"})
@@ -75,5 +77,7 @@ def diagnose(case: Case, measured, **settings):
     from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose as run_diagnosis
     from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
 
+    _case(case)
+    argument("measured", measured, (TimeSeries, *PATH), "a TimeSeries or a time-series file's path")
     ts = measured if isinstance(measured, TimeSeries) else read_timeseries(measured, required=("time_s",))
     return run_diagnosis(case, ts, Settings(**settings))

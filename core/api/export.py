@@ -1,11 +1,11 @@
 """Export a state for another code: a CalculiX input deck (:mod:`gatetherm.api`)."""
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 
 from gatetherm import write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.api.run import Case, Schedule
 
 
@@ -59,7 +59,7 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out / "job.inp", inp)
-    write_text_atomic(out / "gatetherm.json", json.dumps(info, indent=2) + "\n")
+    write_text_atomic(out / "gatetherm.json", json_text(info, "gatetherm.json", indent=2))
     if run:
         info = {**info, "calculix": run_ccx(out, info)}
     return info

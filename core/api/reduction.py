@@ -5,7 +5,12 @@ import dataclasses
 import os
 from pathlib import Path
 
-from gatetherm.api.run import Case, Schedule, condition
+from gatetherm import InputError
+from gatetherm.api.run import Case, Schedule, _case, condition
+from gatetherm.checks import Range, whole_argument
+
+STATES = Range(2, 200, whole=True)
+"""States a reduced model may have (``gatetherm reduce --states``)."""
 
 
 def reduce(case: Case, states: int = 30):
@@ -26,6 +31,11 @@ def reduce(case: Case, states: int = 30):
     """
     from gatetherm.studies.run.reduce import build_rom
 
+    _case(case)
+    states = whole_argument("states", states, STATES, "e.g. 30")
+    if not case.problem.heat or case.time is None:
+        raise InputError("case", f"{case.name} has no transient heat solve (steady or prescribed temperatures): "
+                         "nothing to reduce", "give a case with [time] settings")
     return build_rom(case, states)
 
 

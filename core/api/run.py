@@ -2,19 +2,26 @@
 from __future__ import annotations
 
 import dataclasses
+import fnmatch
 import logging
 import os
 import time as _time
 from pathlib import Path
-from typing import Callable, Mapping
+from typing import Callable, Iterable, Mapping
 
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.checks import POSITIVE, Range, argument, number_argument, whole_argument
+from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.options import SolverOptions
 from gatetherm.process import configure
-from gatetherm.studies.run.case import Case, load_case
-from gatetherm.studies.run.frame_case import gate_frame
+from gatetherm.studies.run.case import Case
+from gatetherm.studies.run.case import load_case as _load_case
+from gatetherm.studies.run.conditions import CONDITIONS
+from gatetherm.studies.run.conditions import condition as _condition
+from gatetherm.studies.run.config import Config
+from gatetherm.studies.run.frame_case import gate_frame as _gate_frame
 from gatetherm.studies.run.scenario import ScenarioRun, run_scenario
 from gatetherm.studies.run.schedules import Schedule, condition_schedule, file_schedule
 
@@ -25,6 +32,44 @@ STATE_BUDGET_BYTES = 512e6
 
 __all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "SolverOptions", "beam_coefficients", "condition", "configure", "gate_frame",
            "load_case", "run", "schedule_file"]
+
+
+DIMS = Range(2, 3, whole=True)
+NUMBERS = Range(min(CONDITIONS), max(CONDITIONS), whole=True)
+WRITTEN = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf",
+           "fields/fields.h5", "channels.png", "oil_temperatures.png", "response.png", "deformed.png")
+"""What :meth:`Run.write` may write into its folder (paths relative to it)."""
+PATH = (str, os.PathLike)
+
+
+def _case(case, name: str = "case") -> Case:
+    return argument(name, case, Case, "a Case", "make one with gt.load_case(path) or gt.gate_frame()")
+
+
+def gate_frame(dim: int = 2, config: Config | str | os.PathLike | None = None, condition: int = 1, *,
+               mesh: FrameMesh | None = None) -> Case:
+    whole_argument("dim", dim, DIMS, "gate_frame(dim=2): a plane-stress section, or dim=3: the solid")
+    argument("config", config, (*PATH, Config, type(None)), "a model file's path, a Config or None",
+             "None gives the shipped paper model")
+    whole_argument("condition", condition, NUMBERS, "one of the paper's conditions")
+    argument("mesh", mesh, (FrameMesh, type(None)), "a FrameMesh of this frame or None")
+    return _gate_frame(int(dim), config, int(condition), mesh=mesh)
+
+
+gate_frame.__doc__ = _gate_frame.__doc__
+
+
+def load_case(path: str | os.PathLike, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
+    argument("path", path, PATH, "the path of a .toml case file")
+    number_argument("mesh_factor", mesh_factor, POSITIVE, "e.g. 0.5 for elements half as large")
+    argument("overrides", overrides, (Mapping, type(None)), "a dict {dotted key: value} or None",
+             'e.g. {"thermal.free.film": 8.0}')
+    for key in overrides or {}:
+        argument("overrides key", key, str, 'a dotted key of the case file, e.g. "thermal.free.film"')
+    return _load_case(path, float(mesh_factor), dict(overrides) if overrides is not None else None)
+
+
+load_case.__doc__ = _load_case.__doc__
 
 
 def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:
@@ -42,8 +87,16 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
     Returns
     -------
     Schedule
-        5 h of ``oil_degC`` (°C), ``pump`` (0/1) and ``ambient_degC`` (°C) samples.
+        5 h of ``oil_degC`` (°C), ``pump`` (0/1) and ``ambient_degC`` (°C) samples; a step that
+        does not divide the 5 h is refused (the schedule would end short of them).
     """
+    number = whole_argument("number", number, NUMBERS, "one of the paper's conditions")
+    argument("case", case, (Case, type(None)), "a frame Case or None")
+    step_s = number_argument("step_s", step_s, POSITIVE, "e.g. 60")
+    duration = _condition(number).duration
+    if abs(duration / step_s - round(duration / step_s)) > 1e-9 * duration / step_s:
+        raise InputError("step_s", f"{step_s:g} s does not divide the condition's {duration:g} s",
+                         "give a divisor of it, e.g. 60")
     supply = getattr(getattr(case, "origin", None), "config", None)
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
 
@@ -67,6 +120,7 @@ def beam_coefficients(case: Case, source: str = "theory") -> tuple[float, float]
     """
     from gatetherm.studies.control.methods import Settings, coefficients
 
+    _case(case)
     if source not in ("theory", "fe"):
         raise InputError("source", f"unknown source {source!r}", "choose 'theory' or 'fe'")
     ki, kc, _ = coefficients(case, None, Settings(k_source=source))
@@ -89,6 +143,9 @@ def schedule_file(path: str | os.PathLike, case: Case, step_s: float = 60.0) -> 
     -------
     Schedule
     """
+    argument("path", path, PATH, "the path of a time-series file")
+    _case(case)
+    step_s = number_argument("step_s", step_s, POSITIVE, "e.g. 60")
     return file_schedule(path, sorted(case.inputs()), case.held(), case.defaults, step_s)
 
 
@@ -131,6 +188,7 @@ class Run:
         """(time, heat state) kept nearest ``t`` (s); a time no state is kept near is an error."""
         from gatetherm.studies.run.output import nearest_state
 
+        t = number_argument("t", t, fix="give a time of the run, s (one of run.kept)")
         kept, U = nearest_state(self.scenario, t)
         step = float(np.median(np.diff(self.time))) if len(self.time) > 1 else 1.0
         if abs(kept - t) > 1e-6 * max(step, 1.0):
@@ -155,7 +213,8 @@ class Run:
         """
         from gatetherm.studies.run.output import nodal_fields
 
-        t = float(self.time[-1]) if t is None else float(t)
+        argument("name", name, str, 'a field\'s name, e.g. "T"')
+        t = float(self.time[-1]) if t is None else number_argument("t", t, fix="give one of run.kept, s")
         _, U = self.state(t)
         fields = nodal_fields(self.scenario.model, U, stress=name not in ("T", "u"))
         if name not in fields:
@@ -210,7 +269,11 @@ class Run:
         """
         from gatetherm.studies.run.output import write_json, write_run
 
-        out = Path(out)
+        out = Path(argument("out", out, PATH, "a folder's path"))
+        argument("pictures", pictures, bool, "True or False")
+        if fields_every is not None:
+            number_argument("fields_every", fields_every, POSITIVE, "an interval, s, e.g. 3600")
+        self._refuse_overwriting(out)
         out.mkdir(parents=True, exist_ok=True)
         fields = field_times(self.time, fields_every or _fields_every(self.case)) & set(self.kept)
         sched = self.scenario.schedule
@@ -239,6 +302,19 @@ class Run:
         write_json(out / "summary.json", summary)
         return summary
 
+    def _refuse_overwriting(self, out: Path) -> None:
+        """InputError if a file the case reads (its schedule, mesh, the case file) is one that
+        :meth:`write` would write into ``out`` (the command line refuses the same)."""
+        root = out.resolve()
+        for f in self.case.files:
+            try:
+                rel = Path(f).resolve().relative_to(root).as_posix()
+            except ValueError:
+                continue
+            if any(fnmatch.fnmatch(rel, w) for w in WRITTEN):
+                raise InputError("out", f"writing into '{out}' would overwrite the case's input '{f}'",
+                                 "choose another folder")
+
     def _picture_time(self) -> float | None:
         """When the deformed picture shows the case: δ's first peak where it has one, else the end."""
         if self.scenario.model.elastic is None:
@@ -247,6 +323,25 @@ class Run:
         peak = figs.get("first_peak_min")
         return peak * 60.0 if peak is not None else float(self.time[-1])
 
+
+
+def _effects(effects) -> dict[str, float] | None:
+    """``effects`` checked: None or a mapping of effect keys (str) to finite numbers."""
+    argument("effects", effects, (Mapping, type(None)), "a dict {key: value} or None",
+             '{KIND@TARGET: value}; gatetherm diagnose --list-effects lists them')
+    if effects is None:
+        return None
+    for key, value in effects.items():
+        argument("effects key", key, str, "an effect's key, KIND@TARGET")
+        number_argument(f"effects[{key!r}]", value, fix="give the effect's parameter, a finite number")
+    return dict(effects)
+
+
+def _times(name: str, values, rng: Range) -> list[float]:
+    """``values``: an iterable of numbers (not a string) each in ``rng``."""
+    if isinstance(values, (str, bytes)) or not isinstance(values, Iterable):
+        argument(name, values, (list, tuple), "a sequence of times, s")
+    return [number_argument(f"{name}[{i}]", v, rng, "give times within the run, s") for i, v in enumerate(values)]
 
 
 def field_times(times, every: float) -> set[float]:
@@ -293,8 +388,18 @@ def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, floa
     Run
     """
     t0 = _time.perf_counter()
+    _case(case)
+    argument("schedule", schedule, (Schedule, type(None)), "a Schedule or None",
+             "make one with gt.condition(n) or gt.schedule_file(path, case)")
+    effects = _effects(effects)
+    argument("on_step", on_step, (Callable, type(None)), "a function on_step(i, n) or None")
+    argument("check_order", check_order, bool, "True or False")
+    if fields_every is not None:
+        number_argument("fields_every", fields_every, POSITIVE, "an interval, s, e.g. 3600")
     schedule = case.schedule if schedule is None else schedule
     times = [float(t) for t in schedule.times]
+    if keep is not None:
+        keep = _times("keep", keep, Range(times[0], times[-1], unit="s"))
     fields = field_times(times, fields_every or _fields_every(case))
     if keep is None:
         n = len(case.mesh.points) * case.problem.order ** case.dim

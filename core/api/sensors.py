@@ -5,7 +5,11 @@ import os
 from pathlib import Path
 from typing import Mapping
 
-from gatetherm.api.run import Case
+from gatetherm.api.run import Case, _case
+from gatetherm.checks import Range, number_argument, whole_argument
+
+SPAN = Range(-1e9, 1e9)
+"""What a bound of ``ranges`` may be, in the input's unit (°C, W, 1/min …)."""
 
 
 def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, **settings):
@@ -61,11 +65,17 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
     from gatetherm.studies.sensors.candidates import Box
     from gatetherm.studies.sensors.place import PlacementSettings, place_sensors as place
 
+    _case(case)
+    count = whole_argument("count", count, Range(1, 50), "e.g. 3")
     fit = {k: settings.pop(k) for k in ("form", "max_inputs", "min_gain") if k in settings}
     if isinstance(settings.get("ranges"), Mapping):
-        settings["ranges"] = tuple((k, float(lo), float(hi)) for k, (lo, hi) in settings["ranges"].items())
+        settings["ranges"] = tuple((k, *(number_argument(f"ranges[{k!r}]", v, SPAN, "give LO, HI in the input's unit")
+                                         for v in (lo, hi))) for k, (lo, hi) in settings["ranges"].items())
     if "exclude" in settings:
         settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
+        for i, box in enumerate(settings["exclude"]):
+            for v in (*box.lo, *box.hi):
+                number_argument(f"exclude[{i}]", v, fix="give a box's low and high corners, m")
     if "boundaries" in settings:
         b = settings["boundaries"]
         settings["boundaries"] = (b,) if isinstance(b, str) else tuple(b)

@@ -43,12 +43,12 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import logging
 import math
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.cli.options import add_model_options, refuse_model_options
 
 log = logging.getLogger(__name__)
@@ -123,6 +123,9 @@ def _settings(args):
     control = PredictiveParams(mode=args.updates, max_updates=args.max_updates, interval_s=params.update_interval_s)
     sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
     model = None
+    if args.model is not None and args.method != "paper":
+        raise InputError("--model/--method", f"--model replays a fitted error model: --method {args.method} would "
+                         "be ignored", "drop --method, or drop --model")
     if args.model is not None:  # a bad model file or --target fails before --out is touched
         from gatetherm.studies.errormodel.model import load_model
         from gatetherm.studies.errormodel.replay import loop_target
@@ -191,11 +194,11 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     replaced = [name for name in WRITTEN if name in ts]
     if replaced:
         log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
-    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=out_dir,
+    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=Path(args.out),
                       source=what, rom_source=args.rom)
     summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
                "config": case.source, "dim": case.dim, **({"model": args.model} if args.model else {})}
-    text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
+    text = json_text(summary, "summary.json", indent=2)
     loop = comp.loop
     out = ts.with_columns(u_piezo_um=loop.stroke_um, delta_pred_um=loop.delta_pred_um,
                           delta_comp_um=loop.delta_comp_um)
@@ -213,7 +216,7 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     if actuator:
         save(plot_piezo_loops(actuator), out_dir / "piezo_loops.png")
     write_text_atomic(out_dir / "summary.json", text)
-    print(f"wrote {out_dir}/compensated.csv, compensation.png, "
+    print(f"wrote {args.out}/compensated.csv, compensation.png, "
           f"{'piezo_loops.png, ' if actuator else ''}summary.json")
     print(f"{what}: {comp.head}; swing {summary['swing_um']:.2f} um, "
           f"prediction error band {_um(summary['prediction_error_band_um'])}, "

@@ -163,7 +163,7 @@ def run(args: argparse.Namespace) -> int:
               f"{', '.join(diag.too_coarse)}; " + ("the diagnosis replayed it with P2 elements" if diag.order == 2 else
                                                   "refine the mesh (--mesh-factor) or set order = 2")
               + " (report.md, 1. Replay)")
-    print(f"wrote {out}/report.md, diagnosis.json ({diag.runs} model runs, {diag.seconds:.0f} s)")
+    print(f"wrote {args.out}/report.md, diagnosis.json ({diag.runs} model runs, {diag.seconds:.0f} s)")
     return 0
 
 
@@ -186,7 +186,7 @@ def _write(args, case, diag, adopted, out: Path) -> None:
         f"gatetherm diagnose of {args.data}: verdict {diag.verdict}, pieces "
         + ", ".join(r.piece.label for r in diag.pieces) + f"\nbase model: {case.source}"))
     if text is not None:
-        files["model"] = str(out / "model.toml")
+        files["model"] = str(Path(args.out) / "model.toml")
         write_text_atomic(out / "model.toml", text)
     write_text_atomic(out / "report.md", report_markdown(diag, str(args.data), case.source, files))
     write_json(out / "diagnosis.json", {**diag.summary(), "data": str(args.data), "config": case.source,

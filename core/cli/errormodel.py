@@ -9,14 +9,15 @@ filled gaps) and ``DIR/prediction.png``.
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 
 import numpy as np
 
 from gatetherm import InputError, write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.studies.errormodel.fit import FIT_FORMS, FitParams, fit_error_model, fraction_span
-from gatetherm.studies.errormodel.model import check_columns, input_gaps, load_model, predict, save_model, score
+from gatetherm.studies.errormodel.model import (check_columns, check_leakage, input_gaps, load_model, predict,
+                                               save_model, score)
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
 
 log = logging.getLogger(__name__)
@@ -79,6 +80,7 @@ def run_fit(args) -> int:
     targets = _names(args.targets, "--targets", "ch1_um,ch2_um")
     candidates = _names(args.candidates, "--candidates", "t1_degC,t2_degC")
     inputs = _names(args.inputs, "--inputs", "spindle_rpm") or ()
+    check_leakage(targets, candidates, inputs, ("--targets", "--candidates", "--inputs"))
     ts = read_timeseries(args.data, required=("time_s", *targets, *(candidates or ()), *inputs))
     params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                        differences=args.differences, resolution_K=args.resolution_K)
@@ -86,7 +88,7 @@ def run_fit(args) -> int:
     with output_dir(args.out, FIT_OUTPUTS, keep=(args.data,)) as out:
         model = fit_error_model(ts, targets, candidates, inputs, params, span, source=str(args.data))
         save_model(out / "model.json", model)
-    print(f"wrote {out}/model.json (fitted on {span[0]:g} .. {span[1]:g} s, {model.fit_span['samples']} samples)")
+    print(f"wrote {args.out}/model.json (fitted on {span[0]:g} .. {span[1]:g} s, {model.fit_span['samples']} samples)")
     for m in model.targets:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
         print(f"{m.target}: {m.form}; sensors {', '.join(m.sensors)}; time constants {taus}; "
@@ -126,8 +128,8 @@ def run_predict(args) -> int:
         source = {"source": f"gatetherm errormodel predict {args.model}"}
         write_timeseries(out / "prediction.csv", TimeSeries(cols, source))
         save(plot_model_prediction(model, ts), out / "prediction.png")
-        write_text_atomic(out / "summary.json", json.dumps(summary, indent=2, allow_nan=False) + "\n")
-    print(f"wrote {out}/prediction.csv, prediction.png, summary.json")
+        write_text_atomic(out / "summary.json", json_text(summary, "summary.json", indent=2))
+    print(f"wrote {args.out}/prediction.csv, prediction.png, summary.json")
     for name, g in gaps.items():
         print(f"{name}: {g.filled} missing samples filled (longest gap {g.longest_s:.0f} s), "
               f"{g.unpredicted} in gaps over {model.max_gap_s:.0f} s not predicted")

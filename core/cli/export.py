@@ -44,12 +44,14 @@ def run(args) -> int:
     import gatetherm as gt
     from gatetherm.outdir import output_dir
     from gatetherm.studies.run.ccx import check_time
+    from gatetherm.studies.run.conditions import condition as check_condition
 
     if (args.case is None) == (args.condition is None):
         raise InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
     if args.case:
         refuse_model_options(args, "CASE.toml")
-    gt.condition(args.condition or 1)
+    if args.condition is not None:  # 0 is no condition (it ran condition 1)
+        check_condition(args.condition)
     case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config, args.condition)
     what = str(args.case) if args.case else f"condition {args.condition}"
     schedule = case.schedule

@@ -3,6 +3,8 @@ case file (``case.toml`` with ``schedule.csv``: a paper condition) that ``gateth
 runs and a user can copy."""
 from __future__ import annotations
 
+from pathlib import Path
+
 from gatetherm.geometry.mesh import save_mesh
 from gatetherm.cli.options import add_model_options
 
@@ -30,8 +32,9 @@ def run(args) -> int:
         fm = case.mesh
         for name in OUTPUTS[:2]:
             save_mesh(fm, out / name)
-            print(f"wrote {out / name}")
+            print(f"wrote {Path(args.out) / name}")
         write_frame_case(case, args.condition, out)
+    out = Path(args.out)
     print(f"wrote {out / 'case.toml'} and {out / 'schedule.csv'} (the frame as a case: gatetherm run {out / 'case.toml'})")
     c = fm.counts()
     print(f"{args.dim}-D frame: {c['nodes']} nodes, {c['elements']} elements")

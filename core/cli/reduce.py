@@ -50,7 +50,7 @@ def run(args) -> int:
         checks = gt.check_rom(case, red.rom, schedules)
         gt.write_reduction(out, red, checks, case, args.states, seconds)
     b = red.error_bound
-    print(f"wrote {out}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} unknowns "
+    print(f"wrote {args.out}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} unknowns "
           f"in {seconds:.1f} s; BT bound " + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items()))
     for c in checks:
         print(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm, "

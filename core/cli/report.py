@@ -60,14 +60,15 @@ def run(args) -> int:
         print(f"{key:<16} {status}" + (f" ({seconds:.0f} s)" if status in ("computed", "cached") else ""), flush=True)
 
     with output_dir(args.out, PAGE) as out:  # the sections' folders are the cache: kept
-        results = build(out, SECTIONS, args.full, args.workers, set(args.section) if args.section else None, tell)
+        results = build(Path(args.out), SECTIONS, args.full, args.workers,  # the cache: beside the page
+                        set(args.section) if args.section else None, tell)
         code = code_digest()
         write_text_atomic(out / "index.html", report_html(SECTIONS, results, args.out, args.full, code))
         write_text_atomic(out / "validation.md", results_markdown(SECTIONS, results, args.out, args.full, code))
     if docs is not None:
         write_text_atomic(page, results_markdown(SECTIONS, results, "R", args.full, code, figures=False,
                                                  previous=before))
-    print(f"wrote {out}/index.html and validation.md" + (f" and {page}" if page else "")
+    print(f"wrote {args.out}/index.html and validation.md" + (f" and {page}" if page else "")
           + f" in {time.perf_counter() - t0:.0f} s")
     return 0
 
@@ -84,7 +85,7 @@ def _drift(args) -> int:
         result = compute(ts, out, Path(args.data).name)
         write_text_atomic(out / "index.html", drift_html(result, args.data, f"gatetherm report --data {args.data} "
                                                                             f"--out {args.out}"))
-    print(f"wrote {out}/index.html and drift.png")
+    print(f"wrote {args.out}/index.html and drift.png")
     for line in result.notes[:-1]:
         print(line)
     return 0

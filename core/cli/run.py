@@ -30,7 +30,7 @@ def run(args) -> int:
             res = gt.run(case, keep=picture_keep(case.schedule, every), on_step=Progress(case.name),
                          check_order=True)
             summary = res.write(out, pictures=not args.no_pictures, painter=painter, release=True)
-    print(f"wrote {out}/timeseries.csv, summary.json and fields/")
+    print(f"wrote {args.out}/timeseries.csv, summary.json and fields/")
     for name, q in summary["probes"].items():
         print(f"{name}: " + ", ".join(f"{k} {v:.6g}" for k, v in q.items() if v is not None))
     for name, v in summary["relative"].items():

@@ -17,13 +17,19 @@ from gatetherm.cli.options import add_model_options, number, refuse_model_option
 OUTPUTS = ("sensors.toml", "model.json", "curve.csv", "curve.png", "machine.png", "summary.json")
 COUNT, LOADS, STATES = Range(1, 50, whole=True), Range(0, 500, whole=True), Range(2, 200, whole=True)
 NOISE, LENGTH = Range(0.0, unit="K"), Range(0.0, unit="m")
+SEED = Range(0, 2**32 - 1, whole=True)
+SPAN = Range(-1e9, 1e9)
+"""What a bound of ``--range`` may be, in the input's unit (°C, W, 1/min …)."""
 
 
-def _floats(text: str, option: str, example: str) -> list[float]:
+def _floats(text: str, option: str, fix: str, rng: Range = Range()) -> list[float]:
     try:
-        return [float(v) for v in text.replace(":", ",").split(",")]
+        values = [float(v) for v in text.replace(":", ",").split(",")]
     except ValueError:
-        raise InputError(option, f"{text!r} is not a list of numbers", f"e.g. {option} {example}") from None
+        raise InputError(option, f"{text!r} is not a list of numbers", fix) from None
+    for v in values:
+        rng.check(option, v, fix)
+    return values
 
 
 def register(sub) -> None:
@@ -52,7 +58,8 @@ def register(sub) -> None:
     p.add_argument("--range", action="append", default=[], metavar="NAME=LO:HI",
                    help="range of an input in the generated loads (default: its span over the case's schedules); "
                    "repeatable")
-    p.add_argument("--seed", type=int, default=0, metavar="N", help="seed of the generated loads and the noise")
+    p.add_argument("--seed", type=number(SEED), default=0, metavar="N",
+                   help="seed of the generated loads and the noise (0 to 2^32 - 1)")
     p.add_argument("--states", type=number(STATES), default=30, metavar="N", help="states of the reduced model (default 30)")
     p.add_argument("--form", choices=("auto", "static", "dynamic"), default="auto",
                    help="error-model family (default auto: dynamic only if 3%% better)")
@@ -64,7 +71,7 @@ def register(sub) -> None:
 def _settings(args, dim: int) -> dict:
     boxes = []
     for text in args.exclude:
-        v = _floats(text, "--exclude", "0,0,0.2,0.1" if dim == 2 else "0,0,0,0.2,0.1,0.1")
+        v = _floats(text, "--exclude", f"e.g. --exclude {'0,0,0.2,0.1' if dim == 2 else '0,0,0,0.2,0.1,0.1'}")
         if len(v) != 2 * dim or any(a > b for a, b in zip(v[:dim], v[dim:])):
             raise InputError(f"--exclude {text}", f"is not a {dim}-D box", f"give {2 * dim} numbers: the low "
                              "corner, then the high one")
@@ -72,9 +79,11 @@ def _settings(args, dim: int) -> dict:
     ranges = {}
     for text in args.range:
         name, _, span = text.partition("=")
-        v = _floats(span, f"--range {name}", f"{name or 'spindle_W'}=0:200")
+        v = _floats(span, f"--range {name}", f"e.g. --range {name or 'spindle_W'}=0:200", SPAN)
         if not name or len(v) != 2:
             raise InputError(f"--range {text}", "is not NAME=LO:HI", "e.g. --range spindle_W=0:200")
+        if v[0] > v[1]:
+            raise InputError(f"--range {text}", "its low end is above its high end", f"e.g. --range {name}=0:200")
         ranges[name] = (v[0], v[1])
     names = tuple(n.strip() for n in (args.candidates or "").split(",") if n.strip())
     return {"boundaries": names, "spacing_m": args.spacing, "exclude": boxes, "min_distance_m": args.min_distance,
@@ -103,7 +112,7 @@ def run(args) -> int:
         seconds = time.perf_counter() - t0
         check = gt.check_placement(case, placement) if args.check else None
         summary = gt.write_placement(out, placement, case, check, {"seconds_total": round(seconds, 2)})
-    _report(placement, summary, check, out, seconds)
+    _report(placement, summary, check, args.out, seconds)
     return 0
 
 

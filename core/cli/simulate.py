@@ -30,17 +30,21 @@ def run(args) -> int:
     import gatetherm as gt
     from gatetherm.outdir import output_dir
     from gatetherm.solvers.effects import parse_effect
+    from gatetherm.studies.run.conditions import condition as check_condition
 
     with gt.plot.Painter(0 if args.no_pictures else 2) as painter:  # before the work it overlaps
-        case = gt.gate_frame(args.dim, args.config, args.condition or 1)
+        if args.condition is not None:
+            check_condition(args.condition)  # 0 is no condition (it ran condition 1)
+        case = gt.gate_frame(args.dim, args.config, 1 if args.condition is None else args.condition)
         effects = dict(parse_effect(s, case.targets) for s in args.effect)  # on top of the model file's
         schedule = gt.schedule_file(args.schedule, case) if args.schedule else case.schedule
         every = max(args.fields_every, 1.0) * 60.0
         with output_dir(args.out, OUTPUTS, keep=(args.config, args.schedule)) as out:
             res = gt.run(case, schedule, effects, keep=picture_keep(schedule, every),
-                         on_step=Progress(f"condition {args.condition or 'file'}"), fields_every=every)
+                         on_step=Progress(f"condition {args.condition}" if args.condition is not None else
+                                                   f"schedule {args.schedule}"), fields_every=every)
             s = res.write(out, pictures=not args.no_pictures, fields_every=every, painter=painter, release=True)
-    print(f"wrote {out}/timeseries.csv, summary.json, fields/ and plots")
+    print(f"wrote {args.out}/timeseries.csv, summary.json, fields/ and plots")
     print("first peak {first_peak_um} µm at {first_peak_min} min, swing {swing_um} µm, wall time {w} s"
           .format(**{k: (round(v, 2) if isinstance(v, float) else v) for k, v in s.items()}, w=s["wall_time_s"]))
     return 0

@@ -7,6 +7,7 @@ from the point files after every run), ``DIR/study.json`` and the PNGs of the st
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.cli.options import Progress, add_parallel_options
@@ -50,7 +51,7 @@ def _sweep(args, study, tasks, out) -> list:
     from gatetherm.studies.sweeps.runner import PointStore, run_studies, write_table
     from gatetherm.studies.sweeps.sweep import table
 
-    (records,), failed = run_studies([(tasks, PointStore(out))], args.workers, args.scheduler,
+    (records,), failed = run_studies([(tasks, PointStore(Path(args.out)))], args.workers, args.scheduler,
                                      Progress(f"sweep {study.name}"))
     columns, rows = table(tasks, records, study.columns)
     write_table(out / "table.csv", columns, rows)
@@ -58,7 +59,7 @@ def _sweep(args, study, tasks, out) -> list:
         {"name": study.name, "dim": study.dim, "config": study.case or study.base.source, "compute": list(study.compute),
          "set": dict(study.fixed), "grid": {k: list(v) for k, v in study.grid}}, indent=2) + "\n")
     n_skip = sum(r["status"] == "skipped" for r in rows)
-    print(f"wrote {out / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} done, "
+    print(f"wrote {Path(args.out) / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} done, "
           f"{n_skip} skipped (frame cannot be built), {len(failed)} failed")
     if not args.no_plots and study.plots:
         from gatetherm.validation.plots import save

@@ -40,7 +40,7 @@ from scipy.optimize import minimize
 
 from gatetherm import InputError
 from gatetherm.studies.errormodel import select
-from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, residual_stats
+from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, check_leakage, residual_stats
 from gatetherm.studies.errormodel.paper import fit_paper_form
 from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps, noise_sd
 
@@ -145,6 +145,7 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
     names = tuple(series.names if hasattr(series, "names") else series)
     targets = tuple(targets)
     candidates = tuple(candidates) if candidates is not None else default_candidates(names, targets)
+    check_leakage(targets, candidates, tuple(inputs))
     for name in ("time_s", *targets, *candidates, *inputs):
         if name not in names:
             raise InputError(f"{source or 'data'}: column {name}", "missing", f"columns are {', '.join(names)}")

@@ -14,7 +14,6 @@ the fitting span. :func:`predict` evaluates it with numpy only.
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError, write_text_atomic
+from gatetherm.checks import first_nonfinite, json_text, parse_json
 from gatetherm.files import read_text
 from gatetherm.studies.errormodel.terms import GapReport, Term, evaluate, fill_gaps
 
@@ -221,12 +221,42 @@ def from_dict(data: dict, where: str = "model") -> ErrorModel:
     missing = [s for m in model.targets for s in m.sensors if s not in ref]
     if missing:
         raise InputError(f"{where}: reference_degC", f"no reference for {missing[0]}", "add its reference temperature")
+    if not model.targets:
+        raise InputError(f"{where}: targets", "is empty: the model predicts nothing",
+                         "give a model.json from 'gatetherm errormodel fit'")
+    bad = first_nonfinite(to_dict(model))
+    if bad is not None:
+        raise InputError(f"{where}: {bad[0]}", f"is {bad[1]}, not a finite number",
+                         "give a model.json from 'gatetherm errormodel fit'")
+    _refuse_leaks(model, where)
     return model
 
 
+def check_leakage(targets, candidates=(), inputs=(), names=("targets", "candidates", "inputs")) -> None:
+    """InputError if a target is among the candidate sensors or the inputs (``names``: how the
+    caller calls the three): a model of a channel that reads the channel itself predicts nothing
+    (its held-out error would be round-off) and would be silently wrong."""
+    for field, given in zip(names[1:], (candidates or (), inputs or ())):
+        leak = [c for c in given if c in set(targets)]
+        if leak:
+            raise InputError(f"{field} {leak[0]}", f"is a target ({names[0]}): a model cannot read the column it "
+                             "predicts", f"drop {leak[0]} from {field}")
+
+
+def _refuse_leaks(model: ErrorModel, where: str) -> None:
+    """InputError if a target's model reads the target itself (or another column of the model's
+    targets): a prediction of a channel from itself is no prediction."""
+    for m in model.targets:
+        leak = [c for c in m.columns if c == m.target]
+        if leak:
+            raise InputError(f"{where}: targets.{m.target}", "reads its own target column",
+                             "fit the model again without it among the candidates and inputs")
+
+
 def save_model(path, model: ErrorModel) -> None:
-    """Write ``model`` to ``path`` as JSON, atomically."""
-    write_text_atomic(path, json.dumps(to_dict(model), indent=1, allow_nan=False) + "\n")
+    """Write ``model`` to ``path`` as JSON, atomically; NonFiniteError naming the quantity if
+    a number of it is NaN or infinite (nothing is written then)."""
+    write_text_atomic(path, json_text(to_dict(model), Path(path).name, indent=1))
 
 
 def load_model(path) -> ErrorModel:
@@ -241,9 +271,6 @@ def load_model(path) -> ErrorModel:
     -------
     ErrorModel
     """
-    text = read_text(Path(path), fix="give a model.json from 'gatetherm errormodel fit'")
-    try:
-        data = json.loads(text)
-    except ValueError as err:
-        raise InputError(str(path), f"not JSON ({err})", "give a model.json from 'gatetherm errormodel fit'") from None
+    fix = "give a model.json from 'gatetherm errormodel fit'"
+    data = parse_json(read_text(Path(path), fix=fix), str(path), fix)
     return from_dict(data, str(path))

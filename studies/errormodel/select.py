@@ -130,6 +130,7 @@ def forward(cv: CrossValidation, candidates: list[Candidate], fixed: np.ndarray,
         pool = [c for c in candidates if c not in chosen and len(used | c.sensors) <= max_sensors
                 and (not c.is_input or inputs < max_inputs)]
         scored = [(cv.error(np.column_stack([fixed] + [d.w for d in chosen] + [c.w])), k) for k, c in enumerate(pool)]
+        scored = [(e, k) for e, k in scored if np.isfinite(e)]  # a term that makes the model singular adds nothing
         if not scored:
             return path
         err, k = min(scored)

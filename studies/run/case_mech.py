@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from gatetherm.checks import Range
+from gatetherm.checks import ACCELERATION, Range
 from gatetherm.geometry.interface import interface_name, parts
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.expr import Value
@@ -57,7 +57,8 @@ def read_loads(top: Table, fm: FrameMesh, names) -> dict:
     out: dict = {}
     if "gravity" in top.data:
         g = top.sub("gravity", KEYS["gravity"])
-        out["gravity"] = tuple(vector(g, "acceleration", names, fm.dim, unit="m/s²"))
+        out["gravity"] = tuple(Value.of(v.text or v.constant, v.key, ACCELERATION)
+                               for v in vector(g, "acceleration", names, fm.dim, unit="m/s²"))
     lt = top.sub("loads", tuple(fm.boundaries) + tuple(fm.sensors))
     loads, points = [], []
     for name in lt.data:

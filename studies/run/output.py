@@ -1,7 +1,6 @@
 """Writers for a run directory: the time series, fields for ParaView, summary JSON, picture input."""
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Callable
@@ -9,6 +8,7 @@ from typing import Callable
 import numpy as np
 
 from gatetherm import atomic_path, write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.geometry.mesh import to_meshio
 from gatetherm.geometry.vtu import write_vtu
 from gatetherm.process import give_back
@@ -167,7 +167,7 @@ def volume_grid(fmesh, point_data: dict[str, np.ndarray]):
 
 
 def write_json(path: Path, data: dict) -> None:
-    write_text_atomic(path, json.dumps(data, indent=2, sort_keys=True) + "\n")
+    write_text_atomic(path, json_text(data, Path(path).name, indent=2, sort_keys=True))
 
 
 def nearest_state(run, t: float) -> tuple[float, np.ndarray]:

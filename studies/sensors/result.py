@@ -5,13 +5,13 @@ from __future__ import annotations
 import csv
 import dataclasses
 import io
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from gatetherm import write_text_atomic
+from gatetherm.checks import json_text
 from gatetherm.studies.errormodel.model import ErrorModel, save_model
 from gatetherm.studies.sensors.candidates import Candidates
 from gatetherm.studies.sensors.models import settings_of
@@ -118,7 +118,7 @@ class Placement:
         save_model(out / "model.json", self.model)
         write_text_atomic(out / "curve.csv", curve_csv(self))
         summary = {**self.summary(), **(extra or {})}
-        write_text_atomic(out / "summary.json", json.dumps(summary, indent=1, allow_nan=False) + "\n")
+        write_text_atomic(out / "summary.json", json_text(summary, "summary.json", indent=1))
         return summary
 
 

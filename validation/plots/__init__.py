@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 
-from gatetherm import atomic_path
+from gatetherm import InputError, atomic_path
 
 
 DPI = 200
@@ -28,6 +28,12 @@ def figure(figsize: tuple[float, float], nrows: int = 1, ncols: int = 1, fig=Non
     else:
         fig.set_size_inches(*figsize)
     return fig.subplots(nrows, ncols, **subplots)
+
+
+MAX_DPI = 2400
+"""Highest resolution :func:`save` writes, dots per inch."""
+MAX_PIXELS = 1e8
+"""Most pixels of a picture :func:`save` writes (a 10 x 6 in figure at 1 290 dpi)."""
 
 
 def save(fig, path: str | os.PathLike, dpi: int = DPI, tight: bool = True) -> None:
@@ -50,7 +56,17 @@ def save(fig, path: str | os.PathLike, dpi: int = DPI, tight: bool = True) -> No
     """
     import numpy as np
 
-    fig = np.asarray(fig, dtype=object).flat[0].figure
+    from gatetherm.checks import Range, argument, number_argument
+
+    argument("path", path, (str, os.PathLike), "the path of a PNG file")
+    number_argument("dpi", dpi, Range(1, MAX_DPI), f"e.g. {DPI}")
+    first = np.asarray(fig, dtype=object).flat[0] if np.asarray(fig, dtype=object).size else None
+    argument("fig", first, type(first) if hasattr(first, "figure") else (), "a Figure, an Axes or what a plot returns")
+    fig = first.figure
+    pixels = float(np.prod(fig.get_size_inches())) * dpi ** 2
+    if pixels > MAX_PIXELS:
+        raise InputError("dpi", f"{dpi:g} dots per inch make a picture of {pixels:.2g} pixels, more than "
+                         f"{MAX_PIXELS:.2g}", f"lower it to at most {dpi * (MAX_PIXELS / pixels) ** 0.5:.0f}")
     if tight:
         fig.tight_layout()
     with atomic_path(path) as tmp:  # zlib's run-length strategy: the same pixels, encoded faster

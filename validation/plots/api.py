@@ -18,6 +18,10 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
+
+from gatetherm import InputError
+from gatetherm.checks import argument
 from gatetherm.validation.plots import save
 from gatetherm.validation.plots.painter import Painter
 
@@ -34,12 +38,23 @@ def _figure():
 
 
 def _axes(ax):
+    if ax is not None and not hasattr(ax, "plot"):
+        argument("ax", ax, (), "a matplotlib Axes or None", "None draws on a new figure")
     return _figure().subplots() if ax is None else ax
 
 
 def _panels(axes):
     """The ``fig`` for a plot of several panels: a new pyplot figure unless ``axes`` are given."""
+    if axes is not None and not all(hasattr(a, "plot") for a in np.asarray(axes, dtype=object).flat):
+        argument("axes", axes, (), "matplotlib Axes (as many as the plot's panels) or None",
+                 "None draws on a new figure")
     return _figure() if axes is None else None
+
+
+def _run(run, what: str = "a Run") -> None:
+    """TypeError unless ``run`` is a run of the API (:func:`gatetherm.run`)."""
+    if not hasattr(run, "scenario"):
+        argument("run", run, (), what, "make one with gt.run(case)")
 
 
 def _title(run, t: float | None = None) -> str:
@@ -163,8 +178,8 @@ def field(run, name: str = "T", t: float | None = None, ax=None):
     """
     from gatetherm.validation.plots.field import plot_field
 
-    t = float(run.time[-1]) if t is None else float(t)
-    kept, _ = run.state(t)
+    _run(run)
+    kept, _ = run.state(float(run.time[-1]) if t is None else t)
     return plot_field(run.scenario.model.fmesh, name, run.field(name, kept), _title(run, kept), _axes(ax))
 
 
@@ -186,6 +201,10 @@ def deformed(run, t: float | None = None, ax=None):
     """
     from gatetherm.validation.plots.field import draw_deformed
 
+    _run(run)
+    if run.scenario.model.elastic is None:
+        raise InputError("run", f"{run.case.name} has no displacements (a heat-only case): nothing to deform",
+                         "plot its temperature: gt.plot.field(run, 'T')")
     kept, _ = run.state(float(run.time[-1]) if t is None else float(t))
     return draw_deformed(run.scenario, kept, lambda s: _title(run, s), ax=_axes(ax))
 

@@ -133,6 +133,7 @@ class Painter:
             except BaseException:  # noqa: BLE001 - the caller reports the pictures not drawn
                 log.exception("the painting process failed")
             finally:
+                signal.signal(signal.SIGTERM, signal.SIG_IGN)  # a second SIGTERM here: no SystemExit out of the child
                 if child:
                     with contextlib.suppress(OSError):
                         if code:  # stopped: the second one too
