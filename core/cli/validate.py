@@ -182,8 +182,8 @@ def run_calibrate(args) -> int:
 
 def _zoo_arguments(p) -> None:
     p.add_argument("--machines", metavar="NAME,...", help="machines of the zoo, comma separated (default: all)")
-    p.add_argument("--timeout", type=number(POSITIVE), default=240.0, metavar="S",
-                   help="time limit of one cell, s (default 240)")
+    p.add_argument("--timeout", type=number(POSITIVE), default=300.0, metavar="S",
+                   help="time limit of one cell, s (default 300)")
 
 
 def run_zoo(args) -> int:
