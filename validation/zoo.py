@@ -136,7 +136,7 @@ class Context:
 
 
 def _one_line(text: str, limit: int = 300) -> str:
-    line = " ".join(str(text).split())
+    line = " ".join(str(text).split()).replace(str(EXAMPLES), "validation/examples")
     return line if len(line) <= limit else line[:limit - 1] + "…"
 
 
