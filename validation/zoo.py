@@ -13,8 +13,8 @@ and each cell's files under ``DIR/<machine>/<capability>/``.
 What each cell's number is (the capability's key, then its value):
 
 * ``run``: the swing (max − min) of δ over the run, µm (steady: its value);
-* ``reduce``: the largest error of δ of a 20-state reduced model against the FE run on the
-  case's own schedule, µm;
+* ``reduce``: the largest error of δ of the reduced model ``gatetherm reduce`` makes (its default
+  30 states) against the FE run on the case's own schedule, µm;
 * ``paper``, ``mlr``, ``rom``: the residual band (max |δ_comp| after the compensator's settling
   time) of ``gt.compensate`` with that method, µm, beside the same band of δ uncompensated;
 * ``errormodel comp``: the same of an error model fitted on the first half of the run
@@ -165,13 +165,14 @@ def cell_run(ctx: Context):
 def cell_reduce(ctx: Context):
     import gatetherm as gt
 
-    red = gt.reduce(ctx.case, 20)
+    red = gt.reduce(ctx.case)  # its default states, as `gatetherm reduce`
     (check,) = gt.check_rom(ctx.case, red.rom, [ctx.case.schedule])
     err = check.errors.get(ctx.delta)
     if err is None:
         raise RuntimeError(f"the check has no {ctx.delta}")
     worst = max((v for k, v in check.errors.items() if k.endswith("_degC")), default=float("nan"))
-    return float(err), f"20 states: {ctx.delta} within {err:.3g} µm of FE, temperatures within {worst:.3g} K"
+    return float(err), (f"{red.rom.states if hasattr(red.rom, 'states') else 'default'} states: {ctx.delta} within "
+                        f"{err:.3g} µm of FE, temperatures within {worst:.3g} K")
 
 
 def _compensated(ctx: Context, comp):
