@@ -16,7 +16,8 @@ The paper's frame is a case like any other: ``gt.gate_frame(dim=2)``.
 
 The functions live by task in this package's modules: :mod:`gatetherm.api.run` (cases,
 schedules, runs), :mod:`gatetherm.api.reduction`, :mod:`gatetherm.api.control` (compensation,
-diagnosis), :mod:`gatetherm.api.sensors` and :mod:`gatetherm.api.export`; every public name is offered here.
+diagnosis), :mod:`gatetherm.api.sensors`,
+:mod:`gatetherm.api.export` and :mod:`gatetherm.api.zoo`; every public name is offered here.
 
 ### Errors
 
@@ -47,8 +48,9 @@ from gatetherm.api.reduction import check_rom, check_schedules, reduce, write_re
 from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, gate_frame, load_case, run, \
     schedule_file
 from gatetherm.api.sensors import check_placement, place_sensors, write_placement
+from gatetherm.api.zoo import validate_zoo
 
 __all__ = ["Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
            "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame",
-           "load_case", "place_sensors", "reduce",
-           "run", "schedule_file", "write_placement", "write_reduction"]
+           "load_case", "place_sensors", "reduce", "run", "schedule_file", "validate_zoo", "write_placement",
+           "write_reduction"]

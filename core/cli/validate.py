@@ -180,6 +180,25 @@ def run_calibrate(args) -> int:
     return 0
 
 
+def _zoo_arguments(p) -> None:
+    p.add_argument("--machines", metavar="NAME,...", help="machines of the zoo, comma separated (default: all)")
+    p.add_argument("--timeout", type=number(POSITIVE), default=300.0, metavar="S",
+                   help="time limit of one cell, s (default 300)")
+
+
+def run_zoo(args) -> int:
+    import gatetherm as gt
+
+    machines = [m.strip() for m in args.machines.split(",") if m.strip()] if args.machines else None
+    matrix = gt.validate_zoo(args.out, machines, timeout_s=args.timeout,
+                             on_cell=lambda m, c, cell: print(f"{m}, {c}: {cell['text']}", flush=True))
+    cells = [c for row in matrix.values() for c in row.values()]
+    print(f"wrote {args.out}/zoo.md and zoo.json: {len(matrix)} machines x {len(next(iter(matrix.values())))} "
+          f"capabilities, {sum(c['status'] == 'ok' for c in cells)} numbers, "
+          f"{sum(c['status'] == 'refused' for c in cells)} refusals, {sum(c['status'] == 'failed' for c in cells)} failed")
+    return 0
+
+
 TARGETS = {
     "beam": ("beam theory vs FE: K_i, K_C over l/l4 and beta, error table, series, report", _swept, run_beam),
     "design": ("tie-bar position minimising the 5-h swing of delta; a second tie bar above the arms",
@@ -196,6 +215,8 @@ TARGETS = {
                  "then the hidden-effect cases", _compound_arguments, run_compound),
     "case-diagnosis": ("diagnose runs of a case file's frame (the C-frame) with hidden pieces of the case",
                        _case_diagnosis_arguments, run_case_diagnosis),
+    "zoo": ("every capability on every shipped machine (validation/examples): the matrix zoo.md, zoo.json",
+            _zoo_arguments, run_zoo),
     "calibrate": ("refit the default paper model to the paper's figures (a record of the procedure)",
                   _calibrate_arguments, run_calibrate),
 }

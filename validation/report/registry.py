@@ -138,6 +138,10 @@ SECTIONS: tuple[Section, ...] = (
             about="the first 2 of the 48 random pairs on 12-mm elements, no single-piece cases (each "
                   "diagnosis takes 1-2 min)",
             inputs=(PAPER_MODEL,), also="gatetherm validate compound --out DIR"),
+    Section("zoo", "The machine zoo: every capability on every machine", "zoo:compute",
+            subset={"machines": None, "timeout_s": 300.0},
+            about="", inputs=("gatetherm.validation:examples/*/*",), tools=("ccx",),
+            also="gatetherm validate zoo --out Z"),
     Section("speed", "Speed and scaling", "speed:compute", inputs=tuple(str(BENCHMARKS / f) for f in BENCHMARK_FILES),
             also="; ".join(BENCHMARK_FILES.values())),
 )
