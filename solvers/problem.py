@@ -55,6 +55,8 @@ class Source:
     """Power density, W/m³ (times :attr:`per`)."""
     per: float = 1.0
     """The density is ``per × density``: 1 for a density, 1/volume (1/m³) for a power (W) in the region."""
+    loss: str = ""
+    """The output column that reports its power over time (a machine element's loss, W), empty: none."""
 
 
 @dataclass(frozen=True)
