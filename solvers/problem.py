@@ -23,9 +23,12 @@ class Film:
 
     boundary: str
     h: float
-    """Film coefficient, W/(m² K)."""
+    """Film coefficient, W/(m² K) (with a :attr:`law`: the reference coefficient of the matrix)."""
     ambient: Value
     """Ambient temperature, °C."""
+    law: object = None
+    """A :class:`~gatetherm.solvers.convection.FilmLaw` (a correlation, radiation) that gives the
+    coefficient from the surface temperature and the inputs; None: the constant :attr:`h`."""
 
 
 @dataclass(frozen=True)

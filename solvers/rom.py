@@ -100,6 +100,10 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
     """The seam: read the switched linear system off an assembled model (heat solve with a read-out).
     ``columns(problem, key) -> (name, scale)`` names each read-out key as a data-format column."""
     h, prob, r = model.heat, model.problem, model.readout
+    if h.varying:
+        raise InputError(f"film of '{h.varying[0].boundary}'", "follows the temperature (a correlation or radiation): "
+                         "the reduced model is linear and would hold it at its reference",
+                         "give the film as a number to reduce the case")
     T0, n = float(prob.T0), h.n
     fixed = h.fixed_dofs
     free = complement(n, fixed)
