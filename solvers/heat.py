@@ -135,6 +135,42 @@ class VaryingFilm:
         return (self.law(self.surface(U), Ta, env) - self.h_ref) * (self.A @ U[:len(self.a)] - self.a * Ta)
 
 
+@dataclass(frozen=True)
+class MovingLoad:
+    """A power spread over the part of a region inside a band of ``length`` centred at a moving
+    ``position`` along a direction: each unknown's share of the region's load ``∫ t v`` is the
+    integral over the band of a hat of half-width ``spacing`` around its point (a band shorter than
+    the elements moves smoothly from node to node), normalised to the power."""
+
+    weights: np.ndarray
+    """``∫ t v`` over the region (solid unknowns)."""
+    along: np.ndarray
+    """Coordinate of every solid unknown's point along the direction, m."""
+    spacing: float
+    """Extent of an unknown along the direction, m (the median element's over the order)."""
+    length: float
+    position: Value
+    value: Value
+    """The power, W."""
+
+    def vector(self, env) -> np.ndarray:
+        """The load of a unit power at the position of ``env`` (solid unknowns, sums to 1)."""
+        p, half, d = float(self.position(env)), 0.5 * self.length, self.spacing
+        w = self.weights * (_hat_integral((p + half - self.along) / d) - _hat_integral((p - half - self.along) / d))
+        total = w.sum()
+        if not total > 0:
+            raise InputError(self.position.key or "position", f"the band at {p:g} m ({self.length:g} m long) "
+                             f"misses its region (from {self.along.min():g} to {self.along.max():g} m)",
+                             "keep the position on the region along the direction")
+        return w / total
+
+
+def _hat_integral(u: np.ndarray) -> np.ndarray:
+    """``∫_{-∞}^{u} max(0, 1 − |x|) dx``."""
+    u = np.clip(u, -1.0, 1.0)
+    return np.where(u < 0, 0.5 * (u + 1) ** 2, 1 - 0.5 * (1 - u) ** 2)
+
+
 PICARD_TOL = 1e-10
 """Change of every varying film's boundary-mean temperature, K, at which the Picard iterations stop."""
 PICARD_MAX = 200
@@ -166,6 +202,8 @@ class HeatSystem:
     order found from that step matrix)."""
     varying: tuple[VaryingFilm, ...] = ()
     """Films whose coefficient follows the temperature (Picard iterations: :func:`picard`)."""
+    moving: tuple[MovingLoad, ...] = ()
+    """Sources that follow a position."""
 
     @property
     def n(self) -> int:
@@ -190,6 +228,8 @@ class HeatSystem:
         out = np.zeros(self.n)
         for load in self.loads:
             out += load.vector * load.value(env)
+        for m in self.moving:
+            out[:len(m.weights)] += m.vector(env) * m.value(env)
         for p, on in zip(self.pumped, mode):
             out[p.inlet] += p.coefficients(on)[1] * p.supply(env)
         return out
@@ -492,10 +532,14 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         cb = cells()
         K = K + asm(film, cb, h=problem.faces.h, t=2.0)
         loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
+    moving = []
     for src in problem.sources:
         cb = cells()
         on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
         vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        if src.position is not None:
+            moving.append(moving_load(mesh, basis, src, vec, order))
+            continue
         loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
@@ -533,4 +577,15 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     log.info("heat system: %d unknowns (P%d), %d fixed", n, order, len(np.unique(np.concatenate(
         [d for d, _ in fixed]))) if fixed else 0)
     return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, s,
-                      tuple(varying))
+                      tuple(varying), tuple(moving))
+
+
+def moving_load(mesh, basis, src, weights: np.ndarray, order: int) -> MovingLoad:
+    """The :class:`MovingLoad` of a source with a position (its region's load ``weights``)."""
+    d = np.asarray(src.direction, float)
+    along = d @ mesh.p
+    cells = mesh.subdomains[src.region]
+    extent = np.ptp(along[mesh.t[:, cells]], axis=0)
+    locs = basis.doflocs if getattr(basis, "doflocs", None) is not None else mesh.p
+    return MovingLoad(weights, d @ locs[:, :len(weights)], float(np.median(extent)) / order, src.length,
+                      src.position, src.density)

@@ -60,6 +60,13 @@ class Source:
     """The density is ``per × density``: 1 for a density, 1/volume (1/m³) for a power (W) in the region."""
     loss: str = ""
     """The output column that reports its power over time (a machine element's loss, W), empty: none."""
+    position: Value | None = None
+    """A source that moves: the centre of the band its power is spread over, m along :attr:`direction`
+    (None: spread over the whole region)."""
+    direction: tuple[float, ...] = ()
+    """Unit vector along which :attr:`position` and :attr:`length` are measured."""
+    length: float = 0.0
+    """Extent of the band along the direction, m."""
 
 
 @dataclass(frozen=True)
@@ -259,6 +266,7 @@ def values(problem: Problem) -> list[Value]:
     """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
     out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
     out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    out += [s.position for s in problem.sources if s.position is not None]
     out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
     out += [*problem.gravity, *(v for x in (*problem.loads, *problem.supports) for v in x.values)]
     return out + [v for pl in problem.point_loads for v in pl.force]

@@ -104,6 +104,9 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
         raise InputError(f"film of '{h.varying[0].boundary}'", "follows the temperature (a correlation or radiation): "
                          "the reduced model is linear and would hold it at its reference",
                          "give the film as a number to reduce the case")
+    if h.moving:
+        raise InputError(f"sources.{next(s.region for s in prob.sources if s.position is not None)}", "moves (it has a position): the reduced model's "
+                         "inputs are fixed load vectors", "reduce a case whose sources stay in place")
     T0, n = float(prob.T0), h.n
     fixed = h.fixed_dofs
     free = complement(n, fixed)

@@ -321,7 +321,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             sources.append(case_sources.read_source(
                 src.sub(r, KEYS["sources.REGION"]), r, names,
                 lambda r=r: case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else
-                region_volume(fm, r, thickness.get(r, 1.0))))
+                region_volume(fm, r, thickness.get(r, 1.0)), fm.dim))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:

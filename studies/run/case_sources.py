@@ -23,8 +23,10 @@ ELEMENT_KEYS = {
     "motor": ("speed", "torque", "efficiency", "idle"),
 }
 """The keys of each element ``kind``."""
+MOVING = ("position", "direction", "length")
+"""The keys of a source that moves (with power or kind)."""
 KEYS = {"sources.REGION": ("density", "power", "kind",
-                           *dict.fromkeys(k for keys in ELEMENT_KEYS.values() for k in keys))}
+                           *dict.fromkeys(k for keys in ELEMENT_KEYS.values() for k in keys), *MOVING)}
 """The keys of ``[sources.REGION]`` (as :data:`gatetherm.studies.run.case.KEYS`)."""
 POSITIVE_M = Range(0.0, lo_open=True, unit="m")
 FACTOR = Range(0.0, unit="1")
@@ -71,7 +73,7 @@ def element_loss(t: Table, names) -> Value:
     for k in ("density", "power"):
         if k in t.data:
             t.fail(k, f"goes without kind (the {kind}'s loss is the power)", "remove it or kind")
-    other = next((k for k in t.data if k != "kind" and k not in ELEMENT_KEYS[kind]), None)
+    other = next((k for k in t.data if k != "kind" and k not in ELEMENT_KEYS[kind] + MOVING), None)
     if other:
         t.fail(other, f"is not a key of kind = \"{kind}\"", f"its keys: {', '.join(ELEMENT_KEYS[kind])}")
     if kind == "motor" and t.data.get("efficiency") is not None and not isinstance(t.data["efficiency"], str):
@@ -79,15 +81,37 @@ def element_loss(t: Table, names) -> Value:
     return Value.of(READERS[kind](t, names), t.key("kind"), LOSS)
 
 
-def read_source(t: Table, region: str, names, volume: Callable[[], float]) -> Source:
+def moving(t: Table, names, dim: int) -> dict:
+    """``position``, ``direction`` and ``length`` of a source that moves, as Source's fields ({}: none)."""
+    given = [k for k in MOVING if k in t.data]
+    if not given:
+        return {}
+    missing = next((k for k in MOVING if k not in t.data), None)
+    if missing:
+        t.fail(missing, f"missing: a source that moves needs {', '.join(MOVING)}",
+               'e.g. position = "x_axis", direction = [1, 0], length = 0.05')
+    if "density" in t.data:
+        t.fail("density", "cannot move (a band takes a power)", "give power (W) or kind")
+    d = t.data["direction"]
+    if not (isinstance(d, list) and len(d) == dim and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                          for x in d) and any(d)):
+        t.fail("direction", f"expected {dim} numbers, not all zero, got {d!r}", f"e.g. direction = {[1] + [0] * (dim - 1)}")
+    d = [float(x) for x in d]
+    norm = sum(x * x for x in d) ** 0.5
+    return {"position": t.value("position", names, unit="m"), "direction": tuple(x / norm for x in d),
+            "length": t.number("length", POSITIVE_M)}
+
+
+def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: int = 3) -> Source:
     """The source of the ``[sources.REGION]`` table ``t``; ``volume()`` the region's volume, m³."""
+    band = moving(t, names, dim)
     if "kind" in t.data:
-        return Source(region, element_loss(t, names), 1.0 / volume(), loss=f"P_{region}_W")
-    extra = next((k for k in t.data if k not in ("density", "power")), None)
+        return Source(region, element_loss(t, names), 1.0 / volume(), loss=f"P_{region}_W", **band)
+    extra = next((k for k in t.data if k not in ("density", "power", *MOVING)), None)
     if extra:
         t.fail(extra, "goes with kind only", f"give kind ({', '.join(ELEMENT_KEYS)}) or remove it")
     if ("density" in t.data) == ("power" in t.data):
         t.fail("density", "give either density (W/m³), power (W) or kind (a machine element)")
     if "density" in t.data:
         return Source(region, t.value("density", names, unit="W/m³"))
-    return Source(region, t.value("power", names, unit="W"), 1.0 / volume())
+    return Source(region, t.value("power", names, unit="W"), 1.0 / volume(), **band)
