@@ -121,3 +121,69 @@ def test_bad_moving_source_is_one_line(tmp_path, change, where):
     with pytest.raises(InputError) as err:
         gt.load_case(tmp_path / "c.toml")
     assert where in str(err.value) and "\n" not in str(err.value)
+
+
+PROGRAM = """%
+O1000 (a short feed-axis program)
+N10 G21 G90 G17
+N20 M3 S6000 ; spindle on
+N30 G0 X100.
+N40 G1 X200 F600
+N50 G4 P2000
+N60 M5
+N70 G91 G1 X-30 Y40 F1200 M8
+N80 G4 X1.5
+N90 M30
+N100 G1 X500
+"""
+
+
+def test_nc_program_becomes_a_schedule():
+    """G0 100 mm at 30 m/min (0.2 s), G1 100 mm at 600 mm/min (10 s), 2-s dwell, an incremental
+    G1 of 50 mm at 1200 mm/min (2.5 s), a 1.5-s dwell; nothing after M30."""
+    from gatetherm.studies.run.ncprogram import nc_series, segments
+
+    segs = segments(PROGRAM.replace("%", "").replace("O1000", ""))
+    assert [s.duration for s in segs] == pytest.approx([0.2, 10.0, 2.0, 2.5, 1.5], rel=1e-12)
+    ts = nc_series(PROGRAM.replace("%", "").replace("O1000", ""), step_s=0.5)
+    t = ts.time_s
+    assert t[-1] == pytest.approx(16.2, rel=1e-12) and len(t) == 34
+    at = {round(float(x), 6): i for i, x in enumerate(t)}
+    i = at[5.0]  # 4.8 s into the G1 at 10 mm/s: X = 148 mm, spindle at 6000
+    assert ts["x_m"][i] == pytest.approx(0.148, abs=1e-12) and ts["vx_m_s"][i] == pytest.approx(0.01, rel=1e-12)
+    assert ts["spindle_rpm"][i] == 6000.0 and ts["feed_m_s"][i] == pytest.approx(0.01, rel=1e-12)
+    i = at[11.0]  # dwelling at X = 200 mm, spindle still on (M5 comes after the dwell)
+    assert ts["x_m"][i] == pytest.approx(0.2, abs=1e-12) and ts["vx_m_s"][i] == 0.0 and ts["spindle_rpm"][i] == 6000.0
+    i = at[13.5]  # 1.3 s into the 50-mm move at 20 mm/s along (-0.6, 0.8): 26 mm
+    np.testing.assert_allclose([ts["x_m"][i], ts["y_m"][i], ts["z_m"][i]], [0.2 - 0.0156, 0.0208, 0.0], atol=1e-12)
+    assert ts["feed_m_s"][i] == pytest.approx(0.02, rel=1e-12) and ts["spindle_rpm"][i] == 0.0
+    np.testing.assert_allclose([ts["x_m"][-1], ts["y_m"][-1], ts["z_m"][-1]], [0.17, 0.04, 0.0], atol=1e-12)
+
+
+@pytest.mark.parametrize("text, what", [("G1 X10", "without a feed"), ("G2 X10 Y5 R5 F100", "G2 is not read"),
+                                        ("G1 X10 Q3 F100", "word Q"), ("G1 X5 P2 F100", "G4 dwell only"),
+                                        ("M6", "M6 is not read"), ("X10", "without G0 or G1")])
+def test_bad_nc_program_is_one_line_naming_it(text, what):
+    from gatetherm.studies.run.ncprogram import nc_series
+
+    with pytest.raises(InputError, match=what) as err:
+        nc_series("G21\n" + text, where="p.nc")
+    assert "p.nc, line 2" in str(err.value)
+
+
+def test_a_carriage_driven_by_an_nc_program(tmp_path):
+    """An NC program → schedule (gt.nc_schedule) → a guide's carriage moving with x_m and losing
+    (μ F + seal)|v| at its own velocity: the run reports that loss, and the heat goes in."""
+    (tmp_path / "p.nc").write_text("G21 G90\nG0 X300\nG1 X700 F1200\nG4 X5\nG1 X400 F2400\nM30\n")
+    ts = gt.nc_schedule(tmp_path / "p.nc", step_s=1.0, out=tmp_path / "p.csv")
+    assert ts.time_s[-1] == pytest.approx(0.6 + 20.0 + 5.0 + 7.5, rel=1e-12)
+    text = STRIP.replace("end = 700.0", "end = 33.0").replace("step = 4.0", "step = 1.0").replace(
+        "output = 700.0", "output = 1.0\nschedule = \"p.csv\"").replace("order = 2", "order = 1")
+    text = text.replace('power = 1.0\nposition = "0.3 + 0.002*t"',
+                        'kind = "guide"\nspeed = "vx_m_s"\nload = 2000.0\nseal = 4.0\nposition = "x_m"')
+    (tmp_path / "strip.geo").write_text(STRIP_GEO.format(lc=0.02, L=1.0, w=0.1))
+    (tmp_path / "c.toml").write_text(text)
+    run = gt.run(gt.load_case(tmp_path / "c.toml"))
+    v = np.interp(run.time, ts.time_s, ts["vx_m_s"])
+    np.testing.assert_allclose(run["P_strip_W"], (0.003 * 2000.0 + 4.0) * np.abs(v), rtol=1e-12)
+    assert run["P_strip_W"][10] == pytest.approx(0.2, rel=1e-12)  # 10 W/m·s × 20 mm/s

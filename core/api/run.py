@@ -23,7 +23,7 @@ STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
 __all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "beam_coefficients", "condition", "configure", "gate_frame",
-           "load_case", "run", "schedule_file"]
+           "load_case", "nc_schedule", "run", "schedule_file"]
 
 
 def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Schedule:
@@ -45,6 +45,41 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
     """
     supply = getattr(getattr(case, "origin", None), "config", None)
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
+
+
+def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.0, out: str | os.PathLike | None = None):
+    """An NC program's axis positions, feeds and spindle speed against time: a schedule for a
+    case's moving sources and machine elements (``docs/model.md``, NC programs).
+
+    Parameters
+    ----------
+    path : str or path
+        The program: G0/G1 moves with F (mm/min, or inch/min after G20), G4 dwells (X in s, P in
+        ms), M3/M4/M5 with S (1/min), G90/G91; anything else (arcs, cycles) is refused by line.
+    step_s : float
+        Sample interval, s (the program's end is the last sample).
+    rapid : float
+        The rapid rate of G0 moves, m/min.
+    out : str or path, optional
+        Also write the schedule there (the data format: a case's ``[time] schedule``).
+
+    Returns
+    -------
+    TimeSeries
+        ``time_s``; ``x_m``, ``y_m``, ``z_m`` (axis positions, m); ``vx_m_s``, ``vy_m_s``, ``vz_m_s``
+        (axis velocities, m/s); ``feed_m_s`` (speed along the path, m/s); ``spindle_rpm`` (1/min,
+        negative for M4).
+    """
+    from gatetherm.files import read_text
+    from gatetherm.studies.run.ncprogram import nc_series
+    from gatetherm.studies.run.timeseries import write_timeseries
+
+    if not (np.isfinite(step_s) and step_s > 0) or not (np.isfinite(rapid) and rapid > 0):
+        raise InputError("step_s" if not step_s > 0 else "rapid", "must be a positive number", "e.g. 1.0")
+    ts = nc_series(read_text(path, "", "give an NC program (a text file)"), step_s, str(path), rapid)
+    if out is not None:
+        write_timeseries(out, ts)
+    return ts
 
 
 def beam_coefficients(case: Case, source: str = "theory") -> tuple[float, float]:
