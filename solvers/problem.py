@@ -267,6 +267,7 @@ def values(problem: Problem) -> list[Value]:
     out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
     out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
     out += [s.position for s in problem.sources if s.position is not None]
+    out += [f.law.speed for f in problem.films if f.law is not None]  # a correlation's speed
     out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
     out += [*problem.gravity, *(v for x in (*problem.loads, *problem.supports) for v in x.values)]
     return out + [v for pl in problem.point_loads for v in pl.force]

@@ -198,9 +198,10 @@ class Run:
 
     def summary(self) -> dict:
         """What ``summary.json`` holds: the case, its size, every probe and relative displacement
-        at the last sample, and δ's figures where the case has a δ."""
+        at the last sample, δ's figures where the case has a δ, and every machine element's loss
+        (mean, largest, last, energy; its column ``P_REGION_W`` holds it over time)."""
         from gatetherm.studies.run.output import probe_summary
-        from gatetherm.studies.run.simulate import delta_figures
+        from gatetherm.studies.run.simulate import delta_figures, loss_summary
 
         c, p = self.case, self.case.problem
         out = {"case": c.name, "file": c.source, "dim": p.dim, "order": p.order,
@@ -208,7 +209,8 @@ class Run:
                ("transient" if c.time else "steady"),
                "nodes": len(c.mesh.points), "elements": len(c.mesh.cells), "schedule": self.scenario.schedule.label,
                "effects": self.scenario.effects.describe(), "wall_time_s": round(self.seconds, 2),
-               "march_s": round(self.scenario.result.seconds, 2), **probe_summary(p, self.columns)}
+               "march_s": round(self.scenario.result.seconds, 2), **probe_summary(p, self.columns),
+               **loss_summary(p, self.columns)}
         if "delta_um" in self.columns and len(self.time) > 1:
             out.update(delta_figures(self.time, self["delta_um"]))
         if self.order_check is not None:

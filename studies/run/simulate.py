@@ -106,6 +106,19 @@ def loss_columns(problem: Problem, cols: Mapping[str, np.ndarray]) -> dict[str, 
             for s in problem.sources if s.loss}
 
 
+def loss_summary(problem: Problem, cols: Mapping[str, np.ndarray]) -> dict:
+    """``{"losses": {COLUMN: {"mean_W", "max_W", "last_W", "energy_J"}}}`` of the sources that report
+    their power (:func:`loss_columns`; empty without them); the energy by the trapezoidal rule."""
+    t, out = np.asarray(cols["time_s"], float), {}
+    for s in problem.sources:
+        if s.loss and s.loss in cols:
+            P = np.asarray(cols[s.loss], float)
+            energy = float(np.sum(0.5 * (P[1:] + P[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+            out[s.loss] = {"mean_W": energy / float(t[-1] - t[0]) if len(t) > 1 else float(P[0]),
+                           "max_W": float(P.max()), "last_W": float(P[-1]), "energy_J": energy}
+    return {"losses": out} if out else {}
+
+
 def check_temperatures(U: np.ndarray, t: float) -> None:
     """InputError unless every temperature of the state ``U`` (°C) at ``t`` (s) is admissible
     (:data:`~gatetherm.checks.CELSIUS`): a run that leaves the range has met heat inputs out of
