@@ -164,6 +164,34 @@ class MovingLoad:
                              "keep the position on the region along the direction")
         return w / total
 
+    def anchors(self) -> tuple[np.ndarray, float]:
+        """Positions at which the reduced model takes this load's vector, m, and their spacing: from
+        one end of the region to the other, :data:`ANCHOR_SPACING` bands or elements apart (at most
+        :data:`MAX_ANCHORS`)."""
+        lo, hi = float(self.along.min()), float(self.along.max())
+        step = ANCHOR_SPACING * max(self.length, self.spacing)
+        count = int(min(MAX_ANCHORS, max(2, np.ceil((hi - lo) / step - 1e-6) + 1)))
+        return np.linspace(lo, hi, count), (hi - lo) / (count - 1)
+
+    def interpolated(self) -> list[tuple[str, np.ndarray]]:
+        """The load as fixed vectors times inputs: ``(input expression, vector)`` per anchor ``p_j``,
+        the power times the hat ``max(0, 1 − |position − p_j|/Δ)``: the input matrix interpolated
+        linearly over the positions (exact at the anchors)."""
+        at, gap = self.anchors()
+        power, pos = self.value.text or repr(self.value.constant), self.position.text or repr(self.position.constant)
+        key = self.position.key
+        return [(f"({power})*max(0, 1 - abs(({pos}) - {float(p)!r})/{float(gap)!r})", self._at(float(p), key)) for p in at]
+
+    def _at(self, p: float, key: str) -> np.ndarray:
+        return MovingLoad(self.weights, self.along, self.spacing, self.length, Value(p, "", key),
+                          self.value).vector({})
+
+
+ANCHOR_SPACING = 1.0
+"""Anchors of a moving load in the reduced model are this many band lengths (or elements, if longer) apart."""
+MAX_ANCHORS = 41
+"""Most anchors of one moving load (inputs of the reduced model)."""
+
 
 def _hat_integral(u: np.ndarray) -> np.ndarray:
     """``∫_{-∞}^{u} max(0, 1 − |x|) dx``."""
