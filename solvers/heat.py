@@ -152,6 +152,8 @@ class MovingLoad:
     position: Value
     value: Value
     """The power, W."""
+    span: tuple[float, float] = (-np.inf, np.inf)
+    """The region's extent along the direction, m."""
 
     def vector(self, env) -> np.ndarray:
         """The load of a unit power at the position of ``env`` (solid unknowns, sums to 1)."""
@@ -160,7 +162,7 @@ class MovingLoad:
         total = w.sum()
         if not total > 0:
             raise InputError(self.position.key or "position", f"the band at {p:g} m ({self.length:g} m long) "
-                             f"misses its region (from {self.along.min():g} to {self.along.max():g} m)",
+                             f"misses its region (from {self.span[0]:g} to {self.span[1]:g} m)",
                              "keep the position on the region along the direction")
         return w / total
 
@@ -168,7 +170,7 @@ class MovingLoad:
         """Positions at which the reduced model takes this load's vector, m, and their spacing: from
         one end of the region to the other, :data:`ANCHOR_SPACING` bands or elements apart (at most
         :data:`MAX_ANCHORS`)."""
-        lo, hi = float(self.along.min()), float(self.along.max())
+        lo, hi = self.span
         step = ANCHOR_SPACING * max(self.length, self.spacing)
         count = int(min(MAX_ANCHORS, max(2, np.ceil((hi - lo) / step - 1e-6) + 1)))
         return np.linspace(lo, hi, count), (hi - lo) / (count - 1)
@@ -184,7 +186,7 @@ class MovingLoad:
 
     def _at(self, p: float, key: str) -> np.ndarray:
         return MovingLoad(self.weights, self.along, self.spacing, self.length, Value(p, "", key),
-                          self.value).vector({})
+                          self.value, self.span).vector({})
 
 
 ANCHOR_SPACING = 1.0
@@ -615,5 +617,6 @@ def moving_load(mesh, basis, src, weights: np.ndarray, order: int) -> MovingLoad
     cells = mesh.subdomains[src.region]
     extent = np.ptp(along[mesh.t[:, cells]], axis=0)
     locs = basis.doflocs if getattr(basis, "doflocs", None) is not None else mesh.p
+    inside = along[np.unique(mesh.t[:, cells])]
     return MovingLoad(weights, d @ locs[:, :len(weights)], float(np.median(extent)) / order, src.length,
-                      src.position, src.density)
+                      src.position, src.density, (float(inside.min()), float(inside.max())))

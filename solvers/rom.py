@@ -254,6 +254,8 @@ def _slowest(lhm: LinearHeatModel) -> float:
     temp = [j for j, u in enumerate(lhm.inputs) if u.offset == lhm.T0]
     B = lhm.B[lhm.modes[-1]]
     loss = float(sum(B[:, j] for j in temp).sum()) if temp else 0.0
+    if not loss > 0:  # films to an ambient held at T0 are no input: their conductance is in K's row sums
+        loss = float(lhm.K[lhm.modes[-1]].sum())
     if not loss > 0:
         raise InputError("reduced model", "the case loses no heat to an ambient or a fixed temperature: it never "
                          "settles", "give a film, a fixed temperature or a fluid with a supply")

@@ -47,7 +47,8 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
 
 
-def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.0, out: str | os.PathLike | None = None):
+def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.0, out: str | os.PathLike | None = None,
+                repeat: int = 1):
     """An NC program's axis positions, feeds and spindle speed against time: a schedule for a
     case's moving sources and machine elements (``docs/model.md``, NC programs).
 
@@ -62,6 +63,8 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
         The rapid rate of G0 moves, m/min.
     out : str or path, optional
         Also write the schedule there (the data format: a case's ``[time] schedule``).
+    repeat : int
+        Run the program this many times back to back (each from where the last ended).
 
     Returns
     -------
@@ -76,7 +79,9 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
 
     if not (np.isfinite(step_s) and step_s > 0) or not (np.isfinite(rapid) and rapid > 0):
         raise InputError("step_s" if not step_s > 0 else "rapid", "must be a positive number", "e.g. 1.0")
-    ts = nc_series(read_text(path, "", "give an NC program (a text file)"), step_s, str(path), rapid)
+    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
+        raise InputError("repeat", f"{repeat!r} is not a whole number of runs", "give 1 or more")
+    ts = nc_series(read_text(path, "", "give an NC program (a text file)"), step_s, str(path), rapid, repeat)
     if out is not None:
         write_timeseries(out, ts)
     return ts

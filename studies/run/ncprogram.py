@@ -42,9 +42,10 @@ def _strip(line: str) -> str:
     return re.sub(r"\([^)]*\)", " ", line).split(";")[0].upper()
 
 
-def segments(text: str, where: str = "program", rapid: float = 30.0) -> list[Segment]:
-    """The motion of an NC program ``text`` block by block; ``rapid`` the rapid rate, m/min."""
-    pos, feed, spindle, s_word, absolute, unit, motion = [0.0, 0.0, 0.0], None, 0.0, 0.0, True, 1e-3, None
+def segments(text: str, where: str = "program", rapid: float = 30.0, start=(0.0, 0.0, 0.0)) -> list[Segment]:
+    """The motion of an NC program ``text`` block by block from the axis position ``start`` (m);
+    ``rapid`` the rapid rate, m/min."""
+    pos, feed, spindle, s_word, absolute, unit, motion = list(start), None, 0.0, 0.0, True, 1e-3, None
     out = []
     for number, raw in enumerate(text.splitlines(), 1):
         line = _strip(raw)
@@ -111,11 +112,16 @@ def segments(text: str, where: str = "program", rapid: float = 30.0) -> list[Seg
     return out
 
 
-def nc_series(text: str, step_s: float = 1.0, where: str = "program", rapid: float = 30.0) -> TimeSeries:
-    """The schedule of an NC program ``text``: the columns :data:`COLUMNS` every ``step_s``
-    seconds (and at its end), each the value at that instant (velocities: of the block then
-    running, a block's start belonging to it)."""
-    segs = [s for s in segments(text, where, rapid) if s.duration > 0]
+def nc_series(text: str, step_s: float = 1.0, where: str = "program", rapid: float = 30.0,
+              repeat: int = 1) -> TimeSeries:
+    """The schedule of an NC program ``text`` run ``repeat`` times back to back (each run from where
+    the last ended): the columns :data:`COLUMNS` every ``step_s`` seconds (and at its end), each
+    the value at that instant (velocities: of the block then running, a block's start belonging
+    to it)."""
+    segs: list[Segment] = []
+    for _ in range(repeat):
+        segs += segments(text, where, rapid, segs[-1].end if segs else (0.0, 0.0, 0.0))
+    segs = [s for s in segs if s.duration > 0]
     if not segs:
         raise InputError(where, "has no move or dwell", "give G0/G1 moves or G4 dwells")
     ends = np.cumsum([s.duration for s in segs])
