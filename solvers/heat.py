@@ -564,11 +564,17 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
     moving = []
     for src in problem.sources:
-        cb = cells()
-        on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
-        vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        if src.on_boundary:  # a power on a surface: ∫ t v over the boundary, normalised to it
+            vec = boundary_terms(mesh, src.region, e, q, th)[1]
+        else:
+            cb = cells()
+            on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
+            vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
         if src.position is not None:
             moving.append(moving_load(mesh, basis, src, vec, order))
+            continue
+        if src.on_boundary:
+            loads.append((vec / vec.sum(), src.density, "source"))
             continue
         loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
     n_solid = basis.N
@@ -611,12 +617,12 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
 
 
 def moving_load(mesh, basis, src, weights: np.ndarray, order: int) -> MovingLoad:
-    """The :class:`MovingLoad` of a source with a position (its region's load ``weights``)."""
+    """The :class:`MovingLoad` of a source with a position (its region's or boundary's load ``weights``)."""
     d = np.asarray(src.direction, float)
     along = d @ mesh.p
-    cells = mesh.subdomains[src.region]
-    extent = np.ptp(along[mesh.t[:, cells]], axis=0)
+    nodes = mesh.facets[:, mesh.boundaries[src.region]] if src.on_boundary else mesh.t[:, mesh.subdomains[src.region]]
+    extent = np.ptp(along[nodes], axis=0)
     locs = basis.doflocs if getattr(basis, "doflocs", None) is not None else mesh.p
-    inside = along[np.unique(mesh.t[:, cells])]
+    inside = along[np.unique(nodes)]
     return MovingLoad(weights, d @ locs[:, :len(weights)], float(np.median(extent)) / order, src.length,
                       src.position, src.density, (float(inside.min()), float(inside.max())))

@@ -60,6 +60,9 @@ class Source:
     """The density is ``per × density``: 1 for a density, 1/volume (1/m³) for a power (W) in the region."""
     loss: str = ""
     """The output column that reports its power over time (a machine element's loss, W), empty: none."""
+    on_boundary: bool = False
+    """The source lies on the boundary named :attr:`region` (a surface source: :attr:`density` is its
+    power, W, spread over the boundary's area or its band)."""
     position: Value | None = None
     """A source that moves: the centre of the band its power is spread over, m along :attr:`direction`
     (None: spread over the whole region)."""

@@ -23,6 +23,7 @@ Curve Loop(1) = {{1, 2, 3, 4}};
 Plane Surface(1) = {{1}};
 Physical Surface("strip") = {{1}};
 Physical Curve("ends") = {{2, 4}};
+Physical Curve("bottom") = {{1}};
 """
 K, RHO, C, T_TH, H, V, P, W = 100.0, 1000.0, 1000.0, 0.002, 10.0, 0.002, 1.0, 0.02
 """Conductivity, density, heat capacity, thickness (m), face film, speed (m/s), power (W), width (m)."""
@@ -240,3 +241,25 @@ def test_feed_axis_reduced_model_on_an_unseen_program(tmp_path):
     print(f"program_b x30: {ts.time_s[-1]:.0f} s; reduced model of {red.rom.states} states: δ off by {check.errors['delta_um']:.3f} um, "
           f"screw end by {check.errors['T_screw_end_degC']:.3f} K; its march {check.rom_ms:.0f} ms, FE {check.fe_seconds:.1f} s")
     assert check.errors["delta_um"] == pytest.approx(0.178, abs=0.02)  # band: < 0.5 um
+
+
+def test_sources_on_a_boundary_fixed_and_moving(tmp_path):
+    """REGION may be a boundary: a power over its area (here 2 W on the strip's ends, ∫ t v of
+    each end), or a band on it (3 W travelling along the bottom edge): the loads sum to the power,
+    sit on the boundary's nodes only, and the band's centre is the position."""
+    case = _strip(tmp_path, '[sources.ends]\npower = 2.0\n[sources.bottom]\nkind = "guide"\nspeed = 1.0\n'
+                            'load = 1000.0\nposition = "0.2 + 0.004*t"\ndirection = [1, 0]\nlength = 0.06\n')
+    heat = build(case.problem, case.mesh).heat
+    ends = next(ld for ld in heat.loads if ld.kind == "source" and ld.value.constant == 2.0)
+    x, y = heat.basis.doflocs[:, :heat.n_solid]
+    f = ends.vector[:heat.n_solid] * 2.0
+    assert f.sum() == pytest.approx(2.0, rel=1e-12) and np.all((f == 0) | np.isclose(x, 0) | np.isclose(x, 1.0))
+    assert f[np.isclose(x, 0)].sum() == pytest.approx(1.0, rel=1e-12)  # two equal ends
+    band = next(m for m in heat.moving if abs(m.value({}) - 3.0) < 1e-12)
+    g = band.vector({"t": 50.0}) * band.value({})
+    assert g.sum() == pytest.approx(3.0, rel=1e-12) and np.all(np.isclose(y[g != 0], 0.0))
+    assert (g @ x) / g.sum() == pytest.approx(0.4, abs=1e-9)
+    (tmp_path / "c.toml").write_text((tmp_path / "c.toml").read_text().replace("[sources.ends]\npower", "[sources.ends]\ndensity"))
+    with pytest.raises(InputError, match="sources.ends.density.*boundary takes power"):
+        gt.load_case(tmp_path / "c.toml")
+

@@ -315,13 +315,13 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
     else:
         kw.update(case_tables.boundary_conditions(top, fm, names))
-        src = top.sub("sources", tuple(fm.regions))
+        src = top.sub("sources", tuple(fm.regions) + tuple(b for b in fm.boundaries if b not in fm.regions))
         sources = []
         for r in src.data:
             sources.append(case_sources.read_source(
                 src.sub(r, KEYS["sources.REGION"]), r, names,
                 lambda r=r: case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else
-                region_volume(fm, r, thickness.get(r, 1.0)), fm.dim))
+                region_volume(fm, r, thickness.get(r, 1.0)), fm.dim, r not in fm.regions))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:

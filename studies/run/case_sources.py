@@ -1,5 +1,5 @@
-"""``[sources.REGION]`` of a case file: a heat source given as a density, a power, or the loss of
-a machine element (``kind``: a bearing, a ball screw's nut or bearing, a linear guide's
+"""``[sources.REGION]`` of a case file (REGION a region, or a boundary for a surface source): a heat
+source given as a density, a power, or the loss of a machine element (``kind``: a bearing, a ball screw's nut or bearing, a linear guide's
 carriage, a motor) driven by the schedule's columns (:mod:`gatetherm.solvers.elements`).
 
 An element's loss becomes an ordinary power in W (an expression of the run's inputs), spread
@@ -102,11 +102,19 @@ def moving(t: Table, names, dim: int) -> dict:
             "length": t.number("length", POSITIVE_M)}
 
 
-def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: int = 3) -> Source:
-    """The source of the ``[sources.REGION]`` table ``t``; ``volume()`` the region's volume, m³."""
+def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: int = 3,
+                on_boundary: bool = False) -> Source:
+    """The source of the ``[sources.REGION]`` table ``t``; ``volume()`` the region's volume, m³;
+    ``on_boundary``: REGION names a boundary (a surface source: power or kind only)."""
     band = moving(t, names, dim)
+    if on_boundary and "density" in t.data:
+        t.fail("density", "is a volume density: a boundary takes power (W) or kind",
+               "give power, or a heat flux in [thermal.BOUNDARY] flux")
+    if on_boundary:
+        band["on_boundary"] = True
     if "kind" in t.data:
-        return Source(region, element_loss(t, names), 1.0 / volume(), loss=f"P_{region}_W", **band)
+        return Source(region, element_loss(t, names), 1.0 if on_boundary else 1.0 / volume(), loss=f"P_{region}_W",
+                      **band)
     extra = next((k for k in t.data if k not in ("density", "power", *MOVING)), None)
     if extra:
         t.fail(extra, "goes with kind only", f"give kind ({', '.join(ELEMENT_KEYS)}) or remove it")
@@ -114,4 +122,4 @@ def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: 
         t.fail("density", "give either density (W/m³), power (W) or kind (a machine element)")
     if "density" in t.data:
         return Source(region, t.value("density", names, unit="W/m³"))
-    return Source(region, t.value("power", names, unit="W"), 1.0 / volume(), **band)
+    return Source(region, t.value("power", names, unit="W"), 1.0 if on_boundary else 1.0 / volume(), **band)
