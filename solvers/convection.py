@@ -12,8 +12,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
+import scipy.sparse as sp
 
 from gatetherm.solvers.expr import Value
 
@@ -140,3 +142,32 @@ class FilmLaw:
     def __call__(self, Ts: float, Ta: float, env) -> float:
         """The film coefficient at surface temperature ``Ts`` and ambient ``Ta`` (°C), W/(m² K)."""
         return self.convective(Ts, Ta, env) + (float(radiation(self.emissivity, Ts, Ta)) if self.emissivity else 0.0)
+
+
+@dataclass(frozen=True)
+class VaryingFilm:
+    """A film whose coefficient follows its boundary's mean temperature (a FilmLaw): the matrix holds
+    ``h_ref``, the load the rest, ``−(h − h_ref)(A U − a T_amb)``, solved by Picard iterations."""
+
+    boundary: str
+    A: sp.csr_matrix
+    """``∫ t u v`` over the boundary (solid unknowns)."""
+    a: np.ndarray
+    """``∫ t v`` over the boundary (solid unknowns)."""
+    h_ref: float
+    """Coefficient in the matrix, W/(m² K)."""
+    law: Callable
+    """``law(Ts, Ta, env)``: the coefficient at mean surface temperature ``Ts``, W/(m² K)."""
+    ambient: Value
+
+    def surface(self, U: np.ndarray) -> float:
+        """Area-mean temperature of the boundary, °C."""
+        return float(self.a @ U[:len(self.a)] / self.a.sum())
+
+    def h(self, U: np.ndarray, env) -> float:
+        return float(self.law(self.surface(U), self.ambient(env), env))
+
+    def correction(self, U: np.ndarray, env) -> np.ndarray:
+        """The film's part beyond the matrix, on the left-hand side (solid unknowns)."""
+        Ta = self.ambient(env)
+        return (self.law(self.surface(U), Ta, env) - self.h_ref) * (self.A @ U[:len(self.a)] - self.a * Ta)
