@@ -114,3 +114,15 @@ def test_bad_element_source_is_one_line(tmp_path, body, where):
     with pytest.raises(InputError) as err:
         gt.load_case(tmp_path / "c.toml")
     assert where in str(err.value) and "\n" not in str(err.value)
+
+
+def test_bad_bearing_through_the_cli_is_one_line_and_exit_2(tmp_path, capsys):
+    from gatetherm.cli import main
+
+    shutil.copy(DATA / "two_names.geo", tmp_path)
+    (tmp_path / "c.toml").write_text(BLOCK.replace('type = "angular_contact_oil"\n', "").replace(
+        "dm = 0.0825", 'dm = 0.0825\ntype = "tapered"'))
+    (tmp_path / "speed.csv").write_text("time_s,n_spindle\n0,6000\n600,6000\n")
+    assert main(["run", str(tmp_path / "c.toml"), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "sources.plate.type" in err and "angular_contact_oil" in err
