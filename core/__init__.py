@@ -24,7 +24,8 @@ run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 API = ("Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
        "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame", "load_case",
-       "place_sensors", "reduce", "run", "schedule_file", "validate_zoo", "write_placement", "write_reduction")
+       "nc_schedule", "place_sensors", "reduce", "run", "schedule_file", "validate_zoo", "write_placement",
+       "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 
 

@@ -30,10 +30,13 @@ import scipy.sparse as sp
 from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
 from skfem.helpers import dot, grad
 
+from gatetherm import InputError
 from gatetherm.solvers import p1
 from gatetherm.solvers.expr import Value
+from gatetherm.solvers.convection import VaryingFilm
 from gatetherm.solvers.fem import Field, complement, dof_basis, element
 from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
+from gatetherm.solvers.moving import MovingLoad, moving_load
 from gatetherm.solvers.pardiso import Analyses
 from gatetherm.solvers.scheme import TimeScheme
 
@@ -105,6 +108,12 @@ class Pumped:
         return (self.film_on, self.conductance) if on else (self.film_off, 0.0)
 
 
+PICARD_TOL = 1e-10
+"""Change of every varying film's boundary-mean temperature, K, at which the Picard iterations stop."""
+PICARD_MAX = 200
+"""Most Picard iterations of one step (or of a steady state)."""
+
+
 @dataclass(frozen=True)
 class HeatSystem:
     """Assembled operators: ``M U' + K(mode) U = f(env, mode)`` with ``U[fixed]`` given.
@@ -128,6 +137,10 @@ class HeatSystem:
     """The linear mesh's :class:`~gatetherm.solvers.p1.Simplices`: their METIS node order, found
     when a step matrix is first factorised, is the one every factor on the mesh shares (None: an
     order found from that step matrix)."""
+    varying: tuple[VaryingFilm, ...] = ()
+    """Films whose coefficient follows the temperature (Picard iterations: :func:`picard`)."""
+    moving: tuple[MovingLoad, ...] = ()
+    """Sources that follow a position."""
 
     @property
     def n(self) -> int:
@@ -152,6 +165,8 @@ class HeatSystem:
         out = np.zeros(self.n)
         for load in self.loads:
             out += load.vector * load.value(env)
+        for m in self.moving:
+            out[:len(m.weights)] += m.vector(env) * m.value(env)
         for p, on in zip(self.pumped, mode):
             out[p.inlet] += p.coefficients(on)[1] * p.supply(env)
         return out
@@ -162,6 +177,16 @@ class HeatSystem:
         for dofs, value in self.fixed:
             out[dofs] = value(env)
         return out[self.fixed_dofs]
+
+    def correction(self, U: np.ndarray, env) -> np.ndarray:
+        """The varying films' parts beyond the matrix (on the left-hand side), on all unknowns."""
+        out = np.zeros(self.n)
+        for v in self.varying:
+            out[:len(v.a)] += v.correction(U, env)
+        return out
+
+    def surfaces(self, U: np.ndarray) -> np.ndarray:
+        return np.array([v.surface(U) for v in self.varying])
 
     def initial(self, T0: float | None = None) -> np.ndarray:
         return np.full(self.n, self.T0 if T0 is None else T0)
@@ -266,10 +291,29 @@ class HeatSolver:
         mode = sys.mode(env)
         K, f, held = self.K(mode), sys.f(env, mode), sys.boundary_values(env)
         solve, coupling = self._system(K, 1, f"steady heat, mode {mode}")
-        U = np.empty(sys.n)
-        U[sys.fixed_dofs] = held
-        U[self.free] = solve(f[self.free] - (coupling @ held if coupling is not None else 0.0))
-        return U
+
+        def once(rhs):
+            U = np.empty(sys.n)
+            U[sys.fixed_dofs] = held
+            U[self.free] = solve(rhs[self.free] - (coupling @ held if coupling is not None else 0.0))
+            return U
+        U = once(f)
+        return picard(sys, lambda U: once(f - sys.correction(U, env)), U) if sys.varying else U
+
+
+def picard(sys: HeatSystem, solve: Callable[[np.ndarray], np.ndarray], U: np.ndarray) -> np.ndarray:
+    """Iterate ``U ← solve(U)`` (a solve with the varying films' coefficients of ``U``) until no
+    film's boundary-mean temperature changes by more than :data:`PICARD_TOL`."""
+    Ts = sys.surfaces(U)
+    for _ in range(PICARD_MAX):
+        U = solve(U)
+        new = sys.surfaces(U)
+        if np.max(np.abs(new - Ts)) <= PICARD_TOL:
+            return U
+        Ts = new
+    worst = sys.varying[int(np.argmax(np.abs(new - Ts)))].boundary
+    raise InputError(f"film of '{worst}'", f"the coefficient's Picard iterations did not settle in {PICARD_MAX}",
+                     "give a reference film near the largest coefficient the run reaches, or shorter steps")
 
 
 def theta_step(solver: HeatSolver, drive: Drive, U: np.ndarray, t0: float, t1: float, theta: float,
@@ -284,12 +328,19 @@ def theta_step(solver: HeatSolver, drive: Drive, U: np.ndarray, t0: float, t1: f
     if theta < 1:
         f = theta * f + (1 - theta) * sys.f(environment(drive, t0), mode)
     held, fixed = sys.boundary_values(env1) if sys.fixed else np.zeros(0), sys.fixed_dofs
-    W = solver.solve(dt, theta, mode, sys.M @ U / dt + theta * f, theta * held + (1 - theta) * U[fixed])
-    if theta == 1:
-        return W
-    U1 = (W - (1 - theta) * U) / theta
-    U1[fixed] = held
-    return U1
+
+    def step(f):
+        W = solver.solve(dt, theta, mode, sys.M @ U / dt + theta * f, theta * held + (1 - theta) * U[fixed])
+        if theta == 1:
+            return W
+        U1 = (W - (1 - theta) * U) / theta
+        U1[fixed] = held
+        return U1
+    if not sys.varying:
+        return step(f)
+    # the films' rest at the step's weights: θ at the new state (iterated), 1 − θ at the old one
+    f0 = f - (1 - theta) * sys.correction(U, environment(drive, t0)) if theta < 1 else f
+    return picard(sys, lambda U1: step(f0 - theta * sys.correction(U1, env1)), U)
 
 
 def substeps(t0: float, t1: float, scheme: TimeScheme, since: int) -> list[tuple[float, float, float]]:
@@ -405,20 +456,33 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         return CellBasis(mesh, e, intorder=q) if order == 1 else basis
 
     loads: list[tuple[np.ndarray, Value, str]] = []
+    varying = []
     for fl in problem.films:
         A_f, a_f = boundary_terms(mesh, fl.boundary, e, q, th)
         K = K + fl.h * A_f
         loads.append((fl.h * a_f, fl.ambient, "film"))
+        if fl.law is not None:
+            varying.append(VaryingFilm(fl.boundary, A_f.tocsr(), a_f, fl.h, fl.law, fl.ambient))
     for fx in problem.fluxes:
         loads.append((boundary_terms(mesh, fx.boundary, e, q, th)[1], fx.value, "flux"))
     if problem.faces is not None and mesh.dim() == 2:
         cb = cells()
         K = K + asm(film, cb, h=problem.faces.h, t=2.0)
         loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
+    moving = []
     for src in problem.sources:
-        cb = cells()
-        on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
-        vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        if src.on_boundary:  # a power on a surface: ∫ t v over the boundary, normalised to it
+            vec = boundary_terms(mesh, src.region, e, q, th)[1]
+        else:
+            cb = cells()
+            on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
+            vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        if src.position is not None:
+            moving.append(moving_load(mesh, basis, src, vec, order))
+            continue
+        if src.on_boundary:
+            loads.append((vec / vec.sum(), src.density, "source"))
+            continue
         loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
     n_solid = basis.N
     caps, losses, lumped, couplings = [], [], {}, []
@@ -455,4 +519,6 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
     fixed = tuple((basis.get_dofs(mesh.boundaries[c.boundary]).all(), c.value) for c in problem.fixed)
     log.info("heat system: %d unknowns (P%d), %d fixed", n, order, len(np.unique(np.concatenate(
         [d for d, _ in fixed]))) if fixed else 0)
-    return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, s)
+    return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, s,
+                      tuple(varying), tuple(moving))
+

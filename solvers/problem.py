@@ -23,9 +23,12 @@ class Film:
 
     boundary: str
     h: float
-    """Film coefficient, W/(m² K)."""
+    """Film coefficient, W/(m² K) (with a :attr:`law`: the reference coefficient of the matrix)."""
     ambient: Value
     """Ambient temperature, °C."""
+    law: object = None
+    """A :class:`~gatetherm.solvers.convection.FilmLaw` (a correlation, radiation) that gives the
+    coefficient from the surface temperature and the inputs; None: the constant :attr:`h`."""
 
 
 @dataclass(frozen=True)
@@ -55,6 +58,18 @@ class Source:
     """Power density, W/m³ (times :attr:`per`)."""
     per: float = 1.0
     """The density is ``per × density``: 1 for a density, 1/volume (1/m³) for a power (W) in the region."""
+    loss: str = ""
+    """The output column that reports its power over time (a machine element's loss, W), empty: none."""
+    on_boundary: bool = False
+    """The source lies on the boundary named :attr:`region` (a surface source: :attr:`density` is its
+    power, W, spread over the boundary's area or its band)."""
+    position: Value | None = None
+    """A source that moves: the centre of the band its power is spread over, m along :attr:`direction`
+    (None: spread over the whole region)."""
+    direction: tuple[float, ...] = ()
+    """Unit vector along which :attr:`position` and :attr:`length` are measured."""
+    length: float = 0.0
+    """Extent of the band along the direction, m."""
 
 
 @dataclass(frozen=True)
@@ -254,6 +269,8 @@ def values(problem: Problem) -> list[Value]:
     """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
     out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
     out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    out += [s.position for s in problem.sources if s.position is not None]
+    out += [f.law.speed for f in problem.films if f.law is not None]  # a correlation's speed
     out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]
     out += [*problem.gravity, *(v for x in (*problem.loads, *problem.supports) for v in x.values)]
     return out + [v for pl in problem.point_loads for v in pl.force]

@@ -37,6 +37,7 @@ from scipy.sparse.linalg import splu
 
 from gatetherm import InputError
 from gatetherm.solvers import krylov
+from gatetherm.solvers.expr import Value
 from gatetherm.solvers.fem import complement
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 
@@ -101,6 +102,10 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
     """The seam: read the switched linear system off an assembled model (heat solve with a read-out).
     ``columns(problem, key) -> (name, scale)`` names each read-out key as a data-format column."""
     h, prob, r = model.heat, model.problem, model.readout
+    if h.varying:
+        raise InputError(f"film of '{h.varying[0].boundary}'", "follows the temperature (a correlation or radiation): "
+                         "the reduced model is linear and would hold it at its reference",
+                         "give the film as a number to reduce the case")
     T0, n = float(prob.T0), h.n
     fixed = h.fixed_dofs
     free = complement(n, fixed)
@@ -109,6 +114,9 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
         groups.setdefault((p.supply, True), [])
     for load in h.loads:
         groups.setdefault((load.value, load.kind in TEMPERATURE_KINDS), []).append(load.vector)
+    for m in h.moving:  # a moving source: its vector interpolated over positions (MovingLoad.interpolated)
+        for text, vector in m.interpolated():
+            groups.setdefault((Value.of(text, m.position.key), False), []).append(np.r_[vector, np.zeros(n - len(vector))])
     modes = {mode_name(s): s for s in product((True, False), repeat=len(h.pumped))}
     K = {m: h.K(s).tocsr() for m, s in modes.items()}
     inputs, cols = [], {m: [] for m in modes}

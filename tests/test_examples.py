@@ -107,3 +107,18 @@ def test_assembly(tmp_path):
     (a, b, end), _ = run_example("07_assembly.py", tmp_path)
     assert numbers(a.replace("T_a", "")) == [89.0909, 89.0909] and numbers(b.replace("T_b", "")) == [36.3636, 36.3636]
     assert numbers(end) == [112.46]          # tests/test_docs.py: the same case against its closed form
+
+
+def test_spindle_unit(tmp_path):
+    (front, rear, growth), _ = run_example("08_spindle_unit.py", tmp_path)
+    assert numbers(front) == [125.6, 4000, 1, 360.4, 8000, 1]  # tests/test_elements.py: Palmgren's formula itself
+    assert numbers(rear) == [47.6, 4000, 1, 138.9, 8000, 1]
+    assert numbers(growth) == [29.06, 1, 75.83, 2, 2.66, 1]
+
+
+@pytest.mark.slow
+def test_feed_axis(tmp_path):
+    (program, losses, growth), _ = run_example("09_feed_axis.py", tmp_path)
+    assert numbers(program) == [3750.0, 7501]
+    assert numbers(losses) == [18.60, 2.45, 0.66, 1.05]   # tests/test_elements.py: each formula itself
+    assert numbers(growth) == [1, 152.4, 28.82]           # tests/test_moving_source.py: the reduced model on it

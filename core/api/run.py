@@ -30,8 +30,8 @@ log = logging.getLogger(__name__)
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
 
-__all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "SolverOptions", "beam_coefficients", "condition", "configure", "gate_frame",
-           "load_case", "run", "schedule_file"]
+__all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "SolverOptions", "beam_coefficients", "condition",
+           "configure", "gate_frame", "load_case", "nc_schedule", "run", "schedule_file"]
 
 
 DIMS = Range(2, 3, whole=True)
@@ -99,6 +99,46 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
                          "give a divisor of it, e.g. 60")
     supply = getattr(getattr(case, "origin", None), "config", None)
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
+
+
+def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.0, out: str | os.PathLike | None = None,
+                repeat: int = 1):
+    """An NC program's axis positions, feeds and spindle speed against time: a schedule for a
+    case's moving sources and machine elements (``docs/model.md``, NC programs).
+
+    Parameters
+    ----------
+    path : str or path
+        The program: G0/G1 moves with F (mm/min, or inch/min after G20), G4 dwells (X in s, P in
+        ms), M3/M4/M5 with S (1/min), G90/G91; anything else (arcs, cycles) is refused by line.
+    step_s : float
+        Sample interval, s (the program's end is the last sample).
+    rapid : float
+        The rapid rate of G0 moves, m/min.
+    out : str or path, optional
+        Also write the schedule there (the data format: a case's ``[time] schedule``).
+    repeat : int
+        Run the program this many times back to back (each from where the last ended).
+
+    Returns
+    -------
+    TimeSeries
+        ``time_s``; ``x_m``, ``y_m``, ``z_m`` (axis positions, m); ``vx_m_s``, ``vy_m_s``, ``vz_m_s``
+        (axis velocities, m/s); ``feed_m_s`` (speed along the path, m/s); ``spindle_rpm`` (1/min,
+        negative for M4).
+    """
+    from gatetherm.files import read_text
+    from gatetherm.studies.run.ncprogram import nc_series
+    from gatetherm.studies.run.timeseries import write_timeseries
+
+    if not (np.isfinite(step_s) and step_s > 0) or not (np.isfinite(rapid) and rapid > 0):
+        raise InputError("step_s" if not step_s > 0 else "rapid", "must be a positive number", "e.g. 1.0")
+    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
+        raise InputError("repeat", f"{repeat!r} is not a whole number of runs", "give 1 or more")
+    ts = nc_series(read_text(path, "", "give an NC program (a text file)"), step_s, str(path), rapid, repeat)
+    if out is not None:
+        write_timeseries(out, ts)
+    return ts
 
 
 def beam_coefficients(case: Case, source: str = "theory") -> tuple[float, float]:
@@ -223,9 +263,10 @@ class Run:
 
     def summary(self) -> dict:
         """What ``summary.json`` holds: the case, its size, every probe and relative displacement
-        at the last sample, and δ's figures where the case has a δ."""
+        at the last sample, δ's figures where the case has a δ, and every machine element's loss
+        (mean, largest, last, energy; its column ``P_REGION_W`` holds it over time)."""
         from gatetherm.studies.run.output import probe_summary
-        from gatetherm.studies.run.simulate import delta_figures
+        from gatetherm.studies.run.simulate import delta_figures, loss_summary
 
         c, p = self.case, self.case.problem
         out = {"case": c.name, "file": c.source, "dim": p.dim, "order": p.order,
@@ -233,7 +274,8 @@ class Run:
                ("transient" if c.time else "steady"),
                "nodes": len(c.mesh.points), "elements": len(c.mesh.cells), "schedule": self.scenario.schedule.label,
                "effects": self.scenario.effects.describe(), "wall_time_s": round(self.seconds, 2),
-               "march_s": round(self.scenario.result.seconds, 2), **probe_summary(p, self.columns)}
+               "march_s": round(self.scenario.result.seconds, 2), **probe_summary(p, self.columns),
+               **loss_summary(p, self.columns)}
         if "delta_um" in self.columns and len(self.time) > 1:
             out.update(delta_figures(self.time, self["delta_um"]))
         if self.order_check is not None:

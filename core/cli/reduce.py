@@ -26,8 +26,9 @@ def register(sub) -> None:
     add_model_options(p)
     p.add_argument("--states", type=int, default=30, metavar="N", help="states of the reduced model (default 30)")
     p.add_argument("--check", action="append", default=[], metavar="FILE.csv",
-                   help="also check it on this schedule file (repeatable); always on the model's own schedule and, "
-                   "where the model reads their inputs, the paper's conditions 1-3")
+                   help="also check it on this schedule file (repeatable), sampled at the case's [time] step (else "
+                   "60 s); always on the model's own schedule and, where the model reads their inputs, the paper's "
+                   "conditions 1-3")
     p.add_argument("--no-check", action="store_true", help="skip the full FE runs")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.set_defaults(func=run)
@@ -42,7 +43,9 @@ def run(args) -> int:
     if args.case is not None:
         refuse_model_options(args)
     case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config)
-    schedules = [] if args.no_check else [*gt.check_schedules(case), *(gt.schedule_file(f, case) for f in args.check)]
+    step = case.time.step if case.time else 60.0  # a --check file at the case's own step
+    schedules = [] if args.no_check else [*gt.check_schedules(case), *(gt.schedule_file(f, case, step)
+                                                                       for f in args.check)]
     with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files, *args.check)) as out:
         t0 = time.perf_counter()
         red = gt.reduce(case, args.states)

@@ -35,4 +35,6 @@ def run(args) -> int:
         print(f"{name}: " + ", ".join(f"{k} {v:.6g}" for k, v in q.items() if v is not None))
     for name, v in summary["relative"].items():
         print(f"{name}: {v:.6g} um")
+    for name, q in summary.get("losses", {}).items():
+        print(f"{name}: mean {q['mean_W']:.6g} W, max {q['max_W']:.6g} W, energy {q['energy_J']:.6g} J")
     return 0

@@ -29,8 +29,8 @@ from gatetherm.geometry.mesh import FrameMesh, facet_keys
 from gatetherm.solvers.effects import Targets
 from gatetherm.solvers.frame import region_volume
 from gatetherm.solvers.heat import TimeScheme
-from gatetherm.solvers.problem import FaceFilm, Problem, Source, inputs, values
-from gatetherm.studies.run import case_mech, case_mesh, case_tables
+from gatetherm.solvers.problem import FaceFilm, Problem, inputs, values
+from gatetherm.studies.run import case_mech, case_mesh, case_sources, case_tables
 from gatetherm.studies.run.parameters import UNCERTAIN_FIX, mesh_parameter
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
 from gatetherm.studies.run.tables import Table
@@ -45,12 +45,12 @@ KEYS = {
     "initial": ("temperature", "reference"),
     "temperature": ("field", "regions"),
     "faces": ("film", "ambient"),
-    "sources.REGION": ("density", "power"),
     "time": ("end", "step", "output", "schedule", "fields", "scheme"),
     "time.scheme": ("theta", "restart", "restart_intervals"),
     "sensors": ("exclude",),
     **case_mesh.KEYS,
     **case_tables.KEYS,
+    **case_sources.KEYS,
     **case_mech.KEYS,
 }
 """The keys of every table of a case file (NAME, REGION, BOUNDARY, POINT: a name of the case or a
@@ -319,18 +319,13 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
     else:
         kw.update(case_tables.boundary_conditions(top, fm, names))
-        src = top.sub("sources", tuple(fm.regions))
+        src = top.sub("sources", tuple(fm.regions) + tuple(b for b in fm.boundaries if b not in fm.regions))
         sources = []
         for r in src.data:
-            s = src.sub(r, KEYS["sources.REGION"])
-            if ("density" in s.data) == ("power" in s.data):
-                s.fail("density", "give either density (W/m³) or power (W)")
-            if "density" in s.data:
-                sources.append(Source(r, s.value("density", names, unit="W/m³")))
-            else:
-                vol = case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else \
-                    region_volume(fm, r, thickness.get(r, 1.0))
-                sources.append(Source(r, s.value("power", names, unit="W"), 1.0 / vol))
+            sources.append(case_sources.read_source(
+                src.sub(r, KEYS["sources.REGION"]), r, names,
+                lambda r=r: case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else
+                region_volume(fm, r, thickness.get(r, 1.0)), fm.dim, r not in fm.regions))
         kw["sources"] = tuple(sources)
         if "faces" in data:
             if fm.dim != 2:

@@ -14,20 +14,21 @@ from gatetherm.checks import Range, ranges
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.frame import enclosed_volume
 from gatetherm.solvers.material import Material
-from gatetherm.solvers.problem import AXES, Film, FixedTemperature, Fluid, Flux, Probe, Relative, Signals, Support
-from gatetherm.studies.run import case_mech
+from gatetherm.solvers.problem import AXES, FixedTemperature, Fluid, Flux, Probe, Relative, Signals, Support
+from gatetherm.studies.run import case_films, case_mech
 from gatetherm.studies.run.case_mesh import numbers
 from gatetherm.studies.run.tables import Table
 
 KEYS = {
     "materials.REGION": ("k", "rho", "c", "E", "nu", "alpha", "thickness"),
-    "thermal.BOUNDARY": ("film", "ambient", "temperature", "flux"),
+    "thermal.BOUNDARY": ("film", "ambient", "temperature", "flux", "emissivity"),
     "fluids.NAME": ("boundary", "volume", "rho_c", "flow_rate", "capacity", "conductance", "film_on", "film_off",
                     "supply", "pump", "hose_capacity", "hose_loss", "hose_name", "ambient"),
     "supports.BOUNDARY": ("type", "components", "stiffness", "value"),
     "probes.NAME": ("point", "quantities", "region"),
     "relative.NAME": ("a", "b", "axis"),
     "signals": ("theta_A", "theta_B", "theta_C", "delta"),
+    **case_films.KEYS,
     "actuator": ("type", "stroke", "stack_stiffness", "spring_stiffness", "preload", "dead_band", "hysteresis",
                  "reset"),
 }
@@ -74,9 +75,9 @@ def boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
             t.fail("/".join(kinds) or "film", "give exactly one condition: film (with ambient), temperature or flux",
                    "a boundary without a condition is adiabatic; leave it out")
         if kinds == ["film"]:
-            out["films"].append(Film(b, t.number("film", FILM), t.value("ambient", names, unit="°C")))
-        elif "ambient" in t.data:
-            t.fail("ambient", "goes with a film only", "remove it or give film")
+            out["films"].append(case_films.film(t, b, names))
+        elif "ambient" in t.data or "emissivity" in t.data:
+            t.fail("ambient" if "ambient" in t.data else "emissivity", "goes with a film only", "remove it or give film")
         elif kinds == ["temperature"]:
             out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C")))
         else:

@@ -106,7 +106,7 @@ def case_parameters(case) -> tuple[Parameter, ...]:
     as uncertain (:func:`marked`)."""
     doc, pr, out = case.origin.document, case.problem, []
     for f in pr.films:
-        if f.h > 0:
+        if f.h > 0 and f.law is None:  # a correlation's film is not a number to scale
             out.append(factor(f"film_{f.boundary}", "h", "W/(m2 K)", f.h, FILM, f"film coefficient of boundary "
                               f"'{f.boundary}'", lambda v, b=f.boundary: {f"thermal.{b}.film": v}, f.boundary))
     if pr.faces is not None and pr.faces.h > 0:
@@ -120,6 +120,8 @@ def case_parameters(case) -> tuple[Parameter, ...]:
                                   lambda v, n=fl.name, p=p: {f"fluids.{n}.{p}": v}, fl.name))
     for src in pr.sources:
         table = doc.get("sources", {}).get(src.region, {})
+        if "kind" in table:  # a machine element's loss: its operating point, not a factor
+            continue
         key = "density" if "density" in table else "power"
         out.append(factor(f"source_{src.region}", "factor", "1", 1.0, SOURCE, f"factor on the heat source of "
                           f"region '{src.region}'", lambda v, r=src.region, k=key, x=table.get(key):

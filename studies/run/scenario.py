@@ -26,7 +26,7 @@ from gatetherm.solvers.sensors import apply_faults
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.schedules import (STEADY, Schedule, condition_schedule, file_schedule,  # noqa: F401
                                              series_schedule)
-from gatetherm.studies.run.simulate import RunResult, check_temperatures, output_columns, run_model
+from gatetherm.studies.run.simulate import RunResult, check_temperatures, loss_columns, output_columns, run_model
 from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
@@ -129,6 +129,7 @@ def _once(p: Prepared, schedule: Schedule) -> RunResult:
     drive = schedule.drive
     cols = {"time_s": np.asarray(times, float), **{k: np.array([drive(float(t))[k] for t in times])
                                                    for k in drive(0.0)}}
+    cols.update(loss_columns(model.problem, cols))
     cols.update(output_columns(model.problem, keys, Y))
     return RunResult(cols, sorted(states, key=lambda s: s[0]), time.perf_counter() - t0, envs)
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import logging
 import time as _time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -96,6 +96,29 @@ def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarra
     return out
 
 
+def loss_columns(problem: Problem, cols: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The power of every source that reports it (a machine element's loss, W:
+    :attr:`~gatetherm.solvers.problem.Source.loss`) at the times of the input columns ``cols``
+    (``time_s`` and the drive's inputs)."""
+    t = np.asarray(cols["time_s"], float)
+    env = {"t": t, **{k: np.asarray(v, float) for k, v in cols.items() if k != "time_s"}}
+    return {s.loss: np.broadcast_to(np.asarray(s.density(env), float), t.shape).copy()
+            for s in problem.sources if s.loss}
+
+
+def loss_summary(problem: Problem, cols: Mapping[str, np.ndarray]) -> dict:
+    """``{"losses": {COLUMN: {"mean_W", "max_W", "last_W", "energy_J"}}}`` of the sources that report
+    their power (:func:`loss_columns`; empty without them); the energy by the trapezoidal rule."""
+    t, out = np.asarray(cols["time_s"], float), {}
+    for s in problem.sources:
+        if s.loss and s.loss in cols:
+            P = np.asarray(cols[s.loss], float)
+            energy = float(np.sum(0.5 * (P[1:] + P[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
+            out[s.loss] = {"mean_W": energy / float(t[-1] - t[0]) if len(t) > 1 else float(P[0]),
+                           "max_W": float(P.max()), "last_W": float(P[-1]), "energy_J": energy}
+    return {"losses": out} if out else {}
+
+
 def check_temperatures(U: np.ndarray, t: float) -> None:
     """InputError unless every temperature of the state ``U`` (°C) at ``t`` (s) is admissible
     (:data:`~gatetherm.checks.CELSIUS`): a run that leaves the range has met heat inputs out of
@@ -169,6 +192,7 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     for k, Uk, ek in waiting:  # the weights waited for here if not in yet
         Y[k] = model.read(Uk, ek)
     cols = {k: np.array([row[k] for row in inputs]) for k in inputs[0]}
+    cols.update(loss_columns(model.problem, cols))
     cols.update(output_columns(model.problem, model.readout.keys, np.array(Y)))
     secs = _time.perf_counter() - t0
     log.info("marched %d steps in %.2f s%s", len(Y) - 1, secs,
