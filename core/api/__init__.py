@@ -25,5 +25,5 @@ from gatetherm.api.run import Case, Run, Schedule, beam_coefficients, condition,
 from gatetherm.api.sensors import check_placement, place_sensors, write_placement
 
 __all__ = ["Case", "Run", "Schedule", "beam_coefficients", "check_placement", "check_rom", "check_schedules",
-           "compensate", "condition", "configure", "diagnose", "gate_frame", "load_case", "nc_schedule", "place_sensors",
-           "reduce", "run", "schedule_file", "write_placement", "write_reduction"]
+           "compensate", "condition", "configure", "diagnose", "gate_frame", "load_case", "nc_schedule",
+           "place_sensors", "reduce", "run", "schedule_file", "write_placement", "write_reduction"]
