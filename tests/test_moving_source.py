@@ -265,3 +265,18 @@ def test_sources_on_a_boundary_fixed_and_moving(tmp_path):
     with pytest.raises(InputError, match="sources.ends.density.*boundary takes power"):
         gt.load_case(tmp_path / "c.toml")
 
+
+
+def test_a_moving_band_on_an_insulated_strip_adds_its_energy_exactly(tmp_path):
+    """No film: the capacity-weighted rise is the energy put in, P t, to round-off, however the
+    band moves between the nodes (the θ-method weights the loads at both ends of a step)."""
+    (tmp_path / "strip.geo").write_text(STRIP_GEO.format(lc=0.05, L=1.0, w=0.1))
+    text = STRIP.replace("[faces]\nfilm = 10.0\nambient = 20.0\n", "").replace(
+        'position = "0.3 + 0.002*t"', 'position = "0.5 + 0.3*sin(t/7)"').replace("end = 700.0", "end = 100.0").replace(
+        "output = 700.0", "output = 4.0")
+    (tmp_path / "c.toml").write_text(text)
+    case = gt.load_case(tmp_path / "c.toml")
+    heat = build(case.problem, case.mesh).heat
+    for t, U in march(heat, case.schedule.drive, case.schedule.times, case.problem.scheme):
+        energy = float(np.sum(heat.M @ (U - 20.0)))
+        assert energy == pytest.approx(P * t, rel=1e-10, abs=1e-9)
