@@ -57,9 +57,10 @@ class MovingLoad:
         the power times the hat ``max(0, 1 − |position − p_j|/Δ)``: the input matrix interpolated
         linearly over the positions (exact at the anchors)."""
         at, gap = self.anchors()
-        power, pos = self.value.text or repr(self.value.constant), self.position.text or repr(self.position.constant)
-        key = self.position.key
-        return [(f"({power})*max(0, 1 - abs(({pos}) - {float(p)!r})/{float(gap)!r})", self._at(float(p), key)) for p in at]
+        power = self.value.text or repr(self.value.constant)
+        pos, key = self.position.text or repr(self.position.constant), self.position.key
+        return [(f"({power})*max(0, 1 - abs(({pos}) - {float(p)!r})/{float(gap)!r})", self._at(float(p), key))
+                for p in at]
 
     def _at(self, p: float, key: str) -> np.ndarray:
         return MovingLoad(self.weights, self.along, self.spacing, self.length, Value(p, "", key),

@@ -116,7 +116,8 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
         groups.setdefault((load.value, load.kind in TEMPERATURE_KINDS), []).append(load.vector)
     for m in h.moving:  # a moving source: its vector interpolated over positions (MovingLoad.interpolated)
         for text, vector in m.interpolated():
-            groups.setdefault((Value.of(text, m.position.key), False), []).append(np.r_[vector, np.zeros(n - len(vector))])
+            groups.setdefault((Value.of(text, m.position.key), False), []).append(
+                np.r_[vector, np.zeros(n - len(vector))])
     modes = {mode_name(s): s for s in product((True, False), repeat=len(h.pumped))}
     K = {m: h.K(s).tocsr() for m, s in modes.items()}
     inputs, cols = [], {m: [] for m in modes}

@@ -67,7 +67,8 @@ def test_rotating_parts_are_their_formulas(n, D):
     r = D / 2
     red = w * r ** 2 / nu
     disc = (0.36 * red ** 0.5 if red < 2.4e5 else 0.015 * red ** 0.8) * k / r
-    assert cv.FilmLaw("rotating_disc", length=D, speed=Value.of("n"))(Ts, Ta, {"n": -n}) == pytest.approx(disc, rel=1e-9)
+    law = cv.FilmLaw("rotating_disc", length=D, speed=Value.of("n"))
+    assert law(Ts, Ta, {"n": -n}) == pytest.approx(disc, rel=1e-9)
 
 
 @pytest.mark.parametrize("v, L", [(0.5, 0.3), (3.0, 0.8), (20.0, 1.5)])

@@ -1,6 +1,7 @@
 """``[sources.REGION]`` of a case file (REGION a region, or a boundary for a surface source): a heat
-source given as a density, a power, or the loss of a machine element (``kind``: a bearing, a ball screw's nut or bearing, a linear guide's
-carriage, a motor) driven by the schedule's columns (:mod:`gatetherm.solvers.elements`).
+source given as a density, a power, or the loss of a machine element (``kind``: a bearing, a ball
+screw's nut or bearing, a linear guide's carriage, a motor) driven by the schedule's columns
+(:mod:`gatetherm.solvers.elements`); a source may move (``position``: :mod:`gatetherm.solvers.moving`).
 
 An element's loss becomes an ordinary power in W (an expression of the run's inputs), spread
 evenly over the region, and is reported over time as the output column ``P_REGION_W``.
@@ -95,7 +96,8 @@ def moving(t: Table, names, dim: int) -> dict:
     d = t.data["direction"]
     if not (isinstance(d, list) and len(d) == dim and all(isinstance(x, (int, float)) and not isinstance(x, bool)
                                                           for x in d) and any(d)):
-        t.fail("direction", f"expected {dim} numbers, not all zero, got {d!r}", f"e.g. direction = {[1] + [0] * (dim - 1)}")
+        t.fail("direction", f"expected {dim} numbers, not all zero, got {d!r}",
+               f"e.g. direction = {[1] + [0] * (dim - 1)}")
     d = [float(x) for x in d]
     norm = sum(x * x for x in d) ** 0.5
     return {"position": t.value("position", names, unit="m"), "direction": tuple(x / norm for x in d),

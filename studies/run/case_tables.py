@@ -77,7 +77,8 @@ def boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
         if kinds == ["film"]:
             out["films"].append(case_films.film(t, b, names))
         elif "ambient" in t.data or "emissivity" in t.data:
-            t.fail("ambient" if "ambient" in t.data else "emissivity", "goes with a film only", "remove it or give film")
+            t.fail("ambient" if "ambient" in t.data else "emissivity", "goes with a film only",
+                   "remove it or give film")
         elif kinds == ["temperature"]:
             out["fixed"].append(FixedTemperature(b, t.value("temperature", names, unit="°C")))
         else:
