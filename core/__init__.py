@@ -23,8 +23,8 @@ run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
 API = ("Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom", "check_schedules",
-       "compensate", "condition", "configure", "diagnose", "gate_frame", "load_case", "place_sensors", "reduce", "run",
-       "schedule_file", "write_placement", "write_reduction")
+       "compensate", "condition", "configure", "diagnose", "gate_frame", "live", "load_case", "place_sensors", "reduce",
+       "run", "schedule_file", "twin", "write_placement", "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 
 

@@ -19,11 +19,12 @@ schedules, runs), :mod:`gatetherm.api.reduction`, :mod:`gatetherm.api.control` (
 diagnosis) and :mod:`gatetherm.api.sensors`; every public name is offered here.
 """
 from gatetherm.api.control import compensate, diagnose
+from gatetherm.api.live import live, twin
 from gatetherm.api.reduction import check_rom, check_schedules, reduce, write_reduction
 from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, gate_frame, load_case, run, \
     schedule_file
 from gatetherm.api.sensors import check_placement, place_sensors, write_placement
 
 __all__ = ["Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom", "check_schedules",
-           "compensate", "condition", "configure", "diagnose", "gate_frame", "load_case", "place_sensors", "reduce",
-           "run", "schedule_file", "write_placement", "write_reduction"]
+           "compensate", "condition", "configure", "diagnose", "gate_frame", "live", "load_case", "place_sensors", "reduce",
+           "run", "schedule_file", "twin", "write_placement", "write_reduction"]

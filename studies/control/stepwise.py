@@ -79,10 +79,20 @@ class Stepper:
         pred = self._predict(float(t), sample)
         c = self.count
         updated = (c + 1) % self.every == 0
-        if updated:
-            self.held = -(0.0 if math.isnan(pred) else pred)
+        if updated and not math.isnan(pred):  # no forecast yet: the command stays (0 at the start, as batch)
+            self.held = -pred
         self.count, self.t_last = c + 1, float(t)
         return Correction(float(t), self.held, pred, updated)
+
+    def skip(self, t: float) -> Correction:
+        """No usable sample at ``t`` (missing, stale, a jump, or a period the service was down): the
+        command holds, the sample count advances; forecasts restart from the next samples."""
+        self._skip()
+        self.count, self.t_last = self.count + 1, float(t)
+        return Correction(float(t), self.held, math.nan, False)
+
+    def _skip(self) -> None:
+        pass
 
     def _predict(self, t: float, sample) -> float:
         raise NotImplementedError
@@ -117,7 +127,10 @@ class AheadStepper(Stepper):
 
     def _predict(self, t, sample) -> float:
         self.now = (self.now + [self._value(t, sample)])[-2:]
-        return 2 * self.now[1] - self.now[0] if self.count >= 1 else math.nan
+        return 2 * self.now[1] - self.now[0] if len(self.now) == 2 else math.nan
+
+    def _skip(self):
+        self.now = []
 
     def _value(self, t, sample) -> float:
         raise NotImplementedError
@@ -171,6 +184,9 @@ class PaperStepper(Stepper):
             pred = self.R_i * self.Ki * (2 * d_ab - self.prev[0]) - self.R_C * self.Kc * (2 * th_c - self.prev[1])
         self.prev = (d_ab, th_c)
         return pred
+
+    def _skip(self):
+        self.prev = None
 
     def _own(self):
         return {"first": self.first, "prev": None if self.prev is None else list(self.prev), "R_i": self.R_i,

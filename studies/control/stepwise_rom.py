@@ -81,7 +81,7 @@ class RomStepper(Stepper):
         if control.mode == "event":
             nominal = march_rom(disc, self.u, self.modes) @ self.C_delta
             self.threshold = plan_threshold(nominal, control, self.steps)
-        self.updates = 0
+        self.updates, self.started = 0, False
 
     def _filter(self, sample) -> None:
         """The filters' predict (from the previous sample) and update (this sample's readings)."""
@@ -97,10 +97,10 @@ class RomStepper(Stepper):
             self.z, self.P = _update(self.z, self.P, self.H[ok], y[ok], np.full(ok.sum(), self.obs.sensor_K ** 2))
         x, delta = self.z[:r], float(sample["delta_um"])
         model = x @ self.C_delta
-        if k == 0:
-            self.b[-1] = delta - model
-        else:
+        if k and self.started:
             self.Pb = self.Pb + self.Qb
+        if not self.started and math.isfinite(delta):  # β_0 from the first δ read (batch: sample 0)
+            self.b[-1], self.started = delta - model, True
         if math.isfinite(delta):
             phi = np.r_[x @ self.correction.T, 1.0][None, :]
             self.b, self.Pb = _update(self.b, self.Pb, phi, np.array([delta - model]),
@@ -142,13 +142,19 @@ class RomStepper(Stepper):
         self.count, self.t_last = c + 1, float(t)
         return Correction(float(t), self.held, pred, updated)
 
+    def skip(self, t: float) -> Correction:
+        """No usable sample at ``t``: the filters predict across it, the command holds."""
+        self._filter({k: math.nan for k in self.columns})
+        self.count, self.t_last = self.count + 1, float(t)
+        return Correction(float(t), self.held, math.nan, False)
+
     def _own(self):
-        return {"z": self.z.tolist(), "P": self.P.tolist(), "b": self.b.tolist(), "Pb": self.Pb.tolist(),
-                "updates": self.updates, "threshold_um": self.threshold}
+        return {"started": self.started, "z": self.z.tolist(), "P": self.P.tolist(), "b": self.b.tolist(),
+                "Pb": self.Pb.tolist(), "updates": self.updates, "threshold_um": self.threshold}
 
     def _load(self, s):
         self.z, self.P, self.b, self.Pb = (np.array(s[k], float) for k in ("z", "P", "b", "Pb"))
-        self.updates = int(s["updates"])
+        self.updates, self.started = int(s["updates"]), bool(s["started"])
         if self.threshold is not None and s["threshold_um"] != self.threshold:
             raise InputError("compensator state", f"planned for a threshold of {s['threshold_um']} um, "
                              f"this setup plans {self.threshold} um", "resume with the same schedule and model")
