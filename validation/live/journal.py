@@ -51,9 +51,16 @@ class Journal:
     def __init__(self, directory: Path, columns, metadata: dict):
         self.dir, self.columns = Path(directory), tuple(columns)
         self.path = self.dir / LOG
+        self.dir.mkdir(parents=True, exist_ok=True)
         self.state = self._read_state()
         if self.state is not None and self.path.exists():
             self._trim(self.state.get("t_logged"))
+        elif self.path.exists() and any(line and not line.startswith("#") for line in
+                                        self.path.read_text(encoding="utf-8").splitlines()[1:]):
+            if sum(1 for line in self.path.read_text(encoding="utf-8").splitlines()
+                   if line and not line.startswith("#")) > 1:
+                raise InputError(str(self.path), f"has rows but {self.dir / STATE} is missing",
+                                 "give another --out (a log without its state cannot be continued)")
         if not self.path.exists() or self.path.stat().st_size == 0:
             head = [f"# format: {FORMAT}", *(f"# {k}: {v}" for k, v in metadata.items()), ",".join(self.columns)]
             with open(self.path, "w", encoding="utf-8") as f:
