@@ -40,8 +40,8 @@ log = logging.getLogger(__name__)
 class Guards:
     """What the service refuses to pass on to the control."""
 
-    max_offset_um: float = 50.0
-    """Largest correction written, µm."""
+    max_offset_um: float = 100.0
+    """Largest correction written, µm (set it to the control's own limit)."""
     max_change_um: float = 5.0
     """Largest change of the correction per period, µm."""
     max_jump_K: float = 1.0
@@ -176,18 +176,19 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
     """Run the loop until ``params.until_s`` or ``stop``; the counts."""
     from asyncua import ua
 
+    logging.getLogger("asyncua").setLevel(logging.ERROR)  # its notes on session timeouts and unencrypted loopback
     svc, g = Service(stepper, journal, params, read), params.guards
     stop = stop or asyncio.Event()
-    client, resolved, wait, lost_at = None, None, g.retry_first_s, None
+    client, resolved, wait, lost_at, ever = None, None, g.retry_first_s, None, False
     try:
         while not stop.is_set():
             try:
                 if client is None:
                     client, resolved = await _connect(endpoint, nodes, g.timeout_s)
                     if lost_at is not None:
-                        svc.counts["reconnects"] += 1
-                        journal.event(None, f"reconnected after {time.monotonic() - lost_at:.1f} s")
-                    lost_at, wait = None, g.retry_first_s
+                        svc.counts["reconnects"] += ever
+                        journal.event(None, f"{'re' if ever else ''}connected after {time.monotonic() - lost_at:.1f} s")
+                    lost_at, wait, ever = None, g.retry_first_s, True
                     await _write(resolved, nodes, svc.written)
                 sample = await _sample(client, resolved, read, nodes.factor)
                 if sample is None:
@@ -212,15 +213,17 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                                   f"{svc.written:.3f} um")
                     lost_at = lost_at or time.monotonic()
                 await _close(client)
-                client = None
+                client, before = None, time.monotonic()
                 try:
                     await asyncio.wait_for(stop.wait(), wait)
                 except asyncio.TimeoutError:
                     pass
                 wait = min(2 * wait, g.retry_max_s)
-                down = time.monotonic() - lost_at
-                if down > g.hold_s and svc.written != 0.0:
-                    ramped = math.copysign(max(0.0, abs(svc.written) - g.ramp_um_per_s * wait), svc.written)
+                now = time.monotonic()
+                ramping = min(now - before, now - lost_at - g.hold_s)  # wall s of this wait past the hold
+                if ramping > 0 and svc.written != 0.0:
+                    down = now - lost_at
+                    ramped = math.copysign(max(0.0, abs(svc.written) - g.ramp_um_per_s * ramping), svc.written)
                     journal.event(None, f"connection lost {down:.0f} s: correction ramped to {ramped:.3f} um")
                     svc.written = ramped
     finally:
