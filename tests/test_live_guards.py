@@ -104,3 +104,51 @@ def test_a_map_overrides_the_default_layout(tmp_path):
     m = read_map(path, COLUMNS)
     assert m.read["delta_um"] == "ns=3;s=DB1.delta" and m.read["theta_A_degC"] == default_node("theta_A_degC")
     assert m.write == {"offset_um": "ns=3;s=DB1.off"} and m.factor("offset_um") == 0.001 and m.factor("x") == 1.0
+
+
+def test_a_lost_connection_holds_then_ramps_to_zero_at_the_stated_rate(tmp_path):
+    """No server on the port: the correction saved in the state (2 µm) holds for hold_s, then falls at
+    ramp_um_per_s; the service is stopped once it reaches 0."""
+    import asyncio
+    import socket
+    import time
+
+    from gatetherm.validation.live import service as sv
+    from gatetherm.validation.live.nodes import default_map
+
+    svc = service(tmp_path)
+    svc.period(0.0, 0, sample(0))
+    state = {**svc.journal.state, "offset_um": 2.0}
+    svc.journal.save(state)
+    svc.journal.close()
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]  # closed again: nothing listens
+    g = Guards(hold_s=0.5, ramp_um_per_s=1.0, retry_first_s=0.1, retry_max_s=0.2, timeout_s=1.0)
+    journal = Journal(tmp_path, LOGGED, {"source": "test"})
+    stepper = PaperStepper(2.0, 1.0, PARAMS)
+
+    async def run():
+        stop = asyncio.Event()
+
+        async def watch():
+            while "ramped to 0.000 um" not in (tmp_path / "events.log").read_text():
+                await asyncio.sleep(0.05)
+            stop.set()
+
+        task = asyncio.create_task(watch())
+        counts = await asyncio.wait_for(sv.serve(stepper, journal, f"opc.tcp://127.0.0.1:{port}",
+                                                 default_map(COLUMNS), LiveParams(guards=g), COLUMNS, None, stop),
+                                        timeout=600)
+        await task
+        return counts
+
+    t0 = time.monotonic()
+    run_counts = asyncio.run(run())
+    took = time.monotonic() - t0
+    journal.close()
+    events = (tmp_path / "events.log").read_text()
+    ramps = [float(line.split("ramped to ")[1].split()[0]) for line in events.splitlines() if "ramped to" in line]
+    assert "connection lost" in events and ramps[-1] == 0.0 and all(np.diff(ramps) < 0)
+    assert took >= 0.5 + 2.0  # held for hold_s, then 2 µm at 1 µm/s: the rate bounds it from below
+    assert run_counts["reconnects"] == 0
