@@ -111,7 +111,8 @@ def _stepper(case, method, model, target, params, states, out, sched):
 
 def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, model=None, target: str | None = None,
          map=None, period: float = 60.0, update: float | None = None, until: float | None = None,
-         states: int = 30, schedule=None, guards=None, on_period=None, on_ready=None) -> dict:
+         states: int = 30, schedule=None, guards=None, status_port: int | None = None, on_period=None,
+         on_ready=None) -> dict:
     """Compensate a machine over OPC UA: read its sensors every period of its clock, write the correction.
 
     Parameters
@@ -141,6 +142,8 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
         ``rom``: the inputs known in advance (default the case's schedule).
     guards : Guards, optional
         :class:`gatetherm.validation.live.service.Guards` (defaults in docs/live.md).
+    status_port : int, optional
+        Serve the status page on ``http://127.0.0.1:PORT/`` (``/status.json``: the same as data).
     on_period : callable, optional
         Called with each period's logged row (a dict).
     on_ready : callable, optional
@@ -185,7 +188,8 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
         if on_ready is not None:
             on_ready()
         try:
-            counts = asyncio.run(_serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period))
+            counts = asyncio.run(_serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period,
+                                                     status_port))
         finally:
             journal.close()
         return service.summarize(out, counts)
@@ -193,8 +197,9 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
         os.close(fd)
 
 
-async def _serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period):
+async def _serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period, status_port):
     from gatetherm.validation.live.service import serve
+    from gatetherm.validation.live.status import Status, serve_status
 
     stop = asyncio.Event()
     loop = asyncio.get_running_loop()
@@ -205,9 +210,21 @@ async def _serve_until_signal(stepper, journal, endpoint, nodes, params, read, o
             with contextlib.suppress(ValueError, RuntimeError):
                 loop.add_signal_handler(sig, stop.set)
                 handled.append((sig, old))
+    status = server = None
+    if status_port is not None:
+        status = Status(journal.dir, stepper.columns)
+        try:
+            server = await serve_status(status, status_port)
+        except OSError as err:
+            from gatetherm import InputError
+
+            raise InputError("--status-port", f"cannot serve on 127.0.0.1:{status_port} ({err.strerror})",
+                             "give a free port") from None
     try:
-        return await serve(stepper, journal, endpoint, nodes, params, read, on_period, stop)
+        return await serve(stepper, journal, endpoint, nodes, params, read, on_period, stop, status)
     finally:
+        if server is not None:
+            server.close()
         for sig, old in handled:
             loop.remove_signal_handler(sig)
             signal.signal(sig, old)

@@ -28,6 +28,8 @@ def register(sub) -> None:
                    "stopped)")
     p.add_argument("--states", type=int, default=30, metavar="N", help="rom: states of the reduced model (default 30)")
     p.add_argument("--schedule", metavar="S.csv", help="rom: the inputs known in advance (default: the case's)")
+    p.add_argument("--status-port", type=int, metavar="N", help="serve a status page on http://127.0.0.1:N/ "
+                   "(the last hours of delta and the correction, each sensor's health, the guards)")
     p.add_argument("--quiet", action="store_true", help="no line per period")
     p.set_defaults(func=run)
 
@@ -47,7 +49,7 @@ def run(args) -> int:
 
     res = gt.live(case, args.method, endpoint=args.endpoint, out=args.out, model=args.model, target=args.target,
                   map=args.map, period=args.period, until=args.until, states=args.states, schedule=args.schedule,
-                  on_period=line)
+                  status_port=args.status_port, on_period=line)
     band = res.get("compensated_band_um")
     print(f"live: {res['periods']} periods logged to {args.out}/live.csv, {res['missed']} missed, {res['held']} held, "
           f"{res['limited']} limited, {res['reconnects']} reconnects"

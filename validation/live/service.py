@@ -172,8 +172,9 @@ async def _sample(client, nodes, names, scale) -> dict | None:
 
 
 async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params: LiveParams,
-                read: tuple[str, ...], on_period=None, stop: asyncio.Event | None = None) -> dict:
-    """Run the loop until ``params.until_s`` or ``stop``; the counts."""
+                read: tuple[str, ...], on_period=None, stop: asyncio.Event | None = None, status=None) -> dict:
+    """Run the loop until ``params.until_s`` or ``stop``; the counts. ``status``: a
+    :class:`~.status.Status` fed every period's row."""
     from asyncua import ua
 
     logging.getLogger("asyncua").setLevel(logging.ERROR)  # its notes on session timeouts and unencrypted loopback
@@ -202,6 +203,8 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     await asyncio.sleep(params.poll_s)
                     continue
                 row = svc.period(t, k, sample)
+                if status is not None:
+                    status.add(row, svc.counts)
                 await _write(resolved, nodes, svc.written)
                 if on_period is not None:
                     on_period(row)
