@@ -6,6 +6,8 @@ forecast over the horizon, the command) and a fitted error model.
 Runs the C-frame case once (its schedule, 6 h), builds its reduced model, fits an error model on
 the run, then steps each stepper over the 361 samples of the run and prints the median and the
 95th percentile of one step (ms) against the issue's targets (rom < 2 ms, error model < 0.5 ms).
+On a shared machine the percentile also measures the other processes: stalls of ~10 ms every few
+steps that are not the garbage collector (the same with it off) but the scheduler.
 Writes benchmarks/results/live_step.json.
 """
 from __future__ import annotations
@@ -59,7 +61,8 @@ def main() -> None:
                          "max_ms": float(ms.max()), "steps": int(ms.size), "target_ms": TARGETS_MS[name]}
         r = results[name]
         print(f"{name:>10}: one step median {r['median_ms']:.3f} ms, 95th percentile {r['p95_ms']:.3f} ms, "
-              f"max {r['max_ms']:.3f} ms over {r['steps']} steps (target < {r['target_ms']:g} ms: "
+              f"max {r['max_ms']:.3f} ms over {r['steps']} steps (target < {r['target_ms']:g} ms: median "
+              f"{'met' if r['median_ms'] < r['target_ms'] else 'NOT met'}, 95th percentile "
               f"{'met' if r['p95_ms'] < r['target_ms'] else 'NOT met'})")
     results["machine"] = {"python": platform.python_version(), "processor": platform.processor() or platform.machine(),
                           "rom_states": args.states}
