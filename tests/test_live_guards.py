@@ -152,3 +152,19 @@ def test_a_lost_connection_holds_then_ramps_to_zero_at_the_stated_rate(tmp_path)
     assert "connection lost" in events and ramps[-1] == 0.0 and all(np.diff(ramps) < 0)
     assert took >= 0.5 + 2.0  # held for hold_s, then 2 µm at 1 µm/s: the rate bounds it from below
     assert run_counts["reconnects"] == 0
+
+
+@pytest.mark.parametrize("argv, message", [
+    (("twin", "case.toml", "--endpoint", "opc.tcp://127.0.0.1:4840", "--speed", "0"), "--speed: must be > 0"),
+    (("twin", "case.toml", "--endpoint", "http://127.0.0.1:4840"), "--endpoint: 'http://127.0.0.1:4840' is not"),
+    (("live", "--case", "case.toml", "--endpoint", "localhost:4840", "--out", "D"), "--endpoint: 'localhost:4840'"),
+    (("live", "--endpoint", "opc.tcp://127.0.0.1:4840", "--out", "D"), "--case/--model: give the machine's case"),
+    (("twin", "--fault", "theta_A_degC:5", "c.toml", "--endpoint", "opc.tcp://h:1"), "--fault theta_A_degC:5: is not"),
+])
+def test_bad_command_lines_are_one_line_exit_2(argv, message, capsys, monkeypatch, tmp_path):
+    from gatetherm import cli
+
+    monkeypatch.chdir(tmp_path)
+    code = cli.main(list(argv))
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and message in err, err

@@ -36,6 +36,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     import gatetherm as gt
+    from gatetherm.validation.live.twin import endpoint_url
+
+    endpoint_url(args.endpoint)  # a bad endpoint fails before the case is read
 
     if args.model is None and args.case is None:
         raise InputError("--case/--model", "give the machine's case (or a fitted model)", "e.g. --case case.toml")

@@ -34,7 +34,10 @@ def register(sub) -> None:
 
 def run(args) -> int:
     import gatetherm as gt
+    from gatetherm.validation.live.twin import TwinParams, endpoint_url
 
+    endpoint_url(args.endpoint)
+    TwinParams(speed=args.speed, start_s=args.start)  # a bad --speed fails before the model is built
     if not 2 <= args.states <= 200:
         raise InputError("--states", f"{args.states} is outside 2..200", "e.g. --states 30")
     if args.until is not None and not math.isfinite(args.until):
