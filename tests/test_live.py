@@ -108,7 +108,7 @@ def test_twin_and_live_close_the_loop_and_a_second_live_refuses(tmp_path):
     offline = stepped_offline(ts, 10)
     assert np.max(np.abs(offline - ts["offset_wanted_um"])) < 1e-9
     # the twin applied each written correction from the next sample on
-    assert np.max(np.abs(ts["delta_comp_um"][1:] - ts["delta_um"][1:] - ts["offset_um"][:-1])) < 0.2  # δ noise
+    assert np.max(np.abs(ts["delta_residual_um"][1:] - ts["delta_um"][1:] - ts["offset_um"][:-1])) < 0.2  # δ noise
 
 
 @pytest.mark.slow
@@ -124,7 +124,7 @@ def test_closed_loop_six_hours_at_120x_matches_offline_compensation(tmp_path):
     assert summary["periods"] == 361 and summary["missed"] == 0
     assert summary["compensated_band_um"] < 3.0
     ts = read_timeseries(out / "live.csv", required=("time_s",))
-    comp = gt.compensate(ts, gt.load_case(CASE), "rom", actuator=None)
+    comp = gt.compensate(ts, gt.load_case(CASE), "rom", actuator=None)  # = compensate --data live.csv --no-actuator
     residual = ts["delta_um"][1:] + ts["offset_um"][:-1]
     assert np.max(np.abs(comp.loop.delta_comp_um[1:] - residual)) < 0.1
 

@@ -19,7 +19,7 @@ from gatetherm.validation.live.nodes import default_node, read_map
 from gatetherm.validation.live.service import Guards, LiveParams, Service
 
 COLUMNS = ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
-LOGGED = ("time_s", *COLUMNS, "offset_um", "offset_wanted_um", "delta_pred_um", "held", "limited")
+LOGGED = ("time_s", *COLUMNS, "offset_um", "offset_wanted_um", "delta_forecast_um", "held", "limited")
 PARAMS = CompensatorParams(update_interval_s=60.0)  # an update every period
 
 

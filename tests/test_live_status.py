@@ -29,7 +29,7 @@ def rows():
     for k in range(400):  # 400 min: the first 40 fall out of the 6-h span
         a = math.nan if k == 399 else 20.0 + 0.01 * k
         yield {"time_s": 60.0 * k, "theta_A_degC": a, "theta_B_degC": 20.0, "theta_C_degC": 20.0,
-               "delta_um": 0.1 * k, "delta_comp_um": 0.5, "offset_um": -0.1 * k, "held": int(k == 399)}
+               "delta_um": 0.1 * k, "delta_residual_um": 0.5, "offset_um": -0.1 * k, "held": int(k == 399)}
 
 
 def get(url: str) -> tuple[int, str]:

@@ -178,11 +178,11 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
         required = tuple(stepper.columns)
         if map is None:
             extras = tuple(sorted(case.inputs())) if case is not None else ()
-            nodes = default_map((*extras, *required, "delta_comp_um"))
+            nodes = default_map((*extras, *required, "delta_residual_um"))
         else:
             nodes = read_map(map, required)
         read = tuple(n for n in nodes.read if n != "time_s")
-        columns = ("time_s", *read, "offset_um", "offset_wanted_um", "delta_pred_um", "held", "limited")
+        columns = ("time_s", *read, "offset_um", "offset_wanted_um", "delta_forecast_um", "held", "limited")
         journal = jr.Journal(out, columns, {"source": "gatetherm live", "method": label, "endpoint": endpoint,
                                             "period_s": f"{period:g}"})
         if on_ready is not None:

@@ -3,7 +3,7 @@
 Runs the case's reduced model (--states states) on its schedule (or --schedule) in --speed times
 real time and serves its signals in the node layout of docs/live.md: ``time_s`` (the machine's
 clock), the schedule's inputs, the thermocouples and ``delta_um`` with the sensors' noise and
-resolution, and ``delta_comp_um``, δ with the ``offset_um`` written to it applied as an ideal axis
+resolution, and ``delta_residual_um``, δ with the ``offset_um`` written to it applied as an ideal axis
 offset. Prints one line when it ends (--until, or the schedule's end).
 """
 from __future__ import annotations

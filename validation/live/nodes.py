@@ -7,7 +7,7 @@ variable per column of the data format, its string node id the column's name
 
 * read: ``time_s`` (the machine's clock, s), the inputs of the case's schedule (e.g. ``spindle_W``,
   ``ambient_degC``), the thermocouples (``theta_A_degC`` …), ``delta_um`` (the measured,
-  uncompensated δ) and, where the machine reports it, ``delta_comp_um`` (what stays after the
+  uncompensated δ) and, where the machine reports it, ``delta_residual_um`` (what stays after the
   correction);
 * written by ``live``: ``offset_um`` (the axis offset), ``gradient_um_per_m`` and ``reference_m``
   (an offset that grows along the axis from a reference position, where the model gives it).

@@ -138,7 +138,7 @@ class Service:
         self.next = k + 1
         self.counts["periods"] += 1
         row = {"time_s": t, **sample, "offset_um": new, "offset_wanted_um": wanted,
-               "delta_pred_um": corr.predicted_um, "held": held, "limited": limited}
+               "delta_forecast_um": corr.predicted_um, "held": held, "limited": limited}
         self.journal.row(row)
         self.journal.save({"stepper": self.stepper.state(), "next": self.next, "offset_um": self.written,
                            "good": self.good, "good_k": self.good_k, "counts": self.counts, "t_logged": t})
@@ -258,9 +258,9 @@ def summarize(directory, counts: dict, settle_s: float = 600.0) -> dict:
     ts = read_timeseries(directory / "live.csv", required=("time_s",))
     out = {**counts, "rows": len(ts.time_s), "first_s": float(ts.time_s[0]) if len(ts.time_s) else None,
            "last_s": float(ts.time_s[-1]) if len(ts.time_s) else None}
-    if "delta_comp_um" in ts and len(ts.time_s):
+    if "delta_residual_um" in ts and len(ts.time_s):
         late = ts.time_s >= ts.time_s[0] + settle_s
-        comp = ts["delta_comp_um"][late]
+        comp = ts["delta_residual_um"][late]
         out["compensated_band_um"] = float(np.nanmax(np.abs(comp))) if np.isfinite(comp).any() else None
     write_text_atomic(directory / "summary.json", json.dumps(out, indent=2, allow_nan=False) + "\n")
     if counts.get("missed"):

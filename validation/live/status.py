@@ -18,7 +18,7 @@ from pathlib import Path
 
 REFRESH_S = 5
 """The page reloads itself after this many seconds."""
-SERIES = (("delta_um", "#c0392b", "δ measured"), ("delta_comp_um", "#2c7a2c", "δ compensated"),
+SERIES = (("delta_um", "#c0392b", "δ measured"), ("delta_residual_um", "#2c7a2c", "δ compensated"),
           ("offset_um", "#1f4e9c", "correction"))
 
 

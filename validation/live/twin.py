@@ -5,7 +5,7 @@ Every ``step_s`` of machine time the twin advances the reduced model (the exact 
 linear between samples, :mod:`gatetherm.solvers.rom_time`) on the schedule's inputs and publishes
 ``time_s``, the inputs, the thermocouples with the sensors' noise (Gaussian, ``noise_K``) rounded
 to their resolution (``resolution_K``), the measured δ (``noise_um``, ``resolution_um``) and the
-compensated δ ``delta_comp_um`` = δ + the ``offset_um`` read from its own node at that instant (an
+compensated δ ``delta_residual_um`` = δ + the ``offset_um`` read from its own node at that instant (an
 ideal axis offset; the twin's truth, without noise). A sample is published with ``time_s`` set to
 NaN first and to its time last, so a reader that sees the same finite ``time_s`` before and after
 the other values in one read has a consistent sample.
@@ -119,7 +119,7 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
     server.set_server_name("gatetherm twin")
     idx = await server.register_namespace(NAMESPACE)
     obj = await server.nodes.objects.add_object(ua.NodeId(OBJECT, idx), ua.QualifiedName(OBJECT, idx))
-    names = ("time_s", *machine.inputs, *published, "delta_comp_um", *WRITTEN)
+    names = ("time_s", *machine.inputs, *published, "delta_residual_um", *WRITTEN)
     nodes = {}
     for name in names:
         nodes[name] = await obj.add_variable(ua.NodeId(name, idx), ua.QualifiedName(name, idx),
@@ -146,7 +146,7 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
             shown[delta] = _quantise(y[delta], rng, params.noise_um, params.resolution_um)
             comp = float(y[delta]) + (offset if math.isfinite(offset) else 0.0)
             values = {**{k: float(v[machine.k]) for k, v in machine.inputs.items()},
-                      **dict(zip(published, map(float, shown))), "delta_comp_um": comp}
+                      **dict(zip(published, map(float, shown))), "delta_residual_um": comp}
             for name, lo, hi in params.faults:
                 if lo <= t <= hi:
                     values[name] = math.nan
