@@ -45,6 +45,12 @@ def _text(x) -> str:
     return str(int(x)) if x.is_integer() and abs(x) < 1e15 else repr(x)
 
 
+def _data_rows(path: Path) -> int:
+    """Rows after the header line of a log."""
+    lines = [line for line in path.read_text(encoding="utf-8").splitlines() if line and not line.startswith("#")]
+    return max(len(lines) - 1, 0)
+
+
 class Journal:
     """The log, the state and the events of one output directory."""
 
@@ -55,12 +61,9 @@ class Journal:
         self.state = self._read_state()
         if self.state is not None and self.path.exists():
             self._trim(self.state.get("t_logged"))
-        elif self.path.exists() and any(line and not line.startswith("#") for line in
-                                        self.path.read_text(encoding="utf-8").splitlines()[1:]):
-            if sum(1 for line in self.path.read_text(encoding="utf-8").splitlines()
-                   if line and not line.startswith("#")) > 1:
-                raise InputError(str(self.path), f"has rows but {self.dir / STATE} is missing",
-                                 "give another --out (a log without its state cannot be continued)")
+        elif self.path.exists() and _data_rows(self.path):
+            raise InputError(str(self.path), f"has rows but {self.dir / STATE} is missing",
+                             "give another --out (a log without its state cannot be continued)")
         if not self.path.exists() or self.path.stat().st_size == 0:
             head = [f"# format: {FORMAT}", *(f"# {k}: {v}" for k, v in metadata.items()), ",".join(self.columns)]
             with open(self.path, "w", encoding="utf-8") as f:
