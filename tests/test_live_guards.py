@@ -168,3 +168,22 @@ def test_bad_command_lines_are_one_line_exit_2(argv, message, capsys, monkeypatc
     code = cli.main(list(argv))
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and message in err, err
+
+
+def test_the_twins_actuator_drive_equals_the_batch_piezo_drive():
+    """Each new offset written to the twin is one more command of the sequence: the stroke achieved
+    equals apply_commands on the whole sequence (the paper's piezo driven directly, with hysteresis)."""
+    from gatetherm.studies.control.actuator import ActuatorParams, apply_commands
+    from gatetherm.validation.live.twin import Drive
+
+    from dataclasses import replace
+
+    piezo = replace(ActuatorParams(), strategy="direct")  # stepping straight to each voltage: hysteresis shows
+    commands = [-3.0, -7.5, -7.5, -12.0, -4.0, 1.0]
+    drive, ideal = Drive(piezo), Drive(None)
+    got = [drive(c) for c in commands]
+    distinct = [-3.0, -7.5, -12.0, -4.0, 1.0]
+    want = apply_commands(piezo, distinct)[1]
+    assert np.max(np.abs(np.array(got)[[0, 1, 3, 4, 5]] - want)) < 1e-12 and got[2] == got[1]
+    assert np.max(np.abs(want - distinct)) > 0.05  # not ideal
+    assert [ideal(c) for c in commands] == commands

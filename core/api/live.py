@@ -31,7 +31,8 @@ def _schedule(case: Case, schedule):
 
 
 def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until: float | None = None,
-         start: float = 0.0, states: int = 30, rom=None, seed: int = 0, stopped=None, **noise) -> dict:
+         start: float = 0.0, states: int = 30, rom=None, seed: int = 0, actuator: bool = False, stopped=None,
+         **noise) -> dict:
     """Serve a virtual machine over OPC UA: the case's reduced model in ``speed``× real time.
 
     Parameters
@@ -49,6 +50,9 @@ def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until:
         Machine time to stop at (default: the schedule's end) and to start serving at, s.
     seed : int
         Seed of the sensor noise.
+    actuator : bool
+        Apply the correction through the case's ``[actuator]`` (its piezo model: reach, hysteresis,
+        strategy) instead of as an ideal axis offset.
     stopped : callable, optional
         Returns True when the twin should stop (checked every step).
     **noise
@@ -66,10 +70,14 @@ def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until:
     from gatetherm.validation.live.twin import TwinParams, serve
 
     params = TwinParams(speed=speed, start_s=start, until_s=until, seed=seed, **noise)
+    if actuator and case.actuator is None:
+        from gatetherm import InputError
+
+        raise InputError(f"{case.source}: [actuator]", "the case has none", "add one, or apply the ideal offset")
     sched = _schedule(case, schedule)
     rom = rom or build_rom(case, states).rom
     published = tuple(n for n in SENSORS if n in rom.outputs)
-    return asyncio.run(serve(rom, sched, endpoint, params, published, stopped))
+    return asyncio.run(serve(rom, sched, endpoint, params, published, stopped, case.actuator if actuator else None))
 
 
 def _stepper(case, method, model, target, params, states, out, sched):

@@ -4,7 +4,7 @@ Runs the case's reduced model (--states states) on its schedule (or --schedule) 
 real time and serves its signals in the node layout of docs/live.md: ``time_s`` (the machine's
 clock), the schedule's inputs, the thermocouples and ``delta_um`` with the sensors' noise and
 resolution, and ``delta_residual_um``, δ with the ``offset_um`` written to it applied as an ideal axis
-offset. Prints one line when it ends (--until, or the schedule's end).
+offset (or, with --actuator, through the case's [actuator]). Prints one line when it ends (--until, or the schedule's end).
 """
 from __future__ import annotations
 
@@ -25,6 +25,8 @@ def register(sub) -> None:
     p.add_argument("--start", type=float, default=0.0, metavar="SECONDS",
                    help="machine time to start serving at (a twin restarted mid-run; default 0)")
     p.add_argument("--states", type=int, default=30, metavar="N", help="states of the reduced model (default 30)")
+    p.add_argument("--actuator", action="store_true", help="apply the correction through the case's [actuator] "
+                   "(its piezo model) instead of as an ideal axis offset")
     p.add_argument("--wait", action="store_true", help="start the clock once a client has written offset_um")
     p.add_argument("--fault", action="append", default=[], metavar="COL:FROM:TO",
                    help="the column reads NaN from .. to (machine s), a sensor fault (repeatable)")
@@ -51,7 +53,7 @@ def run(args) -> int:
             raise InputError(f"--fault {text}", "is not COL:FROM:TO", "e.g. --fault theta_A_degC:3600:3720") from None
     case = gt.load_case(args.case)
     res = gt.twin(case, args.endpoint, args.speed, schedule=args.schedule, until=args.until, start=args.start,
-                  states=args.states, seed=args.seed, wait=args.wait, faults=tuple(faults))
+                  states=args.states, seed=args.seed, actuator=args.actuator, wait=args.wait, faults=tuple(faults))
     if not res["served"]:
         print("twin: stopped before a client connected")
         return 0

@@ -103,8 +103,29 @@ class Machine:
         return self.rom.C[r] @ self.x + self.rom.D[r] @ self.u[self.k] + self.rom.y0[r]
 
 
-async def serve(rom, schedule, endpoint: str, params: TwinParams, published, stopped=None) -> dict:
-    """Serve the machine until ``params.until_s`` (or the schedule's end); the summary dict."""
+class Drive:
+    """The correction through an actuator model (:mod:`gatetherm.studies.control.actuator`): each new
+    offset is one more command of the sequence, driven with the actuator's strategy and hysteresis."""
+
+    def __init__(self, actuator):
+        self.actuator, self.commands, self.stroke = actuator, [], 0.0
+
+    def __call__(self, offset: float) -> float:
+        """The displacement achieved at the tool for the offset now written, µm."""
+        from gatetherm.studies.control.actuator import apply_commands
+
+        if self.actuator is None:
+            return offset
+        if not self.commands or offset != self.commands[-1]:
+            self.commands.append(offset)
+            self.stroke = float(apply_commands(self.actuator, self.commands)[1][-1])
+        return self.stroke
+
+
+async def serve(rom, schedule, endpoint: str, params: TwinParams, published, stopped=None, actuator=None) -> dict:
+    """Serve the machine until ``params.until_s`` (or the schedule's end); the summary dict. With
+    ``actuator`` (:class:`~gatetherm.studies.control.actuator.ActuatorParams`) the offset drives it;
+    without, it is applied exactly."""
     from asyncua import Server, ua
 
     logging.getLogger("asyncua").setLevel(logging.ERROR)  # its warnings about an unencrypted loopback endpoint
@@ -113,6 +134,7 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
     while machine.times[machine.k] < params.start_s - 1e-9 and machine.k < len(machine.times) - 1:
         machine.advance()
     rng = np.random.default_rng(params.seed)
+    drive = Drive(actuator)
     server = Server()
     await server.init()
     server.set_endpoint(endpoint_url(endpoint))
@@ -144,7 +166,7 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
             shown = y.copy()
             shown[temps] = _quantise(y[temps], rng, params.noise_K, params.resolution_K)
             shown[delta] = _quantise(y[delta], rng, params.noise_um, params.resolution_um)
-            comp = float(y[delta]) + (offset if math.isfinite(offset) else 0.0)
+            comp = float(y[delta]) + drive(offset if math.isfinite(offset) else 0.0)
             values = {**{k: float(v[machine.k]) for k, v in machine.inputs.items()},
                       **dict(zip(published, map(float, shown))), "delta_residual_um": comp}
             for name, lo, hi in params.faults:
