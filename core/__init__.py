@@ -23,9 +23,9 @@ run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
 API = ("Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
-       "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame", "load_case",
-       "nc_schedule", "place_sensors", "reduce", "run", "schedule_file", "validate_zoo", "write_placement",
-       "write_reduction")
+       "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame", "live",
+       "load_case", "nc_schedule", "place_sensors", "reduce", "run", "schedule_file", "twin", "validate_zoo",
+       "write_placement", "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 
 

@@ -44,6 +44,7 @@ Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm.api.control import compensate, diagnose
 from gatetherm.api.export import export_ccx
+from gatetherm.api.live import live, twin
 from gatetherm.api.reduction import check_rom, check_schedules, reduce, write_reduction
 from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, \
     gate_frame, load_case, nc_schedule, run, schedule_file
@@ -51,6 +52,6 @@ from gatetherm.api.sensors import check_placement, place_sensors, write_placemen
 from gatetherm.api.zoo import validate_zoo
 
 __all__ = ["Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
-           "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame",
-           "load_case", "nc_schedule", "place_sensors", "reduce", "run", "schedule_file", "validate_zoo",
+           "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame", "live",
+           "load_case", "nc_schedule", "place_sensors", "reduce", "run", "schedule_file", "twin", "validate_zoo",
            "write_placement", "write_reduction"]

@@ -17,7 +17,7 @@ import threading
 
 #: Sub-command modules of this package, in ``--help`` order.
 COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
-                   "errormodel", "sensors", "export", "report")
+                   "errormodel", "sensors", "export", "report", "twin", "live")
 
 
 class Terminated(BaseException):

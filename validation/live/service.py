@@ -1,0 +1,278 @@
+"""``gatetherm live``: a step-wise compensator beside a machine, over OPC UA.
+
+Every ``period_s`` of the machine's clock (``time_s``, so a twin running faster than real time is
+followed in its own time) the service reads one sample, checks it (the guards below), steps the
+compensator (:mod:`gatetherm.studies.control.stepwise`), limits the correction and writes it to
+the control; it logs the row (:mod:`.journal`), then saves the state. Periods that pass without a
+sample (the service down, the connection lost, the machine clock jumping) are stepped as missing:
+the command holds, the reduced model's filter predicts across them, and they are counted.
+
+Guards (:class:`Guards`, each with its default, docs/live.md):
+
+* the correction is clipped to ±``max_offset_um`` and its change to ±``max_change_um`` per period;
+* a sample with a missing (NaN) value or a jump beyond ``max_jump_K`` (temperatures) or
+  ``max_jump_um`` (δ) per period since the last good one holds the last correction (logged);
+* a lost connection is retried with back-off (``retry_first_s`` doubling to ``retry_max_s``) while
+  the correction holds; after ``hold_s`` the correction ramps to zero at ``ramp_um_per_s``, and
+  the ramped value is what is written on reconnection (a control keeps the last value written
+  while the link is down: its own watchdog is what makes that safe);
+* SIGINT/SIGTERM end the loop between two periods, the state saved.
+"""
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gatetherm import InputError, write_text_atomic
+from gatetherm.validation.live.journal import Journal
+from gatetherm.validation.live.nodes import NodeMap
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Guards:
+    """What the service refuses to pass on to the control."""
+
+    max_offset_um: float = 100.0
+    """Largest correction written, µm (set it to the control's own limit)."""
+    max_change_um: float = 5.0
+    """Largest change of the correction per period, µm."""
+    max_jump_K: float = 1.0
+    """Largest change of a temperature per period that a sensor can show, K."""
+    max_jump_um: float = 10.0
+    """Largest change of a measured δ per period, µm."""
+    retry_first_s: float = 0.5
+    """First wait before reconnecting, wall s (doubled per attempt)."""
+    retry_max_s: float = 8.0
+    """Longest wait between attempts, wall s."""
+    hold_s: float = 60.0
+    """Wall time a lost connection holds the correction before it ramps to zero, s."""
+    ramp_um_per_s: float = 0.1
+    """Rate at which the correction falls to zero while the connection stays lost, µm per wall s."""
+    timeout_s: float = 5.0
+    """Timeout of one OPC UA request, s."""
+
+
+@dataclass(frozen=True)
+class LiveParams:
+    """When the service steps and stops."""
+
+    period_s: float = 60.0
+    """Compensator period on the machine's clock, s (the sampling of the method)."""
+    t0_s: float = 0.0
+    """Machine time of period 0 (the schedule's start), s."""
+    until_s: float | None = None
+    """Machine time to stop after, s (None: until stopped)."""
+    poll_s: float = 0.05
+    """Wall time between reads while waiting for the next period, s."""
+    guards: Guards = field(default_factory=Guards)
+
+
+def _limits(column: str, g: Guards) -> float:
+    return g.max_jump_K if column.endswith("_degC") else g.max_jump_um if column.endswith("_um") else math.inf
+
+
+class Service:
+    """The loop's state between periods (see the module docstring)."""
+
+    def __init__(self, stepper, journal: Journal, params: LiveParams, read: tuple[str, ...]):
+        self.stepper, self.journal, self.p, self.read = stepper, journal, params, read
+        s = journal.state or {}
+        if s:
+            stepper.restore(s["stepper"])
+        self.next = int(s.get("next", 0))
+        self.written = float(s.get("offset_um", 0.0))
+        self.good = dict(s.get("good", {}))
+        self.good_k = s.get("good_k")
+        self.counts = dict(s.get("counts", {"periods": 0, "missed": 0, "held": 0, "limited": 0, "reconnects": 0,
+                                            "restarts": 0}))
+        if s:
+            self.counts["restarts"] += 1
+
+    def bad(self, k: int, sample: dict) -> str | None:
+        """Why ``sample`` (period k) is not used, or None."""
+        for c in self.stepper.columns:
+            x = sample.get(c, math.nan)
+            if not math.isfinite(x):
+                return f"{c} missing"
+            if c in self.good and self.good_k is not None:
+                limit = _limits(c, self.p.guards) * (k - self.good_k)
+                if abs(x - self.good[c]) > limit:
+                    return f"{c} jumped {x - self.good[c]:+.3g} in {k - self.good_k} period(s)"
+        return None
+
+    def period(self, t: float, k: int, sample: dict) -> dict:
+        """Step period k (time t, s) with ``sample``: the row logged."""
+        g = self.p.guards
+        for j in range(self.next, k):  # periods without a sample
+            self.stepper.skip(self.p.t0_s + j * self.p.period_s)
+        if k > self.next:
+            self.counts["missed"] += k - self.next
+            self.journal.event(t, f"{k - self.next} period(s) without a sample (missed)")
+        why = self.bad(k, sample)
+        held = limited = 0
+        if why is not None:
+            corr = self.stepper.skip(t)
+            wanted, held = self.written, 1
+            self.counts["held"] += 1
+            self.journal.event(t, f"sample held: {why}; correction held at {self.written:.3f} um")
+        else:
+            corr = self.stepper.step(t, sample)
+            wanted = corr.offset_um
+            self.good = {c: sample[c] for c in self.stepper.columns}
+            self.good_k = k
+        new = float(np.clip(np.clip(wanted, self.written - g.max_change_um, self.written + g.max_change_um),
+                            -g.max_offset_um, g.max_offset_um))
+        if abs(new - wanted) > 1e-12:
+            limited = 1
+            self.counts["limited"] += 1
+            self.journal.event(t, f"correction limited: {wanted:.3f} -> {new:.3f} um")
+        self.written = new
+        self.next = k + 1
+        self.counts["periods"] += 1
+        row = {"time_s": t, **sample, "offset_um": new, "offset_wanted_um": wanted,
+               "delta_forecast_um": corr.predicted_um, "held": held, "limited": limited}
+        self.journal.row(row)
+        self.journal.save({"stepper": self.stepper.state(), "next": self.next, "offset_um": self.written,
+                           "good": self.good, "good_k": self.good_k, "counts": self.counts, "t_logged": t})
+        return row
+
+
+async def _connect(url: str, nodes: NodeMap, timeout: float):
+    from asyncua import Client, ua
+
+    client = Client(url, timeout=timeout)
+    await client.connect()
+    resolved = {}
+    for table in (nodes.read, nodes.write):
+        for name, text in table.items():
+            nid = ua.NodeId.from_string(text)
+            uri = getattr(nid, "NamespaceUri", None)
+            if uri:
+                nid = ua.NodeId(nid.Identifier, await client.get_namespace_index(uri), nid.NodeIdType)
+            resolved[name] = client.get_node(nid)
+    return client, resolved
+
+
+async def _sample(client, nodes, names, scale) -> dict | None:
+    """One consistent sample (``time_s`` read before and after the rest), or None."""
+    order = ("time_s", *names, "time_s")
+    values = await client.read_values([nodes[n] for n in order])
+    t0, t1 = values[0], values[-1]
+    if t0 is None or t1 is None or not (math.isfinite(t0) and t0 == t1):
+        return None
+    return {n: (math.nan if v is None else float(v) / scale(n)) for n, v in zip(order, values)}
+
+
+async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params: LiveParams,
+                read: tuple[str, ...], on_period=None, stop: asyncio.Event | None = None, status=None) -> dict:
+    """Run the loop until ``params.until_s`` or ``stop``; the counts. ``status``: a
+    :class:`~.status.Status` fed every period's row."""
+    from asyncua import ua
+
+    logging.getLogger("asyncua").setLevel(logging.ERROR)  # its notes on session timeouts and unencrypted loopback
+    svc, g = Service(stepper, journal, params, read), params.guards
+    stop = stop or asyncio.Event()
+    client, resolved, wait, lost_at, ever = None, None, g.retry_first_s, None, False
+    try:
+        while not stop.is_set():
+            try:
+                if client is None:
+                    client, resolved = await _connect(endpoint, nodes, g.timeout_s)
+                    if lost_at is not None:
+                        svc.counts["reconnects"] += ever
+                        journal.event(None, f"{'re' if ever else ''}connected after {time.monotonic() - lost_at:.1f} s")
+                    lost_at, wait, ever = None, g.retry_first_s, True
+                    await _write(resolved, nodes, svc.written)
+                sample = await _sample(client, resolved, read, nodes.factor)
+                if sample is None:
+                    await asyncio.sleep(params.poll_s)
+                    continue
+                t = sample.pop("time_s")
+                k = int(round((t - params.t0_s) / params.period_s))
+                if params.until_s is not None and t > params.until_s + 1e-9:
+                    break
+                if k < svc.next:
+                    await asyncio.sleep(params.poll_s)
+                    continue
+                row = svc.period(t, k, sample)
+                if status is not None:
+                    status.add(row, svc.counts)
+                await _write(resolved, nodes, svc.written)
+                if on_period is not None:
+                    on_period(row)
+                if params.until_s is not None and t >= params.until_s - 1e-9:
+                    break
+            except (OSError, asyncio.TimeoutError, ConnectionError, ua.UaError, RuntimeError) as err:
+                if client is not None or lost_at is None:
+                    journal.event(None, f"connection lost ({type(err).__name__}: {err}); correction held at "
+                                  f"{svc.written:.3f} um")
+                    lost_at = lost_at or time.monotonic()
+                await _close(client)
+                client, before = None, time.monotonic()
+                try:
+                    await asyncio.wait_for(stop.wait(), wait)
+                except asyncio.TimeoutError:
+                    pass
+                wait = min(2 * wait, g.retry_max_s)
+                now = time.monotonic()
+                ramping = min(now - before, now - lost_at - g.hold_s)  # wall s of this wait past the hold
+                if ramping > 0 and svc.written != 0.0:
+                    down = now - lost_at
+                    ramped = math.copysign(max(0.0, abs(svc.written) - g.ramp_um_per_s * ramping), svc.written)
+                    journal.event(None, f"connection lost {down:.0f} s: correction ramped to {ramped:.3f} um")
+                    svc.written = ramped
+    finally:
+        await _close(client)
+    return svc.counts
+
+
+async def _write(resolved, nodes: NodeMap, offset: float) -> None:
+    from asyncua import ua
+
+    if "offset_um" in resolved:
+        await resolved["offset_um"].write_value(ua.DataValue(ua.Variant(offset * nodes.factor("offset_um"),
+                                                                        ua.VariantType.Double)))
+
+
+async def _close(client) -> None:
+    if client is not None:
+        try:
+            await client.disconnect()
+        except Exception:  # noqa: BLE001 - the link is gone already
+            pass
+
+
+def summarize(directory, counts: dict, settle_s: float = 600.0) -> dict:
+    """The run's summary from ``live.csv``: the counts and, where the machine reports its compensated
+    δ, its band after the first ``settle_s`` of machine time (µm); written to ``summary.json``."""
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    ts = read_timeseries(directory / "live.csv", required=("time_s",))
+    out = {**counts, "rows": len(ts.time_s), "first_s": float(ts.time_s[0]) if len(ts.time_s) else None,
+           "last_s": float(ts.time_s[-1]) if len(ts.time_s) else None}
+    if "delta_residual_um" in ts and len(ts.time_s):
+        late = ts.time_s >= ts.time_s[0] + settle_s
+        comp = ts["delta_residual_um"][late]
+        out["compensated_band_um"] = float(np.nanmax(np.abs(comp))) if np.isfinite(comp).any() else None
+    write_text_atomic(directory / "summary.json", json.dumps(out, indent=2, allow_nan=False) + "\n")
+    if counts.get("missed"):
+        log.info("%d period(s) missed", counts["missed"])
+    return out
+
+
+def check(params: LiveParams) -> None:
+    """InputError on a bad period or guard."""
+    if not (math.isfinite(params.period_s) and params.period_s > 0):
+        raise InputError("--period", f"must be > 0, got {params.period_s}", "e.g. --period 60")
+    g = params.guards
+    if min(g.max_offset_um, g.max_change_um, g.max_jump_K, g.max_jump_um, g.retry_first_s, g.hold_s,
+           g.ramp_um_per_s, g.timeout_s) <= 0:
+        raise InputError("live guards", "must be > 0", "see the defaults in docs/live.md")
