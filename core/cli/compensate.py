@@ -156,7 +156,9 @@ def run(args: argparse.Namespace) -> int:
     if args.case is not None:
         refuse_model_options(args)
     if args.condition is not None:
-        gt.condition(args.condition)  # a bad number fails before the model is built
+        from gatetherm.studies.run.conditions import condition as check_condition
+
+        check_condition(args.condition)  # a bad number fails (naming --condition) before the model is built
         case = gt.gate_frame(args.dim, args.config)
     else:
         case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config)

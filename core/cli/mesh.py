@@ -26,7 +26,9 @@ def run(args) -> int:
     from gatetherm.outdir import output_dir
     from gatetherm.studies.run.frame_case import write_frame_case
 
-    gt.condition(args.condition)  # a bad number fails before the frame is meshed
+    from gatetherm.studies.run.conditions import condition as check_condition
+
+    check_condition(args.condition)  # a bad number fails (naming --condition) before the model is built
     with output_dir(args.out, OUTPUTS, keep=(args.config,)) as out:
         case = gt.gate_frame(args.dim, args.config, args.condition)
         fm = case.mesh
