@@ -95,9 +95,21 @@ def give_back() -> None:
 
 def fork() -> int:
     """``os.fork()`` after :func:`give_back`: the child shares no freed pages, which either
-    process would otherwise copy as it reuses them."""
+    process would otherwise copy as it reuses them. SIGINT and SIGTERM are held during the fork:
+    a handler that raises (the command's, a painter's) would raise inside the fork's hooks
+    (``os.register_at_fork``: logging's), where the exception is printed and ignored, so that the
+    signal were lost; held, it is raised in this process as the fork returns (the child starts
+    without it)."""
+    import signal
+
     give_back()
-    return os.fork()
+    if not hasattr(signal, "pthread_sigmask"):
+        return os.fork()
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        return os.fork()
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
 
 def die_with_parent(sig: int) -> bool:
