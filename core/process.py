@@ -91,23 +91,30 @@ def give_back() -> None:
 
 def fork() -> int:
     """``os.fork()`` after :func:`give_back`: the child shares no freed pages, which either
-    process would otherwise copy as it reuses them. SIGINT and SIGTERM are held back across the
-    fork; the child starts with their default actions (end quietly), so that a signal that
-    reaches it while Python sets it up (the parent ending its helpers at once) is no traceback
-    from the parent's handler; a child that wants them sets its own."""
+    process would otherwise copy as it reuses them. SIGINT and SIGTERM are held during the fork:
+    a handler that raises (the command's, a painter's) would raise inside the fork's hooks
+    (``os.register_at_fork``: logging's), where the exception is printed and ignored, so that the
+    signal were lost; held, it is raised in this process as the fork returns. The child starts
+    with their default actions (end quietly), so that a signal that reaches it while Python sets
+    it up (the parent ending its helpers at once) is no traceback from the parent's handler; a
+    child that wants them sets its own."""
     import signal
     import threading
 
     give_back()
+    if not hasattr(signal, "pthread_sigmask"):
+        return os.fork()
     held = {signal.SIGINT, signal.SIGTERM}
     old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    pid = os.fork()
-    if pid == 0 and threading.current_thread() is threading.main_thread():
-        for sig in held:
-            if signal.getsignal(sig) is not signal.SIG_IGN:
-                signal.signal(sig, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_SETMASK, old)
-    return pid
+    try:
+        pid = os.fork()
+        if pid == 0 and threading.current_thread() is threading.main_thread():
+            for sig in held:
+                if signal.getsignal(sig) is not signal.SIG_IGN:
+                    signal.signal(sig, signal.SIG_DFL)
+        return pid
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def die_with_parent(sig: int) -> bool:

@@ -71,27 +71,29 @@ def test_a_failed_picture_is_raised_by_finish_naming_it(tmp_path):
 
 
 def test_a_picture_of_more_than_the_pipe_holds_is_drawn_while_the_caller_works(tmp_path):
+    """``draw`` returns with megabytes not yet in the pipe (a thread writes them as the process
+    reads), and the PNG appears while the caller works, before ``finish``: no wall-clock margin
+    (a busy machine only makes the wait longer; the 300-s guard is for a hang)."""
     out = fresh("""
         def with_mesh(cols, mesh):  # a deformed picture's arguments: a mesh of some MB
             return plot_channels(cols, f"{{len(mesh)}} nodes")
 
         t = np.arange(1000.0)
         cols = {{"time_s": t, **{{f"T{{k}}_degC": np.sin(k * t) for k in range(19)}}}}
-        mesh, t0 = np.zeros((400_000, 3)), time.perf_counter()
-        gt.plot.Painter(0).draw(with_mesh, cols, mesh, path=os.path.join({tmp}, "here.png"))
-        draw = time.perf_counter() - t0
+        mesh, big = np.zeros((400_000, 3)), os.path.join({tmp}, "big.png")
         with gt.plot.Painter(2) as painter:
-            workers, t0 = painter.workers, time.perf_counter()
-            painter.draw(with_mesh, cols, mesh, path=os.path.join({tmp}, "big.png"))
-            given = time.perf_counter() - t0
-            time.sleep(1.0 + 2.0 * draw)  # the caller's work: matplotlib's import and the picture
-            t0 = time.perf_counter()
+            workers = painter.workers
+            painter.draw(with_mesh, cols, mesh, path=big)
+            left = sum(len(box) for box in painter._outbox)  # not yet taken by the pipe when draw returned
+            deadline = time.monotonic() + 300
+            while not os.path.exists(big) and time.monotonic() < deadline:  # the caller's work
+                time.sleep(0.05)
+            drawn = os.path.exists(big)
             painter.finish()
-            waited = time.perf_counter() - t0
-        print(json.dumps({{"workers": workers, "given_s": given, "waited": waited / draw}}))
+        print(json.dumps({{"workers": workers, "left_MB": left / 1e6, "drawn_before_finish": drawn}}))
         """, tmp=str(tmp_path))
-    assert out["workers"] == 2 and out["given_s"] < 0.2  # 10.6 MB: far more than a pipe takes
-    assert out["waited"] < 0.25  # of the picture's time: the 9.6 MB left for finish to write, all of it
+    assert out["workers"] == 2 and out["drawn_before_finish"]
+    assert out["left_MB"] > 5.0  # 10.6 MB given: far more than a pipe takes
     assert (tmp_path / "big.png").stat().st_size > 10_000
 
 
@@ -113,8 +115,8 @@ def test_closed_without_finish_it_draws_what_it_was_given(tmp_path):
 
 def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):
     out = fresh("""
-        t = np.arange(6000.0)
-        cols = {{"time_s": t, **{{f"T{{k}}_degC": np.sin(k * t) for k in range(19)}}}}  # ~3 s to draw
+        t = np.arange(60000.0)
+        cols = {{"time_s": t, **{{f"T{{k}}_degC": np.sin(k * t) for k in range(19)}}}}  # ~30 s to draw
         try:
             with gt.plot.Painter(2) as painter:
                 workers = painter.workers
@@ -132,7 +134,7 @@ def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):
         print(json.dumps({{"workers": workers, "stopped_s": stopped, "left": left}}))
         """, tmp=str(tmp_path))
     assert out["workers"] == 2 and not out["left"]
-    assert out["stopped_s"] < 1.0  # without SIGTERM, the 3 s of the picture
+    assert out["stopped_s"] < 10.0  # achieved <1 s alone; without SIGTERM, the 30 s of the picture
     assert list(tmp_path.iterdir()) == []  # the PNG being written removed
 
 

@@ -207,7 +207,8 @@ def test_compensation(cframe):
     assert np.array_equal(ax[2].lines[0].get_ydata(), comp.loop.delta_comp_um)
     assert np.array_equal(ax[2].lines[1].get_ydata(), comp.loop.stroke_um)
     assert _labels(ax[2]) == ["compensated δ", "actuator stroke (piezo model)"] and _labels(ax[3]) == ["R_i", "R_C"]
-    assert [a.get_ylabel() for a in ax] == ["δ [µm]", "δ − δ_et [µm]", "compensated δ [µm]", "correction factor [1]"]
+    assert [a.get_ylabel() for a in ax] == ["δ [µm]", "δ − δ_et [µm]", "compensated δ [µm]",
+                                            "correction factor [1]"]
     assert ax[3].get_xlabel() == "time [h]" and ax[0].get_title() == comp.label
 
 

@@ -120,11 +120,12 @@ def order_check(case, run) -> OrderCheck | None:
     size = scales({k: cols[k] for k in keys}, {k: p2[k] for k in keys}, case.problem.T_ref)
     scale = {k: size[_unit(k)] for k in keys}
     rel = {k: float((p2[k] - v) / scale[k]) for k, v in p1.items()}
-    below = tuple(k for k in keys if max(abs(p1[k] - base[_unit(k)]), abs(p2[k] - base[_unit(k)])) <= RESOLUTION[_unit(k)])
+    below = tuple(k for k in keys
+                  if max(abs(p1[k] - base[_unit(k)]), abs(p2[k] - base[_unit(k)])) <= RESOLUTION[_unit(k)])
     check = OrderCheck(p1, {k: p2[k] for k in p1}, rel, scale, below)
     worst = check.worst
     if worst is not None and abs(rel[worst]) > TOLERANCE:
-        log.warning("%s: %s changes from %.4g to %.4g from P1 to P2 on this mesh (%+.1f %% of %.4g, the largest "
-                    "output of its unit, check tolerance %g %%): set order = 2 in [case] or refine the mesh", case.path,
-                    worst, p1[worst], p2[worst], 100 * rel[worst], scale[worst], 100 * TOLERANCE)
+        log.warning("%s: %s changes from %.4g to %.4g from P1 to P2 on this mesh (%+.1f %% of %.4g, the scale of "
+                    "its unit's outputs over the run, check tolerance %g %%): set order = 2 in [case] or refine the "
+                    "mesh", case.path, worst, p1[worst], p2[worst], 100 * rel[worst], scale[worst], 100 * TOLERANCE)
     return check
