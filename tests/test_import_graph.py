@@ -33,14 +33,9 @@ def cycles(graph: dict[str, list[str]]) -> list[list[str]]:
     return found
 
 
-ALLOWED: list[list[str]] = [["gatetherm.validation.plots.painter", "gatetherm.validation.plots.run"]]
-"""Circles left for now, each with its reason: the painter pre-imports the run's plot modules, and
-``write_pictures`` hands them to a painter (to be split once the plots' labels land)."""
-
-
 def test_no_import_circles():
     graph = {m: sorted(i for i in imports(p) if i in MODULES and i != m) for m, p in MODULES.items()}
-    assert cycles(graph) == ALLOWED
+    assert cycles(graph) == []
 
 
 def test_the_checker_finds_a_circle():

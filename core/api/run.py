@@ -324,7 +324,7 @@ class Run:
         picture = self._picture_time()
         later = None
         if pictures and painter is not None:  # the plots of the columns at once, the deformed one later
-            from gatetherm.validation.plots.run import prepare_pictures, write_pictures
+            from gatetherm.validation.plots.pictures import prepare_pictures, write_pictures
 
             if picture is not None:
                 prepare_pictures(self.scenario, painter)  # while the fields are solved (if not done before)
@@ -332,7 +332,7 @@ class Run:
             write_pictures(self.scenario, out, self.case.name, None, painter=painter)
 
         def draw(solved):
-            from gatetherm.validation.plots.run import write_pictures
+            from gatetherm.validation.plots.pictures import write_pictures
 
             write_pictures(self.scenario, out, self.case.name, picture, solved, painter=painter, only=later)
 
