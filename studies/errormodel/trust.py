@@ -1,0 +1,75 @@
+"""How far a thermal-error model's prediction can be trusted: its 90 % interval, calibrated on
+held-out data, and a drift detector.
+
+* :func:`calibrate`: the half-width of the 90 % interval is the 90 % quantile of the held-out
+  absolute residuals (those of the model's own cross-validation: forward chaining, leave one run
+  out, or blocked folds). Its coverage is checked out of sample: each held-out block's residuals
+  against the quantile of the blocks that do not overlap it (in forward chaining: that end before
+  it starts), the fraction inside over all checked samples.
+* :func:`term_ranges` / :func:`drift`: each term's range on the fitting rows; a sample is *outside*
+  where a term (not the drift term, which always grows) leaves its range by more than
+  :data:`MARGIN` of the range's width. A file whose share of outside samples exceeds
+  :data:`MAX_OUTSIDE`, or whose measured target leaves the 90 % interval on more than
+  :data:`MAX_MISSED` of its samples, no longer behaves like the fitting data.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+LEVEL = 0.9
+"""Nominal coverage of the interval."""
+MARGIN = 0.25
+"""A term further than this fraction of its fitted range beyond the range is outside it."""
+MAX_OUTSIDE = 0.10
+"""Largest share of samples outside the fitted ranges before the drift warning."""
+MAX_MISSED = 0.25
+"""Largest share of measured samples outside the 90 % interval before the drift warning."""
+
+
+def calibrate(residuals: list[np.ndarray], blocks: list[tuple[int, int]], chain: bool) -> dict:
+    """``half_width_um`` of the 90 % interval, ``coverage`` (out-of-sample check, module docstring;
+    None if no block could be checked) and ``samples`` checked, from the held-out ``residuals`` per
+    block (um) of ``blocks`` (row ranges)."""
+    if not residuals:
+        return {}
+    a = [np.abs(r) for r in residuals]
+    half = float(np.quantile(np.concatenate(a), LEVEL))
+    inside, n = 0, 0
+    for i, (lo, hi) in enumerate(blocks):
+        others = [a[j] for j, (l2, h2) in enumerate(blocks)
+                  if j != i and (h2 <= lo if chain else (h2 <= lo or l2 >= hi))]
+        if not others:
+            continue
+        q = np.quantile(np.concatenate(others), LEVEL)
+        inside += int((a[i] <= q).sum())
+        n += a[i].size
+    return {"half_width_um": half, "coverage": inside / n if n else None, "samples": n, "level": LEVEL}
+
+
+def term_ranges(X: np.ndarray) -> tuple[tuple[float, float], ...]:
+    """Smallest and largest value of each column of ``X`` (the terms on the fitting rows)."""
+    return tuple((float(c.min()), float(c.max())) for c in X.T)
+
+
+def outside(values: list[np.ndarray], ranges, kinds) -> np.ndarray:
+    """Per sample: True where a term's ``values`` (one array per term) leave its range by more than
+    :data:`MARGIN` of its width (drift terms not checked)."""
+    out = np.zeros(values[0].size if values else 0, bool)
+    for v, (lo, hi), kind in zip(values, ranges, kinds):
+        if kind == "drift":
+            continue
+        pad = MARGIN * max(hi - lo, 1e-12)
+        out |= (v < lo - pad) | (v > hi + pad)
+    return out
+
+
+def drift_warning(target: str, share_outside: float, share_missed: float | None) -> str | None:
+    """One line if the data no longer behave like the fitting data (module docstring), else None."""
+    why = []
+    if share_outside > MAX_OUTSIDE:
+        why.append(f"{share_outside:.0%} of the samples outside the fitting data's range")
+    if share_missed is not None and share_missed > MAX_MISSED:
+        why.append(f"{share_missed:.0%} of the measured samples outside the 90 % interval")
+    if not why:
+        return None
+    return f"{target}: the machine no longer behaves like the fitting data ({'; '.join(why)}): refit"
