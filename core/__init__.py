@@ -22,8 +22,9 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("Case", "Run", "Schedule", "beam_coefficients", "check_placement", "check_rom", "check_schedules",
-       "compensate", "condition", "configure", "diagnose", "gate_frame", "load_case", "place_sensors", "reduce", "run",
+API = ("Case", "Prediction", "Run", "Schedule", "beam_coefficients", "check_placement", "check_rom",
+       "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit", "errormodel_predict",
+       "errormodel_refit", "gate_frame", "load_case", "place_sensors", "reduce", "run",
        "schedule_file", "write_placement", "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 

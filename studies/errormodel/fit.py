@@ -92,7 +92,9 @@ class FitParams:
     ``chain`` (forward chaining: the latest blocks, each predicted by the fit on the rows before it).
     Three or more runs are always held out one run at a time."""
     drift: bool = False
-    """Also offer a slow drift, the hours since the run's start (kept only where it earns ``min_gain``)."""
+    """With several runs, also offer a slow drift, the hours since each run's start (kept only where
+    it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with
+    the heating it should explain, and is not offered."""
 
     def __post_init__(self):
         if self.form not in FIT_FORMS:
@@ -182,7 +184,7 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
     used = {s for m in models for s in m.sensors}
     reference = data.reference()
     lo, hi = spans[0] if len(runs) == 1 else (spans[0][0], spans[-1][1])
-    return ErrorModel(tuple(models), {c: reference[c] for c in candidates if c in used},
+    return ErrorModel(tuple(models), {c: reference[c] for c in candidates if c in used and c in reference},
                       {"start_s": float(lo), "end_s": float(hi), "samples": int(data.ok.sum()), "source": str(source),
                        "runs": len(runs)},
                       params.max_gap_s, _settings(params, candidates, inputs), run_reference=data.anchored)
@@ -194,7 +196,7 @@ def _settings(params: FitParams, candidates, inputs) -> dict:
 
 def _base_terms(candidates, inputs, data: Runs, params: FitParams) -> list[Term]:
     base = [Term("sensor", c, tau_s=tau) for c in candidates for tau in (None, *params.sensor_taus_s)]
-    if params.drift and params.form != "paper":
+    if params.drift and data.anchored and params.form != "paper":  # within one run a trend is the heating itself
         base.append(Term("drift", "time_s"))
     if params.form in ("auto", "dynamic"):
         for u in inputs:

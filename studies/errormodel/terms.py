@@ -104,7 +104,7 @@ def evaluate(term: Term, t_s: np.ndarray, columns, reference_degC: dict[str, flo
     reference temperatures (degC) of the sensors; K for sensors and differences, 1 for inputs, h for
     a drift (from ``reference["time_s"]``, s, default the first sample)."""
     if term.kind == "drift":
-        s = (np.asarray(t_s, float) - reference.get("time_s", t_s[0])) / 3600.0
+        s = (np.asarray(t_s, float) - reference_degC.get("time_s", t_s[0])) / 3600.0
     elif term.kind == "input":
         s = (np.abs(columns[term.column]) / term.scale) ** term.exponent
     else:
