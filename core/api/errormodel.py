@@ -12,7 +12,7 @@ from gatetherm.studies.run.timeseries import read_timeseries
 
 @dataclass(frozen=True)
 class Prediction:
-    """What :func:`errormodel_predict` returns."""
+    """What :func:`errormodel_predict` returns: predictions with their 90 % intervals, scores and drift warnings."""
 
     predicted: dict
     """Target -> predicted displacement per sample, um."""
