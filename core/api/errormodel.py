@@ -35,10 +35,11 @@ def _read(data, required=("time_s",)):
         else data
 
 
-ROBUST = FitParams(drift=True)
+ROBUST = FitParams(drift=True, noisy_cv=True)
 """The API's and the command's default fit: blocked cross-validation within a run (forward chaining,
 ``cv="chain"``, measured no better on FL_THERMAL: docs/errormodel.md), leave one run out with three
-or more runs, a drift term offered with several runs."""
+or more runs, a drift term offered with several runs, candidates scored by their expected held-out error
+on readings with the sensors' noise."""
 
 
 def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams = ROBUST,

@@ -91,6 +91,9 @@ class FitParams:
     """Held-out error within a run: ``blocked`` (every block predicted by the fit on the others) or
     ``chain`` (forward chaining: the latest blocks, each predicted by the fit on the rows before it).
     Three or more runs are always held out one run at a time."""
+    noisy_cv: bool = False
+    """Score every candidate by its expected held-out error on readings carrying the sensors' noise
+    (``resolution_K``): a term whose noise costs more than it explains is not chosen."""
     drift: bool = False
     """With several runs, also offer a slow drift, the hours since each run's start (kept only where
     it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with
@@ -245,7 +248,7 @@ def _cv(X, y, data: Runs, rows, params: FitParams, penalty) -> select.CrossValid
     """Leave one run out with three or more runs, else ``params.cv`` within the rows."""
     blocks = data.blocks(rows)
     return select.CrossValidation(X, y, params.folds, blocks=blocks, penalty=penalty,
-                                  chain=blocks is None and params.cv == "chain")
+                                  chain=blocks is None and params.cv == "chain", noisy=params.noisy_cv)
 
 
 def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetModel:

@@ -44,12 +44,14 @@ class CrossValidation:
     on the rows before it only, as a control will use the model)."""
 
     def __init__(self, Z: np.ndarray, y: np.ndarray, folds=(4, 5, 6, 7, 8), blocks=None, penalty=None,
-                 chain: bool = False):
+                 chain: bool = False, noisy: bool = False):
         """``blocks``: explicit ``(start, stop)`` row ranges that partition the rows once (e.g. one
         per separate run, leave-one-run-out) instead of the equal blocks of ``folds``. ``penalty``:
         the noise variance of each base column (module docstring); None = noise-free. ``chain``:
         forward chaining: for each ``K`` in ``folds`` the rows are cut into ``K`` equal blocks and
-        each of the last ``ceil(K / 2)`` blocks is predicted by the fit on the rows before it."""
+        each of the last ``ceil(K / 2)`` blocks is predicted by the fit on the rows before it.
+        ``noisy``: the held-out error is the expected one on readings carrying the ``penalty``
+        noise (:func:`noisy_mae`), so that selection weighs what the noise adds to a prediction."""
         self.Z, self.y, n = Z, y, len(y)
         self.D = np.zeros(Z.shape[1]) if penalty is None else np.asarray(penalty, float)
         if blocks is not None:
@@ -78,6 +80,13 @@ class CrossValidation:
         self._Zf = np.asfortranarray(Z)  # columns gathered fast by error_of
         self.n_fit = np.array([n - (hi - lo) if f is None else f for (lo, hi), f in zip(self.blocks, fits)], float)
         self.n_test = sum(hi - lo for lo, hi in self.blocks)
+        self.noisy = bool(noisy) and bool(np.any(self.D))
+
+    def _mae(self, r: np.ndarray, c: np.ndarray, W: np.ndarray) -> float:
+        """Sum of the absolute held-out residuals ``r``; expected on noisy readings with ``noisy``."""
+        if not self.noisy:
+            return float(np.abs(r).sum())
+        return float(noisy_mae(r, float(np.sqrt((W @ c) ** 2 @ self.D))).sum())
 
     def coefficients(self, W: np.ndarray) -> np.ndarray | None:
         """Per fold the coefficients of the regressors ``Z @ W`` (folds x m); None if singular."""
@@ -102,10 +111,11 @@ class CrossValidation:
         W = np.asarray(W)
         if W.ndim == 2 and W.size and np.all((W == 0) | (W == 1)) and np.all(W.sum(axis=0) == 1):
             return self.error_of(np.argmax(W, axis=0))  # the columns are base columns
-        r = self.residuals(W)
-        if not r:
+        C = self.coefficients(W)
+        if C is None:
             return np.inf
-        return float(sum(np.abs(x).sum() for x in r)) / self.n_test
+        r = [self.Z[lo:hi] @ (W @ c) - self.y[lo:hi] for (lo, hi), c in zip(self.blocks, C)]
+        return sum(self._mae(x, c, W) for x, c in zip(r, C)) / self.n_test
 
     def error_of(self, columns) -> float:
         """:meth:`error` of the model whose regressors are the base columns ``columns`` (indices):
@@ -118,6 +128,9 @@ class CrossValidation:
         except np.linalg.LinAlgError:
             return np.inf
         Zs = self._Zf[:, cols]
+        if self.noisy:
+            W = np.eye(self.Z.shape[1])[:, cols]
+            return sum(self._mae(Zs[lo:hi] @ c - self.y[lo:hi], c, W) for (lo, hi), c in zip(self.blocks, C)) / self.n_test
         total = sum(np.abs(Zs[lo:hi] @ c - self.y[lo:hi]).sum() for (lo, hi), c in zip(self.blocks, C))
         return float(total) / self.n_test
 
@@ -185,6 +198,16 @@ def noisy_least_squares(X: np.ndarray, y: np.ndarray, variance=None) -> np.ndarr
         return np.linalg.lstsq(X, y, rcond=None)[0]
     rows = np.diag(np.sqrt(len(y) * np.asarray(variance, float)))
     return np.linalg.lstsq(np.vstack([X, rows]), np.r_[y, np.zeros(X.shape[1])], rcond=None)[0]
+
+
+def noisy_mae(r: np.ndarray, sd: float) -> np.ndarray:
+    """Expected ``|r + e|`` for ``e`` normal with standard deviation ``sd`` (the folded normal's mean):
+    ``sd sqrt(2/pi) exp(-r^2 / 2 sd^2) + r erf(r / (sd sqrt 2))``; ``|r|`` for ``sd = 0``."""
+    from scipy.special import erf
+
+    if sd <= 0:
+        return np.abs(r)
+    return sd * np.sqrt(2 / np.pi) * np.exp(-r**2 / (2 * sd**2)) + r * erf(r / (sd * np.sqrt(2)))
 
 
 def informative(values: np.ndarray, min_span: float) -> bool:
