@@ -12,7 +12,8 @@ import gatetherm as gt
 from gatetherm.cli import main
 from gatetherm.studies.errormodel import select
 from gatetherm.studies.errormodel.fit import FitParams, fit_error_model
-from gatetherm.studies.errormodel.model import load_model, predict, trust
+from gatetherm.studies.errormodel.model import load_model, predict
+from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.terms import lag
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
 

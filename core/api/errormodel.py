@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from gatetherm.studies.errormodel.fit import FitParams, fit_error_model, fraction_span
-from gatetherm.studies.errormodel.model import ErrorModel, check_columns, input_gaps, load_model, predict, score, trust
+from gatetherm.studies.errormodel.model import ErrorModel, check_columns, input_gaps, load_model, predict, score
+from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.refit import refit
 from gatetherm.studies.run.timeseries import read_timeseries
 

@@ -191,50 +191,6 @@ def predict(model: ErrorModel, columns) -> dict[str, np.ndarray]:
     return out
 
 
-def trust(model: ErrorModel, columns, predicted: dict[str, np.ndarray] | None = None) -> dict[str, dict]:
-    """The 90 % interval and the drift check of every target on ``columns``.
-
-    Parameters
-    ----------
-    model : ErrorModel
-    columns : mapping or TimeSeries
-        As for :func:`predict`; where it holds a target, the measured samples are checked against
-        the interval too.
-    predicted : dict, optional
-        :func:`predict`'s result on ``columns`` (computed if None).
-
-    Returns
-    -------
-    dict
-        Per target: ``lower``, ``upper`` (um per sample; NaN without a calibrated interval),
-        ``outside`` (per sample: a term beyond its fitted range), ``share_outside``,
-        ``share_missed`` (measured samples outside the interval; None if not measured) and
-        ``warning`` (one line, or None; :func:`~gatetherm.studies.errormodel.trust.drift_warning`).
-    """
-    from gatetherm.studies.errormodel import trust as rules
-
-    predicted = predict(model, columns) if predicted is None else predicted
-    values, _, _ = _term_values(model, columns)
-    out = {}
-    for m in model.targets:
-        p = predicted[m.target]
-        half = m.interval.get("half_width_um", np.nan)
-        off = rules.outside(values[m.target], m.ranges, [t.kind for t in m.terms]) if m.ranges \
-            else np.zeros(p.size, bool)
-        missed = None
-        if m.target in columns and np.isfinite(half):
-            y = np.asarray(columns[m.target], float)
-            if model.run_reference:
-                valid = np.flatnonzero(np.isfinite(y))
-                y = y - (y[valid[0]] if valid.size else np.nan)
-            ok = np.isfinite(y) & np.isfinite(p)
-            missed = float(np.mean(np.abs(y[ok] - p[ok]) > half)) if ok.any() else None
-        share = float(off.mean()) if off.size else 0.0
-        out[m.target] = {"lower": p - half, "upper": p + half, "outside": off, "share_outside": share,
-                         "share_missed": missed, "warning": rules.drift_warning(m.target, share, missed)}
-    return out
-
-
 def score(predicted: dict[str, np.ndarray], columns) -> dict[str, dict]:
     """Per predicted target: ``predicted_samples``, and where ``columns`` has the target measured,
     :func:`residual_stats` of measured - predicted over the samples where both exist (um)."""

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from gatetherm.studies.errormodel.model import ErrorModel, _term_values, predict
+
 LEVEL = 0.9
 """Nominal coverage of the interval."""
 MARGIN = 0.25
@@ -73,3 +75,46 @@ def drift_warning(target: str, share_outside: float, share_missed: float | None)
     if not why:
         return None
     return f"{target}: the machine no longer behaves like the fitting data ({'; '.join(why)}): refit"
+
+
+def trust(model: ErrorModel, columns, predicted: dict[str, np.ndarray] | None = None) -> dict[str, dict]:
+    """The 90 % interval and the drift check of every target on ``columns``.
+
+    Parameters
+    ----------
+    model : ErrorModel
+        The fitted model (:mod:`gatetherm.studies.errormodel.model`).
+    columns : mapping or TimeSeries
+        As for :func:`predict`; where it holds a target, the measured samples are checked against
+        the interval too.
+    predicted : dict, optional
+        :func:`predict`'s result on ``columns`` (computed if None).
+
+    Returns
+    -------
+    dict
+        Per target: ``lower``, ``upper`` (um per sample; NaN without a calibrated interval),
+        ``outside`` (per sample: a term beyond its fitted range), ``share_outside``,
+        ``share_missed`` (measured samples outside the interval; None if not measured) and
+        ``warning`` (one line, or None; :func:`~gatetherm.studies.errormodel.trust.drift_warning`).
+    """
+    predicted = predict(model, columns) if predicted is None else predicted
+    values, _, _ = _term_values(model, columns)
+    out = {}
+    for m in model.targets:
+        p = predicted[m.target]
+        half = m.interval.get("half_width_um", np.nan)
+        off = outside(values[m.target], m.ranges, [t.kind for t in m.terms]) if m.ranges \
+            else np.zeros(p.size, bool)
+        missed = None
+        if m.target in columns and np.isfinite(half):
+            y = np.asarray(columns[m.target], float)
+            if model.run_reference:
+                valid = np.flatnonzero(np.isfinite(y))
+                y = y - (y[valid[0]] if valid.size else np.nan)
+            ok = np.isfinite(y) & np.isfinite(p)
+            missed = float(np.mean(np.abs(y[ok] - p[ok]) > half)) if ok.any() else None
+        share = float(off.mean()) if off.size else 0.0
+        out[m.target] = {"lower": p - half, "upper": p + half, "outside": off, "share_outside": share,
+                         "share_missed": missed, "warning": drift_warning(m.target, share, missed)}
+    return out
