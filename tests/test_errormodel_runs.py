@@ -136,3 +136,21 @@ def test_cli_fit_several_runs_predict_and_refit(tmp_path, capsys):
                  "--window-h", "-1", "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "--window-h" in err
+
+
+def test_expected_error_on_noisy_readings_is_the_folded_normal_mean():
+    assert select.noisy_mae(np.array([0.0]), 0.3)[0] == pytest.approx(0.3 * np.sqrt(2 / np.pi), rel=1e-12)
+    assert select.noisy_mae(np.array([-5.0, 5.0]), 0.1) == pytest.approx([5.0, 5.0], rel=1e-12)  # |r| >> sd
+    rng = np.random.default_rng(0)
+    r = np.array([0.2, -0.5])
+    sampled = np.abs(r[:, None] + rng.normal(0.0, 0.4, (2, 200000))).mean(axis=1)
+    assert select.noisy_mae(r, 0.4) == pytest.approx(sampled, abs=0.003)
+
+
+def test_a_drift_across_runs_earns_its_place():
+    """0.3 um/h of drift in every run (e.g. a slowly creeping axis): the drift term is kept, at 0.3 um/h."""
+    drifting = [r.with_columns(d_um=r["d_um"] + 0.3 * r["time_s"] / 3600.0) for r in RUNS]
+    m = fit_error_model(drifting, ["d_um"], SENSORS, (), FitParams(drift=True)).target("d_um")
+    coef = {t.label: b for t, b in zip(m.terms, m.coefficients)}
+    assert coef["drift (h)"] == pytest.approx(0.3, abs=0.01)
+    assert coef["s1_degC"] == pytest.approx(2.0, abs=0.02)
