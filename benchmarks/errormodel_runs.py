@@ -156,7 +156,8 @@ def main() -> None:
               f"90 % +-{m.interval['half_width_um']:.3f} um, held-out inside {m.interval['coverage']:.0%}), "
               f"fixed 6 {res['fixed'][-1]:.3f} um; with noise {res['dirty'][-1]:.3f} um; fitted and applied with "
               f"noise: gatetherm {res['ours_m'][-1]:.3f} um "
-              f"({', '.join(s[:-5] for s in noisy_model.target('delta_um').sensors)}), fixed 6 {res['fixed_m'][-1]:.3f} um")
+              f"({', '.join(s[:-5] for s in noisy_model.target('delta_um').sensors)}), "
+              f"fixed 6 {res['fixed_m'][-1]:.3f} um")
         rows.append([name, round(res["ours"][-1], 3), ", ".join(s[:-5] for s in m.sensors), round(res["fixed"][-1], 3),
                      round(res["dirty"][-1], 3), round(res["dirty"][-1] / res["ours"][-1], 2),
                      round(res["ours_m"][-1], 3), round(res["fixed_m"][-1], 3)])

@@ -154,3 +154,13 @@ def test_a_drift_across_runs_earns_its_place():
     coef = {t.label: b for t, b in zip(m.terms, m.coefficients)}
     assert coef["drift (h)"] == pytest.approx(0.3, abs=0.01)
     assert coef["s1_degC"] == pytest.approx(2.0, abs=0.02)
+
+
+def test_cli_a_run_without_a_column_is_one_line_naming_its_file(tmp_path, capsys):
+    good, bad = tmp_path / "good.csv", tmp_path / "bad.csv"
+    write_timeseries(good, RUNS[0])
+    write_timeseries(bad, TimeSeries({n: RUNS[1][n] for n in ("time_s", "s1_degC", "d_um")}, {"format": FORMAT}))
+    assert main(["errormodel", "fit", "--data", str(good), str(bad), "--targets", "d_um",
+                 "--candidates", "s1_degC,s3_degC", "--out", str(tmp_path / "fit")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.csv" in err[0] and "s3_degC" in err[0]

@@ -54,7 +54,8 @@ def register(subparsers) -> None:
     f = sub.add_parser("fit", help="fit models and write DIR/model.json")
     f.add_argument("--data", required=True, nargs="+", metavar="FILE.csv",
                    help="time-series file(s) (docs/data-format.md); several files are several runs, each its own "
-                   "reference (the model's value at a run's start is its zero), held out one run at a time with 3 or more")
+                   "reference (the model's value at a run's start is its zero), held out one run at a time with 3 "
+                   "or more")
     f.add_argument("--targets", required=True, metavar="COL,...", help="displacement columns to model (um)")
     f.add_argument("--out", required=True, metavar="DIR", help="output directory")
     f.add_argument("--candidates", metavar="COL,...", help="temperature columns to choose from (default: every *_degC)")
@@ -67,9 +68,10 @@ def register(subparsers) -> None:
     f.add_argument("--fit-span", default="0:1", metavar="START:END",
                    help="fitting span as fractions of each run's duration (default 0:1, all)")
     f.add_argument("--cv", choices=CV_KINDS, default=ROBUST.cv,
-                   help="held-out error within a run: blocked (every block predicted by the fit on the others; default) "
-                   "or chain (the latest blocks, each by the fit on the rows before it)")
-    f.add_argument("--no-drift", action="store_true", help="do not offer the slow drift term (hours since the run's start)")
+                   help="held-out error within a run: blocked (every block predicted by the fit on the others; "
+                   "default) or chain (the latest blocks, each by the fit on the rows before it)")
+    f.add_argument("--no-drift", action="store_true",
+                   help="do not offer the slow drift term (hours since the run's start; offered with several runs)")
     f.add_argument("--resolution-K", type=float, default=FitParams.resolution_K, metavar="K",
                    help="the temperature sensors' resolution, also their noise's standard deviation (default 0.05 K, "
                    "a thermocouple): a term spanning less than 10 of these gets no weight, and the coefficients are "
@@ -84,8 +86,10 @@ def register(subparsers) -> None:
     r = sub.add_parser("refit", help="refit a model's coefficients on the last window of new data")
     r.add_argument("model", metavar="MODEL.json", help="from 'gatetherm errormodel fit'")
     r.add_argument("--data", required=True, metavar="FILE.csv", help="the run so far: the model's columns, the targets")
-    r.add_argument("--window-h", type=float, default=24.0, metavar="H", help="refit window at the data's end, h (default 24)")
-    r.add_argument("--applied", metavar="COL,...", help="per target (in the model's order) the column of the correction "
+    r.add_argument("--window-h", type=float, default=24.0, metavar="H",
+                   help="refit window at the data's end, h (default 24)")
+    r.add_argument("--applied", metavar="COL,...",
+                   help="per target (in the model's order) the column of the correction "
                    "the control applied, um: the refit fits measured + applied, not what its own correction left")
     r.add_argument("--out", required=True, metavar="DIR", help="output directory")
     r.set_defaults(func=run_refit)

@@ -130,7 +130,8 @@ class CrossValidation:
         Zs = self._Zf[:, cols]
         if self.noisy:
             W = np.eye(self.Z.shape[1])[:, cols]
-            return sum(self._mae(Zs[lo:hi] @ c - self.y[lo:hi], c, W) for (lo, hi), c in zip(self.blocks, C)) / self.n_test
+            total = sum(self._mae(Zs[lo:hi] @ c - self.y[lo:hi], c, W) for (lo, hi), c in zip(self.blocks, C))
+            return total / self.n_test
         total = sum(np.abs(Zs[lo:hi] @ c - self.y[lo:hi]).sum() for (lo, hi), c in zip(self.blocks, C))
         return float(total) / self.n_test
 
