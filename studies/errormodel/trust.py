@@ -6,7 +6,10 @@ held-out data, and a drift detector.
   out, or blocked folds). Its coverage is checked out of sample: each held-out block's residuals
   against the quantile of the blocks that do not overlap it (in forward chaining: that end before
   it starts), the fraction inside over all checked samples.
-* :func:`term_ranges` / :func:`drift`: each term's range on the fitting rows; a sample is *outside*
+* :func:`trust` widens the interval where the model extrapolates: by the part of the prediction
+  that rests on terms beyond their fitted ranges (:func:`beyond`), which the held-out calibration
+  cannot vouch for.
+* :func:`term_ranges` / :func:`drift_warning`: each term's range on the fitting rows; a sample is *outside*
   where a term (not the drift term, which always grows) leaves its range by more than
   :data:`MARGIN` of the range's width. A file whose share of outside samples exceeds
   :data:`MAX_OUTSIDE`, or whose measured target leaves the 90 % interval on more than
@@ -65,6 +68,15 @@ def outside(values: list[np.ndarray], ranges, kinds) -> np.ndarray:
     return out
 
 
+def beyond(values: list[np.ndarray], ranges, coefficients) -> np.ndarray:
+    """Per sample, the part of the prediction (um) that rests on terms beyond their fitted ranges:
+    ``sum_k |c_k| * (distance of term k's value outside [lo_k, hi_k])``; 0 inside the ranges."""
+    out = np.zeros(values[0].size if values else 0)
+    for v, (lo, hi), c in zip(values, ranges, coefficients):
+        out += abs(c) * np.maximum(0.0, np.maximum(v - hi, lo - v))
+    return out
+
+
 def drift_warning(target: str, share_outside: float, share_missed: float | None) -> str | None:
     """One line if the data no longer behave like the fitting data (module docstring), else None."""
     why = []
@@ -93,7 +105,8 @@ def trust(model: ErrorModel, columns, predicted: dict[str, np.ndarray] | None = 
     Returns
     -------
     dict
-        Per target: ``lower``, ``upper`` (um per sample; NaN without a calibrated interval),
+        Per target: ``lower``, ``upper`` (um per sample, the 90 % interval widened by :func:`beyond`
+        where the model extrapolates; NaN without a calibrated interval),
         ``outside`` (per sample: a term beyond its fitted range), ``share_outside``,
         ``share_missed`` (measured samples outside the interval; None if not measured) and
         ``warning`` (one line, or None; :func:`~gatetherm.studies.errormodel.trust.drift_warning`).
@@ -103,17 +116,17 @@ def trust(model: ErrorModel, columns, predicted: dict[str, np.ndarray] | None = 
     out = {}
     for m in model.targets:
         p = predicted[m.target]
-        half = m.interval.get("half_width_um", np.nan)
+        half = m.interval.get("half_width_um", np.nan) + beyond(values[m.target], m.ranges, m.coefficients)
         off = outside(values[m.target], m.ranges, [t.kind for t in m.terms]) if m.ranges \
             else np.zeros(p.size, bool)
         missed = None
-        if m.target in columns and np.isfinite(half):
+        if m.target in columns and np.all(np.isfinite(half)):
             y = np.asarray(columns[m.target], float)
             if model.run_reference:
                 valid = np.flatnonzero(np.isfinite(y))
                 y = y - (y[valid[0]] if valid.size else np.nan)
             ok = np.isfinite(y) & np.isfinite(p)
-            missed = float(np.mean(np.abs(y[ok] - p[ok]) > half)) if ok.any() else None
+            missed = float(np.mean(np.abs(y[ok] - p[ok]) > half[ok])) if ok.any() else None
         share = float(off.mean()) if off.size else 0.0
         out[m.target] = {"lower": p - half, "upper": p + half, "outside": off, "share_outside": share,
                          "share_missed": missed, "warning": drift_warning(m.target, share, missed)}
