@@ -211,7 +211,7 @@ def test_cli_fit_predict_compensate(tmp_path, capsys):
     assert summary["targets"]["d_um"]["mae_um"] == pytest.approx(0.04, abs=0.01)
     assert (tmp_path / "pred" / "prediction.png").stat().st_size > 0
     head = [ln for ln in (tmp_path / "pred" / "prediction.csv").read_text().splitlines() if not ln.startswith("#")][0]
-    assert head == "time_s,d_um_pred,d_um"
+    assert head == "time_s,d_um_pred,d_um_lo,d_um_hi,d_um"
     assert cli("compensate", "--model", model, "--data", data, "--no-actuator",
                "--out", tmp_path / "comp") == 0
     assert json.loads((tmp_path / "comp" / "summary.json").read_text())["method"] == "errormodel"

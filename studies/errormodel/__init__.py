@@ -2,6 +2,7 @@
 
 :mod:`.terms` the regressors (temperature rises, differences, lagged inputs), :mod:`.select` the
 held-out error and the sensor selection, :mod:`.fit` :func:`~.fit.fit_error_model`, :mod:`.paper` the paper's form,
-:mod:`.model` the fitted model, its ``model.json`` and :func:`~.model.predict`, :mod:`.replay`
-the model in the compensation loop.
+:mod:`.model` the fitted model, its ``model.json`` and :func:`~.model.predict`, :mod:`.runs` the
+fitting data of one run or several, :mod:`.trust` the 90 % interval and the drift check,
+:mod:`.refit` the refit on a window, :mod:`.replay` the model in the compensation loop.
 """

@@ -42,11 +42,14 @@ from gatetherm import InputError
 from gatetherm.studies.errormodel import select
 from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, check_leakage, residual_stats
 from gatetherm.studies.errormodel.paper import fit_paper_form
-from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps, noise_sd
+from gatetherm.studies.errormodel.runs import Runs
+from gatetherm.studies.errormodel.terms import Term, noise_sd
+from gatetherm.studies.errormodel.trust import calibrate, term_ranges
 
 log = logging.getLogger(__name__)
 
 FIT_FORMS = ("auto", "static", "dynamic", "paper")
+CV_KINDS = ("blocked", "chain")
 SQRT2 = float(np.sqrt(2.0))
 #: A temperature term spanning fewer resolutions than this in the fitting span is not offered.
 SPAN_RESOLUTIONS = 10
@@ -84,6 +87,17 @@ class FitParams:
     max_gap_s: float = 300.0
     """Longest gap in a used column that is bridged by linear interpolation, s; rows in longer gaps
     are left out of the fit and not predicted."""
+    cv: str = "blocked"
+    """Held-out error within a run: ``blocked`` (every block predicted by the fit on the others) or
+    ``chain`` (forward chaining: the latest blocks, each predicted by the fit on the rows before it).
+    Three or more runs are always held out one run at a time."""
+    noisy_cv: bool = False
+    """Score every candidate by its expected held-out error on readings carrying the sensors' noise
+    (``resolution_K``): a term whose noise costs more than it explains is not chosen."""
+    drift: bool = False
+    """With several runs, also offer a slow drift, the hours since each run's start (kept only where
+    it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with
+    the heating it should explain, and is not offered."""
 
     def __post_init__(self):
         if self.form not in FIT_FORMS:
@@ -98,6 +112,8 @@ class FitParams:
             raise InputError("exponents, time constants, max_gap_s", f"{bad[0]} is not > 0", "use positive values")
         if not (np.isfinite(self.resolution_K) and self.resolution_K >= 0):
             raise InputError("resolution_K", f"{self.resolution_K} is not >= 0", "e.g. 0.05 (K, a thermocouple)")
+        if self.cv not in CV_KINDS:
+            raise InputError("cv", f"{self.cv!r} is not one of {', '.join(CV_KINDS)}", "e.g. cv chain")
         if not 0 <= self.min_gain < 1:
             raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
 
@@ -116,11 +132,13 @@ def default_candidates(names, targets) -> tuple[str, ...]:
 
 def fit_error_model(series, targets, candidates=None, inputs=(), params: FitParams = FitParams(),
                     span: tuple[float, float] | None = None, source: str = "") -> ErrorModel:
-    """Fit a thermal-error model of each target column.
+    """Fit a thermal-error model of each target column, on one run or several.
 
     Parameters
     ----------
-    series : mapping or TimeSeries
+    series : mapping or TimeSeries, or a list of them
+        One run, or several runs of the same machine (each homed anew: its own reference, the
+        model's value at its start its zero; :mod:`gatetherm.studies.errormodel.runs`). Each has
         ``time_s`` (s, increasing), the targets (um; NaN = not measured), the candidate temperature
         columns (degC) and the inputs (e.g. ``spindle_rpm``, 1/min).
     targets : sequence of str
@@ -131,58 +149,62 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
         Operating inputs for the dynamic terms; none = static and paper forms only.
     params : FitParams
         Budgets, grids, cross-validation and form.
-    span : (float, float), optional
-        Fitting span ``(start_s, end_s)`` of ``time_s``, s, both included; default the whole series.
+    span : (float, float) or list of them, optional
+        Fitting span ``(start_s, end_s)`` of ``time_s``, s, both included, per run or one for all;
+        default each run whole.
     source : str
-        Where the data came from (recorded in the model).
+        Where the data came from (recorded in the model; several files separated by ``", "``).
 
     Returns
     -------
     ErrorModel
-        Models of the targets, the reference temperatures (first valid sample in the span, degC)
-        and the span; see :mod:`gatetherm.studies.errormodel.model`.
+        Models of the targets (with their held-out 90 % intervals), the reference temperatures
+        (first valid sample in the span, degC; none for several runs) and the span; see
+        :mod:`gatetherm.studies.errormodel.model`.
     """
-    names = tuple(series.names if hasattr(series, "names") else series)
+    runs = list(series) if isinstance(series, (list, tuple)) else [series]
+    if not runs:
+        raise InputError("data", "no run given", "give at least one data file")
+    sources = [s.strip() for s in str(source).split(", ")] if source else []
+    names = tuple(runs[0].names if hasattr(runs[0], "names") else runs[0])
     targets = tuple(targets)
     candidates = tuple(candidates) if candidates is not None else default_candidates(names, targets)
     check_leakage(targets, candidates, tuple(inputs))
-    for name in ("time_s", *targets, *candidates, *inputs):
-        if name not in names:
-            raise InputError(f"{source or 'data'}: column {name}", "missing", f"columns are {', '.join(names)}")
+    for k, ts in enumerate(runs):
+        have = tuple(ts.names if hasattr(ts, "names") else ts)
+        for name in ("time_s", *targets, *candidates, *inputs):
+            if name not in have:
+                where = sources[k] if k < len(sources) else (source or "data")
+                raise InputError(f"{where}: column {name}", "missing", f"columns are {', '.join(have)}")
     if not targets or not candidates:
         raise InputError("targets/candidates", "none given", "name at least one target and one temperature column")
-    t = np.asarray(series["time_s"], float)
-    lo, hi = span if span is not None else (t[0], t[-1])
-    in_span = (t >= lo) & (t <= hi)
-    cols, long = {}, np.zeros(t.size, bool)
-    for name in (*candidates, *inputs):
-        v = np.asarray(series[name], float)
-        if not np.isfinite(v[in_span]).any():
-            raise InputError(f"column {name}", "no valid sample in the fitting span", "give measured values")
-        cols[name], gap, report = fill_gaps(t, v, params.max_gap_s)
-        long |= gap
-        if report.filled:
-            log.info("%s: %d missing samples filled (longest gap %.0f s)", name, report.filled, report.longest_s)
-    reference = {c: float(cols[c][np.flatnonzero(in_span & np.isfinite(series[c]))[0]]) for c in candidates}
-    base = _base_terms(candidates, inputs, cols, in_span, params)
-    B = np.column_stack([np.ones(t.size)] + [evaluate(b, t, cols, reference) for b in base])
-    models = [_fit_target(series[y], y, t, base, B, in_span & ~long, cols, reference, params)
-              for y in targets]
+    spans = span if isinstance(span, list) else [span] * len(runs)
+    spans = [s if s is not None else (float(np.asarray(ts["time_s"])[0]), float(np.asarray(ts["time_s"])[-1]))
+             for s, ts in zip(spans, runs)]
+    data = Runs(runs, candidates, inputs, spans, params.max_gap_s, sources)
+    base = _base_terms(candidates, inputs, data, params)
+    B = np.column_stack([np.ones(data.time.size)] + [data.column(b) for b in base])
+    models = [_fit_target(data.target(y), y, data, base, B, params) for y in targets]
     used = {s for m in models for s in m.sensors}
-    return ErrorModel(tuple(models), {c: reference[c] for c in candidates if c in used},
-                      {"start_s": float(lo), "end_s": float(hi), "samples": int(in_span.sum()), "source": str(source)},
-                      params.max_gap_s, _settings(params, candidates, inputs))
+    reference = data.reference()
+    lo, hi = spans[0] if len(runs) == 1 else (spans[0][0], spans[-1][1])
+    return ErrorModel(tuple(models), {c: reference[c] for c in candidates if c in used and c in reference},
+                      {"start_s": float(lo), "end_s": float(hi), "samples": int(data.ok.sum()), "source": str(source),
+                       "runs": len(runs)},
+                      params.max_gap_s, _settings(params, candidates, inputs), run_reference=data.anchored)
 
 
 def _settings(params: FitParams, candidates, inputs) -> dict:
     return {**dataclasses.asdict(params), "candidates": list(candidates), "inputs": list(inputs)}
 
 
-def _base_terms(candidates, inputs, cols, in_span, params: FitParams) -> list[Term]:
+def _base_terms(candidates, inputs, data: Runs, params: FitParams) -> list[Term]:
     base = [Term("sensor", c, tau_s=tau) for c in candidates for tau in (None, *params.sensor_taus_s)]
+    if params.drift and data.anchored and params.form != "paper":  # within one run a trend is the heating itself
+        base.append(Term("drift", "time_s"))
     if params.form in ("auto", "dynamic"):
         for u in inputs:
-            scale = float(np.max(np.abs(cols[u][in_span])))
+            scale = float(max(np.max(np.abs(c[u][r])) for c, r in zip(data.cols, data.rows)))
             if scale == 0:
                 log.warning("input %s is 0 throughout the fitting span: not used", u)
                 continue
@@ -193,9 +215,9 @@ def _base_terms(candidates, inputs, cols, in_span, params: FitParams) -> list[Te
     return base
 
 
-def _variances(terms, t: np.ndarray, params: FitParams) -> np.ndarray:
+def _variances(terms, data: Runs, params: FitParams) -> np.ndarray:
     """Noise variance of the intercept (0) and of each term's values (K^2; 0 for inputs)."""
-    step = float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    step = data.step_s
     return np.array([0.0] + [noise_sd(term, params.resolution_K, step) ** 2 for term in terms])
 
 
@@ -205,12 +227,12 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
     terms, cands, p = [], [], len(base) + 1
     min_span = SPAN_RESOLUTIONS * params.resolution_K
     for j, b in enumerate(base):
-        if (dynamic or b.tau_s is None) and (b.kind == "input" or select.informative(B[:, j + 1], min_span)):
+        free = b.kind in ("input", "drift")
+        if (dynamic or b.tau_s is None) and (free or select.informative(B[:, j + 1], min_span)):
             w = np.zeros(p)
             w[j + 1] = 1.0
             terms.append(b)
-            cands.append(select.Candidate(len(cands), w, frozenset(() if b.kind == "input" else (b.column,)),
-                                          b.kind == "input"))
+            cands.append(select.Candidate(len(cands), w, frozenset(() if free else (b.column,)), b.kind == "input"))
     if params.differences:
         plain = [j for j, b in enumerate(base) if b.kind == "sensor" and b.tau_s is None]
         for i, k in [(i, k) for n, i in enumerate(plain) for k in plain[n + 1:]]:
@@ -223,13 +245,20 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
     return terms, cands
 
 
-def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams) -> TargetModel:
+def _cv(X, y, data: Runs, rows, params: FitParams, penalty) -> select.CrossValidation:
+    """Leave one run out with three or more runs, else ``params.cv`` within the rows."""
+    blocks = data.blocks(rows)
+    return select.CrossValidation(X, y, params.folds, blocks=blocks, penalty=penalty,
+                                  chain=blocks is None and params.cv == "chain", noisy=params.noisy_cv)
+
+
+def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetModel:
     y_all = np.asarray(y_all, float)
-    rows = ok & np.isfinite(y_all)
+    rows = data.ok & np.isfinite(y_all)
     if rows.sum() < 4 * max(params.folds):
         raise InputError(f"target {name}", f"only {rows.sum()} valid samples in the fitting span",
                          f"give at least {4 * max(params.folds)}")
-    cv = select.CrossValidation(B[rows], y_all[rows], params.folds, penalty=_variances(base, t, params))
+    cv = _cv(B[rows], y_all[rows], data, rows, params, _variances(base, data, params))
     if params.form == "paper":
         return fit_paper_form(cv, name, base, B, y_all, rows, SPAN_RESOLUTIONS * params.resolution_K)
     forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
@@ -242,7 +271,7 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams)
         terms, cands = _candidates(base, B[rows], params, form == "dynamic")
         path = select.forward(cv, cands, intercept, params.max_sensors, params.max_inputs)
         pick = select.choose(path, params.min_gain)
-        fits[form] = _refine([terms[k] for k in pick.chosen], pick.cv_mae, t, cols, reference, y_all, rows, params) \
+        fits[form] = _refine([terms[k] for k in pick.chosen], pick.cv_mae, data, y_all, rows, params) \
             if params.refine else ([terms[k] for k in pick.chosen], pick.cv_mae)
         selection += [{"form": form, "terms": [terms[k].label for k in s.chosen], "sensors": s.sensors,
                        "cv_mae_um": s.cv_mae} for s in path]
@@ -250,26 +279,29 @@ def _fit_target(y_all, name, t, base, B, ok, cols, reference, params: FitParams)
                                                fits["dynamic"][1] < fits["static"][1] * (1 - params.min_gain)) \
         else "static"
     terms, cv_mae = fits[form]
-    X = np.column_stack([np.ones(t.size)] + [evaluate(term, t, cols, reference) for term in terms])
-    var = _variances(terms, t, params)
+    X = np.column_stack([np.ones(data.time.size)] + [data.column(term) for term in terms])
+    var = _variances(terms, data, params)
     c = select.noisy_least_squares(X[rows], y_all[rows], var)
+    final = _cv(X[rows], y_all[rows], data, rows, params, var)
+    interval = calibrate(final.residuals(np.eye(X.shape[1])), final.blocks,
+                         chain=params.cv == "chain" and data.blocks(rows) is None)
     return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
                        residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection),
-                       float(np.sqrt(var @ c**2)))
+                       float(np.sqrt(var @ c**2)), interval, term_ranges(X[rows, 1:]))
 
 
-def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
+def _tuned(terms, data: Runs, y_all, rows, params: FitParams):
     """The terms with their lag time constants refined by least squares on the span (each within the
     grid's range widened by sqrt(2)) and their held-out error; inf if two lags of one signal end up
     within a factor sqrt(2) of each other (one of them is redundant)."""
     lagged = [j for j, term in enumerate(terms) if term.tau_s is not None]
-    fixed = [evaluate(term, t, cols, reference)[rows] for term in terms]
+    fixed = [data.column(term)[rows] for term in terms]
     y = y_all[rows]
 
     def design(log_tau):
         cs = list(fixed)
         for j, lt in zip(lagged, log_tau):
-            cs[j] = evaluate(dataclasses.replace(terms[j], tau_s=float(np.exp(lt))), t, cols, reference)[rows]
+            cs[j] = data.column(dataclasses.replace(terms[j], tau_s=float(np.exp(lt))))[rows]
         return np.column_stack([np.ones(y.size)] + cs)
 
     def sse(log_tau):
@@ -277,7 +309,7 @@ def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
         now = list(terms)
         for j, lt in zip(lagged, log_tau):
             now[j] = dataclasses.replace(terms[j], tau_s=float(np.exp(lt)))
-        v = _variances(now, t, params)
+        v = _variances(now, data, params)
         c = select.noisy_least_squares(X, y, v)
         r = X @ c - y
         return float(r @ r + y.size * (v @ c**2))
@@ -293,25 +325,25 @@ def _tuned(terms, t, cols, reference, y_all, rows, params: FitParams):
                and max(a.tau_s, b.tau_s) < SQRT2 * min(a.tau_s, b.tau_s)
                for i, a in enumerate(out) for b in out[i + 1:] if a.tau_s and b.tau_s):
             return out, np.inf
-    X = np.column_stack([np.ones(y.size)] + [evaluate(term, t, cols, reference)[rows] for term in out])
-    cv = select.CrossValidation(X, y, params.folds, penalty=_variances(out, t, params))
+    X = np.column_stack([np.ones(y.size)] + [data.column(term)[rows] for term in out])
+    cv = _cv(X, y, data, rows, params, _variances(out, data, params))
     return out, cv.error(np.eye(X.shape[1]))
 
 
-def _refine(terms, cv_mae, t, cols, reference, y_all, rows, params: FitParams):
+def _refine(terms, cv_mae, data: Runs, y_all, rows, params: FitParams):
     """Refine the selected terms' time constants (:func:`_tuned`), then drop, one at a time, any
     term whose removal (time constants refined again) raises the held-out error by less than
     ``min_gain``: two grid lags that bracket one true time constant become one. Returns the terms
     and their held-out error; the grid's (``terms``, ``cv_mae``) if refining does not lower it."""
     best, best_cv = terms, cv_mae
-    tuned, tuned_cv = _tuned(terms, t, cols, reference, y_all, rows, params)
+    tuned, tuned_cv = _tuned(terms, data, y_all, rows, params)
     if tuned_cv <= best_cv:
         best, best_cv = tuned, tuned_cv
     dropped = True
     while dropped and len(best) > 1:
         dropped = False
         for j in reversed(range(len(best))):
-            fewer, fewer_cv = _tuned(best[:j] + best[j + 1:], t, cols, reference, y_all, rows, params)
+            fewer, fewer_cv = _tuned(best[:j] + best[j + 1:], data, y_all, rows, params)
             if fewer_cv < best_cv * (1 + params.min_gain):
                 log.info("%s dropped: held-out error %.4g without it, %.4g with", best[j].label, fewer_cv, best_cv)
                 best, best_cv, dropped = fewer, min(fewer_cv, best_cv), True

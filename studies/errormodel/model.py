@@ -56,11 +56,17 @@ class TargetModel:
     noise_um: float | None = None
     """Standard deviation the temperature sensors' noise adds to the prediction, um:
     ``sqrt(sum_k (c_k sigma_k)^2)`` at the fit's sensor resolution (None: not recorded)."""
+    interval: dict = field(default_factory=dict)
+    """The 90 % interval from held-out residuals (:func:`~gatetherm.studies.errormodel.trust.calibrate`):
+    ``half_width_um`` (um), ``coverage`` (fraction of held-out samples inside, out of sample),
+    ``samples``, ``level``; empty: not calibrated."""
+    ranges: tuple = ()
+    """Per term its (smallest, largest) value on the fitting rows (the drift detector's reference)."""
 
     @property
     def sensors(self) -> tuple[str, ...]:
         """The temperature columns the model reads, in term order."""
-        cols = [c for t in self.terms if t.kind != "input" for c in t.columns]
+        cols = [c for t in self.terms if t.kind not in ("input", "drift") for c in t.columns]
         return tuple(dict.fromkeys(cols))
 
     @property
@@ -84,6 +90,9 @@ class ErrorModel:
     """Longest gap (s) in a used column that predictions bridge (linear fill); longer gaps are NaN."""
     settings: dict = field(default_factory=dict)
     """The fit settings (:class:`~gatetherm.studies.errormodel.fit.FitParams`) as a dict."""
+    run_reference: bool = False
+    """True (fitted on several runs): every predicted file is its own run, its rises taken from its
+    first sample and the prediction zero there (:mod:`~gatetherm.studies.errormodel.runs`)."""
 
     @property
     def columns(self) -> tuple[str, ...]:
@@ -135,6 +144,23 @@ def input_gaps(model: ErrorModel, columns) -> dict[str, GapReport]:
     return {k: r for k, r in _filled(model, columns)[2].items() if r.filled}
 
 
+def _references(model: ErrorModel, cols, t: np.ndarray) -> dict:
+    if not model.run_reference:
+        return {**model.reference_degC, "time_s": float(model.fit_span.get("start_s", t[0]))}
+    return {**{c: float(v[0]) for c, v in cols.items()}, "time_s": float(t[0])}
+
+
+def _term_values(model: ErrorModel, columns):
+    cols, bad, _ = _filled(model, columns)
+    t = np.asarray(columns["time_s"], float)
+    ref = _references(model, cols, t)
+    values = {}
+    for m in model.targets:
+        vs = [evaluate(term, t, cols, ref) for term in m.terms]
+        values[m.target] = [v - v[0] for v in vs] if model.run_reference else vs
+    return values, bad, t
+
+
 def predict(model: ErrorModel, columns) -> dict[str, np.ndarray]:
     """Evaluate the model at the samples of ``columns``.
 
@@ -146,19 +172,20 @@ def predict(model: ErrorModel, columns) -> dict[str, np.ndarray]:
         ``time_s`` (s, increasing) and every column the model reads (degC, the inputs' units).
         Missing samples (NaN) are filled linearly (held at the ends); in gaps longer than
         ``model.max_gap_s`` the prediction is NaN. Lags start in steady state at the first sample.
+        A model fitted on several runs takes the file as a run of its own: rises from its first
+        sample, the prediction 0 there.
 
     Returns
     -------
     dict
         Target name -> predicted displacement at each sample, um.
     """
-    cols, bad, _ = _filled(model, columns)
-    t = np.asarray(columns["time_s"], float)
+    values, bad, t = _term_values(model, columns)
     out = {}
     for m in model.targets:
-        y = np.full(t.size, m.intercept_um)
-        for term, b in zip(m.terms, m.coefficients):
-            y += b * evaluate(term, t, cols, model.reference_degC)
+        y = np.full(t.size, 0.0 if model.run_reference else m.intercept_um)
+        for v, b in zip(values[m.target], m.coefficients):
+            y += b * v
         y[bad] = np.nan
         out[m.target] = y
     return out
@@ -189,9 +216,11 @@ def to_dict(model: ErrorModel) -> dict:
     targets = {m.target: {"form": m.form, "sensors": list(m.sensors), "intercept_um": m.intercept_um,
                           "terms": [term(t, b) for t, b in zip(m.terms, m.coefficients)],
                           "residual": m.residual, "held_out_mae_um": m.held_out_mae_um,
-                          "selection": list(m.selection), "noise_um": m.noise_um} for m in model.targets}
+                          "selection": list(m.selection), "noise_um": m.noise_um, "interval": m.interval,
+                          "ranges": [list(r) for r in m.ranges]} for m in model.targets}
     return {"format": FORMAT, "fit_span": model.fit_span, "reference_degC": model.reference_degC,
-            "max_gap_s": model.max_gap_s, "settings": model.settings, "targets": targets}
+            "run_reference": model.run_reference, "max_gap_s": model.max_gap_s, "settings": model.settings,
+            "targets": targets}
 
 
 def from_dict(data: dict, where: str = "model") -> ErrorModel:
@@ -209,17 +238,18 @@ def from_dict(data: dict, where: str = "model") -> ErrorModel:
             targets.append(TargetModel(name, d["form"], terms, tuple(float(t["coefficient"]) for t in d["terms"]),
                                        float(d.get("intercept_um", 0.0)), d.get("residual", {}),
                                        d.get("held_out_mae_um"), tuple(d.get("selection", ())),
-                                       d.get("noise_um")))
+                                       d.get("noise_um"), dict(d.get("interval", {})),
+                                       tuple(tuple(float(v) for v in r) for r in d.get("ranges", ()))))
         ref = {str(k): float(v) for k, v in data["reference_degC"].items()}
         model = ErrorModel(tuple(targets), ref, dict(data.get("fit_span", {})), float(data.get("max_gap_s", 300.0)),
-                           dict(data.get("settings", {})))
+                           dict(data.get("settings", {})), bool(data.get("run_reference", False)))
     except InputError as err:
         raise err.at(where) from None
     except (KeyError, TypeError, ValueError, AttributeError) as err:
         raise InputError(where, f"malformed model ({type(err).__name__}: {err})",
                          "give a model.json from 'gatetherm errormodel fit'") from None
     missing = [s for m in model.targets for s in m.sensors if s not in ref]
-    if missing:
+    if missing and not model.run_reference:
         raise InputError(f"{where}: reference_degC", f"no reference for {missing[0]}", "add its reference temperature")
     if not model.targets:
         raise InputError(f"{where}: targets", "is empty: the model predicts nothing",

@@ -3,7 +3,10 @@
 Held-out error: blocked cross-validation. The fitting span's rows are cut into ``K`` contiguous
 blocks of equal length; each block in turn is predicted by the least-squares fit on the others,
 and the mean absolute error over all rows is averaged over several ``K`` (default 4 … 8), so that
-the estimate does not hang on where one set of block edges falls. Blocks are hours long, so the
+the estimate does not hang on where one set of block edges falls. With ``chain`` (forward
+chaining) only the latest blocks are predicted, each by the fit on the rows before it: the error
+of a model on hours later than any it was fitted on. With explicit ``blocks`` (one per run) each
+run is predicted by the fit on the others. Blocks are hours long, so the
 held-out rows are not near-copies of neighbouring fitting rows, as they would be with a shuffled
 split of a slow signal.
 
@@ -35,61 +38,102 @@ import numpy as np
 
 
 class CrossValidation:
-    """Blocked cross-validation of least squares on combinations of the base columns ``Z`` (n x p)."""
+    """Held-out error of least squares on combinations of the base columns ``Z`` (n x p): blocked
+    cross-validation (every block predicted by the fit on all others), explicit blocks (one per
+    run: leave one run out), or forward chaining (each of the latest blocks predicted by the fit
+    on the rows before it only, as a control will use the model)."""
 
-    def __init__(self, Z: np.ndarray, y: np.ndarray, folds=(4, 5, 6, 7, 8), blocks=None, penalty=None):
+    def __init__(self, Z: np.ndarray, y: np.ndarray, folds=(4, 5, 6, 7, 8), blocks=None, penalty=None,
+                 chain: bool = False, noisy: bool = False):
         """``blocks``: explicit ``(start, stop)`` row ranges that partition the rows once (e.g. one
         per separate run, leave-one-run-out) instead of the equal blocks of ``folds``. ``penalty``:
-        the noise variance of each base column (module docstring); None = noise-free."""
+        the noise variance of each base column (module docstring); None = noise-free. ``chain``:
+        forward chaining: for each ``K`` in ``folds`` the rows are cut into ``K`` equal blocks and
+        each of the last ``ceil(K / 2)`` blocks is predicted by the fit on the rows before it.
+        ``noisy``: the held-out error is the expected one on readings carrying the ``penalty``
+        noise (:func:`noisy_mae`), so that selection weighs what the noise adds to a prediction."""
         self.Z, self.y, n = Z, y, len(y)
         self.D = np.zeros(Z.shape[1]) if penalty is None else np.asarray(penalty, float)
         if blocks is not None:
             self.blocks, self.partitions = [(int(lo), int(hi)) for lo, hi in blocks], 1
             if sorted(self.blocks)[0][0] != 0 or sum(hi - lo for lo, hi in self.blocks) != n or len(self.blocks) < 2:
                 raise ValueError("blocks must partition the rows into at least two ranges")
+            fits = [None] * len(self.blocks)
         else:
             if n < 2 * max(folds):
                 raise ValueError(f"{n} samples are too few for {max(folds)} blocks")
-            self.blocks = [(lo, hi) for k in folds
-                           for lo, hi in itertools.pairwise(np.linspace(0, n, k + 1).astype(int))]
+            self.blocks, fits = [], []
+            for k in folds:
+                edges = np.linspace(0, n, k + 1).astype(int)
+                for i, (lo, hi) in enumerate(itertools.pairwise(edges)):
+                    if not chain or i >= k - (k + 1) // 2:
+                        self.blocks.append((int(lo), int(hi)))
+                        fits.append(int(lo) if chain else None)
             self.partitions = len(folds)
         self.G = Z.T @ Z
         self.r = Z.T @ y
-        self.Gb = np.array([Z[lo:hi].T @ Z[lo:hi] for lo, hi in self.blocks])
-        self.rb = np.array([Z[lo:hi].T @ y[lo:hi] for lo, hi in self.blocks])
+        Gb = [Z[lo:hi].T @ Z[lo:hi] for lo, hi in self.blocks]
+        rb = [Z[lo:hi].T @ y[lo:hi] for lo, hi in self.blocks]
+        # each fold's normal equations: all rows but its block, or (chain) the rows before it
+        self.Gf = np.array([self.G - g if f is None else Z[:f].T @ Z[:f] for g, f in zip(Gb, fits)])
+        self.rf = np.array([self.r - b if f is None else Z[:f].T @ y[:f] for b, f in zip(rb, fits)])
         self._Zf = np.asfortranarray(Z)  # columns gathered fast by error_of
-        self.n_fit = np.array([n - (hi - lo) for lo, hi in self.blocks], float)  # rows each fold fits on
+        self.n_fit = np.array([n - (hi - lo) if f is None else f for (lo, hi), f in zip(self.blocks, fits)], float)
+        self.n_test = sum(hi - lo for lo, hi in self.blocks)
+        self.noisy = bool(noisy) and bool(np.any(self.D))
+
+    def _mae(self, r: np.ndarray, c: np.ndarray, W: np.ndarray) -> float:
+        """Sum of the absolute held-out residuals ``r``; expected on noisy readings with ``noisy``."""
+        if not self.noisy:
+            return float(np.abs(r).sum())
+        return float(noisy_mae(r, float(np.sqrt((W @ c) ** 2 @ self.D))).sum())
+
+    def coefficients(self, W: np.ndarray) -> np.ndarray | None:
+        """Per fold the coefficients of the regressors ``Z @ W`` (folds x m); None if singular."""
+        W = np.asarray(W)
+        P = W.T @ (self.D[:, None] * W)
+        A = np.einsum("pi,fpq,qj->fij", W, self.Gf, W) + self.n_fit[:, None, None] * P[None]
+        try:
+            return np.linalg.solve(A, (self.rf @ W)[..., None])[..., 0]
+        except np.linalg.LinAlgError:
+            return None
+
+    def residuals(self, W: np.ndarray) -> list[np.ndarray]:
+        """Per fold the held-out residuals (predicted - measured, unit of y) of the model ``Z @ W``,
+        in the order of :attr:`blocks`; empty if singular."""
+        C = self.coefficients(W)
+        if C is None:
+            return []
+        return [self.Z[lo:hi] @ (W @ c) - self.y[lo:hi] for (lo, hi), c in zip(self.blocks, C)]
 
     def error(self, W: np.ndarray) -> float:
         """Held-out mean absolute error (unit of y) of the model with regressors ``Z @ W``; inf if singular."""
         W = np.asarray(W)
         if W.ndim == 2 and W.size and np.all((W == 0) | (W == 1)) and np.all(W.sum(axis=0) == 1):
             return self.error_of(np.argmax(W, axis=0))  # the columns are base columns
-        A, b, P = W.T @ self.G @ W, W.T @ self.r, W.T @ (self.D[:, None] * W)
-        total = 0.0
-        try:
-            for (lo, hi), Gb, rb, m in zip(self.blocks, self.Gb, self.rb, self.n_fit):
-                c = np.linalg.solve(A - W.T @ Gb @ W + m * P, b - W.T @ rb)
-                total += np.abs(self.Z[lo:hi] @ (W @ c) - self.y[lo:hi]).sum()
-        except np.linalg.LinAlgError:
+        C = self.coefficients(W)
+        if C is None:
             return np.inf
-        return total / (len(self.y) * self.partitions)
+        r = [self.Z[lo:hi] @ (W @ c) - self.y[lo:hi] for (lo, hi), c in zip(self.blocks, C)]
+        return sum(self._mae(x, c, W) for x, c in zip(r, C)) / self.n_test
 
     def error_of(self, columns) -> float:
         """:meth:`error` of the model whose regressors are the base columns ``columns`` (indices):
-        the fast path for selections among many base columns, every block's normal equations
+        the fast path for selections among many base columns, every fold's normal equations
         indexed out of the Gram matrices and solved at once."""
         cols = list(columns)
-        A, b = self.G[np.ix_(cols, cols)], self.r[cols]
         P = self.n_fit[:, None, None] * np.diag(self.D[cols])[None]
         try:
-            C = np.linalg.solve(A[None] - self.Gb[:, cols][:, :, cols] + P,
-                                (b[None] - self.rb[:, cols])[..., None])[..., 0]
+            C = np.linalg.solve(self.Gf[:, cols][:, :, cols] + P, self.rf[:, cols][..., None])[..., 0]
         except np.linalg.LinAlgError:
             return np.inf
         Zs = self._Zf[:, cols]
+        if self.noisy:
+            W = np.eye(self.Z.shape[1])[:, cols]
+            total = sum(self._mae(Zs[lo:hi] @ c - self.y[lo:hi], c, W) for (lo, hi), c in zip(self.blocks, C))
+            return total / self.n_test
         total = sum(np.abs(Zs[lo:hi] @ c - self.y[lo:hi]).sum() for (lo, hi), c in zip(self.blocks, C))
-        return float(total) / (len(self.y) * self.partitions)
+        return float(total) / self.n_test
 
 
 @dataclass(frozen=True, eq=False)
@@ -156,6 +200,16 @@ def noisy_least_squares(X: np.ndarray, y: np.ndarray, variance=None) -> np.ndarr
         return np.linalg.lstsq(X, y, rcond=None)[0]
     rows = np.diag(np.sqrt(len(y) * np.asarray(variance, float)))
     return np.linalg.lstsq(np.vstack([X, rows]), np.r_[y, np.zeros(X.shape[1])], rcond=None)[0]
+
+
+def noisy_mae(r: np.ndarray, sd: float) -> np.ndarray:
+    """Expected ``|r + e|`` for ``e`` normal with standard deviation ``sd`` (the folded normal's mean):
+    ``sd sqrt(2/pi) exp(-r^2 / 2 sd^2) + r erf(r / (sd sqrt 2))``; ``|r|`` for ``sd = 0``."""
+    from scipy.special import erf
+
+    if sd <= 0:
+        return np.abs(r)
+    return sd * np.sqrt(2 / np.pi) * np.exp(-r**2 / (2 * sd**2)) + r * erf(r / (sd * np.sqrt(2)))
 
 
 def informative(values: np.ndarray, min_span: float) -> bool:

@@ -6,7 +6,9 @@ A :class:`Term` is evaluated on a series' own sample times:
 * ``sensor``: the rise ``theta_k = T_k - T_ref,k`` of a temperature column, K;
 * ``difference``: ``theta_k - theta_m`` of two temperature columns, K;
 * ``input``: ``(|u| / scale) ** exponent`` of an operating input such as ``spindle_rpm``
-  (dimensionless; spindle losses grow with the speed roughly as rpm^1..2).
+  (dimensionless; spindle losses grow with the speed roughly as rpm^1..2);
+* ``drift``: the time since the reference instant (``reference["time_s"]``, default the first
+  sample), h: a slow drift, offered only where it earns its place (column ``time_s``).
 
 Any of them may pass through a first-order lag ``tau dx/dt = s - x`` (``tau_s``), integrated
 exactly on the sample times for a signal varying linearly between samples (first-order hold):
@@ -26,15 +28,16 @@ from gatetherm import InputError
 
 log = logging.getLogger(__name__)
 
-KINDS = ("sensor", "difference", "input")
+KINDS = ("sensor", "difference", "input", "drift")
 
 
 @dataclass(frozen=True)
 class Term:
-    """One regressor of a model; its coefficient is in um/K (sensor, difference) or um (input)."""
+    """One regressor of a model; its coefficient is in um/K (sensor, difference), um (input) or
+    um/h (drift)."""
 
     kind: str
-    """``sensor``, ``difference`` or ``input`` (see the module docstring)."""
+    """``sensor``, ``difference``, ``input`` or ``drift`` (see the module docstring)."""
     column: str
     """The column it reads (the first of a difference)."""
     other: str | None = None
@@ -65,13 +68,13 @@ class Term:
     @property
     def unit(self) -> str:
         """Unit of this term's coefficient."""
-        return "um" if self.kind == "input" else "um/K"
+        return {"input": "um", "drift": "um/h"}.get(self.kind, "um/K")
 
     @property
     def label(self) -> str:
         """Short readable name, e.g. ``t4_degC``, ``A-B``, ``lag(spindle_rpm^2, 600 s)``."""
         base = {"sensor": self.column, "difference": f"{self.column}-{self.other}",
-                "input": f"{self.column}^{self.exponent:g}"}[self.kind]
+                "input": f"{self.column}^{self.exponent:g}", "drift": "drift (h)"}[self.kind]
         return base if self.tau_s is None else f"lag({base}, {self.tau_s:.4g} s)"
 
 
@@ -98,8 +101,11 @@ def lag(t_s: np.ndarray, signal: np.ndarray, tau_s: float) -> np.ndarray:
 
 def evaluate(term: Term, t_s: np.ndarray, columns, reference_degC: dict[str, float]) -> np.ndarray:
     """The term's values at the samples ``t_s`` (s) from gap-free ``columns`` (name -> array) and the
-    reference temperatures (degC) of the sensors; K for sensors and differences, 1 for inputs."""
-    if term.kind == "input":
+    reference temperatures (degC) of the sensors; K for sensors and differences, 1 for inputs, h for
+    a drift (from ``reference["time_s"]``, s, default the first sample)."""
+    if term.kind == "drift":
+        s = (np.asarray(t_s, float) - reference_degC.get("time_s", t_s[0])) / 3600.0
+    elif term.kind == "input":
         s = (np.abs(columns[term.column]) / term.scale) ** term.exponent
     else:
         s = columns[term.column] - reference_degC[term.column]
@@ -112,8 +118,9 @@ def noise_sd(term: Term, sensor_K: float, step_s: float) -> float:
     """Standard deviation of the term's values when each temperature reading carries independent
     white noise of ``sensor_K`` (K): ``sensor_K`` for a rise, sqrt(2) times that for a difference,
     reduced by a lag of step ``step_s`` (s) to ``sqrt((1 - a) / (1 + a))`` of it, ``a = exp(-h / tau)``
-    (the stationary variance of a first-order lag of white noise); 0 for an input (a commanded value)."""
-    if term.kind == "input":
+    (the stationary variance of a first-order lag of white noise); 0 for an input (a commanded value)
+    and a drift."""
+    if term.kind in ("input", "drift"):
         return 0.0
     sd = sensor_K * (np.sqrt(2.0) if term.kind == "difference" else 1.0)
     if term.tau_s is not None:
