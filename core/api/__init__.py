@@ -16,9 +16,8 @@ The paper's frame is a case like any other: ``gt.gate_frame(dim=2)``.
 
 The functions live by task in this package's modules: :mod:`gatetherm.api.run` (cases,
 schedules, runs), :mod:`gatetherm.api.reduction`, :mod:`gatetherm.api.control` (compensation,
-<<<<<<< HEAD
-diagnosis), :mod:`gatetherm.api.sensors`,
-:mod:`gatetherm.api.export` and :mod:`gatetherm.api.zoo`; every public name is offered here.
+diagnosis), :mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`,
+:mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and :mod:`gatetherm.api.zoo`; every public name is offered here.
 
 ### Errors
 
@@ -44,28 +43,17 @@ in one line (``str(err)``) which argument is wrong and how to fix it:
 Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm.api.control import compensate, diagnose
+from gatetherm.api.errormodel import Prediction, errormodel_fit, errormodel_predict, errormodel_refit
 from gatetherm.api.export import export_ccx
 from gatetherm.api.live import live, twin
-=======
-diagnosis), :mod:`gatetherm.api.errormodel` and :mod:`gatetherm.api.sensors`; every public name is offered here.
-"""
-from gatetherm.api.control import compensate, diagnose
-from gatetherm.api.errormodel import Prediction, errormodel_fit, errormodel_predict, errormodel_refit
->>>>>>> errmodel
 from gatetherm.api.reduction import check_rom, check_schedules, reduce, write_reduction
 from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, \
     gate_frame, load_case, nc_schedule, run, schedule_file
 from gatetherm.api.sensors import check_placement, place_sensors, write_placement
 from gatetherm.api.zoo import validate_zoo
 
-<<<<<<< HEAD
-__all__ = ["Case", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
-           "check_schedules", "compensate", "condition", "configure", "diagnose", "export_ccx", "gate_frame", "live",
-           "load_case", "nc_schedule", "place_sensors", "reduce", "run", "schedule_file", "twin", "validate_zoo",
-           "write_placement", "write_reduction"]
-=======
-__all__ = ["Case", "Prediction", "Run", "Schedule", "beam_coefficients", "check_placement", "check_rom",
-           "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
-           "errormodel_predict", "errormodel_refit", "gate_frame", "load_case", "place_sensors", "reduce",
-           "run", "schedule_file", "write_placement", "write_reduction"]
->>>>>>> errmodel
+__all__ = ["Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement",
+           "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
+           "errormodel_predict", "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule",
+           "place_sensors", "reduce", "run", "schedule_file", "twin", "validate_zoo", "write_placement",
+           "write_reduction"]
