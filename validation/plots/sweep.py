@@ -40,7 +40,7 @@ def plot_xy(rows: list[dict], x: str, y: str, hue: str | None = None, title: str
             pts = [p for p in sorted((_num(r.get(x)), _num(r.get(y))) for r in grp) if np.isfinite(p).all()]
             if not pts:
                 continue
-            label = ", ".join([_value(hue, h)] * bool(hue) + [_value(k, v) for k, v in zip(lines_by, o)])
+            label = ", ".join(([_value(hue, h)] if hue else []) + [_value(k, v) for k, v in zip(lines_by, o)])
             ax.plot(*zip(*pts), "o", ls=styles[j % len(styles)], ms=3.5, color=f"C{i % 10}", label=label or None)
     if hline is not None:
         ax.axhline(hline, color="0.4", lw=0.8, ls="--")
