@@ -143,26 +143,39 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
         held[dofs] = 1.0
         for m in modes:
             cols[m].append(-(K[m] @ held))
+    n_heat = len(inputs)
+    terms = r.terms.values if r.terms is not None and r.R is not None else ()
+    varying = [j for j, v in enumerate(terms) if not v.is_constant]
+    for j in varying:  # a mechanical load that follows the schedule: an input read out directly (D)
+        inputs.append(Input(terms[j].text, 0.0))
+        for m in modes:
+            cols[m].append(np.zeros(n))
     B = {m: np.column_stack(c)[free] if c else np.zeros((len(free), 0)) for m, c in cols.items()}
     L, W = r.L.toarray(), np.hstack([r.W, np.zeros((len(r.W), n - h.n_solid))])
-    rows, names = [], []
+    rows, names, mech = [], [], []
     for i, key in enumerate(r.keys):
         if key[0] == "sigma" and key[2] == "von_mises":
             continue
         name, scale = columns(prob, key)
         rows.append((L[i] if i < r.n_L else W[i - r.n_L]) * scale)
+        mech.append(r.R[i - r.n_L] * scale if i >= r.n_L and terms else np.zeros(len(terms)))
         names.append(name)
     s = prob.signals
     if s.theta_C:
         rows.append(np.mean([rows[names.index(columns(prob, ("T", c))[0])] for c in s.theta_C], axis=0))
+        mech.append(np.zeros(len(terms)))
         names.append("theta_C_degC")
     R = np.array(rows)
+    mech = np.array(mech).reshape(len(names), len(terms))
+    constant = np.array([v.constant if v.is_constant else 0.0 for v in terms])
     is_W = np.array([i >= r.n_L for i, k in enumerate(r.keys) if not (k[0] == "sigma" and k[2] == "von_mises")]
                     + ([False] if s.theta_C else []))
     ref = np.where(is_W, R.sum(axis=1) * prob.T_ref, 0.0)  # W acts on the rise above T_ref
     D = np.zeros((len(names), len(inputs)))
     for j, (dofs, _) in enumerate(h.fixed):
-        D[:, len(inputs) - len(h.fixed) + j] = R[:, dofs].sum(axis=1)
+        D[:, n_heat - len(h.fixed) + j] = R[:, dofs].sum(axis=1)
+    for k, j in enumerate(varying):
+        D[:, n_heat + k] = mech[:, j]
     walls = {f"T_{m}_degC" for m, b in prob.means if b in {f.boundary for f in prob.fluids}}
     key = [nm for nm in names if nm.endswith("_um") and any(k[0] == "relative" and columns(prob, k)[0] == nm
                                                             for k in r.keys)]
@@ -171,7 +184,8 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
     M = h.M.tocsr()
     if fixed.size:
         M, K = M[free][:, free].tocsr(), {m: k[free][:, free].tocsr() for m, k in K.items()}
-    return LinearHeatModel(M, K, B, R[:, free], D, R.sum(axis=1) * T0 - ref, tuple(inputs), tuple(names),
+    y0 = R.sum(axis=1) * T0 - ref + (mech @ constant if len(terms) else 0.0)  # constant loads: gravity's sag
+    return LinearHeatModel(M, K, B, R[:, free], D, y0, tuple(inputs), tuple(names),
                            tuple(key) or tuple(names), tuple(p.pump.text or repr(p.pump.constant) for p in h.pumped),
                            T0)
 
