@@ -25,7 +25,7 @@ MEANING = (
     "word on choosing them on another machine; nothing says how a probe of a 3-D assembly becomes a mesh "
     "node (`export ccx` refuses probes that are not): points fragmented with the gantry's solids "
     "(`BooleanFragments{ Volume{:}; Point{:}; }`) lose its `feet` boundary on reading (\"supports.feet: unknown "
-    "key\"), so the gantry gives its probes as coordinates; nothing says which condition the axis "
+    "key\"), so the gantry gives its probes as coordinates of its boxes' corners (vertices, so nodes); nothing says which condition the axis "
     "r = 0 of an axisymmetric section needs (none).",
 )
 
