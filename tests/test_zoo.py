@@ -384,3 +384,11 @@ def test_every_cell_of_the_zoo_is_its_pinned_value(contexts, name, capability):
         assert cell["value"] == pytest.approx(expected, rel=TOLERANCE.get(capability, 0.02), abs=1e-3), cell["text"]
     else:
         assert expected in cell["text"], cell["text"]
+
+
+def test_the_command_refuses_an_unknown_machine_in_one_line(tmp_path, capsys):
+    from gatetherm.cli import main
+
+    assert main(["validate", "zoo", "--machines", "lathe", "--out", str(tmp_path / "z")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--machines: unknown machine 'lathe'" in err and "lathe_headstock" in err
