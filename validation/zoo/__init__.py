@@ -193,9 +193,9 @@ def guarded(fn, *args, timeout_s: float = TIMEOUT_S) -> dict:
                 out = here.recv()
             except EOFError:
                 out = None
+            proc.join(5.0)
         else:
             out = {"status": "failed", "value": None, "text": f"FAILED: no result within the {timeout_s:g}-s limit"}
-        proc.join(5.0)
         if proc.is_alive():
             proc.kill()
             proc.join()
