@@ -1,7 +1,8 @@
 // A portal (gantry) milling machine as a coarse 3-D assembly, SI units (m): a bed, two
 // columns, a cross beam on them and a spindle head hanging from the beam's front at mid-span.
-// The spindle's losses heat the head; δ: the tool (the head's lowest point) and the workpiece
-// on the bed approaching along z.
+// The spindle's losses heat the head; δ: the tool (a corner of the head's lowest face) and the
+// workpiece block on the bed under it approaching along z. The probes are corners of the boxes:
+// vertices of the geometry, so nodes of any mesh (`export ccx` compares displacements at nodes).
 //
 //            +=========== beam ===========+      z
 //            |  |       [head]         |  |      |
@@ -11,8 +12,7 @@
 //        |                bed                 |
 //        +------------------------------------+
 //
-// Named groups: regions bed, column_left, column_right, beam, head; boundaries feet, free;
-// points tool, work, T_head, T_beam, T_column.
+// Named groups: regions bed, column_left, column_right, beam, head, work; boundaries feet, free.
 SetFactory("OpenCASCADE");
 If (!Exists(size)) size = 0.2; EndIf
 If (!Exists(beam_height)) beam_height = 0.35; EndIf      // cross-beam depth (z), m
@@ -24,9 +24,8 @@ Box(2) = {0, 0.2, hb, 0.35, 0.4, hc};                    // left column
 Box(3) = {L - 0.35, 0.2, hb, 0.35, 0.4, hc};             // right column
 Box(4) = {0, 0.2, zb, L, 0.4, beam_height};              // cross beam
 Box(5) = {L / 2 - 0.15, -0.1, zb - 0.55, 0.3, 0.3, 0.55 + beam_height};  // head on the beam's front
-Point(101) = {L / 2, 0.05, zb - 0.55};                   // tool: the head's lowest point
-Point(102) = {L / 2, 0.05, hb};                          // workpiece on the bed
-BooleanFragments{ Volume{1:5}; Delete; }{}
+Box(6) = {L / 2 - 0.15, 0.0, hb, 0.3, 0.2, 0.1};         // workpiece block on the bed, under the head
+BooleanFragments{ Volume{1:6}; Delete; }{}
 
 e = 1e-6;
 hd[] = Volume In BoundingBox{L / 2 - 0.15 - e, -0.1 - e, zb - 0.55 - e, L / 2 + 0.15 + e, 0.2 + e, zb + beam_height + e};
@@ -37,6 +36,7 @@ Physical Volume("column_left") = Volume In BoundingBox{-e, 0.2 - e, hb - e, 0.35
 Physical Volume("column_right") = Volume In BoundingBox{L - 0.35 - e, 0.2 - e, hb - e, L + e, 0.6 + e, zb + e};
 Physical Volume("beam") = {bm[]};
 Physical Volume("head") = {hd[]};
+Physical Volume("work") = Volume In BoundingBox{L / 2 - 0.15 - e, -e, hb - e, L / 2 + 0.15 + e, 0.2 + e, hb + 0.1 + e};
 feet[] = Surface In BoundingBox{-e, -e, -e, L + e, D + e, e};
 outer[] = Abs(CombinedBoundary{ Volume{:}; });
 outer[] -= {feet[]};

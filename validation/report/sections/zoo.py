@@ -5,11 +5,11 @@ from gatetherm.validation.report.result import Result, table
 
 MEANING = (
     "run: δ's swing over the duty cycle (steady: its value); reduce: the largest error of δ of a 20-state "
-    "reduced model against FE on the case's schedule; paper, mlr, rom: `gt.compensate`'s residual band "
+    "reduced model against FE on the case's schedule; paper, mlr, rom: `gatetherm compensate`'s residual band "
     "(max |δ_comp| after 10 min) with that method, the uncompensated band beside it in the cell's line; "
     "errormodel comp: the same for an error model fitted on the first half of the run and replayed as "
     "`compensate --model`; sweep: the change of δ's swing between the two points of a one-key study; "
-    "sensors: held-out MAE of δ with three thermocouples placed by `gt.place_sensors` (8 training loads, 3 "
+    "sensors: held-out MAE of δ with three thermocouples placed as `gatetherm sensors` places them (8 training loads, 3 "
     "held out, 20 states), the case's own θ_A, θ_B, θ_C (a designer's choice) beside it; diagnose: the factor "
     "fitted to the hidden piece (a source made stronger in a P2 truth with noise; at most two pieces); "
     "errormodel: `errormodel fit` on the first 60 % and `predict` on the rest, RMS of δ's error there; "
@@ -25,14 +25,14 @@ MEANING = (
     "word on choosing them on another machine; nothing says how a probe of a 3-D assembly becomes a mesh "
     "node (`export ccx` refuses probes that are not): points fragmented with the gantry's solids "
     "(`BooleanFragments{ Volume{:}; Point{:}; }`) lose its `feet` boundary on reading (\"supports.feet: unknown "
-    "key\"), so the gantry gives its probes as coordinates; nothing says which condition the axis "
+    "key\"), so the gantry gives its probes as coordinates of its boxes' corners (vertices, so nodes); nothing says which condition the axis "
     "r = 0 of an axisymmetric section needs (none).",
 )
 
 
 def result(matrix: dict, seconds: float) -> Result:
     """The section of a zoo ``matrix`` (:func:`gatetherm.validation.zoo.run_zoo`)."""
-    from gatetherm.validation.zoo import MACHINES, _short
+    from gatetherm.validation.zoo import MACHINES, short
 
     caps = list(next(iter(matrix.values())))
     cells = [c for row in matrix.values() for c in row.values()]
@@ -43,7 +43,7 @@ def result(matrix: dict, seconds: float) -> Result:
     units = {"diagnose": "factor", "export ccx": "%"}
     matrix_table = table("Every capability on every machine", ("machine", *(f"{c} [{units.get(c, 'µm')}]"
                                                                               for c in caps)),
-                         [(m, *(_short(row[c]) for c in caps)) for m, row in matrix.items()],
+                         [(m, *(short(row[c]) for c in caps)) for m, row in matrix.items()],
                          note="What each number is: the list under the section's heading; every cell's line in "
                               "the next table.")
     lines = table("Every cell in one line", ("machine", "capability", "cell", "s"),

@@ -16,14 +16,14 @@ What each cell's number is (the capability's key, then its value):
 * ``reduce``: the largest error of δ of the reduced model ``gatetherm reduce`` makes (its default
   30 states) against the FE run on the case's own schedule, µm;
 * ``paper``, ``mlr``, ``rom``: the residual band (max |δ_comp| after the compensator's settling
-  time) of ``gt.compensate`` with that method, µm, beside the same band of δ uncompensated;
+  time) of ``gatetherm compensate``'s method, µm, beside the same band of δ uncompensated;
 * ``errormodel comp``: the same of an error model fitted on the first half of the run
   (``errormodel fit``'s defaults, every thermocouple a candidate, the case's power and room
   columns as inputs) and replayed as ``compensate --model`` on the whole run;
 * ``sweep``: the change of δ's swing (steady: of its value) between the two points of a
   one-key study (``gatetherm sweep``, a ``[study] case =`` file), µm;
 * ``sensors``: the held-out error (MAE of δ, µm) of three thermocouples placed by
-  ``gt.place_sensors`` (small settings: 20 states, 8 training loads, 3 held out), beside the
+  ``gatetherm sensors``' placement (small settings: 20 states, 8 training loads, 3 held out), beside the
   same error of the case's own three (θ_A, θ_B, θ_C: a designer's choice), and how many of the
   placed ones lie on a moving part (the machine's :attr:`Machine.moving` regions);
 * ``diagnose``: the factor the diagnosis fits to the one hidden piece (a heat source made
@@ -43,8 +43,6 @@ import json
 import logging
 import math
 import multiprocessing
-import shutil
-import subprocess
 import time
 import traceback
 from dataclasses import dataclass
@@ -56,7 +54,7 @@ from gatetherm import InputError, write_text_atomic
 
 log = logging.getLogger(__name__)
 
-EXAMPLES = Path(__file__).resolve().parent / "examples"
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 CCX_TOLERANCE = 5e-3
 """|δ_ccx / δ − 1| accepted (issue 51: 0.5 %)."""
 TIMEOUT_S = 300.0
@@ -118,11 +116,16 @@ class Context:
     machine: Machine
     case: object
     run: object
+    """The case's run on its own schedule (:class:`~gatetherm.studies.run.scenario.ScenarioRun`)."""
     out: Path
 
     @property
+    def columns(self) -> dict:
+        return self.run.columns
+
+    @property
     def series(self):
-        return self.run.scenario.series({"source": f"zoo run of {self.machine.folder}"})
+        return self.run.series({"source": f"zoo run of {self.machine.folder}"})
 
     @property
     def delta(self) -> str:
@@ -146,207 +149,7 @@ def _band(t, x, settle=SETTLE_S) -> float:
 
 
 def _transient(ctx: Context) -> bool:
-    return ctx.case.time is not None and len(ctx.run.time) > 1
-
-
-# --- the cells: each returns (value, one line) or raises ---------------------------------------
-
-def cell_run(ctx: Context):
-    x, name = ctx.run[ctx.delta], ctx.delta
-    temps = [c for c in ctx.run.columns if c.endswith("_degC") and c != "ambient_degC"]
-    tmax = max(float(np.nanmax(ctx.run[c])) for c in temps) if temps else float("nan")
-    if _transient(ctx):
-        v = float(np.nanmax(x) - np.nanmin(x))
-        return v, f"{name} swing {v:.3g} µm over {ctx.run.time[-1] / 3600:g} h, hottest probe {tmax:.2f} °C"
-    v = float(x[-1])
-    return v, f"steady {name} = {v:.4g}, hottest probe {tmax:.2f} °C"
-
-
-def cell_reduce(ctx: Context):
-    import gatetherm as gt
-
-    red = gt.reduce(ctx.case)  # its default states, as `gatetherm reduce`
-    (check,) = gt.check_rom(ctx.case, red.rom, [ctx.case.schedule])
-    err = check.errors.get(ctx.delta)
-    if err is None:
-        raise RuntimeError(f"the check has no {ctx.delta}")
-    worst = max((v for k, v in check.errors.items() if k.endswith("_degC")), default=float("nan"))
-    return float(err), (f"{red.rom.states if hasattr(red.rom, 'states') else 'default'} states: {ctx.delta} within "
-                        f"{err:.3g} µm of FE, temperatures within {worst:.3g} K")
-
-
-def _compensated(ctx: Context, comp):
-    s = comp.summary
-    loop = comp.loop
-    unc = _band(loop.t_s, loop.delta_um)
-    res = s["residual_band_um"]
-    verdict = "better" if res < unc else "WORSE, no refusal" if res > unc else "same"
-    return float(res), f"residual band {res:.3g} µm vs {unc:.3g} µm uncompensated ({verdict})"
-
-
-def _cell_method(method: str):
-    def cell(ctx: Context):
-        import gatetherm as gt
-
-        return _compensated(ctx, gt.compensate(ctx.run, method=method))
-    cell.__name__ = f"cell_{method}"
-    return cell
-
-
-def _errormodel_fit(ctx: Context, start: float, end: float):
-    from gatetherm.studies.errormodel.fit import FitParams, fit_error_model, fraction_span
-
-    ts = ctx.series
-    drive = getattr(ctx.case.schedule.drive, "columns", ())  # a steady case's drive has no columns
-    candidates = [c for c in ts.names if c.endswith("_degC") and c not in drive]
-    inputs = [c for c in drive if c in ts.names]
-    span = fraction_span(ts.time_s, start, end)
-    return ts, fit_error_model(ts, [ctx.delta], candidates, inputs, FitParams(), span, source="zoo"), span
-
-
-def cell_errormodel_comp(ctx: Context):
-    import gatetherm as gt
-
-    ts, model, _ = _errormodel_fit(ctx, 0.0, 0.5)
-    return _compensated(ctx, gt.compensate(ts, ctx.case, method="errormodel", model=model))
-
-
-def cell_errormodel(ctx: Context):
-    from gatetherm.studies.errormodel.model import predict, score
-
-    ts, model, span = _errormodel_fit(ctx, 0.0, 0.6)
-    pred = predict(model, ts)[ctx.delta]
-    later = ts.time_s > span[1]
-    r = np.asarray(ts[ctx.delta])[later] - pred[later]
-    rms = float(np.sqrt(np.nanmean(r ** 2)))
-    m = model.targets[0]
-    return rms, (f"{m.form} form on {', '.join(m.sensors) or 'no sensor'}: held-out RMS {rms:.3g} µm "
-                 f"(fit RMS {m.residual['rms_um']:.3g} µm)")
-
-
-def cell_sweep(ctx: Context):
-    from gatetherm.studies.sweeps.runner import PointStore, run_studies
-    from gatetherm.studies.sweeps.studyfile import load_study
-    from gatetherm.studies.sweeps.sweep import plan, table
-
-    key, values = ctx.machine.sweep
-    folder = ctx.out / "sweep"
-    folder.mkdir(parents=True, exist_ok=True)
-    study_file = folder / "study.toml"
-    write_text_atomic(study_file, f'[study]\nname = "zoo sweep of {ctx.machine.folder}"\n'
-                                  f'case = "{ctx.machine.case_path.as_posix()}"\n\n'
-                                  f'[grid]\n"{key}" = [{values[0]!r}, {values[1]!r}]\n')
-    study = load_study(study_file)
-    tasks = plan(study)
-    (records,), failed = run_studies([(tasks, PointStore(folder))], 1, None)
-    if failed:
-        raise RuntimeError(f"{len(failed)} of {len(tasks)} points failed: {_one_line(str(failed[0]))}")
-    columns, rows = table(tasks, records, study.columns)
-    stem = ctx.delta.removesuffix("_um")
-    col = "swing_um" if "swing_um" in columns else f"{stem}_final_um" if f"{stem}_final_um" in columns \
-        else next(c for c in columns if c.endswith(("_um", "_degC")) and c not in (key,))
-    a, b = float(rows[0][col]), float(rows[1][col])
-    return b - a, f"{col} {a:.4g} → {b:.4g} over {key} {values[0]:g} → {values[1]:g}"
-
-
-def _on_moving(ctx: Context, node: int) -> bool:
-    mesh = ctx.case.mesh
-    for name in ctx.machine.moving:
-        cells = mesh.cells[mesh.regions[name]] if name in mesh.regions else np.empty((0, 0), int)
-        if np.isin(node, cells):
-            return True
-    return False
-
-
-def cell_sensors(ctx: Context):
-    import gatetherm as gt
-
-    p = gt.place_sensors(ctx.case, 3, loads=8, held_out_loads=3, states=20)
-    target = ctx.delta
-    got = p.curve[-1]
-    placed = got["held_out_mae_um"][target] if isinstance(got, dict) else got.held_out_mae_um[target]
-    designer = None
-    if p.signals is not None:
-        s = p.signals
-        designer = s["held_out_mae_um"][target] if isinstance(s, dict) else s.held_out_mae_um[target]
-    moving = sum(_on_moving(ctx, s.node) for s in p.sensors)
-    where = ", ".join(f"{s.boundary}" for s in p.sensors)
-    return float(placed), (f"{len(p.sensors)} placed (on {where}): held-out MAE {placed:.3g} µm; "
-                           + (f"designer's θ_A, θ_B, θ_C: {designer:.3g} µm; " if designer is not None else "")
-                           + f"{moving} on a moving part")
-
-
-def cell_diagnose(ctx: Context):
-    from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
-    from gatetherm.validation.case_diagnosis import hidden, measured_run
-
-    m = ctx.machine
-    if not m.hidden:
-        raise InputError(f"{m.case_path}", "the zoo hides nothing in this case (no source to strengthen)",
-                         "give the machine a hidden piece in validation/zoo.py")
-    values = hidden(ctx.case, {m.hidden: m.factor})
-    if not _transient(ctx):  # no record to make: the library's word on the steady run itself
-        diagnose(ctx.case, ctx.series, Settings(max_pieces=2))
-    ts = measured_run(ctx.case, values, 51, m.folder)
-    d = diagnose(ctx.case, ts, Settings(max_pieces=2))
-    named = {r.piece.label: r for r in d.pieces}
-    fitted = d.summary()["fitted"]
-    value = next((float(v) for k, v in fitted.items() if m.hidden in k), float("nan"))
-    others = [k for k in named if k != m.hidden]
-    ok = m.hidden in named and not others
-    return value, (f"{d.verdict}; named {', '.join(named) or 'nothing'} (hidden {m.hidden} ×{m.factor:g}"
-                   f"{', found alone' if ok else ', NOT found alone'}); {d.runs} runs, {d.seconds:.0f} s")
-
-
-def cell_report(ctx: Context):
-    from gatetherm.studies.run.timeseries import TimeSeries
-    from gatetherm.validation.report.drift import check_record, compute
-
-    ts = ctx.series
-    if not isinstance(ts, TimeSeries):
-        raise RuntimeError("no time series")
-    check_record(ts, f"{ctx.machine.folder} run")
-    folder = ctx.out / "report"
-    folder.mkdir(parents=True, exist_ok=True)
-    result = compute(ts, folder, "timeseries.csv")
-    x = np.asarray(ts[ctx.delta], float)
-    drift = float(np.nanmax(np.abs(x - x[np.isfinite(x)][0])))
-    return drift, f"drift report: largest drift of {ctx.delta} {drift:.3g} µm, {len(result.notes)} notes"
-
-
-def cell_ccx(ctx: Context):
-    from gatetherm.studies.run.ccx import export_state, relative_from_dat
-
-    case = ctx.case
-    if case.dim != 3:  # as `gatetherm export ccx` refuses it
-        raise InputError(f"{ctx.machine.case_path}: mesh", "CalculiX export is for 3-D models", "give a 3-D mesh")
-    schedule = case.schedule
-    t = float(schedule.times[-1])
-    inp, info = export_state(case, schedule, t, f"gatetherm zoo {ctx.machine.folder}, t = {t / 60:g} min")
-    folder = ctx.out / "ccx"
-    folder.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(folder / "job.inp", inp)
-    exe = shutil.which("ccx")
-    if exe is None:
-        raise InputError("ccx", "CalculiX is not installed: job.inp written, not run", "install calculix-ccx")
-    run = subprocess.run([exe, "job"], cwd=folder, capture_output=True, text=True, timeout=TIMEOUT_S,
-                         env={"OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"})
-    if run.returncode != 0 or "ERROR" in run.stdout:
-        raise RuntimeError(f"ccx failed (exit {run.returncode}): "
-                           + _one_line(next((ln for ln in run.stdout.splitlines() if "ERROR" in ln), run.stderr)))
-    (folder / "job.frd").unlink(missing_ok=True)
-    ccx = relative_from_dat((folder / "job.dat").read_text(), info)
-    rel = {k: ccx[k] / g - 1.0 for k, g in info["relative_m"].items() if g}
-    worst = max(rel, key=lambda k: abs(rel[k]))
-    v = 100.0 * abs(rel[worst])
-    return v, (f"{worst}: gatetherm {info['relative_m'][worst] * 1e6:.4g} µm, CalculiX {ccx[worst] * 1e6:.4g} µm "
-               f"({'within' if v <= 100 * CCX_TOLERANCE else 'OUTSIDE'} 0.5 %)")
-
-
-CELLS = {"run": cell_run, "reduce": cell_reduce, "paper": _cell_method("paper"), "mlr": _cell_method("mlr"),
-         "rom": _cell_method("rom"), "errormodel comp": cell_errormodel_comp, "sweep": cell_sweep,
-         "sensors": cell_sensors, "diagnose": cell_diagnose, "errormodel": cell_errormodel, "report": cell_report,
-         "export ccx": cell_ccx}
+    return ctx.case.time is not None and len(ctx.columns["time_s"]) > 1
 
 
 # --- guarded cells -------------------------------------------------------------------------------
@@ -390,9 +193,9 @@ def guarded(fn, *args, timeout_s: float = TIMEOUT_S) -> dict:
                 out = here.recv()
             except EOFError:
                 out = None
+            proc.join(5.0)
         else:
             out = {"status": "failed", "value": None, "text": f"FAILED: no result within the {timeout_s:g}-s limit"}
-        proc.join(5.0)
         if proc.is_alive():
             proc.kill()
             proc.join()
@@ -403,7 +206,9 @@ def guarded(fn, *args, timeout_s: float = TIMEOUT_S) -> dict:
 
 
 def _machine_cells(name: str, machine: Machine, out: Path, capabilities, timeout_s: float, on_cell) -> dict:
-    import gatetherm as gt
+    from gatetherm.studies.run.case import load_case
+    from gatetherm.studies.run.scenario import run_scenario
+    from gatetherm.validation.zoo.cells import CELLS
 
     folder = out / name
     folder.mkdir(parents=True, exist_ok=True)
@@ -413,8 +218,8 @@ def _machine_cells(name: str, machine: Machine, out: Path, capabilities, timeout
     loaded = []
 
     def load():
-        case = gt.load_case(machine.case_path)
-        loaded.append((case, gt.run(case)))
+        case = load_case(machine.case_path)
+        loaded.append((case, run_scenario(case)))
         return None, ""
 
     start = _outcome(load)
@@ -443,6 +248,8 @@ def run_zoo(out: Path, machines=None, capabilities=CAPABILITIES, timeout_s: floa
             on_cell=None) -> dict:
     """Every capability on every machine: ``{machine: {capability: cell}}``, each cell
     ``{"status": "ok" | "refused" | "failed", "value": float | None, "text": one line, "seconds"}``."""
+    from gatetherm.validation.zoo.cells import CELLS
+
     names = list(MACHINES) if machines is None else list(machines)
     unknown = [n for n in names if n not in MACHINES]
     if unknown:
@@ -454,7 +261,8 @@ def run_zoo(out: Path, machines=None, capabilities=CAPABILITIES, timeout_s: floa
     return {n: _machine_cells(n, MACHINES[n], out, capabilities, timeout_s, on_cell) for n in names}
 
 
-def _short(cell: dict) -> str:
+def short(cell: dict) -> str:
+    """A cell in the matrix: its number (3 digits), ``refused`` or ``FAILED``."""
     if cell["status"] == "ok":
         v = cell["value"]
         return "—" if v is None else f"{v:.3g}"
@@ -469,7 +277,7 @@ def markdown(matrix: dict) -> str:
              "export ccx": "%"}
     head = "| machine | " + " | ".join(f"{c} ({units.get(c, '')})" for c in caps) + " |\n"
     head += "|---|" + "---:|" * len(caps) + "\n"
-    rows = "".join(f"| {m} | " + " | ".join(_short(cells[c]) for c in caps) + " |\n" for m, cells in matrix.items())
+    rows = "".join(f"| {m} | " + " | ".join(short(cells[c]) for c in caps) + " |\n" for m, cells in matrix.items())
     counts = {s: sum(c["status"] == s for cells in matrix.values() for c in cells.values())
               for s in ("ok", "refused", "failed")}
     lines = "".join(f"- **{m}**, {c}: {cells[c]['text']} ({cells[c]['seconds']:g} s)\n"
@@ -487,7 +295,7 @@ def write_zoo(out: Path, machines=None, capabilities=CAPABILITIES, timeout_s: fl
     write_text_atomic(out / "zoo.md", f"# The machine zoo\n\n`gatetherm validate zoo --out {out}` "
                                       f"({seconds:g} s)\n\n{markdown(matrix)}")
     write_text_atomic(out / "zoo.json", json.dumps(
-        {"machines": {n: {"case": str(MACHINES[n].case_path.relative_to(EXAMPLES.parent.parent)),
+        {"machines": {n: {"case": f"validation/examples/{MACHINES[n].folder}/case.toml",
                           "kind": MACHINES[n].kind} for n in matrix},
          "capabilities": list(capabilities), "timeout_s": timeout_s, "seconds": seconds, "cells": matrix},
         indent=2, allow_nan=False) + "\n")
