@@ -48,20 +48,12 @@ import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 
 from gatetherm import InputError, write_text_atomic
+from gatetherm.validation.zoo.context import CCX_TOLERANCE, EXAMPLES, SETTLE_S, TIMEOUT_S, Context, _band, _one_line, \
+    _transient  # noqa: F401 - the cells' shared parts
 
 log = logging.getLogger(__name__)
-
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
-CCX_TOLERANCE = 5e-3
-"""|δ_ccx / δ − 1| accepted (issue 51: 0.5 %)."""
-TIMEOUT_S = 300.0
-"""Default time limit of one cell, s."""
-SETTLE_S = 600.0
-"""The compensator's settling time the bands skip, s (``CompensatorParams.settle_s``' default)."""
-
 
 @dataclass(frozen=True)
 class Machine:
@@ -107,49 +99,6 @@ MACHINES = {
 
 CAPABILITIES = ("run", "reduce", "paper", "mlr", "rom", "errormodel comp", "sweep", "sensors", "diagnose",
                 "errormodel", "report", "export ccx")
-
-
-@dataclass
-class Context:
-    """What the cells of one machine share (made in the parent, inherited by each cell's child)."""
-
-    machine: Machine
-    case: object
-    run: object
-    """The case's run on its own schedule (:class:`~gatetherm.studies.run.scenario.ScenarioRun`)."""
-    out: Path
-
-    @property
-    def columns(self) -> dict:
-        return self.run.columns
-
-    @property
-    def series(self):
-        return self.run.series({"source": f"zoo run of {self.machine.folder}"})
-
-    @property
-    def delta(self) -> str:
-        """The primary output column: δ, else the first relative displacement, else a temperature."""
-        cols = list(self.run.columns)
-        if "delta_um" in cols:
-            return "delta_um"
-        rel = [f"{r.name}_um" for r in self.case.problem.relative]
-        um = [c for c in cols if c.endswith("_um")]
-        return (rel or um or [c for c in cols if c.endswith("_degC")])[0]
-
-
-def _one_line(text: str, limit: int = 300) -> str:
-    line = " ".join(str(text).split()).replace(str(EXAMPLES), "validation/examples")
-    return line if len(line) <= limit else line[:limit - 1] + "…"
-
-
-def _band(t, x, settle=SETTLE_S) -> float:
-    late = np.asarray(t) >= t[0] + settle
-    return float(np.nanmax(np.abs(np.asarray(x)[late])))
-
-
-def _transient(ctx: Context) -> bool:
-    return ctx.case.time is not None and len(ctx.columns["time_s"]) > 1
 
 
 # --- guarded cells -------------------------------------------------------------------------------

@@ -12,7 +12,7 @@ import subprocess
 import numpy as np
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.validation.zoo import CCX_TOLERANCE, TIMEOUT_S, Context, _band, _one_line, _transient
+from gatetherm.validation.zoo.context import CCX_TOLERANCE, TIMEOUT_S, Context, _band, _one_line, _transient
 
 def cell_run(ctx: Context):
     x, name = ctx.columns[ctx.delta], ctx.delta
