@@ -48,7 +48,6 @@ import traceback
 from dataclasses import dataclass
 from pathlib import Path
 
-
 from gatetherm import InputError, write_text_atomic
 from gatetherm.validation.zoo.context import CCX_TOLERANCE, EXAMPLES, SETTLE_S, TIMEOUT_S, Context, _band, _one_line, \
     _transient  # noqa: F401 - the cells' shared parts
