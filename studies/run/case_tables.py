@@ -5,6 +5,7 @@ file and the key (``docs/case-file.md``)."""
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 
 import numpy as np
@@ -12,6 +13,7 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import Range, ranges
 from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.geometry.nearest import nearest_on_body
 from gatetherm.solvers.frame import enclosed_volume
 from gatetherm.solvers.material import Material
 from gatetherm.solvers.problem import AXES, FixedTemperature, Fluid, Flux, Probe, Relative, Signals, Support
@@ -42,6 +44,7 @@ THICKNESS = Range(1e-6, 1e3, unit="m")
 matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
 C-frame example, whose other regions are 0.25–0.6 m thick)."""
 FILM = Range(0.0, unit="W/(m² K)")
+log = logging.getLogger(__name__)
 
 
 def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
@@ -170,7 +173,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
             try:
                 finder(*np.array(xyz)[:, None])
             except ValueError:
-                t.fail("point", f"{list(xyz)} lies outside the mesh", "give a point inside the body")
+                xyz = _onto_body(t, fm, xyz)
         else:
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
                    'e.g. point = "A" or point = [0.1, 0.2]')
@@ -180,6 +183,21 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
         region = t.name("region", fm.regions, "region", default="") or None
         out.append(Probe(name, xyz, tuple(q), region))
     return tuple(out)
+
+
+def _onto_body(t: Table, fm: FrameMesh, xyz: tuple) -> tuple:
+    """Coordinates outside the elements: read at the nearest point of the body if within the
+    tolerance of a point group (a warning gives the distance), else refused with the distance
+    and the nearest point."""
+    near = nearest_on_body(fm.points, fm.cells, xyz)
+    at = ", ".join(f"{v:.6g}" for v in near.point)
+    if near.distance > near.tolerance:
+        t.fail("point", f"{list(xyz)} lies outside the mesh, {near.distance:.3g} m from the body (more than the "
+               f"tolerance {near.tolerance:.3g} m); the nearest point on it is [{at}]",
+               "give a point inside the body")
+    log.warning("%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
+                "the body, [%s]", t.key("point"), list(xyz), near.distance, near.tolerance, at)
+    return tuple(float(v) for v in near.inside)
 
 
 def relative(top: Table, probes, dim: int) -> tuple:
