@@ -226,7 +226,7 @@ def test_cli_fit_predict_compensate(tmp_path, capsys):
 
 
 BAD_FILES = {
-    "missing column": ("time_s,s1_degC\n0,20\n60,21\n", "missing required column 'd_um'"),
+    "missing column": ("time_s,s1_degC\n0,20\n60,21\n", "--targets: 'd_um' is not a column of"),
     "text in a number": ("time_s,s1_degC,d_um\n0,20,1\n60,warm,2\n", "non-numeric value 'warm'"),
     "time not increasing": ("time_s,s1_degC,d_um\n0,20,1\n60,21,2\n60,22,3\n", "not after the previous"),
     "empty file": ("", "no header row"),

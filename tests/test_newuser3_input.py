@@ -55,3 +55,53 @@ def test_probe_far_from_the_body_refused_with_the_distance(tmp_path: Path):
         load_case(path)
     assert "probes.target.point: [0.2, 0.005] lies outside the mesh, 0.1 m from the body (more than the " \
            "tolerance 0.0112 m); the nearest point on it is [0.1, 0.005]" in str(e.value)
+
+
+# ---- 2. messages that name the file, or the option, that lacks a column --------------------------
+
+RUN = "# format: gatetherm-timeseries/1\ntime_s,spindle_W,delta_um,theta_A_degC\n0,350,0,20\n60,350,1,21\n"
+
+
+def test_a_series_read_from_a_file_names_it_when_a_column_is_missing(tmp_path: Path):
+    from gatetherm.studies.run.timeseries import read_timeseries, validate_complete
+
+    (tmp_path / "schedule.csv").write_text(RUN)
+    ts = read_timeseries(tmp_path / "schedule.csv", required=("time_s",))
+    with pytest.raises(InputError) as e:
+        validate_complete(ts.slice(slice(0, 2)), ("theta_A_degC", "theta_B_degC"))
+    assert str(e.value) == f"{tmp_path / 'schedule.csv'}: column theta_B_degC: missing; add a theta_B_degC " \
+                           "column; columns alike: theta_A_degC"
+
+
+def test_a_column_named_by_an_option_blames_the_option_with_look_alikes(tmp_path: Path):
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    (tmp_path / "run.csv").write_text(RUN)
+    with pytest.raises(InputError) as e:
+        read_timeseries(tmp_path / "run.csv", required=("time_s", "delta_mu"), named_by={"delta_mu": "--targets"})
+    assert str(e.value) == f"--targets: 'delta_mu' is not a column of {tmp_path / 'run.csv'}; name a column of the " \
+                           "file; columns alike: delta_um (its columns: time_s, spindle_W, delta_um, theta_A_degC)"
+
+
+def test_errormodel_fit_with_a_mistyped_target_exits_2_naming_the_option(tmp_path: Path, capsys):
+    from gatetherm.cli import main
+
+    (tmp_path / "run.csv").write_text(RUN)
+    got = main(["errormodel", "fit", "--data", str(tmp_path / "run.csv"), "--targets", "delta_mu",
+                "--candidates", "theta_A_degC", "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert got == 2 and err.count("\n") == 1 and "--targets: 'delta_mu' is not a column of" in err
+    assert "columns alike: delta_um" in err and "Traceback" not in err
+
+
+def test_an_expression_naming_a_column_the_schedule_lacks_names_the_schedule(tmp_path: Path):
+    from gatetherm.studies.run.case import load_case
+
+    (tmp_path / "s.csv").write_text("time_s,spindle_W,axis_W\n0,1,2\n40,1,2\n")
+    path = t3(tmp_path, 'temperature = "100 * sin(pi * t / 40)"', 'temperature = "ambient_degC"',
+              extra='schedule = "s.csv"\n')
+    with pytest.raises(InputError) as e:
+        load_case(path)
+    assert str(e.value) == f"{path}: thermal.hot_end.temperature: 'ambient_degC' in 'ambient_degC' is not a column " \
+                           f"of the schedule {tmp_path / 's.csv'}; add the column ambient_degC to it " \
+                           "(inputs here: axis_W, spindle_W, t)"

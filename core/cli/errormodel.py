@@ -102,7 +102,10 @@ def run_fit(args) -> int:
     candidates = _names(args.candidates, "--candidates", "t1_degC,t2_degC")
     inputs = _names(args.inputs, "--inputs", "spindle_rpm") or ()
     check_leakage(targets, candidates, inputs, ("--targets", "--candidates", "--inputs"))
-    runs = [read_timeseries(d, required=("time_s", *targets, *(candidates or ()), *inputs)) for d in args.data]
+    named = {**{c: "--inputs" for c in inputs}, **{c: "--candidates" for c in candidates or ()},
+             **{c: "--targets" for c in targets}}
+    runs = [read_timeseries(d, required=("time_s", *targets, *(candidates or ()), *inputs), named_by=named)
+            for d in args.data]
     params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                        differences=args.differences, resolution_K=args.resolution_K, cv=args.cv,
                        drift=not args.no_drift)
