@@ -105,3 +105,18 @@ def test_an_expression_naming_a_column_the_schedule_lacks_names_the_schedule(tmp
     assert str(e.value) == f"{path}: thermal.hot_end.temperature: 'ambient_degC' in 'ambient_degC' is not a column " \
                            f"of the schedule {tmp_path / 's.csv'}; add the column ambient_degC to it " \
                            "(inputs here: axis_W, spindle_W, t)"
+
+
+# ---- 3. a 2-D thickness in mm ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("thickness, warned", [(350.0, True), (1.05, True), (0.95, False), (0.01, False)])
+def test_a_thickness_beyond_ten_times_the_body_is_read_with_a_warning(tmp_path: Path, caplog, thickness, warned):
+    from gatetherm.studies.run.case import load_case
+
+    path = t3(tmp_path, "c = 440.5\n", f"c = 440.5\nthickness = {thickness}\n")
+    with caplog.at_level(logging.WARNING):
+        case = load_case(path)  # a warning, not a refusal: the body is 0.1 m long (0.1 x 0.01 m)
+    assert case.problem.thickness["bar"] == thickness
+    message = f"materials.bar.thickness: {thickness:g} m is more than 10 times the body's largest in-plane " \
+              f"extent (0.1 m); the thickness is in m ({thickness:g} mm = {thickness / 1000:g} m)"
+    assert (message in caplog.text) == warned, caplog.text

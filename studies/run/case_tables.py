@@ -43,6 +43,9 @@ THICKNESS = Range(1e-6, 1e3, unit="m")
 """Thickness of a 2-D section, from a micrometre to a kilometre: far beyond, the solid's
 matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
 C-frame example, whose other regions are 0.25–0.6 m thick)."""
+THICK = 10.0
+"""A 2-D section deeper than this many times the body's largest in-plane extent is read with a
+warning (a thickness in mm, say: 350 for 0.35 m)."""
 FILM = Range(0.0, unit="W/(m² K)")
 log = logging.getLogger(__name__)
 
@@ -65,7 +68,16 @@ def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
             if fm.dim == 3:
                 t.fail("thickness", "applies to 2-D sections only", "remove it")
             thickness[region] = t.number("thickness", THICKNESS)
+            _plausible_thickness(t, fm, thickness[region])
     return materials, thickness
+
+
+def _plausible_thickness(t: Table, fm: FrameMesh, value: float) -> None:
+    """Warn of a section deeper than :data:`THICK` times the body's largest in-plane extent (mm meant)."""
+    extent = float(np.ptp(fm.points, axis=0).max())
+    if value > THICK * extent:
+        log.warning("%s: %g m is more than %g times the body's largest in-plane extent (%.3g m); the thickness "
+                    "is in m (%g mm = %g m)", t.key("thickness"), value, THICK, extent, value, value / 1000)
 
 
 def boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
