@@ -206,7 +206,9 @@ def test_cli_fit_predict_compensate(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "d_um: dynamic; sensors s1_degC, s3_degC" in out and "forward path, held-out MAE by sensors" in out
     model = tmp_path / "fit" / "model.json"
+    assert f"wrote {model} (fitted on 1 run(s)" in out  # the final file, not the hidden stage's
     assert cli("errormodel", "predict", model, "--data", data, "--out", tmp_path / "pred") == 0
+    assert f"wrote {tmp_path / 'pred' / 'prediction.csv'}, prediction.png" in capsys.readouterr().out
     summary = json.loads((tmp_path / "pred" / "summary.json").read_text())
     assert summary["targets"]["d_um"]["mae_um"] == pytest.approx(0.04, abs=0.01)
     assert (tmp_path / "pred" / "prediction.png").stat().st_size > 0
