@@ -120,3 +120,21 @@ def test_a_thickness_beyond_ten_times_the_body_is_read_with_a_warning(tmp_path: 
     message = f"materials.bar.thickness: {thickness:g} m is more than 10 times the body's largest in-plane " \
               f"extent (0.1 m); the thickness is in m ({thickness:g} mm = {thickness / 1000:g} m)"
     assert (message in caplog.text) == warned, caplog.text
+
+
+# ---- 5. diagnose's P2 replay of gatetherm's own run points to --keep-order ----------------------------
+
+def test_the_p2_replay_warning_points_to_keep_order_for_a_gatetherm_run():
+    import types
+
+    from gatetherm.cli.diagnose import order_warning
+
+    p2 = types.SimpleNamespace(too_coarse=["delta_um"], order=2)
+    made = order_warning(p2, {"source": "gatetherm"})
+    assert made.startswith("warning: the model's discretisation error (P2 - P1) exceeds the resolution on delta_um; "
+                           "the diagnosis replayed it with P2 elements; the data are a run gatetherm simulated")
+    assert "--keep-order replays with P1 (report.md, 1. Replay)" in made
+    assert "--keep-order" not in order_warning(p2, {"source": "CMM log"})  # a measurement: no hint
+    p1 = types.SimpleNamespace(too_coarse=["delta_um"], order=1)  # --keep-order given: the old advice
+    assert order_warning(p1, {"source": "gatetherm"}).endswith("refine the mesh (--mesh-factor) or set order = 2 "
+                                                                "(report.md, 1. Replay)")
