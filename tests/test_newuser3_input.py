@@ -138,3 +138,18 @@ def test_the_p2_replay_warning_points_to_keep_order_for_a_gatetherm_run():
     p1 = types.SimpleNamespace(too_coarse=["delta_um"], order=1)  # --keep-order given: the old advice
     assert order_warning(p1, {"source": "gatetherm"}).endswith("refine the mesh (--mesh-factor) or set order = 2 "
                                                                 "(report.md, 1. Replay)")
+
+
+# ---- 5. the sweep's columns as docs/sweep.md names them --------------------------------------------
+
+def test_a_case_sweeps_temperature_columns_are_named_as_the_runs(tmp_path: Path):
+    """docs/sweep.md: the final temperature of a probe is named as its timeseries.csv column:
+    theta_A/theta_B for the probes [signals] maps to them, T_PROBE for the rest (a θ_C probe too)."""
+    from gatetherm.studies.run.case import load_case
+    from gatetherm.studies.sweeps.studyfile import case_columns
+
+    case = load_case(Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame" / "case.toml")
+    temps = [c for c in case_columns(case) if c.endswith("_final_degC")]
+    assert {"T_TS_final_degC", "theta_A_final_degC", "theta_B_final_degC"} <= set(temps)  # TS is θ_C's probe
+    assert not {"T_TF_final_degC", "T_TB_final_degC"} & set(temps)  # θ_A's and θ_B's probes: no T_ column
+    assert "delta_final_um" in case_columns(case)
