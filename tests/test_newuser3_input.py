@@ -45,6 +45,9 @@ def test_probe_on_the_boundary_read_with_a_warning(tmp_path: Path, caplog):
     assert "probes.target.point: [0.05, 0.010000001] lies 1e-09 m outside the mesh (within the tolerance 0.0112 m)" \
         in caplog.text
     assert "read at the nearest point on the body, [0.05, 0.01]" in caplog.text
+    with caplog.at_level(logging.WARNING):
+        p2 = case.with_order(2)  # made again on the same mesh (the order check): said once
+    assert caplog.text.count("outside the mesh") == 1 and p2.problem.probes[0].xyz == probe.xyz
 
 
 def test_probe_far_from_the_body_refused_with_the_distance(tmp_path: Path):

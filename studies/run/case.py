@@ -353,7 +353,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                  "hold the body with [supports.BOUNDARY] tables")
     kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
     quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
-    probes = case_tables.probes(top, fm, quantities)
+    probes = case_tables.probes(top, fm, quantities, quiet=mesh is not None)  # a remake: said when first read
     relative = case_tables.relative(top, probes, fm.dim) if elastic or "relative" in data else ()
     means = top.sub("means", None)
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)

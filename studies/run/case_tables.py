@@ -164,7 +164,9 @@ def _normal_axis(t: Table, fm: FrameMesh, boundary: str) -> int:
     return int(flat[0])
 
 
-def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
+def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool = False) -> tuple:
+    """The probes; coordinates off the elements by round-off are read on the body with a warning
+    (``quiet``: none, for a case made again on the same mesh, which said it when first read)."""
     pr = top.sub("probes")
     out = []
     finder = None
@@ -185,7 +187,8 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
             try:
                 finder(*np.array(xyz)[:, None])
             except ValueError:
-                xyz = _onto_body(t, fm, xyz)
+                xyz = _onto_body(t, fm, xyz, quiet)
+                finder(*np.array(xyz)[:, None])  # in its element now (a ValueError here is a defect)
         else:
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
                    'e.g. point = "A" or point = [0.1, 0.2]')
@@ -197,7 +200,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
     return tuple(out)
 
 
-def _onto_body(t: Table, fm: FrameMesh, xyz: tuple) -> tuple:
+def _onto_body(t: Table, fm: FrameMesh, xyz: tuple, quiet: bool = False) -> tuple:
     """Coordinates outside the elements: read at the nearest point of the body if within the
     tolerance of a point group (a warning gives the distance), else refused with the distance
     and the nearest point."""
@@ -207,7 +210,7 @@ def _onto_body(t: Table, fm: FrameMesh, xyz: tuple) -> tuple:
         t.fail("point", f"{list(xyz)} lies outside the mesh, {near.distance:.3g} m from the body (more than the "
                f"tolerance {near.tolerance:.3g} m); the nearest point on it is [{at}]",
                "give a point inside the body")
-    log.warning("%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
+    (log.debug if quiet else log.warning)("%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
                 "the body, [%s]", t.key("point"), list(xyz), near.distance, near.tolerance, at)
     return tuple(float(v) for v in near.inside)
 
