@@ -156,3 +156,14 @@ def test_a_case_sweeps_temperature_columns_are_named_as_the_runs(tmp_path: Path)
     assert {"T_TS_final_degC", "theta_A_final_degC", "theta_B_final_degC"} <= set(temps)  # TS is θ_C's probe
     assert not {"T_TF_final_degC", "T_TB_final_degC"} & set(temps)  # θ_A's and θ_B's probes: no T_ column
     assert "delta_final_um" in case_columns(case)
+
+
+def test_compensate_with_a_schedule_for_data_exits_2_naming_the_file(tmp_path: Path, capsys):
+    from gatetherm.cli import main
+
+    example = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame"
+    got = main(["compensate", "--case", str(example / "case.toml"), "--data", str(example / "schedule.csv"),
+                "--out", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert got == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert f"{example / 'schedule.csv'}: column theta_A_degC: missing; add a theta_A_degC column" in err, err
