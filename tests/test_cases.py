@@ -146,7 +146,8 @@ BAD = {
                    "(translation y)"),  # base is the edge x = 0: it holds u_x, so the rotation too
     "bad expression": ("[thermal.base]\ntemperature = \"__import__('os')\"\n", "thermal.base.temperature: '__import__' "
                        "is not allowed"),
-    "unknown input": ("[thermal.base]\ntemperature = \"oil_degC + 1\"\n", "unknown input 'oil_degC'"),
+    "unknown input": ("[thermal.base]\ntemperature = \"oil_degC + 1\"\n", "'oil_degC' in 'oil_degC + 1' is no input: "
+                      "the case has no [time] schedule"),
     "negative k": ("[materials.plate]\nk = -48.0\nE = 2e11\nnu = 0.3\nalpha = 1e-5\n", "materials.plate.k: got -48, must "
                    "be a finite number > 0"),
 }

@@ -206,7 +206,9 @@ def test_cli_fit_predict_compensate(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "d_um: dynamic; sensors s1_degC, s3_degC" in out and "forward path, held-out MAE by sensors" in out
     model = tmp_path / "fit" / "model.json"
+    assert f"wrote {model} (fitted on 1 run(s)" in out  # the final file, not the hidden stage's
     assert cli("errormodel", "predict", model, "--data", data, "--out", tmp_path / "pred") == 0
+    assert f"wrote {tmp_path / 'pred' / 'prediction.csv'}, prediction.png" in capsys.readouterr().out
     summary = json.loads((tmp_path / "pred" / "summary.json").read_text())
     assert summary["targets"]["d_um"]["mae_um"] == pytest.approx(0.04, abs=0.01)
     assert (tmp_path / "pred" / "prediction.png").stat().st_size > 0
@@ -226,7 +228,7 @@ def test_cli_fit_predict_compensate(tmp_path, capsys):
 
 
 BAD_FILES = {
-    "missing column": ("time_s,s1_degC\n0,20\n60,21\n", "missing required column 'd_um'"),
+    "missing column": ("time_s,s1_degC\n0,20\n60,21\n", "--targets: 'd_um' is not a column of"),
     "text in a number": ("time_s,s1_degC,d_um\n0,20,1\n60,warm,2\n", "non-numeric value 'warm'"),
     "time not increasing": ("time_s,s1_degC,d_um\n0,20,1\n60,21,2\n60,22,3\n", "not after the previous"),
     "empty file": ("", "no header row"),

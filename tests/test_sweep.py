@@ -150,9 +150,11 @@ def test_point_key_is_the_final_model():
     assert sweep.point_key(direct, 3, ("coefficients",), None, ()) != sweep.point_key(direct, 2, ("coefficients",), None, ())
 
 
-def test_sweep_writes_one_row_per_point_and_resumes(study_dir, monkeypatch):
+def test_sweep_writes_one_row_per_point_and_resumes(study_dir, monkeypatch, capsys):
     out = study_dir / "out"
     assert main(["sweep", str(study_dir / "study.toml"), "--out", str(out), "--workers", "1"]) == 0
+    printed = capsys.readouterr().out
+    assert f"wrote {out / 'Ki_norm_fe_vs_derived.l_over_l4.png'}\n" in printed and ".gatetherm-tmp" not in printed, printed
     rows = _table(out / "table.csv")
     assert list(rows[0])[:4] == ["derived.l_over_l4", "derived.beta", "status", "note"]
     assert [r["status"] for r in rows] == ["ok", "skipped", "ok", "ok"]

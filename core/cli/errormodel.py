@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from pathlib import Path
 
 import numpy as np
 
@@ -102,7 +103,10 @@ def run_fit(args) -> int:
     candidates = _names(args.candidates, "--candidates", "t1_degC,t2_degC")
     inputs = _names(args.inputs, "--inputs", "spindle_rpm") or ()
     check_leakage(targets, candidates, inputs, ("--targets", "--candidates", "--inputs"))
-    runs = [read_timeseries(d, required=("time_s", *targets, *(candidates or ()), *inputs)) for d in args.data]
+    named = {**{c: "--inputs" for c in inputs}, **{c: "--candidates" for c in candidates or ()},
+             **{c: "--targets" for c in targets}}
+    runs = [read_timeseries(d, required=("time_s", *targets, *(candidates or ()), *inputs), named_by=named)
+            for d in args.data]
     params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                        differences=args.differences, resolution_K=args.resolution_K, cv=args.cv,
                        drift=not args.no_drift)
@@ -112,7 +116,7 @@ def run_fit(args) -> int:
         model = dataclasses.replace(model, fit_span={**model.fit_span, "source": ", ".join(args.data)})
         save_model(out / "model.json", model)
     held = "leave one run out" if len(runs) >= 3 else args.cv
-    print(f"wrote {out}/model.json (fitted on {len(runs)} run(s), {model.fit_span['samples']} samples; "
+    print(f"wrote {Path(args.out) / 'model.json'} (fitted on {len(runs)} run(s), {model.fit_span['samples']} samples; "
           f"held-out error: {held})")
     for m in model.targets:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
@@ -158,7 +162,7 @@ def run_predict(args) -> int:
         write_timeseries(out / "prediction.csv", TimeSeries(cols, source))
         save(plot_model_prediction(model, ts), out / "prediction.png")
         write_text_atomic(out / "summary.json", json_text(summary, "summary.json", indent=2))
-    print(f"wrote {out}/prediction.csv, prediction.png, summary.json")
+    print(f"wrote {Path(args.out) / 'prediction.csv'}, prediction.png, summary.json")
     for name, g in result.gaps.items():
         print(f"{name}: {g.filled} missing samples filled (longest gap {g.longest_s:.0f} s), "
               f"{g.unpredicted} in gaps over {model.max_gap_s:.0f} s not predicted")
@@ -186,7 +190,7 @@ def run_refit(args) -> int:
                                    dict(zip(model.names, applied)) if applied else None)
     with output_dir(args.out, FIT_OUTPUTS, keep=(args.data, args.model)) as out:
         save_model(out / "model.json", new)
-    print(f"wrote {out}/model.json (refitted on the last {args.window_h:g} h)")
+    print(f"wrote {Path(args.out) / 'model.json'} (refitted on the last {args.window_h:g} h)")
     for name, r in report.items():
         verdict = "kept the current coefficients" if r["kept"] else "refitted"
         print(f"{name}: {verdict}: on the window's last quarter {r['refit_mae_um']:.3g} um refitted against "

@@ -69,5 +69,5 @@ def _sweep(args, study, tasks, out) -> list:
             path = out / f"{spec.y}_vs_{spec.x}{'_by_' + spec.hue if spec.hue else ''}.png".replace("/", "_")
             others = [k for k, _ in study.grid if k not in (spec.x, spec.hue)]
             save(plot_xy(rows, spec.x, spec.y, spec.hue, study.name, lines_by=others), path)
-            print(f"wrote {path}")
+            print(f"wrote {Path(args.out) / path.name}")  # the final file, not the stage's
     return failed

@@ -158,7 +158,8 @@ def rom_prediction(ts: TimeSeries, rom: ReducedModel, params: CompensatorParams,
     sensors = tuple(sensors)
     missing = [s for s in sensors if s not in ts]
     if missing:
-        raise InputError(f"column {missing[0]}", "named as an observer sensor but absent", "name columns of the file")
+        raise InputError(f"{getattr(ts, 'source', '') or 'data'}: column {missing[0]}",
+                         "named as an observer sensor but absent", "name columns of the file")
     channels = [rom.output(s) for s in sensors]
     pumps = set().union(*(Value.of(p).names() for p in rom.pumps)) - {"t"}
     read = set().union(*(Value.of(u.text).names() for u in rom.inputs)) | pumps

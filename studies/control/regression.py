@@ -68,7 +68,8 @@ def regression_features(ts: TimeSeries) -> tuple[str, ...]:
 def _design(ts: TimeSeries, features) -> np.ndarray:
     missing = [f for f in features if f not in ts]
     if missing:
-        raise InputError(f"column {missing[0]}", "used by the regression model but absent",
+        raise InputError(f"{getattr(ts, 'source', '') or 'data'}: column {missing[0]}",
+                         "used by the regression model but absent",
                          "apply the model to a run with the same sensors")
     return np.column_stack([np.ones(len(ts))] + [rises(ts, f) for f in features])
 

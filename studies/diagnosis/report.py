@@ -85,7 +85,8 @@ def report_markdown(d: Diagnosis, data: str, model: str, files: dict[str, str]) 
               + (f"**Above the resolution on {', '.join(label(c) for c in d.too_coarse)}**: " + (
                   "the model's own discretisation error shows in the data, so the diagnosis replayed the model "
                   "with P2 elements (about four times the cost of a run in 2-D); to diagnose with P1, refine the mesh "
-                  "(`--mesh-factor`, or `size` in the case)." if d.order == 2 else
+                  "(`--mesh-factor`, or `size` in the case); for a run gatetherm simulated on this mesh with P1 (the "
+                  "same error in the data), `--keep-order` replays with P1." if d.order == 2 else
                   "the model's own discretisation error shows in the data and the pieces below may partly stand in "
                   "for it; refine the mesh (`--mesh-factor`, or `size` in the case) or set `order = 2`.")
                  if d.too_coarse else "Below the resolution: the mesh is fine enough for these sensors.")]

@@ -174,7 +174,7 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
         have = tuple(ts.names if hasattr(ts, "names") else ts)
         for name in ("time_s", *targets, *candidates, *inputs):
             if name not in have:
-                where = sources[k] if k < len(sources) else (source or "data")
+                where = sources[k] if k < len(sources) else (source or getattr(ts, "source", "") or "data")
                 raise InputError(f"{where}: column {name}", "missing", f"columns are {', '.join(have)}")
     if not targets or not candidates:
         raise InputError("targets/candidates", "none given", "name at least one target and one temperature column")

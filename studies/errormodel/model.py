@@ -122,7 +122,7 @@ def check_columns(model: ErrorModel, columns, where: str = "data") -> None:
     """Raise InputError if ``columns`` (a mapping or TimeSeries) lacks ``time_s`` or a column the model reads."""
     for name in ("time_s", *model.columns):
         if name not in columns:
-            raise InputError(f"{where}: column {name}", "missing; the model reads it",
+            raise InputError(f"{getattr(columns, 'source', '') or where}: column {name}", "missing; the model reads it",
                              f"give a file with the columns {', '.join(('time_s',) + model.columns)}")
 
 

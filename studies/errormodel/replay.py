@@ -59,7 +59,8 @@ def replay(model: ErrorModel, ts: TimeSeries, target: str, params: CompensatorPa
     m = model.target(target)
     check_columns(model, ts)
     if target not in ts:
-        raise InputError(f"column {target}", "missing; the compensation loop needs the measured displacement",
+        raise InputError(f"{getattr(ts, 'source', '') or 'data'}: column {target}",
+                         "missing; the compensation loop needs the measured displacement",
                          f"give a file with a {target} column")
     loop_ts = TimeSeries({"time_s": ts.time_s, "delta_um": ts[target]}, dict(ts.metadata))
     if correction:

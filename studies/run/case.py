@@ -33,7 +33,7 @@ from gatetherm.solvers.problem import FaceFilm, Problem, inputs, values
 from gatetherm.studies.run import case_mech, case_mesh, case_sources, case_tables
 from gatetherm.studies.run.parameters import UNCERTAIN_FIX, mesh_parameter
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
-from gatetherm.studies.run.tables import Table
+from gatetherm.studies.run.tables import Inputs, Table
 from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
@@ -301,7 +301,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         ({"rho", "c"} if time else set())
     need = ({"E", "nu"} if mechanical else need) | ({"rho"} if "gravity" in data else set())
     materials, thickness = case_tables.materials(top, fm, need)
-    names = ("t", *columns)
+    names = Inputs(("t", *columns), f"the schedule {time.schedule}" if time and time.schedule else "")
     init = top.sub("initial", KEYS["initial"])
     T0 = init.number("temperature", CELSIUS, 20.0)
     kw: dict = {}
@@ -353,7 +353,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                  "hold the body with [supports.BOUNDARY] tables")
     kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
     quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
-    probes = case_tables.probes(top, fm, quantities)
+    probes = case_tables.probes(top, fm, quantities, quiet=mesh is not None)  # a remake: said when first read
     relative = case_tables.relative(top, probes, fm.dim) if elastic or "relative" in data else ()
     means = top.sub("means", None)
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)

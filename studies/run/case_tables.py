@@ -5,6 +5,7 @@ file and the key (``docs/case-file.md``)."""
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
 
 import numpy as np
@@ -12,6 +13,7 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import Range, ranges
 from gatetherm.geometry.mesh import FrameMesh
+from gatetherm.geometry.nearest import nearest_on_body
 from gatetherm.solvers.frame import enclosed_volume
 from gatetherm.solvers.material import Material
 from gatetherm.solvers.problem import AXES, FixedTemperature, Fluid, Flux, Probe, Relative, Signals, Support
@@ -41,7 +43,11 @@ THICKNESS = Range(1e-6, 1e3, unit="m")
 """Thickness of a 2-D section, from a micrometre to a kilometre: far beyond, the solid's
 matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
 C-frame example, whose other regions are 0.25–0.6 m thick)."""
+THICK = 10.0
+"""A 2-D section deeper than this many times the body's largest in-plane extent is read with a
+warning (a thickness in mm, say: 350 for 0.35 m)."""
 FILM = Range(0.0, unit="W/(m² K)")
+log = logging.getLogger(__name__)
 
 
 def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
@@ -62,7 +68,16 @@ def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
             if fm.dim == 3:
                 t.fail("thickness", "applies to 2-D sections only", "remove it")
             thickness[region] = t.number("thickness", THICKNESS)
+            _plausible_thickness(t, fm, thickness[region])
     return materials, thickness
+
+
+def _plausible_thickness(t: Table, fm: FrameMesh, value: float) -> None:
+    """Warn of a section deeper than :data:`THICK` times the body's largest in-plane extent (mm meant)."""
+    extent = float(np.ptp(fm.points, axis=0).max())
+    if value > THICK * extent:
+        log.warning("%s: %g m is more than %g times the body's largest in-plane extent (%.3g m); the thickness "
+                    "is in m (%g mm = %g m)", t.key("thickness"), value, THICK, extent, value, value / 1000)
 
 
 def boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
@@ -149,7 +164,9 @@ def _normal_axis(t: Table, fm: FrameMesh, boundary: str) -> int:
     return int(flat[0])
 
 
-def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
+def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool = False) -> tuple:
+    """The probes; coordinates off the elements by round-off are read on the body with a warning
+    (``quiet``: none, for a case made again on the same mesh, which said it when first read)."""
     pr = top.sub("probes")
     out = []
     finder = None
@@ -170,7 +187,8 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
             try:
                 finder(*np.array(xyz)[:, None])
             except ValueError:
-                t.fail("point", f"{list(xyz)} lies outside the mesh", "give a point inside the body")
+                xyz = _onto_body(t, fm, xyz, quiet)
+                finder(*np.array(xyz)[:, None])  # in its element now (a ValueError here is a defect)
         else:
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
                    'e.g. point = "A" or point = [0.1, 0.2]')
@@ -180,6 +198,21 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
         region = t.name("region", fm.regions, "region", default="") or None
         out.append(Probe(name, xyz, tuple(q), region))
     return tuple(out)
+
+
+def _onto_body(t: Table, fm: FrameMesh, xyz: tuple, quiet: bool = False) -> tuple:
+    """Coordinates outside the elements: read at the nearest point of the body if within the
+    tolerance of a point group (a warning gives the distance), else refused with the distance
+    and the nearest point."""
+    near = nearest_on_body(fm.points, fm.cells, xyz)
+    at = ", ".join(f"{v:.6g}" for v in near.point)
+    if near.distance > near.tolerance:
+        t.fail("point", f"{list(xyz)} lies outside the mesh, {near.distance:.3g} m from the body (more than the "
+               f"tolerance {near.tolerance:.3g} m); the nearest point on it is [{at}]",
+               "give a point inside the body")
+    (log.debug if quiet else log.warning)("%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
+                "the body, [%s]", t.key("point"), list(xyz), near.distance, near.tolerance, at)
+    return tuple(float(v) for v in near.inside)
 
 
 def relative(top: Table, probes, dim: int) -> tuple:

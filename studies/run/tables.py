@@ -8,6 +8,18 @@ from pathlib import Path
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, FINITE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
+from gatetherm.studies.run.timeseries import alike
+
+
+class Inputs(tuple):
+    """The input names of a case's expressions (``t`` and the schedule's columns) and the file the
+    columns come from (``source``, e.g. ``"the schedule s.csv"``; empty: no schedule), which the
+    message about an unknown input names."""
+
+    def __new__(cls, names, source: str = ""):
+        self = super().__new__(cls, names)
+        self.source = source
+        return self
 
 
 class Table:
@@ -67,6 +79,13 @@ class Table:
         except ExpressionError as err:
             self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
         unknown = sorted(v.names() - set(names))
+        if unknown and isinstance(names, Inputs):
+            u, columns = unknown[0], [n for n in names if n != "t"]
+            if names.source:
+                self.fail(k, f"'{u}' in '{v}' is not a column of {names.source}",
+                          f"add the column {u} to it{alike(u, columns)} (inputs here: {', '.join(sorted(names))})")
+            self.fail(k, f"'{u}' in '{v}' is no input: the case has no [time] schedule",
+                      f"give [time] schedule = a time-series file with a {u} column, or a number")
         if unknown:
             self.fail(k, f"unknown input '{unknown[0]}' in '{v}'", f"inputs here: {', '.join(sorted(names))}")
         return v

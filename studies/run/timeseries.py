@@ -12,6 +12,7 @@ and column.
 from __future__ import annotations
 
 import csv
+import difflib
 import logging
 import math
 import re
@@ -57,6 +58,8 @@ class TimeSeries:
     """Column name -> values in the column's unit (s, degC, um, 0/1); read-only copies."""
     metadata: dict[str, str] = field(default_factory=dict)
     """'# key: value' lines of the file, e.g. {"format": FORMAT, "condition": "2"}."""
+    source: str = field(default="", compare=False, repr=False)
+    """The file it was read from, named by the messages about its columns; empty when made in memory."""
 
     def __post_init__(self):
         cols = {}
@@ -94,11 +97,11 @@ class TimeSeries:
 
     def with_columns(self, **arrays) -> TimeSeries:
         """A new series with these columns replaced in place or appended at the end."""
-        return TimeSeries({**self.columns, **arrays}, dict(self.metadata))
+        return TimeSeries({**self.columns, **arrays}, dict(self.metadata), self.source)
 
     def slice(self, mask_or_slice) -> TimeSeries:
         """A new series with the rows selected by a boolean mask, index array or slice."""
-        return TimeSeries({k: v[mask_or_slice] for k, v in self.columns.items()}, dict(self.metadata))
+        return TimeSeries({k: v[mask_or_slice] for k, v in self.columns.items()}, dict(self.metadata), self.source)
 
 
 def rises(ts: TimeSeries, name: str) -> np.ndarray:
@@ -110,12 +113,32 @@ def rises(ts: TimeSeries, name: str) -> np.ndarray:
     return values - values[0]
 
 
+def alike(name: str, columns) -> str:
+    """``; columns alike: a, b`` for the ``columns`` that look like ``name`` (difflib), else ``""``."""
+    close = difflib.get_close_matches(name, list(columns), n=3, cutoff=0.6)
+    return f"; columns alike: {', '.join(close)}" if close else ""
+
+
+def missing_column(name: str, columns, source: str = "", named_by: str = "") -> InputError:
+    """The error for a column ``name`` that the file ``source`` (with ``columns``) lacks: blamed on
+    the option or key ``named_by`` that named it, if given, else on the file; with its columns that
+    look alike."""
+    file = source or "the data"
+    if named_by:
+        return InputError(named_by, f"{name!r} is not a column of {file}",
+                          f"name a column of the file{alike(name, columns)} (its columns: {', '.join(columns)})")
+    return InputError(f"{source}: column {name}" if source else f"column {name}", "missing",
+                      f"add a {name} column{alike(name, columns)}")
+
+
 def validate_complete(ts: TimeSeries, names, source: str = "") -> None:
-    """Raise InputError naming the first data row where any of ``names`` is missing."""
+    """Raise InputError naming the file (``source``, else the series') and the first data row where any
+    of ``names`` is missing."""
+    source = source or ts.source
     where = f"{source}: " if source else ""
     for name in names:
         if name not in ts:
-            raise InputError(f"{where}column {name}", "missing", f"add a {name} column")
+            raise missing_column(name, ts.names, source)
     missing = np.zeros(len(ts), dtype=bool)
     for name in names:
         missing |= np.isnan(ts[name])
@@ -141,8 +164,10 @@ def _parse_value(text: str, where: str) -> float:
     return value
 
 
-def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS) -> TimeSeries:
-    """Read and validate a time-series CSV; see the module docstring and docs/data-format.md."""
+def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS, named_by: dict | None = None) -> TimeSeries:
+    """Read and validate a time-series CSV; see the module docstring and docs/data-format.md.
+    ``required``: the columns it must have; ``named_by``: for those named by the user, the option or
+    key that named each (``{"ch1_um": "--targets"}``), blamed when the file lacks it."""
     path = Path(path)
     lines = read_text(path, fix="give a time-series CSV file (docs/data-format.md)").splitlines()
     metadata: dict[str, str] = {}
@@ -164,9 +189,11 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS) -> TimeSeries
             raise InputError(f"{path}, line {header_line}", f"empty or repeated column name {name!r}",
                              "give every column a unique name")
     for name in required:
+        if name in (named_by or {}) and name not in header:
+            raise missing_column(name, header, str(path), named_by[name])
         if name not in header:
             raise InputError(f"{path}, line {header_line}", f"missing required column {name!r}",
-                             f"add it to the header (required: {', '.join(required)})")
+                             f"add it to the header (required: {', '.join(required)}){alike(name, header)}")
     unknown = [h for h in header if h not in INPUT_COLUMNS + OUTPUT_COLUMNS + OPTIONAL_COLUMNS
                and not _SENSOR_COLUMN.match(h)]
     if unknown:
@@ -209,7 +236,7 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS) -> TimeSeries
         bad = np.flatnonzero(~np.isnan(values) & ~rng.mask(values)) if rng else ()
         if len(bad):
             fail(int(bad[0]), name, f"got {show(values[bad[0]])}, must be {rng}", "check the value and its unit")
-    return TimeSeries(cols, metadata)
+    return TimeSeries(cols, metadata, str(path))
 
 
 def _format_value(x: float) -> str:
