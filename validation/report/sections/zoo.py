@@ -4,8 +4,8 @@ from __future__ import annotations
 from gatetherm.validation.report.result import Result, table
 
 MEANING = (
-    "run: δ's swing over the duty cycle (steady: its value); reduce: the largest error of δ of a 20-state "
-    "reduced model against FE on the case's schedule; paper, mlr, rom: `gatetherm compensate`'s residual band "
+    "run: δ's swing over the duty cycle (steady: its value); reduce: the largest error of δ of a "
+    "reduced model of `gatetherm reduce`'s default size against FE on the case's schedule; paper, mlr, rom: `gatetherm compensate`'s residual band "
     "(max |δ_comp| after 10 min) with that method, the uncompensated band beside it in the cell's line; "
     "errormodel comp: the same for an error model fitted on the first half of the run and replayed as "
     "`compensate --model`; sweep: the change of δ's swing between the two points of a one-key study; "
@@ -17,9 +17,7 @@ MEANING = (
     "run and CalculiX, the largest |δ_ccx/δ − 1| (acceptance 0.5 %). A refusal is the library's own "
     "one-line message (an `InputError`); FAILED is any other exception, a crash or the cell's time limit.",
     "The six new machines were written from docs/case-file.md and docs/data-format.md alone. Where the docs "
-    "were silent or wrong: a `[contacts]` joint with tangential stiffness 0 (\"a frictionless slide\") at the "
-    "ball screw's floating support, and one with both stiffnesses, is refused as a free part although the "
-    "feet are clamped (left commented out in the case file: issue 51, free-body check); data-format.md "
+    "were silent or wrong: data-format.md "
     "calls `oil_degC` and `pump` required, but a case's schedule needs only the columns its values read; "
     "`[signals]` describes θ_A, θ_B, θ_C in the paper frame's words (heated column face, tie bar), with no "
     "word on choosing them on another machine; nothing says how a probe of a 3-D assembly becomes a mesh "
