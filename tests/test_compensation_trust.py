@@ -61,7 +61,7 @@ def test_k_fit_gives_the_difference_no_weight(twin):
     _, _, ts = twin
     ki, kc, warning = fit_coefficients_noted(ts)
     assert ki == 0.0  # no weight: the difference is within 10 resolutions
-    assert warning.startswith("K_i, K_C fit: no weight for theta_A - theta_B (spans 0.0353 K): under 10 sensor resolutions (0.5 K)")
+    assert warning == "K_i, K_C fit: no weight for theta_A - theta_B (spans 0.0353 K): under 10 sensor resolutions (0.5 K)"
     # K_C alone: the least squares of delta on -theta_C, a closed form
     x = -(ts["theta_C_degC"] - ts["theta_C_degC"][0])
     assert kc == pytest.approx(float(x @ ts["delta_um"] / (x @ x)), rel=1e-12)
@@ -90,9 +90,12 @@ def test_compensate_says_what_was_dropped_or_bounded(twin):
     paper = compensate(ts, case, Settings("paper")).summary
     assert paper["k_source"] == "fit" and paper["Ki_um_per_K"] == 0.0
     assert len(paper["warnings"]) == 1 and "no weight for theta_A - theta_B" in paper["warnings"][0]
+    assert paper["sensor_noise_um"] == pytest.approx(0.05 * abs(paper["Kc_um_per_K"]), rel=1e-12)  # K_i = 0
     mlr = compensate(ts, case, Settings("mlr", force=True)).summary
     assert max(abs(v) for k, v in mlr["regression"].items() if k != "intercept_um") < 5
     assert len(mlr["warnings"]) == 1 and "bounded by the sensor noise" in mlr["warnings"][0]
+    coefficients = [v for k, v in mlr["regression"].items() if k != "intercept_um"]
+    assert mlr["sensor_noise_um"] == pytest.approx(0.05 * np.linalg.norm(coefficients), rel=1e-12)
 
 
 def test_cli_prints_the_warning_and_which_residual_is_which(twin, tmp_path, capsys):

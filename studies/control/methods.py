@@ -40,7 +40,7 @@ from gatetherm.studies.control.compensator import (NEEDED, ClosedLoop, Compensat
 from gatetherm.studies.control.observer import ObserverParams
 from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams, rom_prediction
 from gatetherm.studies.control.regression import (RESOLUTION_K, THETAS, fit_coefficients_noted, fit_regression,
-                                                  regression_forecast)
+                                                  prediction_noise_um, regression_forecast)
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.scenario import ScenarioCache, prepare, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, validate_complete
@@ -179,14 +179,16 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         notes = [note] if note else []
         loop = paper_loop(ts, ki, kc, params, actuator)
         if source == "fit":
-            checked = _refitted(lambda: paper_loop(ts, *fit_coefficients_noted(held.before(ts, s.held_out),
-                                                                               s.resolution_K)[:2], params, actuator), f"K_i, K_C fitted on the first "
-                                f"{100 * (1 - s.held_out):.0f} % of the record")
+            before = held.before(ts, s.held_out)
+            checked = _refitted(lambda: paper_loop(ts, *fit_coefficients_noted(before, s.resolution_K)[:2], params,
+                                                   actuator),
+                                f"K_i, K_C fitted on the first {100 * (1 - s.held_out):.0f} % of the record")
         else:
             checked = loop, f"as applied (K_i, K_C from {source}, nothing fitted on the record)"
-        extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source}
+        noise = prediction_noise_um((ki, kc), s.resolution_K, difference_first=True)
+        extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source, "sensor_noise_um": noise}
         label = f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source}), {every}"
-        head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source})"
+        head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source}; {s.resolution_K:g}-K sensor noise adds ±{noise:.2g} um)"
     elif s.method == "mlr":
         if case is None:
             raise InputError("--method mlr", "needs a model to train on", "give --case, or the frame's --config/--dim")
@@ -197,10 +199,12 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         checked = _refitted(lambda: close_loop(ts, external_prediction(ts, regression_forecast(
             fit_regression(held.before(train, s.held_out), THETAS, s.resolution_K), ts), params), params, actuator),
             f"regression fitted on the first {100 * (1 - s.held_out):.0f} % of the model's run")
-        extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))}}
+        noise = prediction_noise_um(mlr.coefficients, s.resolution_K)
+        extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))},
+                 "sensor_noise_um": noise}
         label = f"regression on theta_A, theta_B, theta_C ({case.schedule.label} of the model), 1-sample forecast, " \
             + every
-        head = f"mlr ({label})"
+        head = f"mlr ({label}; {s.resolution_K:g}-K sensor noise adds ±{noise:.2g} um)"
     else:
         loop, extra, label = _rom_loop(ts, case, s, actuator, rom, rom_dir, cache, source, rom_source)
         notes = [extra.pop("budget_warning")] if extra.get("budget_warning") else []
@@ -256,6 +260,9 @@ def _model_check(model, loop, fraction: float, source: str) -> held.Benefit:
     if same and overlaps(float(model.fit_span.get("end_s", -np.inf)), start, loop.t_s):
         return held.unchecked(loop, fraction, f"the error model was fitted on this record ({fitted_on}) into its "
                               f"last {fraction * 100:.0f} %; refit it with --fit-span 0:{1 - fraction:g}")
+    if same:
+        return held.benefit(loop, fraction, f"as applied (the error model was fitted on this record before its last "
+                            f"{fraction * 100:.0f} %)")
     return held.benefit(loop, fraction, f"as applied (the error model was fitted on {fitted_on or 'other data'})")
 
 

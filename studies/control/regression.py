@@ -20,7 +20,8 @@ no coefficient is larger than the noise makes identifiable: two nearly collinear
 symmetric ram's theta_A ~ theta_B) share a bounded weight instead of +-1e5 um/K. Where the bound
 moves no coefficient by more than the 0.1 um resolution of delta on one noisy reading, plain least
 squares is kept (a well-posed fit is unchanged); else the bounded fit is used. Exactly dependent
-regressors are refused. What was dropped or bounded is said in one line (:attr:`LinearModel.warning`, :func:`fit_coefficients_noted`).
+regressors are refused. What was dropped or bounded is said in one line
+(:attr:`LinearModel.warning`, :func:`fit_coefficients_noted`).
 """
 from __future__ import annotations
 
@@ -101,7 +102,7 @@ def _noisy_fit(x: np.ndarray, y: np.ndarray, sd, labels, what: str, resolution_K
                      + ", ".join(bounded))
     warning = f"{what}: {'; '.join(parts)}" if parts else ""
     if warning:
-        log.warning("%s", warning)
+        log.info("%s", warning)
     return c, warning
 
 
@@ -121,7 +122,21 @@ def fit_coefficients_noted(ts: TimeSeries, resolution_K: float = RESOLUTION_K) -
 
 def fit_coefficients(ts: TimeSeries) -> tuple[float, float]:
     """(K_i, K_C) in um/K: :func:`fit_coefficients_noted` without its warning (logged)."""
-    return fit_coefficients_noted(ts)[:2]
+    ki, kc, warning = fit_coefficients_noted(ts)
+    if warning:
+        log.warning("%s", warning)
+    return ki, kc
+
+
+def prediction_noise_um(coefficients, resolution_K: float = RESOLUTION_K, difference_first: bool = False) -> float:
+    """What white noise of ``resolution_K`` (K) on each thermocouple adds to a prediction with these
+    coefficients (um/K), one standard deviation, um: ``sqrt(sum sigma_k^2 c_k^2)``, sigma_k sqrt(2)
+    resolutions for a difference (the first coefficient where ``difference_first``: K_i)."""
+    c = np.asarray(coefficients, float)
+    sd = np.full(c.size, float(resolution_K))
+    if difference_first and c.size:
+        sd[0] = noise_sd(Term("difference", "theta_A_degC", other="theta_B_degC"), resolution_K, 0.0)
+    return float(np.sqrt(np.sum((sd * c) ** 2)))
 
 
 def regression_features(ts: TimeSeries) -> tuple[str, ...]:
