@@ -41,7 +41,8 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
         and without it, um, ``verdict`` better, no-gain, worse or unchecked, ``forced``; ``warning`` where forced
         or unchecked; ``warnings``, a list of one-line notes: what the K_i, K_C or mlr fit dropped or bounded
         for the thermocouples' noise, ``resolution_K`` (default 0.05 K), and a rom update budget used up
-        before the record ends, whose time is ``budget_exhausted_s``, s).
+        before the record ends, whose time is ``budget_exhausted_s``, s; paper and mlr: ``sensor_noise_um``, what
+        the thermocouples' noise adds to the prediction, one standard deviation, um).
     """
     from gatetherm.studies.control.methods import Settings, compensate as methods_compensate
 

@@ -38,7 +38,7 @@ from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import (NEEDED, ClosedLoop, CompensatorParams, close_loop, compensate as
                                                    paper_loop, external_prediction, summarize)
 from gatetherm.studies.control.observer import ObserverParams
-from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams, rom_prediction
+from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams, budget_warning, rom_prediction
 from gatetherm.studies.control.regression import (RESOLUTION_K, THETAS, fit_coefficients_noted, fit_regression,
                                                   prediction_noise_um, regression_forecast)
 from gatetherm.studies.run.case import Case
@@ -317,15 +317,9 @@ def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache, source: str,
              "predictive": dataclasses.asdict(control), "observer": dataclasses.asdict(s.observer),
              "budget_exhausted_s": None}
     if cmds.exhausted_at is not None:
-        extra["budget_exhausted_s"] = out = float(pr.t_s[cmds.exhausted_at])
-        after = loop.t_s >= out
-        span_h, out_h = (loop.t_s[-1] - loop.t_s[0]) / 3600, (out - loop.t_s[0]) / 3600
-        need = math.ceil(control.max_updates * span_h / max(out_h, 1e-9))
-        extra["budget_warning"] = (
-            f"rom: the update budget of {control.max_updates} was used up at {out_h:.2f} h of the record's "
-            f"{span_h:.2f} h; the command was held from then on (|δ| compensated up to "
-            f"{np.nanmax(np.abs(loop.delta_comp_um[after])):.1f} um after it): give --max-updates {need} "
-            f"or more for a record this long, or --updates fixed")
+        extra["budget_exhausted_s"] = float(pr.t_s[cmds.exhausted_at])
+        extra["budget_warning"] = budget_warning(loop.t_s, loop.delta_comp_um, extra["budget_exhausted_s"],
+                                                 control.max_updates)
     how = f"threshold {cmds.threshold_um:.2f} um" if cmds.threshold_um is not None else \
         f"every {s.params.update_interval_s / 60:g} min"
     return loop, extra, f"reduced model ({rom.states} states), Kalman filter on {', '.join(s.sensors)}, {how}"

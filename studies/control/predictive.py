@@ -155,6 +155,17 @@ def commands(rom: ReducedModel, disc: Discrete, est: Estimate, u: np.ndarray, mo
     return Commands(cmd, np.array(updates, int), pred, h, out)
 
 
+def budget_warning(t_s: np.ndarray, delta_comp_um: np.ndarray, out_s: float, max_updates: int) -> str:
+    """One line: the budget of ``max_updates`` used up at ``out_s`` (s) of the record ``t_s`` (s), the
+    largest compensated |δ| (um) after it and the budget a record this long needs at the same pace."""
+    span_h, out_h = (t_s[-1] - t_s[0]) / 3600, (out_s - t_s[0]) / 3600
+    need = int(np.ceil(max_updates * span_h / max(out_h, 1e-9)))
+    return (f"rom: the update budget of {max_updates} was used up at {out_h:.2f} h of the record's {span_h:.2f} h; "
+            f"the command was held from then on (|δ| compensated up to "
+            f"{np.nanmax(np.abs(delta_comp_um[t_s >= out_s])):.1f} um after it): give --max-updates {need} or more "
+            f"for a record this long, or --updates fixed")
+
+
 THERMOCOUPLES = ("theta_A_degC", "theta_B_degC", "theta_C_degC")
 """The observer's default channels: the paper's three thermocouples."""
 
