@@ -91,6 +91,7 @@ def test_compensate_says_what_was_dropped_or_bounded(twin):
     assert paper["k_source"] == "fit" and paper["Ki_um_per_K"] == 0.0
     assert len(paper["warnings"]) == 1 and "no weight for theta_A - theta_B" in paper["warnings"][0]
     assert paper["sensor_noise_um"] == pytest.approx(0.05 * abs(paper["Kc_um_per_K"]), rel=1e-12)  # K_i = 0
+    assert paper["Kc_um_per_K"] == pytest.approx(-2.70, abs=0.01)
     mlr = compensate(ts, case, Settings("mlr", force=True)).summary
     assert max(abs(v) for k, v in mlr["regression"].items() if k != "intercept_um") < 5
     assert len(mlr["warnings"]) == 1 and "bounded by the sensor noise" in mlr["warnings"][0]
@@ -157,5 +158,6 @@ def test_refit_advice_can_be_followed(twin, tmp_path, capsys):
     assert end >= summary["benefit"]["start_s"] and end - summary["benefit"]["start_s"] < 1e-6  # the same instant
     assert summary["benefit"]["verdict"] != "unchecked", summary["benefit"]
     assert summary["benefit"]["basis"].startswith("as applied")
+
 
 
