@@ -75,7 +75,7 @@ def test_regression_coefficients_are_bounded_by_the_noise(twin):
     exact = fit_regression(ts, THETAS, resolution_K=0.0)  # plain least squares: the absurd pair
     a, b = exact.coefficients[:2]
     assert a == pytest.approx(36.3, abs=0.5) and b == pytest.approx(-38.7, abs=0.5)  # the user's +-2.49e5 in small
-    assert "bounded by the sensor noise (0.05 K), nearly collinear signals: theta_A_degC" in with_noise.warning
+    assert "bounded by the sensor noise (0.05 K) (least squares would fit the noise): theta_A_degC" in with_noise.warning
     assert "(least squares alone: 36.32)" in with_noise.warning and exact.warning == ""
 
     def noise_um(model):  # what 0.05 K of noise on each reading adds to the prediction (the error model's noise_um)

@@ -98,7 +98,7 @@ def _noisy_fit(x: np.ndarray, y: np.ndarray, sd, labels, what: str, resolution_K
         parts.append(f"no weight for {', '.join(dropped)}: under {SPAN_RESOLUTIONS} sensor resolutions "
                      f"({min_span:g} K)")
     if bounded:
-        parts.append(f"bounded by the sensor noise ({resolution_K:g} K), nearly collinear signals: "
+        parts.append(f"bounded by the sensor noise ({resolution_K:g} K) (least squares would fit the noise): "
                      + ", ".join(bounded))
     warning = f"{what}: {'; '.join(parts)}" if parts else ""
     if warning:
