@@ -17,9 +17,11 @@ regressor spanning fewer than :data:`~gatetherm.studies.errormodel.fit.SPAN_RESO
 resolutions gets no weight (coefficient 0), and every fit minimises ``|y - X c|^2 + n sum_k
 sigma_k^2 c_k^2`` (sigma_k the noise of regressor k, sqrt(2) resolutions for a difference), so that
 no coefficient is larger than the noise makes identifiable: two nearly collinear signals (a
-symmetric ram's theta_A ~ theta_B) share a bounded weight instead of +-1e5 um/K. Where the bound
-moves no coefficient by more than the 0.1 um resolution of delta on one noisy reading, plain least
-squares is kept (a well-posed fit is unchanged); else the bounded fit is used. Exactly dependent
+symmetric ram's theta_A ~ theta_B) share a bounded weight instead of +-1e5 um/K. Where least
+squares' coefficients add at most :data:`INFLATION` (2) times the noise the bounded ones add to a
+prediction (or within delta's 0.1 um resolution of it), the fit is identified and plain least
+squares is kept, unchanged; else the bounded fit is used, and the coefficients it moved by more
+than delta's resolution on one noisy reading are named. Exactly dependent
 regressors are refused. What was dropped or bounded is said in one line
 (:attr:`LinearModel.warning`, :func:`fit_coefficients_noted`).
 """
@@ -47,6 +49,10 @@ RESOLUTION_K = FitParams.resolution_K
 DELTA_RESOLUTION_UM = 0.1
 """Resolution of delta, um: a coefficient moved by the noise bound by more than this on one
 noisy reading (|change| x sigma) is reported as bounded."""
+INFLATION = 2.0
+"""Least squares stands where the noise its coefficients add to a prediction, sqrt(sum sigma_k^2 c_k^2),
+is at most this many times that of the bounded fit (or within delta's resolution of it): the fit is
+identified and the bound would only shrink it."""
 
 
 @dataclass(frozen=True)
@@ -89,10 +95,14 @@ def _noisy_fit(x: np.ndarray, y: np.ndarray, sd, labels, what: str, resolution_K
     c, plain = np.zeros(x.shape[1]), np.zeros(x.shape[1])
     c[keep] = noisy_least_squares(x[:, keep], y, sd[keep] ** 2)
     plain[keep] = np.linalg.lstsq(x[:, keep], y, rcond=None)[0]
+    noise_plain, noise_bound = (float(np.linalg.norm(sd * v)) for v in (plain, c))
     bounded = [f"{labels[j]} {c[j]:.4g} um/K (least squares alone: {plain[j]:.4g})" for j in keep[first:]
                if abs(plain[j] - c[j]) * sd[j] > DELTA_RESOLUTION_UM]
-    if not bounded:  # the bound changes no prediction by the resolution of delta: plain least squares
-        c = plain
+    if noise_plain <= INFLATION * noise_bound or noise_plain - noise_bound <= DELTA_RESOLUTION_UM:
+        c, bounded = plain, []  # identified: least squares, unchanged
+    else:
+        log.info("%s: the sensors' noise would add %.3g um to least squares' prediction, %.3g um bounded", what,
+                 noise_plain, noise_bound)
     parts = []
     if dropped:
         parts.append(f"no weight for {', '.join(dropped)}: under {SPAN_RESOLUTIONS} sensor resolutions "
