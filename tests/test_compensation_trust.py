@@ -112,7 +112,7 @@ def test_cli_prints_the_warning_and_which_residual_is_which(twin, tmp_path, caps
     assert "regression fitted on the first 70 % of the model's run" in lines[2]
 
 
-def test_rom_budget_used_up_is_warned_with_its_time(twin):
+def test_rom_budget_used_up_is_warned_with_its_time(twin, caplog):
     """300 W in the bed the reduced model does not know of: forecast errors re-trigger updates, and a
     budget of 20 runs out at 4.85 h of the 8-h record (the user's 60 ran out at 4.8 h of 6 h)."""
     _, case, _ = twin
@@ -126,6 +126,19 @@ def test_rom_budget_used_up_is_warned_with_its_time(twin):
     [line] = s["warnings"]
     assert line.startswith(f"rom: the update budget of 20 was used up at {out / 3600:.2f} h of the record's 8.00 h")
     assert "give --max-updates" in line
+    # the live form (step by step) warns at the same update, one sample before it acts
+    from gatetherm.studies.control.compensator import CompensatorParams, controller_grid
+    from gatetherm.studies.control.stepwise_rom import RomStepper
+    from gatetherm.studies.run.reduce import build_rom
+
+    params = CompensatorParams()
+    grid = controller_grid(ts, params, extra=("front_W", "rear_W"))[0]
+    stepper = RomStepper(build_rom(case, 10).rom, grid, params, PredictiveParams(max_updates=20))
+    with caplog.at_level(logging.WARNING, logger="gatetherm.studies.control.stepwise_rom"):
+        for c, t in enumerate(grid.time_s):
+            stepper.step(float(t), {k: grid[k][c] for k in grid.names})
+    [record] = [r for r in caplog.records if r.name.endswith("stepwise_rom") and "update budget" in r.getMessage()]
+    assert record.getMessage().startswith(f"update budget of 20 used up at t = {out - 60:g} s")
     ample = compensate(ts, case, Settings("rom", states=10, control=PredictiveParams(max_updates=200), force=True))
     assert ample.summary["budget_exhausted_s"] is None and ample.summary["warnings"] == []
     assert ample.summary["updates"] < 200
