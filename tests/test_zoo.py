@@ -43,7 +43,7 @@ def test_the_zoo_has_eight_machines_of_six_new_kinds_and_twelve_capabilities():
 
 # δ swing over the 6-h duty cycle (µm), pinned; band: a machine-tool's thermal error, 1 .. 200 µm
 SWING_UM = {"lathe_headstock": 11.18, "grinding_wheelhead": 33.95, "ballscrew_axis": 49.12, "vertical_column": 7.70,
-            "rotary_table": 15.73, "c_frame": 54.9, "gantry": 81.71}
+            "rotary_table": 15.73, "c_frame": 54.9, "gantry": 84.22}
 
 
 @pytest.mark.parametrize("name", [n for n in TWO_D if n != "joint"] + SLOW_3D)
@@ -257,7 +257,8 @@ PINNED = {
     ("c_frame", "run"): ("ok", 54.89),
     ("c_frame", "reduce"): ("ok", 0.001542),
     ("c_frame", "paper"): ("ok", 2.353),
-    ("c_frame", "mlr"): ("ok", 2.56),
+    # qactl: theta_A and theta_B span 0.47 K (< 10 resolutions): no weight (least squares: +-1390 um/K, 2.56 um)
+    ("c_frame", "mlr"): ("ok", 3.046),
     ("c_frame", "rom"): ("ok", 1.096),
     ("c_frame", "errormodel comp"): ("ok", 11.21),
     ("c_frame", "sweep"): ("ok", -4.921),
@@ -289,21 +290,25 @@ PINNED = {
     ("lathe_headstock", "errormodel"): ("ok", 3.339),
     ("lathe_headstock", "report"): ("ok", 11.18),
     ("lathe_headstock", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
-    ("gantry", "run"): ("ok", 81.71),
-    ("gantry", "reduce"): ("ok", 0.006666),
-    ("gantry", "paper"): ("ok", 4.424),
-    ("gantry", "mlr"): ("ok", 2.387),
-    ("gantry", "rom"): ("ok", 1.195),
-    ("gantry", "errormodel comp"): ("ok", 2.936),
-    ("gantry", "sweep"): ("ok", -16.02),
-    ("gantry", "sensors"): ("ok", 0.3867),
-    ("gantry", "diagnose"): ("refused", "refused: supports: the part made of regions bed, column_left, column_right, beam, head, work"),
-    ("gantry", "errormodel"): ("ok", 1.278),
-    ("gantry", "report"): ("ok", 81.71),
-    ("gantry", "export ccx"): ("ok", 2.376e-06),
+    ("gantry", "run"): ("ok", 84.22),
+    ("gantry", "reduce"): ("ok", 0.008687),
+    # qactl: theta_C spans 0.43 K (< 10 resolutions): K_C and its regression coefficient get no weight
+    # (least squares: K_C 0.74 um/K, 1.181 um; the regression's -34.4 um/K, 1.885 um)
+    ("gantry", "paper"): ("ok", 1.399),
+    ("gantry", "mlr"): ("ok", 2.915),
+    ("gantry", "rom"): ("ok", 1.17),
+    ("gantry", "errormodel comp"): ("ok", 3.164),
+    ("gantry", "sweep"): ("ok", -16.89),
+    ("gantry", "sensors"): ("ok", 0.4068),
+    ("gantry", "diagnose"): ("refused", "refused: supports: the part made of regions bed, column_left, column_right, beam, head"),
+    ("gantry", "errormodel"): ("ok", 0.5225),
+    ("gantry", "report"): ("ok", 84.22),
+    ("gantry", "export ccx"): ("refused", "refused: probe tool: is not a node of the mesh; put probes on mesh"),
     ("grinding_wheelhead", "run"): ("ok", 33.95),
     ("grinding_wheelhead", "reduce"): ("ok", 0.1473),
-    ("grinding_wheelhead", "paper"): ("ok", 0.6648),
+    # qactl: theta_C spans 0.42 K in the first 70 %: the held-out refit gives it no weight and leaves δ worse
+    # (least squares there: K_C 83 um/K against 48 on the whole record; the cell was ok, 0.6648 um)
+    ("grinding_wheelhead", "paper"): ("refused", "refused: --method paper: paper would leave δ 44.38 um > 14.39 um"),
     ("grinding_wheelhead", "mlr"): ("ok", 3.629),
     ("grinding_wheelhead", "rom"): ("ok", 1.178),
     ("grinding_wheelhead", "errormodel comp"): ("ok", 1.495),
@@ -327,8 +332,10 @@ PINNED = {
     ("ballscrew_axis", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
     ("vertical_column", "run"): ("ok", 7.7),
     ("vertical_column", "reduce"): ("ok", 5.089),
-    ("vertical_column", "paper"): ("ok", 5.127),
-    ("vertical_column", "mlr"): ("ok", 0.8838),
+    # qactl: K_i bounded by the sensor noise, 3.71 um/K (least squares: 14.77, 5.127 um)
+    ("vertical_column", "paper"): ("ok", 4.167),
+    # qactl: theta_A, theta_B bounded, 2.02 and -3.22 um/K (least squares: +-15.5, 0.8838 um on noise-free data)
+    ("vertical_column", "mlr"): ("ok", 1.032),
     ("vertical_column", "rom"): ("ok", 0.1998),
     ("vertical_column", "errormodel comp"): ("ok", 0.7161),
     ("vertical_column", "sweep"): ("ok", -0.251),
@@ -357,7 +364,6 @@ selections are greedy on small differences, the rom's observer on the run's nois
 
 @pytest.fixture(scope="module")
 def contexts(tmp_path_factory):
-    from gatetherm.studies.run.scenario import run_scenario
     from gatetherm.validation.zoo import Context
 
     made = {}
@@ -365,7 +371,7 @@ def contexts(tmp_path_factory):
     def get(name):
         if name not in made:
             case = gt.load_case(MACHINES[name].case_path)
-            made[name] = Context(MACHINES[name], case, run_scenario(case), tmp_path_factory.mktemp(name))
+            made[name] = Context(MACHINES[name], case, gt.run(case), tmp_path_factory.mktemp(name))
         return made[name]
     return get
 
@@ -373,8 +379,7 @@ def contexts(tmp_path_factory):
 @pytest.mark.slow
 @pytest.mark.parametrize("name,capability", [(m, c) for m in MACHINES for c in CAPABILITIES if (m, c) in PINNED])
 def test_every_cell_of_the_zoo_is_its_pinned_value(contexts, name, capability):
-    from gatetherm.validation.zoo import TIMEOUT_S
-    from gatetherm.validation.zoo.cells import CELLS
+    from gatetherm.validation.zoo import CELLS, TIMEOUT_S
 
     status, expected = PINNED[name, capability]
     cell = guarded(CELLS[capability], contexts(name), timeout_s=TIMEOUT_S)
@@ -384,11 +389,3 @@ def test_every_cell_of_the_zoo_is_its_pinned_value(contexts, name, capability):
         assert cell["value"] == pytest.approx(expected, rel=TOLERANCE.get(capability, 0.02), abs=1e-3), cell["text"]
     else:
         assert expected in cell["text"], cell["text"]
-
-
-def test_the_command_refuses_an_unknown_machine_in_one_line(tmp_path, capsys):
-    from gatetherm.cli import main
-
-    assert main(["validate", "zoo", "--machines", "lathe", "--out", str(tmp_path / "z")]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "--machines: unknown machine 'lathe'" in err and "lathe_headstock" in err

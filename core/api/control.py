@@ -30,7 +30,8 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
     **settings
         Fields of :class:`gatetherm.studies.control.methods.Settings` (``Ki``, ``Kc``,
         ``k_source``, ``states``, ``params``, ``control``, ``sensors``, ``force``: apply a correction
-        that would make δ worse, ``held_out``: the checked fraction, default 0.3); ``rom=`` a reduced model.
+        that would make δ worse, ``held_out``: the checked fraction, default 0.3, ``resolution_K``: the
+        thermocouples' noise that bounds the fits, K); ``rom=`` a reduced model.
 
     Returns
     -------
@@ -38,7 +39,10 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
         ``.loop`` (the compensated δ, the strokes, the updates), ``.summary`` (bands, updates;
         ``benefit``: ``held_out_um`` and ``uncompensated_um``, the largest |δ| on the held-out span with
         and without it, um, ``verdict`` better, no-gain, worse or unchecked, ``forced``; ``warning`` where forced
-        or unchecked).
+        or unchecked; ``warnings``, a list of one-line notes: what the K_i, K_C or mlr fit dropped or bounded
+        for the thermocouples' noise, ``resolution_K`` (default 0.05 K), and a rom update budget used up
+        before the record ends, whose time is ``budget_exhausted_s``, s; paper and mlr: ``sensor_noise_um``, what
+        the thermocouples' noise adds to the prediction, one standard deviation, um).
     """
     from gatetherm.studies.control.methods import Settings, compensate as methods_compensate
 

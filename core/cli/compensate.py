@@ -37,7 +37,14 @@ it (gatetherm.studies.control.benefit). A correction that would leave δ there w
 compensation is refused in one line naming the figures and a better choice (exit 2), unless
 ``--force``: then it is written with a warning, printed and in summary.json (``benefit``,
 ``warning``); so is one within the 0.1-um resolution of no compensation (``no-gain``) or one that
-cannot be checked. Every summary.json has ``benefit``.
+cannot be checked. Every summary.json has ``benefit``. The first printed line's residual band is the
+correction as applied over the whole run; the held-out line says whether its figure is that same
+correction or a separate check refitted before the held-out span (mlr, --k-source fit).
+
+Never silently unsure: what the K_i, K_C fit (--k-source fit) or the mlr regression dropped or
+bounded for the thermocouples' noise (0.05 K), and a rom update budget used up before the record
+ends (with the time), are each printed as one ``warning:`` line and listed in summary.json's
+``warnings``.
 """
 from __future__ import annotations
 
@@ -220,13 +227,18 @@ def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
     write_text_atomic(out_dir / "summary.json", text)
     print(f"wrote {args.out}/compensated.csv, compensation.png, "
           f"{'piezo_loops.png, ' if actuator else ''}summary.json")
+    settle = settings.params.settle_s / 60
     print(f"{what}: {comp.head}; swing {summary['swing_um']:.2f} um, "
           f"prediction error band {_um(summary['prediction_error_band_um'])}, "
-          f"residual band {_um(summary['residual_band_um'])} "
+          f"residual band {_um(summary['residual_band_um'])} over the whole run after {settle:g} min, as applied "
           f"({_um(summary['residual_at_updates_um'])} at the update instants), {summary['updates']} updates")
     b = summary["benefit"]
-    print(f"held-out last {b['fraction'] * 100:.0f} %: {_um(b['held_out_um'])} compensated, "
+    what_checked = "the correction as applied" if b["basis"].startswith("as applied") else \
+        "a separate check, not the correction applied above"
+    print(f"held-out last {b['fraction'] * 100:.0f} % ({what_checked}): {_um(b['held_out_um'])} compensated, "
           f"{_um(b['uncompensated_um'])} uncompensated ({b['verdict']}; {b['basis']})")
+    for line in summary.get("warnings", []):
+        print(f"warning: {line}")
     if "warning" in summary:
         print(f"warning: {summary['warning']}")
     return 0

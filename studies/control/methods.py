@@ -15,6 +15,11 @@ correction sent to the machine's control as an offset.
 Before a correction is returned, its benefit on the record's held-out last 30 % is measured
 (:mod:`.benefit`): one that would leave δ worse than no compensation is refused with one line
 naming a better choice, or, with ``force``, applied with a warning in the summary.
+
+Never silently unsure: what a fit on the record dropped or bounded for the sensors' noise
+(:mod:`.regression`: K_i, K_C of ``--k-source fit``, the mlr regression) and a rom update budget
+used up before the record ends are each one line in the summary's ``warnings`` (a list; the CLI
+prints each as ``warning: ...``).
 """
 from __future__ import annotations
 
@@ -33,8 +38,9 @@ from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import (NEEDED, ClosedLoop, CompensatorParams, close_loop, compensate as
                                                    paper_loop, external_prediction, summarize)
 from gatetherm.studies.control.observer import ObserverParams
-from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams, rom_prediction
-from gatetherm.studies.control.regression import THETAS, fit_coefficients, fit_regression, regression_forecast
+from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams, budget_warning, rom_prediction
+from gatetherm.studies.control.regression import (RESOLUTION_K, THETAS, fit_coefficients_noted, fit_regression,
+                                                  prediction_noise_um, regression_forecast)
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.scenario import ScenarioCache, prepare, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, validate_complete
@@ -73,6 +79,9 @@ class Settings:
     """Apply a correction that would leave δ worse on the held-out span (with a warning) instead of refusing it."""
     held_out: float = held.HELD_OUT
     """Fraction of the record, at its end, on which the benefit is checked, dimensionless."""
+    resolution_K: float = RESOLUTION_K
+    """Thermocouple resolution (noise standard deviation), K: bounds the K_i, K_C and mlr fits
+    (:mod:`.regression`)."""
 
 
 @dataclass(frozen=True)
@@ -91,27 +100,33 @@ class Compensation:
 def coefficients(case: Case | None, ts: TimeSeries, s: Settings, cache: ScenarioCache | None = None
                  ) -> tuple[float, float, str]:
     """K_i, K_C (um/K) and their source (``explicit`` or a :data:`K_SOURCES` entry)."""
+    return _coefficients(case, ts, s, cache)[:3]
+
+
+def _coefficients(case, ts, s: Settings, cache) -> tuple[float, float, str, str]:
+    """:func:`coefficients` and the fit's warning ('' unless fitted and something was dropped or bounded)."""
     if s.Ki is not None or s.Kc is not None:
         if s.Ki is None or s.Kc is None or s.k_source:
             raise InputError("--Ki/--Kc", "give both, and not together with --k-source",
                              "e.g. --Ki 2.1 --Kc 0.8, or --k-source fit")
         if not (math.isfinite(s.Ki) and math.isfinite(s.Kc)):
             raise InputError("--Ki/--Kc", "must be finite numbers", "e.g. --Ki 2.1 --Kc 0.8")
-        return s.Ki, s.Kc, "explicit"
+        return s.Ki, s.Kc, "explicit", ""
     beam = case is not None and case.parameters is not None
     source = s.k_source or ("theory" if beam else "fit")
     if source == "fit":
-        return (*fit_coefficients(ts), source)
+        ki, kc, note = fit_coefficients_noted(ts, s.resolution_K)
+        return ki, kc, source, note
     if not beam:
         raise InputError("--k-source", f"'{source}' needs the paper frame's beam model; this case has none",
                          "use --k-source fit or --Ki/--Kc")
     if source == "theory":
         from gatetherm.solvers.beam import theory_coefficients
 
-        return (*theory_coefficients(case.parameters), source)
+        return (*theory_coefficients(case.parameters), source, "")
     from gatetherm.solvers.reduced import tip_coefficients_um
 
-    return (*tip_coefficients_um(prepare(case, cache=cache).model), source)
+    return (*tip_coefficients_um(prepare(case, cache=cache).model), source, "")
 
 
 def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Settings(),
@@ -160,37 +175,44 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         return _checked(ts, loop, checked, s, actuator, extra, label, head)
     validate_complete(ts, NEEDED)
     if s.method == "paper":
-        ki, kc, source = coefficients(case, ts, s, cache)
+        ki, kc, source, note = _coefficients(case, ts, s, cache)
+        notes = [note] if note else []
         loop = paper_loop(ts, ki, kc, params, actuator)
         if source == "fit":
-            checked = _refitted(lambda: paper_loop(ts, *fit_coefficients(held.before(ts, s.held_out)), params,
-                                                   actuator), f"K_i, K_C fitted on the first "
-                                f"{100 * (1 - s.held_out):.0f} % of the record")
+            before = held.before(ts, s.held_out)
+            checked = _refitted(lambda: paper_loop(ts, *fit_coefficients_noted(before, s.resolution_K)[:2], params,
+                                                   actuator),
+                                f"K_i, K_C fitted on the first {100 * (1 - s.held_out):.0f} % of the record")
         else:
             checked = loop, f"as applied (K_i, K_C from {source}, nothing fitted on the record)"
-        extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source}
+        noise = prediction_noise_um((ki, kc), s.resolution_K, difference_first=True)
+        extra = {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source, "sensor_noise_um": noise}
         label = f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source}), {every}"
-        head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source})"
+        head = f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source}; {s.resolution_K:g}-K sensor noise adds ±{noise:.2g} um)"
     elif s.method == "mlr":
         if case is None:
             raise InputError("--method mlr", "needs a model to train on", "give --case, or the frame's --config/--dim")
         train = run_scenario(case, cache=cache).series({})
-        mlr = fit_regression(train, THETAS)
+        mlr = fit_regression(train, THETAS, s.resolution_K)
+        notes = [f"{mlr.warning} (on the model's own run, {case.schedule.label})"] if mlr.warning else []
         loop = close_loop(ts, external_prediction(ts, regression_forecast(mlr, ts), params), params, actuator)
         checked = _refitted(lambda: close_loop(ts, external_prediction(ts, regression_forecast(
-            fit_regression(held.before(train, s.held_out), THETAS), ts), params), params, actuator),
+            fit_regression(held.before(train, s.held_out), THETAS, s.resolution_K), ts), params), params, actuator),
             f"regression fitted on the first {100 * (1 - s.held_out):.0f} % of the model's run")
-        extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))}}
+        noise = prediction_noise_um(mlr.coefficients, s.resolution_K)
+        extra = {"regression": {"intercept_um": mlr.intercept_um, **dict(zip(mlr.features, mlr.coefficients))},
+                 "sensor_noise_um": noise}
         label = f"regression on theta_A, theta_B, theta_C ({case.schedule.label} of the model), 1-sample forecast, " \
             + every
-        head = f"mlr ({label})"
+        head = f"mlr ({label}; {s.resolution_K:g}-K sensor noise adds ±{noise:.2g} um)"
     else:
         loop, extra, label = _rom_loop(ts, case, s, actuator, rom, rom_dir, cache, source, rom_source)
+        notes = [extra.pop("budget_warning")] if extra.get("budget_warning") else []
         head = f"rom ({label})"
         checked = loop, "as applied (the reduced model and its causal Kalman filter fit nothing on the record)"
     check_loop, basis = checked
     b = held.unchecked(loop, s.held_out, basis) if check_loop is None else held.benefit(check_loop, s.held_out, basis)
-    return _checked(ts, loop, b, s, actuator, extra, label, head)
+    return _checked(ts, loop, b, s, actuator, extra, label, head, notes)
 
 
 def _refitted(make, basis: str):
@@ -201,7 +223,7 @@ def _refitted(make, basis: str):
         return None, f"{basis} failed: {err}"
 
 
-def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head) -> Compensation:
+def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head, notes=()) -> Compensation:
     """The compensation with its held-out benefit, refused (InputError) where it would make δ worse
     unless forced (:func:`.benefit.guard`)."""
     name = "error model" if s.method == "errormodel" else s.method
@@ -210,7 +232,7 @@ def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, hea
     summary = {**summarize(loop, s.params.settle_s), "method": s.method, **extra,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(s.params),
                "actuator": dataclasses.asdict(actuator) if actuator else None, "benefit": b.as_dict(),
-               **({"warning": warning} if warning else {})}
+               **({"warning": warning} if warning else {}), "warnings": list(notes)}
     return Compensation(loop, summary, label, head, extra)
 
 
@@ -219,7 +241,8 @@ def _better(ts, s: Settings, actuator) -> str:
     held-out span where that beats no compensation there, else no compensation."""
     if s.method != "paper" and all(n in ts for n in NEEDED):
         try:
-            loop = paper_loop(ts, *fit_coefficients(held.before(ts, s.held_out)), s.params, actuator)
+            loop = paper_loop(ts, *fit_coefficients_noted(held.before(ts, s.held_out), s.resolution_K)[:2], s.params,
+                              actuator)
         except InputError:
             loop = None
         if loop is not None:
@@ -234,10 +257,26 @@ def _model_check(model, loop, fraction: float, source: str) -> held.Benefit:
     fitted_on = str(model.fit_span.get("source", ""))
     start = held.span_start(loop.t_s, fraction)
     same = bool(fitted_on) and _same_file(fitted_on, source)
-    if same and float(model.fit_span.get("end_s", -np.inf)) >= start:
+    if same and overlaps(float(model.fit_span.get("end_s", -np.inf)), start, loop.t_s):
         return held.unchecked(loop, fraction, f"the error model was fitted on this record ({fitted_on}) into its "
                               f"last {fraction * 100:.0f} %; refit it with --fit-span 0:{1 - fraction:g}")
+    if same:
+        return held.benefit(loop, fraction, f"as applied (the error model was fitted on this record before its last "
+                            f"{fraction * 100:.0f} %)")
     return held.benefit(loop, fraction, f"as applied (the error model was fitted on {fitted_on or 'other data'})")
+
+
+#: Fraction of a sample interval within which a fit's end and the held-out start count as the same instant.
+SAME_INSTANT = 0.01
+
+
+def overlaps(end_s: float, start_s: float, t_s) -> bool:
+    """True if a fit ending at ``end_s`` reaches into a held-out span starting at ``start_s`` (s) by more
+    than :data:`SAME_INSTANT` of the record's median sample interval: a fit to ``--fit-span 0:0.7``
+    ends where the last 30 % starts, up to round-off (15120 s against 15119.999999999998 s)."""
+    t = np.asarray(t_s, float)
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    return end_s > start_s + SAME_INSTANT * step
 
 
 def _same_file(a: str, b: str) -> bool:
@@ -275,7 +314,12 @@ def _rom_loop(ts, case, s: Settings, actuator, rom, rom_dir, cache, source: str,
     pr, cmds = rom_prediction(ts, rom, s.params, control, s.observer, s.sensors)
     loop = close_loop(ts, pr, s.params, actuator)
     extra = {"rom": where, "rom_states": rom.states, "sensors": list(s.sensors), "threshold_um": cmds.threshold_um,
-             "predictive": dataclasses.asdict(control), "observer": dataclasses.asdict(s.observer)}
+             "predictive": dataclasses.asdict(control), "observer": dataclasses.asdict(s.observer),
+             "budget_exhausted_s": None}
+    if cmds.exhausted_at is not None:
+        extra["budget_exhausted_s"] = float(pr.t_s[cmds.exhausted_at])
+        extra["budget_warning"] = budget_warning(loop.t_s, loop.delta_comp_um, extra["budget_exhausted_s"],
+                                                 control.max_updates)
     how = f"threshold {cmds.threshold_um:.2f} um" if cmds.threshold_um is not None else \
         f"every {s.params.update_interval_s / 60:g} min"
     return loop, extra, f"reduced model ({rom.states} states), Kalman filter on {', '.join(s.sensors)}, {how}"

@@ -13,7 +13,8 @@ sample of latency as in the paper's procedure.
   worst forecast residual over that hold. ``h`` is chosen before the run as the smallest
   value (on a ``threshold_step_um`` grid) for which the same rule, run on the reduced model's
   open-loop forecast of the whole schedule, needs at most ``plan_fraction`` of the update budget;
-  the budget ``max_updates`` is never exceeded.
+  the budget ``max_updates`` (per run, not per hour) is never exceeded; where it runs out before
+  the record ends, the command is held from then on and :attr:`Commands.exhausted_at` says when.
 * ``fixed``: updates every ``interval_s`` from c + 1 = 1; each command is the minimax of the
   forecast over its own hold.
 """
@@ -43,7 +44,8 @@ class PredictiveParams:
     mode: str = "event"
     """"event": updates when the forecast residual would exceed the threshold; "fixed": every interval_s."""
     max_updates: int = 60
-    """Update budget over the run (event mode), the paper's 60 per 5 h."""
+    """Update budget over the whole run (event mode): the paper's count, 60 in its 5-h runs; a longer
+    record needs a larger budget in proportion (a budget used up before the end is warned of)."""
     interval_s: float = 300.0
     """Update period of the fixed mode, s."""
     horizon_s: float = 3600.0
@@ -117,6 +119,9 @@ class Commands:
     """One-step forecast δ̂(c | c−1) for each sample, µm (NaN at the first)."""
     threshold_um: float | None
     """Event threshold h (None in the fixed mode)."""
+    exhausted_at: int | None = None
+    """Grid index of the last update where the budget ran out before the last sample (the command is
+    held from there to the end); None otherwise."""
 
 
 def commands(rom: ReducedModel, disc: Discrete, est: Estimate, u: np.ndarray, modes: np.ndarray,
@@ -142,9 +147,23 @@ def commands(rom: ReducedModel, disc: Discrete, est: Estimate, u: np.ndarray, mo
             held, _ = minimax(window, half)
             updates.append(c + 1)
         cmd[c + 1] = held
-    if params.mode == "event" and len(updates) >= params.max_updates:
-        log.warning("update budget of %d used up", params.max_updates)
-    return Commands(cmd, np.array(updates, int), pred, h)
+    out = None
+    if params.mode == "event" and len(updates) >= params.max_updates and updates[-1] < N - 1:
+        out = updates[-1]
+        log.warning("update budget of %d used up at sample %d of %d: the command is held from then on",
+                    params.max_updates, out, N - 1)
+    return Commands(cmd, np.array(updates, int), pred, h, out)
+
+
+def budget_warning(t_s: np.ndarray, delta_comp_um: np.ndarray, out_s: float, max_updates: int) -> str:
+    """One line: the budget of ``max_updates`` used up at ``out_s`` (s) of the record ``t_s`` (s), the
+    largest compensated |δ| (um) after it and the budget a record this long needs at the same pace."""
+    span_h, out_h = (t_s[-1] - t_s[0]) / 3600, (out_s - t_s[0]) / 3600
+    need = int(np.ceil(max_updates * span_h / max(out_h, 1e-9)))
+    return (f"rom: the update budget of {max_updates} was used up at {out_h:.2f} h of the record's {span_h:.2f} h; "
+            f"the command was held from then on (|δ| compensated up to "
+            f"{np.nanmax(np.abs(delta_comp_um[t_s >= out_s])):.1f} um after it): give --max-updates {need} or more "
+            f"for a record this long, or --updates fixed")
 
 
 THERMOCOUPLES = ("theta_A_degC", "theta_B_degC", "theta_C_degC")

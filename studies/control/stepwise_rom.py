@@ -10,6 +10,7 @@ saved as JSON; the setup is rebuilt from the same reduced model and schedule.
 """
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
@@ -24,6 +25,8 @@ from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams
 from gatetherm.studies.control.stepwise import Correction, Stepper
 from gatetherm.studies.run.reduce import series_inputs
 from gatetherm.studies.run.timeseries import TimeSeries
+
+log = logging.getLogger(__name__)
 
 
 def schedule_grid(ts: TimeSeries, rom: ReducedModel, params: CompensatorParams) -> TimeSeries:
@@ -139,6 +142,9 @@ class RomStepper(Stepper):
             if due:
                 self.held, updated = float(minimax(window, half)[0]), True
                 self.updates += 1
+                if self.control.mode == "event" and self.updates == self.control.max_updates and c + 1 < self.n - 1:
+                    log.warning("update budget of %d used up at t = %g s (acting from the next sample), before the "
+                                "schedule's end: the command is held from then on", self.updates, t)
         self.count, self.t_last = c + 1, float(t)
         return Correction(float(t), self.held, pred, updated)
 
