@@ -5,7 +5,6 @@ import dataclasses
 import os
 from pathlib import Path
 
-from gatetherm import InputError
 from gatetherm.api.run import Case, Schedule, _case, condition
 from gatetherm.checks import Range, whole_argument
 
@@ -33,9 +32,6 @@ def reduce(case: Case, states: int = 30):
 
     _case(case)
     states = whole_argument("states", states, STATES, "e.g. 30")
-    if not case.problem.heat or case.time is None:
-        raise InputError("case", f"{case.name} has no transient heat solve (steady or prescribed temperatures): "
-                         "nothing to reduce", "give a case with [time] settings")
     return build_rom(case, states)
 
 

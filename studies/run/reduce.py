@@ -41,10 +41,11 @@ FORMAT = "gatetherm-rom/2"
 
 def build_rom(case: Case, states: int = 30, cache: ScenarioCache | None = None) -> Reduction:
     """Assemble ``case`` (its effects on) and reduce it to ``states`` states."""
+    if not case.problem.heat or case.time is None:
+        raise InputError("case", f"{case.name} has no transient heat solve (steady or prescribed temperatures): "
+                         "nothing to reduce", "give a case with [time] settings")
     t0 = time.perf_counter()
     model = prepare(case, cache=cache).model
-    if model.heat is None:
-        raise InputError(case.source, "has no heat solve to reduce", "give a case with thermal conditions")
     build = time.perf_counter() - t0
     red = reduce(linear_heat_model(model, column), states)
     red.seconds["model_build"] = build

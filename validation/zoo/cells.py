@@ -6,8 +6,6 @@ Each ``cell_*`` takes the machine's :class:`~gatetherm.validation.zoo.Context` a
 """
 from __future__ import annotations
 
-import shutil
-import subprocess
 
 import numpy as np
 
@@ -180,27 +178,15 @@ def cell_report(ctx: Context):
 
 
 def cell_ccx(ctx: Context):
-    from gatetherm.studies.run.ccx import export_state, relative_from_dat
+    from gatetherm.studies.run.ccx import export_state, run_ccx
 
-    case = ctx.case
-    if case.dim != 3:  # as `gatetherm export ccx` refuses it
-        raise InputError(f"{ctx.machine.case_path}: mesh", "CalculiX export is for 3-D models", "give a 3-D mesh")
-    schedule = case.schedule
+    case, schedule = ctx.case, ctx.case.schedule
     t = float(schedule.times[-1])
     inp, info = export_state(case, schedule, t, f"gatetherm zoo {ctx.machine.folder}, t = {t / 60:g} min")
     folder = ctx.out / "ccx"
     folder.mkdir(parents=True, exist_ok=True)
     write_text_atomic(folder / "job.inp", inp)
-    exe = shutil.which("ccx")
-    if exe is None:
-        raise InputError("ccx", "CalculiX is not installed: job.inp written, not run", "install calculix-ccx")
-    run = subprocess.run([exe, "job"], cwd=folder, capture_output=True, text=True, timeout=TIMEOUT_S,
-                         env={"OMP_NUM_THREADS": "1", "PATH": "/usr/bin:/bin"})
-    if run.returncode != 0 or "ERROR" in run.stdout:
-        raise RuntimeError(f"ccx failed (exit {run.returncode}): "
-                           + _one_line(next((ln for ln in run.stdout.splitlines() if "ERROR" in ln), run.stderr)))
-    (folder / "job.frd").unlink(missing_ok=True)
-    ccx = relative_from_dat((folder / "job.dat").read_text(), info)
+    ccx = run_ccx(folder, info, timeout=TIMEOUT_S)["relative_m"]
     rel = {k: ccx[k] / g - 1.0 for k, g in info["relative_m"].items() if g}
     worst = max(rel, key=lambda k: abs(rel[k]))
     v = 100.0 * abs(rel[worst])
