@@ -42,8 +42,8 @@ def test_the_zoo_has_eight_machines_of_six_new_kinds_and_twelve_capabilities():
 # --- loads and runs ---------------------------------------------------------------------------
 
 # δ swing over the 6-h duty cycle (µm), pinned; band: a machine-tool's thermal error, 1 .. 200 µm
-SWING_UM = {"lathe_headstock": 11.18, "grinding_wheelhead": 33.95, "ballscrew_axis": 49.12, "vertical_column": 7.70,
-            "rotary_table": 15.73, "c_frame": 54.9, "gantry": 84.22}
+SWING_UM = {"c_frame": 54.89, "lathe_headstock": 11.18, "gantry": 81.71, "grinding_wheelhead": 33.95,
+            "ballscrew_axis": 89.45, "vertical_column": 7.7, "rotary_table": 15.73}
 
 
 @pytest.mark.parametrize("name", [n for n in TWO_D if n != "joint"] + SLOW_3D)
@@ -138,8 +138,9 @@ def test_a_free_body_is_refused_naming_the_part(tmp_path, name):
     assert "\n" not in text and "free to move" in text and "translation y" in text
     named = set(re.search(r"the part made of regions? (.+?) is free", text).group(1).split(", "))
     joined = {r for c in gt.load_case(MACHINES[name].case_path).problem.contacts for r in c.between}
-    # a bonded machine is one part (every region named); with a joint, the part on one side of it
-    assert named == regions if not joined else named < regions
+    # a bonded machine is one part (every region named); with a joint, the part on one side of it, or the
+    # whole machine where the joint's stiffness holds its sides together (the ball screw's floating support)
+    assert named == regions if not joined else named <= regions
 
 
 # --- node numbering -----------------------------------------------------------------------------
@@ -250,112 +251,105 @@ def test_an_unknown_machine_is_refused():
 
 # --- every cell of the matrix, pinned (slow: the whole zoo) -------------------------------------
 
-# (status, value or words of the refusal or failure) of every cell, as `gatetherm validate zoo` gave them on
-# this branch (docs/validation.md, "The machine zoo"); a root cause fixed elsewhere changes its cells: update them.
-# Not pinned: a cell that ran out of its time limit (c_frame's diagnosis, > 300 s on a loaded machine).
+# (status, value or words of the refusal) of every cell, as `gatetherm validate zoo --out Z` gave them
+# (Z/zoo.json; docs/validation.md, "The machine zoo"); a root cause fixed elsewhere changes its cells: update them.
 PINNED = {
     ("c_frame", "run"): ("ok", 54.89),
     ("c_frame", "reduce"): ("ok", 0.001542),
-    ("c_frame", "paper"): ("ok", 2.353),
-    # qactl: theta_A and theta_B span 0.47 K (< 10 resolutions): no weight (least squares: +-1390 um/K, 2.56 um)
+    ("c_frame", "paper"): ("ok", 2.351),
     ("c_frame", "mlr"): ("ok", 3.046),
     ("c_frame", "rom"): ("ok", 1.096),
-    ("c_frame", "errormodel comp"): ("ok", 11.21),
+    ("c_frame", "errormodel comp"): ("ok", 6.144),
     ("c_frame", "sweep"): ("ok", -4.921),
     ("c_frame", "sensors"): ("ok", 0.2758),
-    ("c_frame", "errormodel"): ("ok", 2.931),
+    ("c_frame", "diagnose"): ("ok", 1.299),
+    ("c_frame", "errormodel"): ("ok", 0.4606),
     ("c_frame", "report"): ("ok", 54.89),
-    ("c_frame", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
+    ("c_frame", "export ccx"): ("ok", 1.179e-05),
     ("joint", "run"): ("ok", 47.38),
-    ("joint", "reduce"): ("failed", "FAILED: RuntimeError: Factor is exactly singular"),
-    ("joint", "paper"): ("refused", "refused: column theta_A_degC: missing; add a theta_A_degC column"),
-    ("joint", "mlr"): ("refused", "refused: column theta_A_degC: missing; add a theta_A_degC column"),
-    ("joint", "rom"): ("refused", "refused: column theta_A_degC: missing; add a theta_A_degC column"),
-    ("joint", "errormodel comp"): ("refused", "refused: target ux_a_um: only 1 valid samples in the fitting span;"),
+    ("joint", "reduce"): ("refused", "case: two blocks and a joint has no transient heat solve (steady or pr"),
+    ("joint", "paper"): ("refused", "column theta_A_degC: missing; add a theta_A_degC column; columns alike"),
+    ("joint", "mlr"): ("refused", "column theta_A_degC: missing; add a theta_A_degC column; columns alike"),
+    ("joint", "rom"): ("refused", "column theta_A_degC: missing; add a theta_A_degC column; columns alike"),
+    ("joint", "errormodel comp"): ("refused", "target ux_a_um: only 1 valid samples in the fitting span; give at leas"),
     ("joint", "sweep"): ("ok", -0.8701),
-    ("joint", "sensors"): ("refused", "has no relative displacement to predict; add a [relative] table (the"),
-    ("joint", "diagnose"): ("refused", "refused: --data: 1 samples are too few to train and hold out; give a"),
-    ("joint", "errormodel"): ("refused", "refused: target ux_a_um: only 1 valid samples in the fitting span;"),
-    ("joint", "report"): ("refused", "refused: joint run: 1 data row: a drift needs two samples or more;"),
-    ("joint", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
+    ("joint", "sensors"): ("refused", "validation/examples/joint/case.toml: has no relative displacement to p"),
+    ("joint", "diagnose"): ("refused", "--data: 1 samples are too few to train and hold out; give a longer run"),
+    ("joint", "errormodel"): ("refused", "target ux_a_um: only 1 valid samples in the fitting span; give at leas"),
+    ("joint", "report"): ("refused", "joint run: 1 data row: a drift needs two samples or more; give the who"),
+    ("joint", "export ccx"): ("refused", "contacts.joint.stiffness: an elastic joint layer has no CalculiX count"),
     ("lathe_headstock", "run"): ("ok", 11.18),
     ("lathe_headstock", "reduce"): ("ok", 0.07311),
     ("lathe_headstock", "paper"): ("ok", 2.86),
     ("lathe_headstock", "mlr"): ("ok", 3.194),
     ("lathe_headstock", "rom"): ("ok", 0.4643),
-    ("lathe_headstock", "errormodel comp"): ("ok", 6.552),
+    ("lathe_headstock", "errormodel comp"): ("ok", 4.003),
     ("lathe_headstock", "sweep"): ("ok", -0.1053),
-    ("lathe_headstock", "sensors"): ("ok", 0.2145),
-    ("lathe_headstock", "diagnose"): ("refused", "refused: supports: the part made of regions bed, housing, spindle, bearing_front, bearing_rear, carriage"),
-    ("lathe_headstock", "errormodel"): ("ok", 3.339),
+    ("lathe_headstock", "sensors"): ("ok", 0.2218),
+    ("lathe_headstock", "diagnose"): ("ok", 1.601),
+    ("lathe_headstock", "errormodel"): ("ok", 0.8076),
     ("lathe_headstock", "report"): ("ok", 11.18),
-    ("lathe_headstock", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
-    ("gantry", "run"): ("ok", 84.22),
-    ("gantry", "reduce"): ("ok", 0.008687),
-    # qactl: theta_C spans 0.43 K (< 10 resolutions): K_C and its regression coefficient get no weight
-    # (least squares: K_C 0.74 um/K, 1.181 um; the regression's -34.4 um/K, 1.885 um)
-    ("gantry", "paper"): ("ok", 1.399),
-    ("gantry", "mlr"): ("ok", 2.915),
-    ("gantry", "rom"): ("ok", 1.17),
-    ("gantry", "errormodel comp"): ("ok", 3.164),
-    ("gantry", "sweep"): ("ok", -16.89),
-    ("gantry", "sensors"): ("ok", 0.4068),
-    ("gantry", "diagnose"): ("refused", "refused: supports: the part made of regions bed, column_left, column_right, beam, head"),
-    ("gantry", "errormodel"): ("ok", 0.5225),
-    ("gantry", "report"): ("ok", 84.22),
-    ("gantry", "export ccx"): ("refused", "refused: probe tool: is not a node of the mesh; put probes on mesh"),
+    ("lathe_headstock", "export ccx"): ("ok", 0.0001232),
+    ("gantry", "run"): ("ok", 81.71),
+    ("gantry", "reduce"): ("ok", 0.006666),
+    ("gantry", "paper"): ("ok", 4.95),
+    ("gantry", "mlr"): ("ok", 7.296),
+    ("gantry", "rom"): ("ok", 1.195),
+    ("gantry", "errormodel comp"): ("ok", 4.614),
+    ("gantry", "sweep"): ("ok", -16.02),
+    ("gantry", "sensors"): ("ok", 0.3867),
+    ("gantry", "diagnose"): ("ok", 1.3),
+    ("gantry", "errormodel"): ("ok", 3.031),
+    ("gantry", "report"): ("ok", 81.71),
+    ("gantry", "export ccx"): ("ok", 2.376e-06),
     ("grinding_wheelhead", "run"): ("ok", 33.95),
     ("grinding_wheelhead", "reduce"): ("ok", 0.1473),
-    # qactl: theta_C spans 0.42 K in the first 70 %: the held-out refit gives it no weight and leaves δ worse
-    # (least squares there: K_C 83 um/K against 48 on the whole record; the cell was ok, 0.6648 um)
-    ("grinding_wheelhead", "paper"): ("refused", "refused: --method paper: paper would leave δ 44.38 um > 14.39 um"),
+    ("grinding_wheelhead", "paper"): ("refused", "--method paper: paper would leave δ 44.38 um > 14.39 um uncompensated "),
     ("grinding_wheelhead", "mlr"): ("ok", 3.629),
     ("grinding_wheelhead", "rom"): ("ok", 1.178),
-    ("grinding_wheelhead", "errormodel comp"): ("ok", 1.495),
+    ("grinding_wheelhead", "errormodel comp"): ("ok", 6.46),
     ("grinding_wheelhead", "sweep"): ("ok", 0.07095),
-    ("grinding_wheelhead", "sensors"): ("ok", 1.17),
-    ("grinding_wheelhead", "diagnose"): ("refused", "refused: supports: the part made of regions bed, column, head, motor, bearings, spindle, wheel, table"),
-    ("grinding_wheelhead", "errormodel"): ("ok", 3.944),
+    ("grinding_wheelhead", "sensors"): ("ok", 0.5995),
+    ("grinding_wheelhead", "diagnose"): ("ok", 1.301),
+    ("grinding_wheelhead", "errormodel"): ("ok", 3.599),
     ("grinding_wheelhead", "report"): ("ok", 19.56),
-    ("grinding_wheelhead", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
-    ("ballscrew_axis", "run"): ("ok", 49.12),
-    ("ballscrew_axis", "reduce"): ("ok", 0.137),
-    ("ballscrew_axis", "paper"): ("ok", 0.2969),
-    ("ballscrew_axis", "mlr"): ("ok", 3.103),
-    ("ballscrew_axis", "rom"): ("ok", 1.281),
-    ("ballscrew_axis", "errormodel comp"): ("ok", 11.02),
-    ("ballscrew_axis", "sweep"): ("ok", -8.679),
-    ("ballscrew_axis", "sensors"): ("ok", 0.2463),
-    ("ballscrew_axis", "diagnose"): ("refused", "refused: supports: the part made of regions bed, motor, bearing_block, support_block, screw, nut"),
-    ("ballscrew_axis", "errormodel"): ("ok", 2.867),
-    ("ballscrew_axis", "report"): ("ok", 49.12),
-    ("ballscrew_axis", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
+    ("grinding_wheelhead", "export ccx"): ("ok", 2.768e-05),
+    ("ballscrew_axis", "run"): ("ok", 89.45),
+    ("ballscrew_axis", "reduce"): ("ok", 0.3885),
+    ("ballscrew_axis", "paper"): ("ok", 0.4641),
+    ("ballscrew_axis", "mlr"): ("ok", 6.513),
+    ("ballscrew_axis", "rom"): ("ok", 2.103),
+    ("ballscrew_axis", "errormodel comp"): ("ok", 24.59),
+    ("ballscrew_axis", "sweep"): ("ok", -16.27),
+    ("ballscrew_axis", "sensors"): ("ok", 1.646),
+    ("ballscrew_axis", "diagnose"): ("ok", 1.398),
+    ("ballscrew_axis", "errormodel"): ("ok", 2.61),
+    ("ballscrew_axis", "report"): ("ok", 89.45),
+    ("ballscrew_axis", "export ccx"): ("refused", "contacts.floating.stiffness: an elastic joint layer has no CalculiX co"),
     ("vertical_column", "run"): ("ok", 7.7),
-    ("vertical_column", "reduce"): ("ok", 5.089),
-    # qactl: K_i bounded by the sensor noise, 3.71 um/K (least squares: 14.77, 5.127 um)
+    ("vertical_column", "reduce"): ("ok", 0.004755),
     ("vertical_column", "paper"): ("ok", 4.167),
-    # qactl: theta_A, theta_B bounded, 2.02 and -3.22 um/K (least squares: +-15.5, 0.8838 um on noise-free data)
     ("vertical_column", "mlr"): ("ok", 1.032),
     ("vertical_column", "rom"): ("ok", 0.1998),
-    ("vertical_column", "errormodel comp"): ("ok", 0.7161),
+    ("vertical_column", "errormodel comp"): ("ok", 1.845),
     ("vertical_column", "sweep"): ("ok", -0.251),
-    ("vertical_column", "sensors"): ("ok", 0.1847),
+    ("vertical_column", "sensors"): ("ok", 0.1836),
     ("vertical_column", "diagnose"): ("ok", 1.302),
-    ("vertical_column", "errormodel"): ("ok", 1.21),
+    ("vertical_column", "errormodel"): ("ok", 0.1463),
     ("vertical_column", "report"): ("ok", 7.7),
-    ("vertical_column", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
+    ("vertical_column", "export ccx"): ("refused", "contacts.bolted.stiffness: an elastic joint layer has no CalculiX coun"),
     ("rotary_table", "run"): ("ok", 15.73),
     ("rotary_table", "reduce"): ("ok", 0.003928),
     ("rotary_table", "paper"): ("ok", 0.2128),
     ("rotary_table", "mlr"): ("ok", 0.4547),
     ("rotary_table", "rom"): ("ok", 0.2015),
-    ("rotary_table", "errormodel comp"): ("ok", 0.02419),
+    ("rotary_table", "errormodel comp"): ("ok", 0.3375),
     ("rotary_table", "sweep"): ("ok", -0.6922),
-    ("rotary_table", "sensors"): ("ok", 0.08319),
-    ("rotary_table", "diagnose"): ("refused", "refused: supports: the part made of regions bed, housing, stator, bearing, table"),
-    ("rotary_table", "errormodel"): ("ok", 0.02064),
+    ("rotary_table", "sensors"): ("ok", 0.07958),
+    ("rotary_table", "diagnose"): ("ok", 1.305),
+    ("rotary_table", "errormodel"): ("ok", 0.1087),
     ("rotary_table", "report"): ("ok", 15.73),
-    ("rotary_table", "export ccx"): ("refused", "mesh: CalculiX export is for 3-D models; give a 3-D mesh"),
+    ("rotary_table", "export ccx"): ("ok", 0.0002534),
 }
 TOLERANCE = {"sensors": 0.15, "diagnose": 0.05, "errormodel": 0.15, "errormodel comp": 0.15, "rom": 0.15}
 """Relative tolerance of a pinned number (default 2 %): the sensor placement's and the error models'
