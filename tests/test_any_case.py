@@ -64,7 +64,8 @@ def test_three_compensation_methods_with_the_cases_actuator(case):
     assert loop.update_t_s[0] == 60.0 and loop.stroke_um[0] == 0.0 and loop.delta_comp_um[0] == run["delta_um"][0]
     assert rom["residual_band_um"] == pytest.approx(1.10, abs=0.1) and rom["updates"] == 41  # ≤ 3 µm, ≤ 60
     assert rom["piezo_saturated_updates"] == 0 and rom["rom_states"] == 30
-    assert got["mlr"]["residual_band_um"] == pytest.approx(2.56, abs=0.1)
+    # θ_A and θ_B span 0.47 K, under 10 sensor resolutions: no weight (plain least squares, ±1390 µm/K: 2.56 µm)
+    assert got["mlr"]["residual_band_um"] == pytest.approx(3.05, abs=0.1)
     assert got["paper"]["k_source"] == "fit" and got["paper"]["residual_band_um"] == pytest.approx(2.35, abs=0.1)
 
 
