@@ -70,6 +70,7 @@ def test_phases_of_a_case_are_cut_where_an_input_steps():
     assert ph[-1].closed and input_phases(t, {"ambient_degC": 20.0 + 0 * t})[0].label == "whole run"
 
 
+@pytest.mark.slow  # 198 s since room drift is a candidate when the record has the room (issue 51)
 def test_diagnose_case_names_the_hidden_pieces(case, tmp_path, capsys):
     """A film of the case off by ×1.75 and a thermocouple offset, found blind through the command;
     the example's mesh is flagged by the discretisation check (P2 − P1 of δ: 1.23 resolutions), so the
