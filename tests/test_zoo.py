@@ -204,7 +204,7 @@ def full_p2_relative(case):
 
 # |full P2 − P1| / scale of the worst output, pinned; the check's verdict (warned: > 2 %)
 P2_WORST = {"lathe_headstock": (0.0059, False), "grinding_wheelhead": (0.0040, False),
-            "ballscrew_axis": (0.0335, True), "vertical_column": (0.0143, False), "rotary_table": (0.0011, False),
+            "ballscrew_axis": (0.0196, False), "vertical_column": (0.0143, False), "rotary_table": (0.0011, False),
             "c_frame": (0.0136, False), "gantry": (0.041, True)}
 
 
