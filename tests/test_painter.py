@@ -12,6 +12,7 @@ import textwrap
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import gatetherm as gt
 from gatetherm.validation.plots.run import plot_channels
@@ -113,8 +114,13 @@ def test_closed_without_finish_it_draws_what_it_was_given(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big.png", "small.png"]
 
 
-def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):
+@pytest.mark.parametrize("stop_s", [None, 1e-9], ids=["terminated", "killed"])
+def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path, stop_s):
+    """Stopped by SIGTERM the process removes its PNG's temporary; killed (a rendering that does
+    not return to Python within ``STOP_S``: forced here by ``STOP_S = 0``) the painter does."""
     out = fresh("""
+        import gatetherm.validation.plots.painter as painting
+        painting.STOP_S = {stop_s} or painting.STOP_S
         t = np.arange(60000.0)
         cols = {{"time_s": t, **{{f"T{{k}}_degC": np.sin(k * t) for k in range(19)}}}}  # ~30 s to draw
         try:
@@ -132,7 +138,7 @@ def test_an_error_in_the_block_stops_the_processes_at_once(tmp_path):
         except ChildProcessError:  # none left running or unreaped
             left = False
         print(json.dumps({{"workers": workers, "stopped_s": stopped, "left": left}}))
-        """, tmp=str(tmp_path))
+        """, tmp=str(tmp_path), stop_s=stop_s)
     assert out["workers"] == 2 and not out["left"]
     assert out["stopped_s"] < 10.0  # achieved <1 s alone; without SIGTERM, the 30 s of the picture
     assert list(tmp_path.iterdir()) == []  # the PNG being written removed

@@ -14,6 +14,7 @@ when it is given, in the process.
 from __future__ import annotations
 
 import contextlib
+import glob
 import logging
 import os
 import select
@@ -22,6 +23,7 @@ import threading
 import time
 from pathlib import Path
 
+from gatetherm import TEMP_PREFIX
 from gatetherm.process import can_fork, end_with_parent, fork, keep_freed, message, receive, send
 
 log = logging.getLogger(__name__)
@@ -69,6 +71,15 @@ def _serve(jobs: int, replies: int) -> None:
             reply = (isinstance(err, OSError), f"{type(err).__name__}: {err}"[:4000])
         with contextlib.suppress(BrokenPipeError):  # closed without waiting for the answers
             send(replies, reply)
+
+
+def _remove_temporaries(paths) -> None:
+    """Remove the temporaries :func:`gatetherm.atomic_path` made for ``paths`` (a process killed
+    while writing one cannot)."""
+    for path in paths:
+        for tmp in path.parent.glob(f"{TEMP_PREFIX}{glob.escape(path.stem)}.*{glob.escape(path.suffix)}"):
+            with contextlib.suppress(OSError):
+                tmp.unlink()
 
 
 def _can_fork() -> bool:
@@ -243,6 +254,7 @@ class Painter:
         for jobs, replies in self._pipes:
             os.close(jobs)
             os.close(replies)
+        given = [path for queued in self._queued for path in queued]
         self._pipes, self._queued, self._outbox, self._reserved, self._prepared = [], [], [], [], {}
         pid, self._pid = self._pid, None
         if pid is None:
@@ -251,9 +263,11 @@ class Painter:
             os.kill(pid, signal.SIGTERM)
             end = time.monotonic() + STOP_S
             while os.waitpid(pid, os.WNOHANG) == (0, 0):
-                if time.monotonic() > end:
+                if time.monotonic() > end:  # inside a long rendering: killed, its temporary removed here
                     os.kill(pid, signal.SIGKILL)
-                    break
+                    os.waitpid(pid, 0)
+                    _remove_temporaries(given)
+                    return
                 time.sleep(0.01)
             else:
                 return
