@@ -41,11 +41,8 @@ in one line (``str(err)``) which argument is wrong and how to fix it:
 - ``OSError`` for a file that cannot be written (a full disk), naming the file.
 
 Anything else is a defect of gatetherm: please report it.
-
-:class:`~gatetherm.InputError` and the argument ranges (:class:`~gatetherm.checks.Range`,
-``POSITIVE``) are offered here too: the command line checks its options with the same ranges.
 """
-from gatetherm import InputError
+from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
 from gatetherm.api.control import compensate, diagnose
 from gatetherm.api.errormodel import Prediction, errormodel_fit, errormodel_predict, errormodel_refit
 from gatetherm.api.export import export_ccx
@@ -55,7 +52,7 @@ from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficie
     gate_frame, load_case, nc_schedule, run, schedule_file
 from gatetherm.api.sensors import check_placement, place_sensors, write_placement
 from gatetherm.api.zoo import validate_zoo
-from gatetherm.checks import POSITIVE, Range
+from gatetherm.checks import POSITIVE, Range  # noqa: F401
 
 __all__ = ["Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement",
            "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
