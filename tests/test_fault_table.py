@@ -53,6 +53,7 @@ from pathlib import Path
 import gatetherm.outdir as od
 from gatetherm.cli import main
 sig, point, argv = int(sys.argv[1]), sys.argv[2], sys.argv[3:]
+signal.signal(signal.SIGINT, signal.default_int_handler)  # as on a terminal (a job started with '&' ignores it)
 def fault(*args):
     if point == "started":
         Path(args[1], "partial.json").write_text('{"half": ')
