@@ -63,6 +63,9 @@ def test_simulate_reports_progress_and_writes_what_it_prints(config, tmp_path):
     first, second = res.summary().splitlines()
     assert first == f"wrote {tmp_path / 's'}/timeseries.csv, summary.json, fields/ and plots"
     assert second.startswith(f"first peak {round(s['first_peak_um'], 2)} µm at {s['first_peak_min']} min")
+    with pytest.raises(InputError, match="^out: this run was written into .* as a one-shot run"):
+        res.write(tmp_path / "again")  # written with out=: its solver is released
+    assert not (tmp_path / "again").exists()
     with pytest.raises(InputError, match="^condition/schedule: "):
         gt.simulate(1, "s.csv")
 

@@ -41,6 +41,9 @@ class RunResult:
     """The paper's frame (:func:`simulate`) rather than a case file (:func:`run_case`)."""
     fields_every: float | None = None
     """Interval of the written fields, s (None: the case's own)."""
+    released: bool = False
+    """Written with ``out=`` as a one-shot run (its elastic solver released as it was written):
+    it is not written again."""
 
     def write(self, out: str | os.PathLike, pictures: bool = True) -> "RunResult":
         """Write the run into ``out`` as one transaction (:func:`gatetherm.outdir.output_dir`):
@@ -55,6 +58,11 @@ class RunResult:
         from gatetherm.outdir import output_dir
 
         argument("out", out, PATH, "a folder's path")
+        if self.released:
+            from gatetherm import InputError
+
+            raise InputError("out", f"this run was written into '{self.folder}' as a one-shot run",
+                             "run it without out= to write it more than once")
         with output_dir(out, OUTPUTS, keep=self.run.case.files) as stage:
             figures = self.run.write(stage, pictures=pictures, fields_every=self.fields_every)
         return dataclasses.replace(self, figures=figures, folder=str(out))
@@ -125,7 +133,8 @@ def run_case(path: str | os.PathLike, out: str | os.PathLike | None = None, *, p
         return case, case.schedule, case.files, case.time.fields if case.time else 1.0, {"check_order": True}
 
     res, figures = _written(make, out, pictures, on_progress)
-    return RunResult(res, res.summary() if figures is None else figures, None if out is None else str(out))
+    return RunResult(res, res.summary() if figures is None else figures, None if out is None else str(out),
+                     released=out is not None)
 
 
 def simulate(condition: int | None = None, schedule: str | os.PathLike | None = None, *, dim: int = 2,
@@ -145,7 +154,8 @@ def simulate(condition: int | None = None, schedule: str | os.PathLike | None = 
     config : str or path, optional
         A model file (default: the shipped paper model).
     effects : sequence of str
-        Effects on top of the model file's, each ``NAME:PARAM=VALUE`` or ``KIND@TARGET=VALUE``.
+        Effects on top of the model file's, each ``KEY:PARAM=VALUE`` or ``KEY=VALUE`` (KEY: ``KIND@TARGET``;
+        ``gatetherm diagnose --list-effects``).
     fields_every : float
         Interval of the written fields, s (at least 60).
     out : str or path, optional
@@ -180,4 +190,4 @@ def simulate(condition: int | None = None, schedule: str | os.PathLike | None = 
 
     res, figures = _written(make, out, pictures, on_progress)
     return RunResult(res, res.summary() if figures is None else figures, None if out is None else str(out), True,
-                     every)
+                     every, out is not None)

@@ -162,7 +162,8 @@ class ReductionRun:
         """The lines ``gatetherm reduce`` prints (no final newline)."""
         red, b = self.reduction, self.reduction.error_bound
         lines = [f"wrote {self.folder}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} "
-                 f"unknowns in {self.seconds:.1f} s; BT bound " + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items())]
+                 f"unknowns in {self.seconds:.1f} s; BT bound "
+                 + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items())]
         for c in self.checks:
             lines.append(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm, "
                          f"θ {c.max_theta_error_K:.3f} K; reduced run {c.rom_ms:.2f} ms (FE {c.fe_seconds:.1f} s)")
