@@ -150,8 +150,6 @@ CLI_OFFENDERS = {
     "gatetherm.cli.errormodel": "front-b", "gatetherm.cli.sensors": "front-b", "gatetherm.cli.sweep": "front-b",
     "gatetherm.cli.report": "front-b", "gatetherm.cli.validate": "front-b",
     "gatetherm.cli.live": "live2", "gatetherm.cli.twin": "live2",
-    "gatetherm.cli.api_reference": "documents gt.plot (gatetherm.validation.plots.api), which gatetherm.api "
-                                   "does not import",
 }
 
 

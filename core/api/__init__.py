@@ -68,3 +68,13 @@ __all__ = ["BeamCoefficients", "Case", "Export", "FrameFiles", "Prediction", "Re
            "export_ccx", "gate_frame", "live", "load_case", "mesh_frame", "nc_schedule", "place_sensors",
            "reduce", "reduce_case", "run", "run_case", "schedule_file", "simulate", "twin", "validate_zoo",
            "write_placement", "write_reduction"]
+
+
+def __getattr__(name: str):
+    """``gatetherm.api.plot``: the plots (:mod:`gatetherm.validation.plots.api`, as ``gt.plot``),
+    imported on first use."""
+    if name == "plot":
+        import importlib
+
+        return importlib.import_module("gatetherm.validation.plots.api")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
