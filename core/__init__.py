@@ -22,10 +22,12 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
-       "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit", "errormodel_predict",
-       "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule", "place_sensors", "reduce",
-       "run", "schedule_file", "twin", "validate_zoo", "write_placement", "write_reduction")
+API = ("BeamCoefficients", "Case", "Export", "FrameFiles", "Prediction", "ReductionRun", "Run", "RunResult",
+       "Schedule", "SolverOptions", "beam_coefficients", "beam_normalised", "check_placement", "check_rom",
+       "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
+       "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live",
+       "load_case", "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "run", "run_case",
+       "schedule_file", "simulate", "twin", "validate_zoo", "write_placement", "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 
 

@@ -295,9 +295,9 @@ def test_an_export_time_is_a_step_of_the_run():
 def test_equations_no_solver_can_solve_are_one_line(tmp_path, capsys, monkeypatch):
     """A factorisation that fails (PARDISO's zero pivot) is reported as bad input, exit 2."""
     from gatetherm.solvers.linsolve import SolverError
-    import gatetherm
+    import gatetherm.api
 
     def fail(*a, **k):
         raise SolverError("the matrix cannot be factorised (PARDISO phase 22 failed: zero pivot)")
-    monkeypatch.setattr(gatetherm, "load_case", fail, raising=False)
+    monkeypatch.setattr(gatetherm.api, "run_case", fail)
     refused(capsys, 2, ["run", "c.toml", "--out", tmp_path / "o"], "error: the matrix cannot be factorised")

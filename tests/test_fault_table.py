@@ -26,14 +26,17 @@ COARSE = "[mesh]\nsize = 0.03\nsize_3d = 0.04\n"
 STUDY = '[study]\ncompute = ["coefficients"]\n[set]\n"mesh.size" = 0.03\n[grid]\n"geometry.l4" = [0.25, 0.3]\n'
 
 #: command: (argv with {d} for the inputs' folder and {out} for --out, the module whose OUTPUTS
-#: name its output set, the attribute, quick: also faulted after all files were written)
+#: name its output set (of gatetherm.cli, or a dotted path: the API's module of the command), the
+#: attribute, quick: also faulted after all files were written)
 TABLE = {
-    "run": ("run {d}/case.toml --no-pictures --out {out}", "run", "OUTPUTS", False),
-    "simulate": ("simulate --condition 1 --config {d}/c.toml --no-pictures --out {out}", "simulate", "OUTPUTS",
-                 False),
-    "mesh": ("mesh --config {d}/c.toml --out {out}", "mesh", "OUTPUTS", True),
-    "export": ("export ccx --condition 1 --time 60 --dim 3 --config {d}/c.toml --out {out}", "export", "OUTPUTS", False),
-    "reduce": ("reduce --config {d}/c.toml --states 4 --no-check --out {out}", "reduce", "OUTPUTS", False),
+    "run": ("run {d}/case.toml --no-pictures --out {out}", "gatetherm.api.jobs", "OUTPUTS", False),
+    "simulate": ("simulate --condition 1 --config {d}/c.toml --no-pictures --out {out}",
+                 "gatetherm.api.jobs", "OUTPUTS", False),
+    "mesh": ("mesh --config {d}/c.toml --out {out}", "gatetherm.api.frame", "OUTPUTS", True),
+    "export": ("export ccx --condition 1 --time 60 --dim 3 --config {d}/c.toml --out {out}",
+               "gatetherm.api.export", "OUTPUTS", False),
+    "reduce": ("reduce --config {d}/c.toml --states 4 --no-check --out {out}",
+               "gatetherm.api.reduction", "OUTPUTS", False),
     "sensors": ("sensors --config {d}/c.toml --count 1 --loads 2 --states 4 --out {out}", "sensors", "OUTPUTS",
                 False),
     "errormodel fit": ("errormodel fit --data {d}/data.csv --targets d_um --out {out}", "errormodel",
@@ -98,7 +101,7 @@ def previous_run(command: str, out: Path) -> dict[str, str]:
     """Fill ``out`` with a previous run's output set (each file naming itself) and a file of the
     user's; the digests of all."""
     _, module, attr, _ = TABLE[command]
-    names = getattr(importlib.import_module(f"gatetherm.cli.{module}"), attr)
+    names = getattr(importlib.import_module(module if "." in module else f"gatetherm.cli.{module}"), attr)
     for name in (*names, "my_notes.txt"):
         p = out / name.replace("*", "old")
         p.parent.mkdir(parents=True, exist_ok=True)

@@ -1,6 +1,7 @@
 """Export a state for another code: a CalculiX input deck (:mod:`gatetherm.api`)."""
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
@@ -10,7 +11,7 @@ from gatetherm.api.run import Case, Schedule
 
 
 def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *, schedule: Schedule | None = None,
-               title: str | None = None, run: bool = False) -> dict:
+               title: str | None = None, run: bool = False, on_step=None) -> dict:
     """Write ``out/job.inp``, a CalculiX 2.20 deck of ``case``'s state at ``time``, and
     ``out/gatetherm.json``, gatetherm's own displacements there (run ``ccx job`` in ``out``).
 
@@ -39,6 +40,8 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
         The deck's heading.
     run : bool
         Also run ``ccx job`` there (InputError if ``ccx`` is not installed) and add its results.
+    on_step : callable, optional
+        ``on_step(i, n)`` after each of the ``n`` samples of the run to ``time``.
 
     Returns
     -------
@@ -51,15 +54,136 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
         ``run``: ``calculix``, CalculiX's ``probes_m`` and ``relative_m`` and ``worst`` (the
         largest probe difference over gatetherm's largest displacement).
     """
-    from gatetherm.studies.run.ccx import check_time, export_state, run_ccx
+    from gatetherm.studies.run.ccx import check_time, export_state
 
     schedule = case.schedule if schedule is None else schedule
     t = check_time(schedule, float(schedule.times[-1]) if time is None else float(time))
-    inp, info = export_state(case, schedule, t, title or f"gatetherm {case.name}, t = {t / 60:g} min")
+    inp, info = export_state(case, schedule, t, title or f"gatetherm {case.name}, t = {t / 60:g} min", on_step)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    return _write_deck(out, inp, info, run)
+
+
+def _write_deck(out: Path, inp: str, info: dict, run: bool) -> dict:
+    """``out/job.inp`` and ``out/gatetherm.json``; with ``run``, CalculiX run there (its results in the dict)."""
+    from gatetherm.studies.run.ccx import run_ccx
+
     write_text_atomic(out / "job.inp", inp)
     write_text_atomic(out / "gatetherm.json", json_text(info, "gatetherm.json", indent=2))
     if run:
         info = {**info, "calculix": run_ccx(out, info)}
     return info
+
+
+OUTPUTS = ("job.inp", "gatetherm.json", "ccx.log")
+"""What :meth:`Export.write` writes; writing again replaces all of it (CalculiX's own files are left)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Export:
+    """A state exported for CalculiX by :func:`export_case`, and the folder it was written into."""
+
+    deck: str
+    """``job.inp``'s text."""
+    info: dict
+    """``gatetherm.json``'s content (:func:`export_ccx`'s result; with a CalculiX run, ``calculix`` too)."""
+    run: bool = False
+    """CalculiX runs (ran) in the folder written."""
+    files: tuple = ()
+    """Input files the written folder must keep."""
+    folder: str | None = None
+    """The folder it was written into, as given (None: not written)."""
+
+    def write(self, out: str | os.PathLike) -> "Export":
+        """Write ``out/job.inp`` and ``out/gatetherm.json`` (with :attr:`run`, run ``ccx job`` there)
+        in one transaction.
+
+        Returns
+        -------
+        Export
+            This result with :attr:`folder` ``out`` (and CalculiX's results in :attr:`info`).
+        """
+        from gatetherm.outdir import output_dir
+
+        with output_dir(out, OUTPUTS, keep=self.files) as stage:
+            info = _write_deck(stage, self.deck, self.info, self.run)
+        return dataclasses.replace(self, info=info, folder=str(out))
+
+    def summary(self) -> str:
+        """The lines ``gatetherm export ccx`` prints (no final newline)."""
+        info, ccx = self.info, self.info.get("calculix")
+        lines = [f"wrote {self.folder}/job.inp ({info['element']}, {info['nodes']} nodes) and gatetherm.json"
+                 + ("" if self.run else f"; run: cd {self.folder} && ccx job")]
+        for name, v in info["relative_m"].items():
+            lines.append(f"gatetherm {name}: {v * 1e6:.6g} um" + (
+                f", CalculiX {ccx['relative_m'][name] * 1e6:.6g} um ({ccx['relative_m'][name] / v - 1:+.1e})"
+                if ccx and v else ""))
+        if ccx:
+            lines.append(f"CalculiX against gatetherm at the probes: largest difference {ccx['worst']:.1e} of the "
+                         "largest displacement")
+        return "\n".join(lines)
+
+
+def export_case(case: Case | str | os.PathLike | None = None, *, condition: int | None = None,
+                time: float | None = None, dim: int = 2, config: str | os.PathLike | None = None, run: bool = False,
+                out: str | os.PathLike | None = None, on_progress=None) -> Export:
+    """A case file's state (or the paper's frame's under a condition) as a CalculiX deck: what
+    ``gatetherm export ccx`` does (:func:`export_ccx` for what the deck holds and refuses).
+
+    Parameters
+    ----------
+    case : Case or str or path, optional
+        A case, or a case file's path (give this or ``condition``).
+    condition : int, optional
+        The paper's frame (``dim``, ``config``) under its condition 1, 2 or 3.
+    time : float, optional
+        Time of the state, s: a step of the schedule (default its last).
+    dim : int
+        The frame's 2 or 3 (with ``condition``).
+    config : str or path, optional
+        The frame's model file (with ``condition``).
+    run : bool
+        Also run ``ccx job`` in ``out`` and compare.
+    out : str or path, optional
+        Also write it there (:meth:`Export.write`), the folder checked and locked before the run
+        to ``time``.
+    on_progress : callable, optional
+        ``on_progress(i, n)`` after each of the ``n`` samples of the run to ``time``.
+
+    Returns
+    -------
+    Export
+    """
+    from gatetherm import InputError
+    from gatetherm.api.case import PATH, gate_frame, load_case
+    from gatetherm.checks import argument
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.ccx import check_time, export_state
+    from gatetherm.studies.run.conditions import condition as check_condition
+
+    argument("case", case, (Case, *PATH, type(None)), "a Case, a case file's path or None")
+    argument("out", out, (*PATH, type(None)), "a folder's path or None")
+    argument("run", run, bool, "True or False")
+    if (case is None) == (condition is None):
+        raise InputError("case/condition", "give one of the two", "e.g. condition=1, time=900")
+    if condition is not None:  # 0 is no condition (it would run condition 1)
+        check_condition(condition)
+    what = str(case) if case is not None and not isinstance(case, Case) else f"condition {condition}"
+    if isinstance(case, Case):
+        what = case.name
+    else:
+        case = load_case(case) if case is not None else gate_frame(dim, config, condition)
+    schedule = case.schedule
+    t = check_time(schedule, float(schedule.times[-1]) if time is None else time)
+    title = f"gatetherm {what}, t = {t / 60:g} min"
+    files = (config, *case.files)
+
+    def made() -> Export:
+        return Export(*export_state(case, schedule, t, title, on_progress), run, files)
+
+    if out is None:
+        return made()
+    with output_dir(out, OUTPUTS, keep=files) as stage:
+        result = made()
+        info = _write_deck(stage, result.deck, result.info, run)
+    return dataclasses.replace(result, info=info, folder=str(out))

@@ -4,6 +4,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from pathlib import Path
+from typing import Callable
 
 from gatetherm.api.run import Case, Schedule, _case, condition
 from gatetherm.checks import Range, whole_argument
@@ -117,3 +118,126 @@ def write_reduction(out: str | os.PathLike, red, checks, case: Case, states: int
         summary["max_delta_error_um"] = max(c.max_delta_error_um for c in checks)
     write_json(out / "summary.json", summary)
     return summary
+
+
+OUTPUTS = ("rom.npz", "rom.key", "summary.json")
+"""What :meth:`ReductionRun.write` writes; writing again replaces all of it."""
+
+
+@dataclasses.dataclass(frozen=True)
+class ReductionRun:
+    """A reduced model made by :func:`reduce_case`, its checks and the folder it was written into."""
+
+    case: Case
+    """The case it was reduced from."""
+    reduction: object
+    """:func:`reduce`'s result (``.rom``, ``.error_bound`` in µm, ``.basis`` …)."""
+    checks: list
+    """Per checked schedule, the largest error of every output (δ in µm, temperatures in K)."""
+    states: int
+    """States asked for."""
+    seconds: float
+    """Wall time of the reduction, s."""
+    files: tuple = ()
+    """Input files the written folder must keep (the model file, the case's files, the checked schedules)."""
+    folder: str | None = None
+    """The folder it was written into, as given (None: not written)."""
+
+    def write(self, out: str | os.PathLike) -> "ReductionRun":
+        """Write ``out/rom.npz``, ``out/rom.key`` and, last, ``out/summary.json``
+        (:func:`write_reduction`) in one transaction.
+
+        Returns
+        -------
+        ReductionRun
+            This result with :attr:`folder` ``out``.
+        """
+        from gatetherm.outdir import output_dir
+
+        with output_dir(out, OUTPUTS, keep=self.files) as stage:
+            write_reduction(stage, self.reduction, self.checks, self.case, self.states, self.seconds)
+        return dataclasses.replace(self, folder=str(out))
+
+    def summary(self) -> str:
+        """The lines ``gatetherm reduce`` prints (no final newline)."""
+        red, b = self.reduction, self.reduction.error_bound
+        lines = [f"wrote {self.folder}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} "
+                 f"unknowns in {self.seconds:.1f} s; BT bound "
+                 + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items())]
+        for c in self.checks:
+            lines.append(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm, "
+                         f"θ {c.max_theta_error_K:.3f} K; reduced run {c.rom_ms:.2f} ms (FE {c.fe_seconds:.1f} s)")
+            lines.append("  largest error per output: " + ", ".join(f"{k} {v:.3g}" for k, v in c.errors.items()))
+        return "\n".join(lines)
+
+
+def reduce_case(case: Case | str | os.PathLike | None = None, *, dim: int = 2, config: str | os.PathLike | None = None,
+                states: int = 30, check=(), check_fe: bool = True, out: str | os.PathLike | None = None,
+                on_progress=None) -> ReductionRun:
+    """A reduced heat model of a case (or the paper's frame), checked against full FE runs:
+    what ``gatetherm reduce`` does.
+
+    Parameters
+    ----------
+    case : Case or str or path, optional
+        A case, or a case file's path (default: the paper's frame of ``dim`` and ``config``).
+    dim : int
+        The frame's 2 or 3 (without ``case``).
+    config : str or path, optional
+        The frame's model file (without ``case``).
+    states : int
+        States of the reduced model, 2 ... 200.
+    check : sequence of str or path
+        Schedule files to check it on as well, sampled at the case's ``[time]`` step (else 60 s).
+    check_fe : bool
+        Check it on :func:`check_schedules` and ``check`` (False: no full FE run at all).
+    out : str or path, optional
+        Also write it there (:meth:`ReductionRun.write`), the folder checked and locked before
+        the reduction starts.
+    on_progress : callable, optional
+        ``on_progress(i, n)`` after the reduction (i = 1) and after each of the checks (n = 1 +
+        the number of checked schedules).
+
+    Returns
+    -------
+    ReductionRun
+    """
+    import time
+
+    from gatetherm.api.case import PATH, gate_frame, load_case, schedule_file
+    from gatetherm.checks import argument
+    from gatetherm.outdir import output_dir
+    from gatetherm.studies.run.reduce import check as check_one
+    from gatetherm.studies.run.scenario import ScenarioCache
+
+    states = whole_argument("states", states, STATES, "e.g. 30")
+    argument("case", case, (Case, *PATH, type(None)), "a Case, a case file's path or None")
+    argument("out", out, (*PATH, type(None)), "a folder's path or None")
+    argument("check_fe", check_fe, bool, "True or False")
+    argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
+    for i, f in enumerate(check):
+        argument(f"check[{i}]", f, PATH, "a schedule file's path")
+    if not isinstance(case, Case):
+        case = load_case(case) if case is not None else gate_frame(dim, config)
+    step = case.time.step if case.time else 60.0  # a check file at the case's own step
+    schedules = [*check_schedules(case), *(schedule_file(f, case, step) for f in check)] if check_fe else []
+    files = (config, *case.files, *check)
+    progress = on_progress or (lambda i, n: None)
+
+    def made() -> ReductionRun:
+        t0 = time.perf_counter()
+        red = reduce(case, states)
+        seconds = time.perf_counter() - t0
+        progress(1, 1 + len(schedules))
+        cache, checks = ScenarioCache(), []
+        for i, s in enumerate(schedules):
+            checks += check_one(case, red.rom, [s], cache)
+            progress(2 + i, 1 + len(schedules))
+        return ReductionRun(case, red, checks, states, seconds, files)
+
+    if out is None:
+        return made()
+    with output_dir(out, OUTPUTS, keep=files) as stage:
+        result = made()
+        write_reduction(stage, result.reduction, result.checks, case, states, result.seconds)
+    return dataclasses.replace(result, folder=str(out))

@@ -117,7 +117,6 @@ def _os_message(err: OSError) -> str:
 def _run(argv: list[str] | None) -> int:
     import logging
 
-    from gatetherm import InputError
     from gatetherm.cli.options import UsageError
 
     parser = build_parser(_command(sys.argv[1:] if argv is None else argv))
@@ -135,9 +134,7 @@ def _run(argv: list[str] | None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from gatetherm.options import SolverOptions
-    from gatetherm.process import configure
-    from gatetherm.studies.sweeps.runner import PointsFailed
+    from gatetherm.api import InputError, PointsFailed, SolverError, SolverOptions, configure
 
     logging.captureWarnings(True)  # the numerical libraries' warnings: in the log, shown with -v
     logging.getLogger("py.warnings").setLevel(logging.INFO if args.verbose else logging.ERROR)
@@ -154,10 +151,7 @@ def _run(argv: list[str] | None) -> int:
         return _say(f"error: {err}", 2)
     except PointsFailed as err:
         return _say(f"error: {err}", 1)
-    except RuntimeError as err:  # the equations of the input cannot be solved (a solver ran: it is imported)
-        linsolve = sys.modules.get("gatetherm.solvers.linsolve")
-        if linsolve is None or not isinstance(err, linsolve.SolverError):
-            raise
+    except SolverError as err:  # the equations of the input cannot be solved
         return _say(f"error: {err}", 2)
     except OSError as err:
         return _say(f"error: {_os_message(err)}", 1)

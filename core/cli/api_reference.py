@@ -96,16 +96,17 @@ def _entry(prefix: str, name: str, obj) -> list[str]:
 
 def public() -> list[tuple[str, str, object]]:
     """(prefix, name, object) of every documented public name: ``gt.NAME`` and ``gt.plot.NAME``."""
-    import gatetherm as gt
+    import gatetherm.api as gt
 
-    return [("gt.", n, getattr(gt, n)) for n in gt.API] + [("gt.plot.", n, getattr(gt.plot, n)) for n in gt.plot.__all__]
+    return [("gt.", n, getattr(gt, n)) for n in gt.__all__] + [("gt.plot.", n, getattr(gt.plot, n))
+                                                             for n in gt.plot.__all__]
 
 
 def markdown() -> str:
     """``docs/api.md``."""
     import gatetherm.api
-    import gatetherm.validation.plots.api as plots
 
+    plots = gatetherm.api.plot
     names = public()
     L = ["# Python API reference", "",
          "Generated from the docstrings by `python -m gatetherm.cli.api_reference > docs/api.md` "

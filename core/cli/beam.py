@@ -2,11 +2,7 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
-
-from gatetherm import InputError
-from gatetherm.solvers.beam import normalised
 
 
 def register(subparsers) -> None:
@@ -26,16 +22,13 @@ def register(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import gatetherm.api as gt
+
     a, b = args.l_over_l4, args.beta
     if not (math.isfinite(a) and a > 0):
-        raise InputError("--l-over-l4", f"must be a finite number > 0, got {a}",
-                         "pass l/l4, e.g. --l-over-l4 1.5")
+        raise gt.InputError("--l-over-l4", f"must be a finite number > 0, got {a}",
+                            "pass l/l4, e.g. --l-over-l4 1.5")
     if not b >= 0:  # also rejects nan
-        raise InputError("--beta", f"must be >= 0, got {b}", "pass e.g. --beta 0.1")
-    ki, kc = (float(v) for v in normalised(a, b))
-    if args.json:
-        print(json.dumps({"Ki_norm": ki, "Kc_norm": kc}))
-    else:
-        print(f"l/l4 = {a:g}, beta = {b:g}: Ki/(3 alpha l^2/8h) = {ki:.6g}, "
-              f"Kc/(alpha l_C) = {kc:.6g}")
+        raise gt.InputError("--beta", f"must be >= 0, got {b}", "pass e.g. --beta 0.1")
+    print(gt.beam_normalised(a, b).summary(as_json=args.json))
     return 0

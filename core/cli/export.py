@@ -2,11 +2,7 @@
 gatetherm against an independent FE code."""
 from __future__ import annotations
 
-from gatetherm import InputError
-from gatetherm.cli.options import add_model_options, refuse_model_options
-
-#: What an export writes into --out; a rerun replaces all of it (ccx's own files are left).
-OUTPUTS = ("job.inp", "gatetherm.json", "ccx.log")
+from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
 
 DESCRIPTION = (
     "Write DIR/job.inp for CalculiX 2.20 (run 'ccx job' in DIR) and DIR/gatetherm.json with gatetherm's own "
@@ -41,31 +37,14 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import gatetherm as gt
-    from gatetherm.outdir import output_dir
-    from gatetherm.studies.run.ccx import check_time
-    from gatetherm.studies.run.conditions import condition as check_condition
+    import gatetherm.api as gt
 
     if (args.case is None) == (args.condition is None):
-        raise InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
+        raise gt.InputError("CASE.toml/--condition", "give one of the two", "e.g. --condition 1 --time 15")
     if args.case:
         refuse_model_options(args, "CASE.toml")
-    if args.condition is not None:  # 0 is no condition (it ran condition 1)
-        check_condition(args.condition)
-    case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config, args.condition)
-    what = str(args.case) if args.case else f"condition {args.condition}"
-    schedule = case.schedule
-    t = check_time(schedule, float(schedule.times[-1]) if args.time is None else args.time * 60.0)
-    with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files)) as out:
-        info = gt.export_ccx(case, out, t, schedule=schedule, title=f"gatetherm {what}, t = {t / 60:g} min",
-                             run=args.run)
-    print(f"wrote {args.out}/job.inp ({info['element']}, {info['nodes']} nodes) and gatetherm.json"
-          + ("" if args.run else f"; run: cd {args.out} && ccx job"))
-    ccx = info.get("calculix")
-    for name, v in info["relative_m"].items():
-        print(f"gatetherm {name}: {v * 1e6:.6g} um" + (f", CalculiX {ccx['relative_m'][name] * 1e6:.6g} um "
-                                                      f"({ccx['relative_m'][name] / v - 1:+.1e})" if ccx and v else ""))
-    if ccx:
-        print(f"CalculiX against gatetherm at the probes: largest difference {ccx['worst']:.1e} of the largest "
-              "displacement")
+    res = gt.export_case(args.case, condition=args.condition, time=None if args.time is None else args.time * 60.0,
+                         dim=args.dim, config=args.config, run=args.run, out=args.out,
+                         on_progress=Progress(f"export {args.case or f'condition {args.condition}'}"))
+    print(res.summary())
     return 0

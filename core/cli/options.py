@@ -1,12 +1,10 @@
-"""Options shared by several commands, and the terminal progress bar."""
+"""Options shared by several commands, and the terminal progress bar. Only the standard
+library is imported here (the parsers are built before a command imports :mod:`gatetherm.api`)."""
 from __future__ import annotations
 
 import argparse
 import os
 import sys
-
-from gatetherm import InputError
-from gatetherm.checks import Range
 
 
 class _Default(int):
@@ -24,6 +22,8 @@ def refuse_model_options(args, case: str = "--case") -> None:
     given = [o for o, v in (("--dim", args.dim), ("--config", args.config))
              if v is not None and type(v) is not _Default]
     if given:
+        from gatetherm.api import InputError
+
         raise InputError(f"{case}/{given[0]}", "a case file gives its own model and mesh", f"drop {given[0]}")
 
 
@@ -64,9 +64,16 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(f"{self.prog}: error: {message} (see '{self.prog} --help')")
 
 
-def number(rng: Range):
-    """An argparse ``type``: a number (a whole one if ``rng.whole``) admissible in ``rng``."""
+def number(rng):
+    """An argparse ``type``: a number (a whole one if ``rng.whole``) admissible in ``rng``, a
+    :class:`gatetherm.api.Range` or the name of one there (``"POSITIVE"``, ``"WORKERS"``: looked
+    up when a value is parsed, so that building the parser imports no library)."""
     def parse(text: str):
+        nonlocal rng
+        if isinstance(rng, str):
+            import gatetherm.api
+
+            rng = getattr(gatetherm.api, rng)
         try:
             value = int(text) if rng.whole else float(text)
         except ValueError:
@@ -78,16 +85,5 @@ def number(rng: Range):
     return parse
 
 
-FIELD_FILES = ("fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5")
-"""The field files of a run in its --out (studies.run.output.write_fields)."""
-WORKERS = Range(1, whole=True)
-"""Worker processes."""
-
-
-def picture_keep(schedule, every: float, picture_every: float = 300.0) -> list[float]:
-    """The sample times whose states a written run needs: the fields every ``every`` s, the
-    candidates of the deformed picture (every ``picture_every`` s: it shows δ's first peak) and
-    the end."""
-    times = [float(t) for t in schedule.times]
-    on = [t for t in times if any(abs(t / e - round(t / e)) < 1e-9 for e in (every, picture_every))]
-    return sorted(set(on) | {times[-1]})
+WORKERS = "WORKERS"
+"""Worker processes: :data:`gatetherm.api.WORKERS`, for :func:`number`."""

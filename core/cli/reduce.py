@@ -9,14 +9,9 @@ the full FE run).
 """
 from __future__ import annotations
 
-import time
-
-from gatetherm import InputError
-from gatetherm.cli.options import add_model_options, refuse_model_options
+from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
 
 MAX_STATES = 200
-#: What a run writes into --out; a rerun replaces all of it.
-OUTPUTS = ("rom.npz", "rom.key", "summary.json")
 
 
 def register(sub) -> None:
@@ -35,28 +30,14 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import gatetherm as gt
-    from gatetherm.outdir import output_dir
+    import gatetherm.api as gt
 
     if not 2 <= args.states <= MAX_STATES:
-        raise InputError("--states", f"{args.states} is outside 2..{MAX_STATES}", "e.g. --states 30")
+        raise gt.InputError("--states", f"{args.states} is outside 2..{MAX_STATES}", "e.g. --states 30")
     if args.case is not None:
         refuse_model_options(args)
-    case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config)
-    step = case.time.step if case.time else 60.0  # a --check file at the case's own step
-    schedules = [] if args.no_check else [*gt.check_schedules(case), *(gt.schedule_file(f, case, step)
-                                                                       for f in args.check)]
-    with output_dir(args.out, OUTPUTS, keep=(args.config, *case.files, *args.check)) as out:
-        t0 = time.perf_counter()
-        red = gt.reduce(case, args.states)
-        seconds = time.perf_counter() - t0
-        checks = gt.check_rom(case, red.rom, schedules)
-        gt.write_reduction(out, red, checks, case, args.states, seconds)
-    b = red.error_bound
-    print(f"wrote {args.out}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} unknowns "
-          f"in {seconds:.1f} s; BT bound " + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items()))
-    for c in checks:
-        print(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm, "
-              f"θ {c.max_theta_error_K:.3f} K; reduced run {c.rom_ms:.2f} ms (FE {c.fe_seconds:.1f} s)")
-        print("  largest error per output: " + ", ".join(f"{k} {v:.3g}" for k, v in c.errors.items()))
+    res = gt.reduce_case(args.case, dim=args.dim, config=args.config, states=args.states,
+                         check=args.check, check_fe=not args.no_check, out=args.out,
+                         on_progress=Progress(f"reduce {args.case or 'frame'}"))
+    print(res.summary())
     return 0

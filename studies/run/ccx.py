@@ -225,10 +225,11 @@ def check_time(schedule, t: float) -> float:
     return near[0]
 
 
-def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
+def export_state(case, schedule, t: float, title: str, on_step=None) -> tuple[str, dict]:
     """Run ``case`` through ``schedule`` and export the state at ``t`` (s, a step of the run):
     (``job.inp`` text, ``gatetherm.json`` content: gatetherm's displacement at every probe and
-    its relative displacements in m, the probes' nodes and weights, the mesh size)."""
+    its relative displacements in m, the probes' nodes and weights, the mesh size).
+    ``on_step(i, n)`` is called after each of the run's ``n`` samples."""
     from gatetherm.solvers.heat import environment
     from gatetherm.solvers.model import static_displacement
     from gatetherm.studies.run.scenario import run_scenario
@@ -236,7 +237,7 @@ def export_state(case, schedule, t: float, title: str) -> tuple[str, dict]:
     t = check_time(schedule, t)
     refuse(case.problem)  # before the run
     env = environment(schedule.drive, t)
-    run = run_scenario(case, schedule, keep_times=[t])
+    run = run_scenario(case, schedule, keep_times=[t], on_step=on_step)
     model = run.model
     U = next((s[1] for s in run.result.states if abs(s[0] - t) < 1e-6), None)
     if model.heat is not None and U is None:
