@@ -102,6 +102,7 @@ def test_twin_and_live_close_the_loop_and_a_second_live_refuses(tmp_path):
     assert finish(tw)[0] == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["periods"] == 31 and summary["missed"] == 0 and summary["held"] == 0
+    assert summary["monitor"] == "not worse" and summary["worse"] == 0  # the right sign is never fallen back
     assert summary["compensated_band_um"] == pytest.approx(1.1, abs=0.6)  # band: ±3 µm
     ts = read_timeseries(out / "live.csv", required=("time_s",))
     assert np.array_equal(ts.time_s, 60.0 * np.arange(31))
@@ -121,7 +122,7 @@ def test_closed_loop_six_hours_at_120x_matches_offline_compensation(tmp_path):
     assert code == 0, err
     assert finish(tw)[0] == 0
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["periods"] == 361 and summary["missed"] == 0
+    assert summary["periods"] == 361 and summary["missed"] == 0 and summary["monitor"] == "not worse"
     assert summary["compensated_band_um"] < 3.0
     ts = read_timeseries(out / "live.csv", required=("time_s",))
     comp = gt.compensate(ts, gt.load_case(CASE), "rom", actuator=None)  # = compensate --data live.csv --no-actuator
@@ -165,3 +166,33 @@ def test_faults_nan_kill_9_and_twin_restart(tmp_path):
     events = (out / "events.log").read_text()
     assert "theta_A_degC missing" in events and "connection lost" in events and "reconnected" in events
     assert np.max(np.abs(np.diff(ts["offset_um"]))) <= 5.0 + 1e-9  # the change limit per period
+
+
+@pytest.mark.slow
+def test_a_wrong_sign_on_the_twin_is_caught_by_the_never_worse_monitor(tmp_path):
+    """``gt.live`` through the library against a twin, its map scaling the offset by −1 (a control
+    taking the offset with the other sign) and reading the twin's compensated δ: the monitor
+    (a window of 10 periods) judges the compensation worse once, flags every later row and ramps
+    the correction to zero, after which the twin's compensated δ is its uncompensated δ."""
+    port, out, path = free_port(), tmp_path / "out", tmp_path / "map.toml"
+    path.write_text('[read]\ndelta_residual_um = "nsu=urn:gatetherm:machine;s=delta_residual_um"\n'
+                    '[scale]\noffset_um = -1.0\n')
+    tw = twin(port, "--speed", 600, "--until", 1800, "--states", 10)
+    try:
+        res = gt.live(gt.load_case(CASE), "rom", endpoint=f"opc.tcp://127.0.0.1:{port}", out=out, map=path,
+                      until=1800, states=10, monitor={"window": 10})
+    finally:
+        assert finish(tw)[0] == 0
+    assert res["periods"] == 31 and res["monitor"] == "worse"
+    ts = read_timeseries(out / "live.csv", required=("time_s",))
+    first = int(np.argmax(ts["worse"] == 1))
+    assert first >= 9 and np.all(ts["worse"][first:] == 1) and np.all(ts["worse"][:first] == 0)
+    verdict = res["worse_verdict"]
+    assert verdict["compensated_um"] > verdict["uncompensated_um"] + 1.0
+    zero = np.flatnonzero(ts["offset_um"] == 0.0)
+    assert zero[-1] == len(ts.time_s) - 1 and ts["offset_um"][-1] == 0.0
+    back = zero[zero > first][1:]  # the twin applies a correction from the next sample on
+    assert np.max(np.abs(ts["delta_residual_um"][back] - ts["delta_um"][back])) < 0.2  # δ noise
+    assert (out / "events.log").read_text().count("compensation makes delta worse") == 1
+    print(f"verdict at t = {verdict['t_s']:g} s: {verdict['compensated_um']:.2f} um > "
+          f"{verdict['uncompensated_um']:.2f} um; worse from row {first}, zero from row {zero[zero > first][0]}")
