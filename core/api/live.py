@@ -248,7 +248,7 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
                                                      status_port))
         finally:
             journal.close()
-        return service.summarize(out, counts)
+        return jr.summarize(out, counts)
     finally:
         os.close(fd)
 

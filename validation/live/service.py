@@ -28,7 +28,6 @@ and scaled down with the offset when the monitor's fallback ramps it.
 from __future__ import annotations
 
 import asyncio
-import json
 import logging
 import math
 import time
@@ -36,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gatetherm import InputError, write_text_atomic
+from gatetherm import InputError
 from gatetherm.validation.live.journal import Journal
 from gatetherm.validation.live.monitor import Monitor, Watch
 from gatetherm.validation.live.nodes import NodeMap
@@ -288,31 +287,6 @@ async def _close(client) -> None:
             await client.disconnect()
         except Exception:  # noqa: BLE001 - the link is gone already
             pass
-
-
-def summarize(directory, counts: dict, settle_s: float = 600.0) -> dict:
-    """The run's summary from ``live.csv``: the counts, the never-worse monitor's verdict
-    (``monitor``: "not worse", "worse" or "inactive (no delta_um read)"; ``worse_verdict``: its
-    figures) and, where the machine reports its compensated δ, its band after the first
-    ``settle_s`` of machine time (µm); written to ``summary.json``."""
-    from gatetherm.studies.run.timeseries import read_timeseries
-
-    ts = read_timeseries(directory / "live.csv", required=("time_s",))
-    out = {**counts, "rows": len(ts.time_s), "first_s": float(ts.time_s[0]) if len(ts.time_s) else None,
-           "last_s": float(ts.time_s[-1]) if len(ts.time_s) else None}
-    if "delta_residual_um" in ts and len(ts.time_s):
-        late = ts.time_s >= ts.time_s[0] + settle_s
-        comp = ts["delta_residual_um"][late]
-        out["compensated_band_um"] = float(np.nanmax(np.abs(comp))) if np.isfinite(comp).any() else None
-    state = directory / "state.json"
-    watch = json.loads(state.read_text(encoding="utf-8")).get("monitor") if state.exists() else None
-    out["monitor"] = ("inactive (no delta_um read)" if "delta_um" not in ts
-                      else "worse" if watch and watch.get("worse") else "not worse")
-    out["worse_verdict"] = watch.get("worse") if watch else None
-    write_text_atomic(directory / "summary.json", json.dumps(out, indent=2, allow_nan=False) + "\n")
-    if counts.get("missed"):
-        log.info("%d period(s) missed", counts["missed"])
-    return out
 
 
 def check(params: LiveParams) -> None:
