@@ -196,3 +196,63 @@ def test_a_wrong_sign_on_the_twin_is_caught_by_the_never_worse_monitor(tmp_path)
     assert (out / "events.log").read_text().count("compensation makes delta worse") == 1
     print(f"verdict at t = {verdict['t_s']:g} s: {verdict['compensated_um']:.2f} um > "
           f"{verdict['uncompensated_um']:.2f} um; worse from row {first}, zero from row {zero[zero > first][0]}")
+
+
+@pytest.mark.slow
+def test_an_axis_model_writes_the_gradient_and_reference_to_the_twins_nodes(tmp_path):
+    """A two-probe error model along an axis (δ(s) = 0.5 + 2 s + (1.5 + 4 s) θ_A-rise, µm, probes at
+    0 and 1 m), stepped by ``gt.live`` against a twin: every logged row has the closed form's
+    gradient for its offset (gradient = −(2 + 4 r) with offset = −(0.5 + 1.5 r)), and the twin's
+    ``gradient_um_per_m`` and ``reference_m`` nodes hold the last values logged."""
+    import asyncio
+    import threading
+
+    from gatetherm.studies.errormodel.model import ErrorModel, TargetModel
+    from gatetherm.studies.errormodel.terms import Term
+    from gatetherm.validation.live.service import Guards
+
+    def probe(name, s):
+        return TargetModel(name, "static", (Term("sensor", "theta_A_degC"),), (1.5 + 4.0 * s,), 0.5 + 2.0 * s)
+
+    model = ErrorModel((probe("delta_p0_um", 0.0), probe("delta_p1_um", 1.0)), {"theta_A_degC": 20.0},
+                       {"start_s": 0.0, "end_s": 1.0, "samples": 2})
+    port, out, seen, done = free_port(), tmp_path / "out", {}, threading.Event()
+
+    def watch():  # a second client on the twin: the values of the written nodes as they change
+        from asyncua import Client
+
+        async def run():
+            end = time.monotonic() + LIMIT_S
+            while not done.is_set() and time.monotonic() < end:
+                try:
+                    async with Client(f"opc.tcp://127.0.0.1:{port}", timeout=5) as c:
+                        idx = await c.get_namespace_index("urn:gatetherm:machine")
+                        from asyncua import ua
+                        nodes = {n: c.get_node(ua.NodeId(n, idx)) for n in ("gradient_um_per_m", "reference_m")}
+                        while not done.is_set():
+                            seen.update({n: await v.read_value() for n, v in nodes.items()})
+                            await asyncio.sleep(0.02)
+                except (OSError, asyncio.TimeoutError, ConnectionError):
+                    await asyncio.sleep(0.2)
+        asyncio.run(run())
+
+    tw = twin(port, "--speed", 120, "--until", 1200, "--states", 10)
+    thread = threading.Thread(target=watch, daemon=True)
+    thread.start()
+    try:
+        res = gt.live(None, endpoint=f"opc.tcp://127.0.0.1:{port}", out=out, model=model,
+                      axis={"delta_p0_um": 0.0, "delta_p1_um": 1.0}, until=1200, guards=Guards(max_change_um=100.0))
+    finally:
+        done.set()
+        thread.join(timeout=LIMIT_S)
+        assert finish(tw)[0] == 0
+    assert res["periods"] == 21 and res["limited"] == 0
+    ts = read_timeseries(out / "live.csv", required=("time_s",))
+    on = ts["offset_um"] != 0.0  # before the first update both commands are 0
+    r = (-ts["offset_um"][on] - 0.5) / 1.5
+    assert on.sum() >= 15 and np.all(ts["gradient_um_per_m"][~on] == 0.0)
+    assert np.max(np.abs(ts["gradient_um_per_m"][on] - -(2.0 + 4.0 * r))) < 1e-9 and np.all(ts["reference_m"] == 0.0)
+    assert np.ptp(ts["gradient_um_per_m"][on]) > 0.05  # it moved with θ_A (0.24 um/m in 20 min)
+    assert seen["gradient_um_per_m"] == ts["gradient_um_per_m"][-1] and seen["reference_m"] == 0.0
+    print(f"gradient {ts['gradient_um_per_m'][-1]:.3f} um/m at offset {ts['offset_um'][-1]:.3f} um; "
+          f"the twin's node {seen['gradient_um_per_m']:.3f}")
