@@ -45,11 +45,11 @@ class Monitor:
 
     def __post_init__(self):
         if isinstance(self.window, bool) or not isinstance(self.window, int) or self.window < 2:
-            raise InputError("monitor window", f"{self.window!r} is not a whole number of periods >= 2", "e.g. 30")
+            raise InputError("monitor window (--window)", f"{self.window!r} is not a whole number of periods >= 2", "e.g. 30")
         if not (math.isfinite(self.margin_um) and self.margin_um >= 0):
-            raise InputError("monitor margin", f"{self.margin_um!r} is not a number of um >= 0", "e.g. 1.0")
+            raise InputError("monitor margin (--margin)", f"{self.margin_um!r} is not a number of um >= 0", "e.g. 1.0")
         if self.fallback not in FALLBACKS:
-            raise InputError("monitor fallback", f"{self.fallback!r} is not one of {', '.join(FALLBACKS)}",
+            raise InputError("monitor fallback (--fallback)", f"{self.fallback!r} is not one of {', '.join(FALLBACKS)}",
                              "e.g. zero")
 
 
