@@ -102,6 +102,7 @@ def test_twin_and_live_close_the_loop_and_a_second_live_refuses(tmp_path):
     assert finish(tw)[0] == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["periods"] == 31 and summary["missed"] == 0 and summary["held"] == 0
+    assert summary["monitor"] == "not worse" and summary["worse"] == 0  # the right sign is never fallen back
     assert summary["compensated_band_um"] == pytest.approx(1.1, abs=0.6)  # band: ±3 µm
     ts = read_timeseries(out / "live.csv", required=("time_s",))
     assert np.array_equal(ts.time_s, 60.0 * np.arange(31))
@@ -121,7 +122,7 @@ def test_closed_loop_six_hours_at_120x_matches_offline_compensation(tmp_path):
     assert code == 0, err
     assert finish(tw)[0] == 0
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["periods"] == 361 and summary["missed"] == 0
+    assert summary["periods"] == 361 and summary["missed"] == 0 and summary["monitor"] == "not worse"
     assert summary["compensated_band_um"] < 3.0
     ts = read_timeseries(out / "live.csv", required=("time_s",))
     comp = gt.compensate(ts, gt.load_case(CASE), "rom", actuator=None)  # = compensate --data live.csv --no-actuator
@@ -165,3 +166,93 @@ def test_faults_nan_kill_9_and_twin_restart(tmp_path):
     events = (out / "events.log").read_text()
     assert "theta_A_degC missing" in events and "connection lost" in events and "reconnected" in events
     assert np.max(np.abs(np.diff(ts["offset_um"]))) <= 5.0 + 1e-9  # the change limit per period
+
+
+@pytest.mark.slow
+def test_a_wrong_sign_on_the_twin_is_caught_by_the_never_worse_monitor(tmp_path):
+    """``gt.live`` through the library against a twin, its map scaling the offset by −1 (a control
+    taking the offset with the other sign) and reading the twin's compensated δ: the monitor
+    (a window of 10 periods) judges the compensation worse once, flags every later row and ramps
+    the correction to zero, after which the twin's compensated δ is its uncompensated δ."""
+    port, out, path = free_port(), tmp_path / "out", tmp_path / "map.toml"
+    path.write_text('[read]\ndelta_residual_um = "nsu=urn:gatetherm:machine;s=delta_residual_um"\n'
+                    '[scale]\noffset_um = -1.0\n')
+    tw = twin(port, "--speed", 600, "--until", 1800, "--states", 10)
+    try:
+        res = gt.live(gt.load_case(CASE), "rom", endpoint=f"opc.tcp://127.0.0.1:{port}", out=out, map=path,
+                      until=1800, states=10, monitor={"window": 10})
+    finally:
+        assert finish(tw)[0] == 0
+    assert res["periods"] == 31 and res["monitor"] == "worse"
+    ts = read_timeseries(out / "live.csv", required=("time_s",))
+    first = int(np.argmax(ts["worse"] == 1))
+    assert first >= 9 and np.all(ts["worse"][first:] == 1) and np.all(ts["worse"][:first] == 0)
+    verdict = res["worse_verdict"]
+    assert verdict["compensated_um"] > verdict["uncompensated_um"] + 1.0
+    zero = np.flatnonzero(ts["offset_um"] == 0.0)
+    assert zero[-1] == len(ts.time_s) - 1 and ts["offset_um"][-1] == 0.0
+    back = zero[zero > first][1:]  # the twin applies a correction from the next sample on
+    assert np.max(np.abs(ts["delta_residual_um"][back] - ts["delta_um"][back])) < 0.2  # δ noise
+    assert (out / "events.log").read_text().count("compensation makes delta worse") == 1
+    print(f"verdict at t = {verdict['t_s']:g} s: {verdict['compensated_um']:.2f} um > "
+          f"{verdict['uncompensated_um']:.2f} um; worse from row {first}, zero from row {zero[zero > first][0]}")
+
+
+@pytest.mark.slow
+def test_an_axis_model_writes_the_gradient_and_reference_to_the_twins_nodes(tmp_path):
+    """A two-probe error model along an axis (δ(s) = 0.5 + 2 s + (1.5 + 4 s) θ_A-rise, µm, probes at
+    0 and 1 m), stepped by ``gt.live`` against a twin: every logged row has the closed form's
+    gradient for its offset (gradient = −(2 + 4 r) with offset = −(0.5 + 1.5 r)), and the twin's
+    ``gradient_um_per_m`` and ``reference_m`` nodes hold the last values logged."""
+    import asyncio
+    import threading
+
+    from gatetherm.studies.errormodel.model import ErrorModel, TargetModel
+    from gatetherm.studies.errormodel.terms import Term
+    from gatetherm.validation.live.service import Guards
+
+    def probe(name, s):
+        return TargetModel(name, "static", (Term("sensor", "theta_A_degC"),), (1.5 + 4.0 * s,), 0.5 + 2.0 * s)
+
+    model = ErrorModel((probe("delta_p0_um", 0.0), probe("delta_p1_um", 1.0)), {"theta_A_degC": 20.0},
+                       {"start_s": 0.0, "end_s": 1.0, "samples": 2})
+    port, out, seen, done = free_port(), tmp_path / "out", {}, threading.Event()
+
+    def watch():  # a second client on the twin: the values of the written nodes as they change
+        from asyncua import Client
+
+        async def run():
+            end = time.monotonic() + LIMIT_S
+            while not done.is_set() and time.monotonic() < end:
+                try:
+                    async with Client(f"opc.tcp://127.0.0.1:{port}", timeout=5) as c:
+                        idx = await c.get_namespace_index("urn:gatetherm:machine")
+                        from asyncua import ua
+                        nodes = {n: c.get_node(ua.NodeId(n, idx)) for n in ("gradient_um_per_m", "reference_m")}
+                        while not done.is_set():
+                            seen.update({n: await v.read_value() for n, v in nodes.items()})
+                            await asyncio.sleep(0.02)
+                except (OSError, asyncio.TimeoutError, ConnectionError):
+                    await asyncio.sleep(0.2)
+        asyncio.run(run())
+
+    tw = twin(port, "--speed", 120, "--until", 1200, "--states", 10)
+    thread = threading.Thread(target=watch, daemon=True)
+    thread.start()
+    try:
+        res = gt.live(None, endpoint=f"opc.tcp://127.0.0.1:{port}", out=out, model=model,
+                      axis={"delta_p0_um": 0.0, "delta_p1_um": 1.0}, until=1200, guards=Guards(max_change_um=100.0))
+    finally:
+        done.set()
+        thread.join(timeout=LIMIT_S)
+        assert finish(tw)[0] == 0
+    assert res["periods"] == 21 and res["limited"] == 0
+    ts = read_timeseries(out / "live.csv", required=("time_s",))
+    on = ts["offset_um"] != 0.0  # before the first update both commands are 0
+    r = (-ts["offset_um"][on] - 0.5) / 1.5
+    assert on.sum() >= 15 and np.all(ts["gradient_um_per_m"][~on] == 0.0)
+    assert np.max(np.abs(ts["gradient_um_per_m"][on] - -(2.0 + 4.0 * r))) < 1e-9 and np.all(ts["reference_m"] == 0.0)
+    assert np.ptp(ts["gradient_um_per_m"][on]) > 0.05  # it moved with θ_A (0.24 um/m in 20 min)
+    assert seen["gradient_um_per_m"] == ts["gradient_um_per_m"][-1] and seen["reference_m"] == 0.0
+    print(f"gradient {ts['gradient_um_per_m'][-1]:.3f} um/m at offset {ts['offset_um'][-1]:.3f} um; "
+          f"the twin's node {seen['gradient_um_per_m']:.3f}")

@@ -46,7 +46,7 @@ def test_nan_and_jump_hold_the_correction_and_limits_clip_it(tmp_path):
     assert svc.period(300.0, 5, jump)["held"] == 1
     row = svc.period(480.0, 8, sample(8))  # periods 6 and 7 without a sample
     assert row["held"] == 0 and svc.counts == {"periods": 7, "missed": 2, "held": 2, "limited": 4, "reconnects": 0,
-                                               "restarts": 0}
+                                               "restarts": 0, "worse": 0}
     events = (tmp_path / "events.log").read_text()
     assert "theta_B_degC missing" in events and "delta_um jumped +25" in events and "2 period(s)" in events
     ts = read_timeseries(tmp_path / "live.csv", required=("time_s",))

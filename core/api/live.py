@@ -30,16 +30,17 @@ def _schedule(case: Case, schedule):
     return schedule if hasattr(schedule, "drive") else schedule_file(schedule, case)
 
 
-def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until: float | None = None,
+def twin(case: Case | str | Path, endpoint: str, speed: float = 1.0, *, schedule=None, until: float | None = None,
          start: float = 0.0, states: int = 30, rom=None, seed: int = 0, actuator: bool = False, stopped=None,
          **noise) -> dict:
     """Serve a virtual machine over OPC UA: the case's reduced model in ``speed``× real time.
 
     Parameters
     ----------
-    case : Case
+    case : Case or path
         The machine: its reduced model (built with ``states`` states unless ``rom`` is given), its
-        schedule and its [signals] (θ_A, θ_B, θ_C, δ).
+        schedule and its [signals] (θ_A, θ_B, θ_C, δ). A path is read once the other arguments are
+        checked.
     endpoint : str
         ``opc.tcp://HOST:PORT`` to serve on.
     speed : float
@@ -66,13 +67,20 @@ def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until:
         ``served`` samples, ``start_s``, ``end_s`` and ``compensated_band_after_10_min_um`` (µm,
         the twin's true δ with the correction applied).
     """
+    import math
+
+    from gatetherm import InputError
     from gatetherm.studies.run.reduce import build_rom
-    from gatetherm.validation.live.twin import TwinParams, serve
+    from gatetherm.validation.live.twin import TwinParams, endpoint_url, serve
 
+    endpoint_url(endpoint)
     params = TwinParams(speed=speed, start_s=start, until_s=until, seed=seed, **noise)
+    if rom is None and not 2 <= states <= 200:
+        raise InputError("--states", f"{states} is outside 2..200", "e.g. --states 30")
+    if until is not None and not math.isfinite(until):
+        raise InputError("--until", "must be a finite number of seconds", "e.g. --until 21600")
+    case = _case(case)
     if actuator and case.actuator is None:
-        from gatetherm import InputError
-
         raise InputError(f"{case.source}: [actuator]", "the case has none", "add one, or apply the ideal offset")
     sched = _schedule(case, schedule)
     rom = rom or build_rom(case, states).rom
@@ -80,7 +88,16 @@ def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until:
     return asyncio.run(serve(rom, sched, endpoint, params, published, stopped, case.actuator if actuator else None))
 
 
-def _stepper(case, method, model, target, params, states, out, sched):
+def _case(case):
+    """``case``, read if it is a path."""
+    if isinstance(case, (str, Path)):
+        from gatetherm.api.run import load_case
+
+        return load_case(case)
+    return case
+
+
+def _stepper(case, method, model, target, params, states, out, sched, axis=None):
     from gatetherm import InputError
     from gatetherm.studies.control.methods import METHODS, Settings, coefficients
     from gatetherm.studies.control.predictive import PredictiveParams
@@ -94,7 +111,15 @@ def _stepper(case, method, model, target, params, states, out, sched):
         from gatetherm.studies.errormodel.replay import loop_target
 
         m = load_model(model) if isinstance(model, (str, Path)) else model
+        if axis is not None:
+            from gatetherm.validation.live.axis import AxisStepper
+
+            probes = {k: error_model_stepper(m, m.target(k).target, params) for k in axis.positions_m}
+            return AxisStepper(probes, axis), f"errormodel {model} along an axis ({len(probes)} probes)"
         return error_model_stepper(m, loop_target(m, target), params), f"errormodel {model}"
+    if axis is not None:
+        raise InputError("--axis", f"the {method} method gives delta at one point, not along an axis",
+                         "give a --model with a target per probe, or leave --axis out (offset only)")
     if method not in METHODS[:3]:
         raise InputError("--method", f"unknown method {method!r}", "choose paper, mlr or rom, or give --model")
     if case is None:
@@ -117,16 +142,18 @@ def _stepper(case, method, model, target, params, states, out, sched):
     return RegressionStepper(fit_regression(run, THETAS), params), "mlr"
 
 
-def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, model=None, target: str | None = None,
-         map=None, period: float = 60.0, update: float | None = None, until: float | None = None,
-         states: int = 30, schedule=None, guards=None, status_port: int | None = None, on_period=None,
-         on_ready=None) -> dict:
+def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint: str, out, model=None,
+         target: str | None = None, map=None, period: float = 60.0, update: float | None = None,
+         until: float | None = None, states: int = 30, schedule=None, guards=None, monitor=None,
+         axis: dict | None = None, reference: float | None = None, status_port: int | None = None,
+         on_period=None, on_ready=None) -> dict:
     """Compensate a machine over OPC UA: read its sensors every period of its clock, write the correction.
 
     Parameters
     ----------
-    case : Case, optional
-        The machine's case (methods ``paper``, ``mlr``, ``rom``; not needed with ``model``).
+    case : Case or path, optional
+        The machine's case (methods ``paper``, ``mlr``, ``rom``; not needed with ``model``); a path
+        is read once the endpoint is checked.
     method : str
         ``"paper"``, ``"mlr"`` or ``"rom"``.
     endpoint : str
@@ -150,6 +177,15 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
         ``rom``: the inputs known in advance (default the case's schedule).
     guards : Guards, optional
         :class:`gatetherm.validation.live.service.Guards` (defaults in docs/live.md).
+    monitor : Monitor or dict, optional
+        The never-worse monitor, :class:`gatetherm.validation.live.monitor.Monitor` or a dict of its
+        fields (default: a window of 30 periods, a margin of 1 µm, fallback ``"zero"``; docs/live.md).
+    axis : dict, optional
+        With ``model``: target channel -> its probe's position along the axis, m (two or more). The
+        offset is then written at the reference position with a gradient along the axis
+        (``gradient_um_per_m``, ``reference_m``); without, the offset only.
+    reference : float, optional
+        The reference position s0 of the offset, m (default the smallest probe position).
     status_port : int, optional
         Serve the status page on ``http://127.0.0.1:PORT/`` (``/status.json``: the same as data).
     on_period : callable, optional
@@ -160,8 +196,8 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
     Returns
     -------
     dict
-        The counts (``periods``, ``missed``, ``held``, ``limited``, ``reconnects``, ``restarts``), the
-        rows logged and ``compensated_band_um`` where the machine reports its compensated δ; also
+        The counts (``periods``, ``missed``, ``held``, ``limited``, ``reconnects``, ``restarts``,
+        ``worse``: periods after a worse verdict), ``monitor`` (the verdict or None), the rows logged and ``compensated_band_um`` where the machine reports its compensated δ; also
         written to ``out/summary.json``.
     """
     import os
@@ -171,10 +207,21 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
     from gatetherm.validation.live.nodes import default_map, read_map
     from gatetherm.validation.live.twin import endpoint_url
 
+    from gatetherm import InputError
+    from gatetherm.validation.live.axis import Axis
+    from gatetherm.validation.live.monitor import Monitor
+
     endpoint_url(endpoint)
+    if model is None and case is None:
+        raise InputError("--case/--model", "give the machine's case (or a fitted model)", "e.g. --case case.toml")
     guards = guards or service.Guards()
-    params = service.LiveParams(period_s=float(period), until_s=until, guards=guards)
+    params = service.LiveParams(period_s=float(period), until_s=until, guards=guards, monitor=Monitor(**monitor) if isinstance(monitor, dict) else monitor or Monitor())
     service.check(params)
+    axis = Axis(dict(axis), reference) if axis else None
+    if axis is not None and model is None:
+        raise InputError("--axis", "needs a fitted --model with a target per probe",
+                         "give --model, or leave --axis out (offset only)")
+    case = _case(case)
     every = update if update is not None else (300.0 if abs(300.0 / period - round(300.0 / period)) < 1e-9
                                                and period <= 300.0 else period)
     cp = CompensatorParams(sample_interval_s=float(period), update_interval_s=float(every))
@@ -182,15 +229,16 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
     fd = jr.lock(out)
     try:
         sched = _schedule(case, schedule) if case is not None else None
-        stepper, label = _stepper(case, method, model, target, cp, states, out, sched)
+        stepper, label = _stepper(case, method, model, target, cp, states, out, sched, axis)
         required = tuple(stepper.columns)
         if map is None:
             extras = tuple(sorted(case.inputs())) if case is not None else ()
-            nodes = default_map((*extras, *required, "delta_residual_um"))
+            nodes = default_map((*extras, *required, "delta_residual_um"), gradient=axis is not None)
         else:
             nodes = read_map(map, required)
         read = tuple(n for n in nodes.read if n != "time_s")
-        columns = ("time_s", *read, "offset_um", "offset_wanted_um", "delta_forecast_um", "held", "limited")
+        columns = ("time_s", *read, "offset_um", "offset_wanted_um", "delta_forecast_um", "held", "limited", "worse",
+                   *(("gradient_um_per_m", "reference_m") if axis is not None else ()))
         journal = jr.Journal(out, columns, {"source": "gatetherm live", "method": label, "endpoint": endpoint,
                                             "period_s": f"{period:g}"})
         if on_ready is not None:
@@ -200,7 +248,7 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
                                                      status_port))
         finally:
             journal.close()
-        return service.summarize(out, counts)
+        return jr.summarize(out, counts)
     finally:
         os.close(fd)
 

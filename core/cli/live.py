@@ -5,11 +5,15 @@ docs/live.md) every --period of the machine's clock (``time_s``), steps the comp
 paper, mlr or rom on --case, or a fitted --model), writes the offset (um) and logs every sample and
 correction to DIR/live.csv (flushed each period), its state to DIR/state.json (a restart into the
 same --out resumes), the guards' events to DIR/events.log and, when it ends, DIR/summary.json. A
-second ``live`` on the same --out refuses. SIGINT/SIGTERM end it between two periods.
+second ``live`` on the same --out refuses. SIGINT/SIGTERM end it between two periods. Where the
+machine reports its measured delta, a compensation that leaves delta worse than none over the last
+--window periods (by more than --margin um) is warned once, flagged (``worse``) and by default ramped
+to zero (--fallback). With --model and --axis TARGET=S (two or more probes along the axis) it also
+writes a gradient along the axis and its reference position (--reference).
 """
 from __future__ import annotations
 
-from gatetherm import InputError
+from gatetherm.api import InputError
 
 
 def register(sub) -> None:
@@ -28,33 +32,53 @@ def register(sub) -> None:
                    "stopped)")
     p.add_argument("--states", type=int, default=30, metavar="N", help="rom: states of the reduced model (default 30)")
     p.add_argument("--schedule", metavar="S.csv", help="rom: the inputs known in advance (default: the case's)")
+    p.add_argument("--window", type=int, default=30, metavar="N", help="never-worse monitor: periods compared "
+                   "(default 30)")
+    p.add_argument("--margin", type=float, default=1.0, metavar="UM", help="never-worse monitor: how much larger the "
+                   "compensated |delta| may be before it counts as worse, um (default 1)")
+    p.add_argument("--fallback", choices=("zero", "hold", "warn"), default="zero", help="after a worse verdict: ramp "
+                   "the correction to zero, hold it, or only warn (default zero)")
+    p.add_argument("--axis", action="append", default=[], metavar="TARGET=S", help="--model: a target's probe "
+                   "position along the axis, m (repeat, two or more: a gradient is written)")
+    p.add_argument("--reference", type=float, metavar="S", help="--axis: reference position of the offset, m "
+                   "(default the smallest probe position)")
     p.add_argument("--status-port", type=int, metavar="N", help="serve a status page on http://127.0.0.1:N/ "
                    "(the last hours of delta and the correction, each sensor's health, the guards)")
     p.add_argument("--quiet", action="store_true", help="no line per period")
     p.set_defaults(func=run)
 
 
+def _axis(items) -> dict:
+    axis = {}
+    for text in items:
+        name, sep, value = text.partition("=")
+        try:
+            axis[name.strip()] = float(value)
+        except ValueError:
+            raise InputError(f"--axis {text}", "is not TARGET=S", "e.g. --axis delta_x0_um=0.25") from None
+        if not sep or not name.strip():
+            raise InputError(f"--axis {text}", "is not TARGET=S", "e.g. --axis delta_x0_um=0.25")
+    return axis
+
+
 def run(args) -> int:
-    import gatetherm as gt
-    from gatetherm.validation.live.twin import endpoint_url
-
-    endpoint_url(args.endpoint)  # a bad endpoint fails before the case is read
-
-    if args.model is None and args.case is None:
-        raise InputError("--case/--model", "give the machine's case (or a fitted model)", "e.g. --case case.toml")
-    case = gt.load_case(args.case) if args.case else None
+    import gatetherm.api as api
 
     def line(row):
         if not args.quiet:
+            grad = row.get("gradient_um_per_m")
             print(f"t = {row['time_s']:8g} s  delta {row.get('delta_um', float('nan')):7.2f} um  offset "
-                  f"{row['offset_um']:7.2f} um{'  held' if row['held'] else ''}{'  limited' if row['limited'] else ''}",
-                  flush=True)
+                  f"{row['offset_um']:7.2f} um" + (f"  gradient {grad:7.2f} um/m" if grad is not None else "")
+                  + f"{'  held' if row['held'] else ''}{'  limited' if row['limited'] else ''}"
+                  + f"{'  worse' if row.get('worse') else ''}", flush=True)
 
-    res = gt.live(case, args.method, endpoint=args.endpoint, out=args.out, model=args.model, target=args.target,
-                  map=args.map, period=args.period, until=args.until, states=args.states, schedule=args.schedule,
-                  status_port=args.status_port, on_period=line)
+    res = api.live(args.case, args.method, endpoint=args.endpoint, out=args.out, model=args.model, target=args.target,
+                   map=args.map, period=args.period, until=args.until, states=args.states, schedule=args.schedule,
+                   monitor={"window": args.window, "margin_um": args.margin, "fallback": args.fallback}, axis=_axis(args.axis) or None,
+                   reference=args.reference, status_port=args.status_port, on_period=line)
     band = res.get("compensated_band_um")
     print(f"live: {res['periods']} periods logged to {args.out}/live.csv, {res['missed']} missed, {res['held']} held, "
           f"{res['limited']} limited, {res['reconnects']} reconnects"
-          + (f"; compensated delta after 10 min within +/-{band:.2f} um" if band is not None else ""))
+          + (f"; compensated delta after 10 min within +/-{band:.2f} um" if band is not None else "")
+          + (f"; compensation made delta worse ({res['worse']} periods fallen back)" if res["monitor"] == "worse" else ""))
     return 0

@@ -1,6 +1,7 @@
 """What ``gatetherm live`` keeps in its output directory: a lock, the log ``live.csv`` in the data
 format (a row per period, flushed and synced as it is written), the compensator's state
-``state.json`` (written atomically after the row) and the guards' events ``events.log``.
+``state.json`` (written atomically after the row), the guards' events ``events.log`` and, at the
+end, ``summary.json`` (:func:`summarize`).
 
 On a restart the rows after the state's last period (a row written, the state not yet) and a
 trailing partial line are cut, so the log continues exactly where the state resumes.
@@ -9,12 +10,17 @@ from __future__ import annotations
 
 import fcntl
 import json
+import logging
 import math
 import os
 from pathlib import Path
 
+import numpy as np
+
 from gatetherm import InputError, write_text_atomic
 from gatetherm.studies.run.timeseries import FORMAT
+
+log = logging.getLogger(__name__)
 
 LOG, STATE, EVENTS, LOCK = "live.csv", "state.json", "events.log", "live.lock"
 
@@ -124,3 +130,28 @@ class Journal:
     def close(self) -> None:
         self.file.close()
         self.events.close()
+
+
+def summarize(directory, counts: dict, settle_s: float = 600.0) -> dict:
+    """The run's summary from ``live.csv``: the counts, the never-worse monitor's verdict
+    (``monitor``: "not worse", "worse" or "inactive (no delta_um read)"; ``worse_verdict``: its
+    figures) and, where the machine reports its compensated δ, its band after the first
+    ``settle_s`` of machine time (µm); written to ``summary.json``."""
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    ts = read_timeseries(directory / "live.csv", required=("time_s",))
+    out = {**counts, "rows": len(ts.time_s), "first_s": float(ts.time_s[0]) if len(ts.time_s) else None,
+           "last_s": float(ts.time_s[-1]) if len(ts.time_s) else None}
+    if "delta_residual_um" in ts and len(ts.time_s):
+        late = ts.time_s >= ts.time_s[0] + settle_s
+        comp = ts["delta_residual_um"][late]
+        out["compensated_band_um"] = float(np.nanmax(np.abs(comp))) if np.isfinite(comp).any() else None
+    state = directory / "state.json"
+    watch = json.loads(state.read_text(encoding="utf-8")).get("monitor") if state.exists() else None
+    out["monitor"] = ("inactive (no delta_um read)" if "delta_um" not in ts
+                      else "worse" if watch and watch.get("worse") else "not worse")
+    out["worse_verdict"] = watch.get("worse") if watch else None
+    write_text_atomic(directory / "summary.json", json.dumps(out, indent=2, allow_nan=False) + "\n")
+    if counts.get("missed"):
+        log.info("%d period(s) missed", counts["missed"])
+    return out

@@ -54,10 +54,11 @@ class NodeMap:
         return self.scale.get(name, 1.0)
 
 
-def default_map(columns) -> NodeMap:
-    """The default layout for the read ``columns`` (``time_s`` first) and ``offset_um`` written."""
+def default_map(columns, gradient: bool = False) -> NodeMap:
+    """The default layout for the read ``columns`` (``time_s`` first) and ``offset_um`` written (with
+    ``gradient``, also ``gradient_um_per_m`` and ``reference_m``)."""
     names = ("time_s", *(c for c in columns if c != "time_s"))
-    return NodeMap({n: default_node(n) for n in names}, {"offset_um": default_node("offset_um")})
+    return NodeMap({n: default_node(n) for n in names}, {n: default_node(n) for n in WRITTEN[:3 if gradient else 1]})
 
 
 def read_map(path, columns) -> NodeMap:

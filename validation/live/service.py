@@ -16,12 +16,18 @@ Guards (:class:`Guards`, each with its default, docs/live.md):
   the correction holds; after ``hold_s`` the correction ramps to zero at ``ramp_um_per_s``, and
   the ramped value is what is written on reconnection (a control keeps the last value written
   while the link is down: its own watchdog is what makes that safe);
+* the never-worse monitor (:mod:`.monitor`): where the machine reports its measured δ, a
+  compensation that leaves δ worse than none over a window is warned once, flagged and (default)
+  ramped to zero, the verdict kept across restarts;
 * SIGINT/SIGTERM end the loop between two periods, the state saved.
+
+Where the compensator gives a gradient along an axis (:mod:`.axis`), it is written beside the
+offset (``gradient_um_per_m``, ``reference_m``): as decided on a good sample, held on a held one,
+and scaled down with the offset when the monitor's fallback ramps it.
 """
 from __future__ import annotations
 
 import asyncio
-import json
 import logging
 import math
 import time
@@ -29,8 +35,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gatetherm import InputError, write_text_atomic
+from gatetherm import InputError
 from gatetherm.validation.live.journal import Journal
+from gatetherm.validation.live.monitor import Monitor, Watch
 from gatetherm.validation.live.nodes import NodeMap
 
 log = logging.getLogger(__name__)
@@ -73,6 +80,8 @@ class LiveParams:
     poll_s: float = 0.05
     """Wall time between reads while waiting for the next period, s."""
     guards: Guards = field(default_factory=Guards)
+    monitor: Monitor = field(default_factory=Monitor)
+    """The never-worse monitor (:mod:`.monitor`)."""
 
 
 def _limits(column: str, g: Guards) -> float:
@@ -91,10 +100,17 @@ class Service:
         self.written = float(s.get("offset_um", 0.0))
         self.good = dict(s.get("good", {}))
         self.good_k = s.get("good_k")
+        self.gradient = s.get("gradient_um_per_m")
+        self.reference = stepper.axis.s0 if hasattr(stepper, "axis") else None
         self.counts = dict(s.get("counts", {"periods": 0, "missed": 0, "held": 0, "limited": 0, "reconnects": 0,
                                             "restarts": 0}))
+        self.counts.setdefault("worse", 0)
+        self.watch = Watch(params.monitor, s.get("monitor"))
         if s:
             self.counts["restarts"] += 1
+            if self.watch.worse is not None:
+                journal.event(None, f"resumed fallen back ({params.monitor.fallback}): compensation made delta "
+                              f"worse at t = {self.watch.worse['t_s']:g} s")
 
     def bad(self, k: int, sample: dict) -> str | None:
         """Why ``sample`` (period k) is not used, or None."""
@@ -118,6 +134,15 @@ class Service:
             self.journal.event(t, f"{k - self.next} period(s) without a sample (missed)")
         why = self.bad(k, sample)
         held = limited = 0
+        applied = self.written  # the correction held over this period
+        unc = sample.get("delta_um", math.nan)
+        comp = sample.get("delta_residual_um", math.nan)
+        comp = comp if math.isfinite(comp) else unc + applied
+        if why is None and self.watch.add(t, unc, comp, applied) is not None:
+            w = self.watch.worse
+            self.journal.event(t, f"compensation makes delta worse: largest |residual| {w['compensated_um']:.2f} um > "
+                               f"{w['uncompensated_um']:.2f} um uncompensated over the last "
+                               f"{self.p.monitor.window} periods; fallback {self.p.monitor.fallback}")
         if why is not None:
             corr = self.stepper.skip(t)
             wanted, held = self.written, 1
@@ -128,9 +153,17 @@ class Service:
             wanted = corr.offset_um
             self.good = {c: sample[c] for c in self.stepper.columns}
             self.good_k = k
-        new = float(np.clip(np.clip(wanted, self.written - g.max_change_um, self.written + g.max_change_um),
+        gradient = getattr(corr, "gradient_um_per_m", None)
+        gradient = self.gradient if held or gradient is None else gradient
+        target = self.watch.command(wanted)
+        new = float(np.clip(np.clip(target, self.written - g.max_change_um, self.written + g.max_change_um),
                             -g.max_offset_um, g.max_offset_um))
-        if abs(new - wanted) > 1e-12:
+        if gradient is not None and target != wanted:  # fallen back: the gradient scaled with the offset
+            gradient = gradient * new / self.written if self.written else 0.0
+        self.gradient = gradient
+        worse = int(self.watch.worse is not None)
+        self.counts["worse"] += worse
+        if abs(new - target) > 1e-12:
             limited = 1
             self.counts["limited"] += 1
             self.journal.event(t, f"correction limited: {wanted:.3f} -> {new:.3f} um")
@@ -138,10 +171,12 @@ class Service:
         self.next = k + 1
         self.counts["periods"] += 1
         row = {"time_s": t, **sample, "offset_um": new, "offset_wanted_um": wanted,
-               "delta_forecast_um": corr.predicted_um, "held": held, "limited": limited}
+               "delta_forecast_um": corr.predicted_um, "held": held, "limited": limited, "worse": worse,
+               "gradient_um_per_m": gradient, "reference_m": getattr(corr, "reference_m", None)}
         self.journal.row(row)
         self.journal.save({"stepper": self.stepper.state(), "next": self.next, "offset_um": self.written,
-                           "good": self.good, "good_k": self.good_k, "counts": self.counts, "t_logged": t})
+                           "gradient_um_per_m": self.gradient, "good": self.good, "good_k": self.good_k,
+                           "counts": self.counts, "monitor": self.watch.state(), "t_logged": t})
         return row
 
 
@@ -190,7 +225,7 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                         svc.counts["reconnects"] += ever
                         journal.event(None, f"{'re' if ever else ''}connected after {time.monotonic() - lost_at:.1f} s")
                     lost_at, wait, ever = None, g.retry_first_s, True
-                    await _write(resolved, nodes, svc.written)
+                    await _write(resolved, nodes, svc.written, svc.gradient, svc.reference)
                 sample = await _sample(client, resolved, read, nodes.factor)
                 if sample is None:
                     await asyncio.sleep(params.poll_s)
@@ -205,7 +240,7 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                 row = svc.period(t, k, sample)
                 if status is not None:
                     status.add(row, svc.counts)
-                await _write(resolved, nodes, svc.written)
+                await _write(resolved, nodes, svc.written, svc.gradient, svc.reference)
                 if on_period is not None:
                     on_period(row)
                 if params.until_s is not None and t >= params.until_s - 1e-9:
@@ -228,18 +263,22 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     down = now - lost_at
                     ramped = math.copysign(max(0.0, abs(svc.written) - g.ramp_um_per_s * ramping), svc.written)
                     journal.event(None, f"connection lost {down:.0f} s: correction ramped to {ramped:.3f} um")
+                    if svc.gradient:
+                        svc.gradient *= ramped / svc.written
                     svc.written = ramped
     finally:
         await _close(client)
     return svc.counts
 
 
-async def _write(resolved, nodes: NodeMap, offset: float) -> None:
+async def _write(resolved, nodes: NodeMap, offset: float, gradient=None, reference=None) -> None:
+    """Write the offset and, where the compensator gives them and the map names them, the gradient
+    and its reference position."""
     from asyncua import ua
 
-    if "offset_um" in resolved:
-        await resolved["offset_um"].write_value(ua.DataValue(ua.Variant(offset * nodes.factor("offset_um"),
-                                                                        ua.VariantType.Double)))
+    for name, value in (("offset_um", offset), ("gradient_um_per_m", gradient), ("reference_m", reference)):
+        if name in resolved and name in nodes.write and value is not None and math.isfinite(value):
+            await resolved[name].write_value(ua.DataValue(ua.Variant(value * nodes.factor(name), ua.VariantType.Double)))
 
 
 async def _close(client) -> None:
@@ -248,24 +287,6 @@ async def _close(client) -> None:
             await client.disconnect()
         except Exception:  # noqa: BLE001 - the link is gone already
             pass
-
-
-def summarize(directory, counts: dict, settle_s: float = 600.0) -> dict:
-    """The run's summary from ``live.csv``: the counts and, where the machine reports its compensated
-    δ, its band after the first ``settle_s`` of machine time (µm); written to ``summary.json``."""
-    from gatetherm.studies.run.timeseries import read_timeseries
-
-    ts = read_timeseries(directory / "live.csv", required=("time_s",))
-    out = {**counts, "rows": len(ts.time_s), "first_s": float(ts.time_s[0]) if len(ts.time_s) else None,
-           "last_s": float(ts.time_s[-1]) if len(ts.time_s) else None}
-    if "delta_residual_um" in ts and len(ts.time_s):
-        late = ts.time_s >= ts.time_s[0] + settle_s
-        comp = ts["delta_residual_um"][late]
-        out["compensated_band_um"] = float(np.nanmax(np.abs(comp))) if np.isfinite(comp).any() else None
-    write_text_atomic(directory / "summary.json", json.dumps(out, indent=2, allow_nan=False) + "\n")
-    if counts.get("missed"):
-        log.info("%d period(s) missed", counts["missed"])
-    return out
 
 
 def check(params: LiveParams) -> None:
