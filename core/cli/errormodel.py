@@ -107,7 +107,7 @@ def run_fit(args) -> int:
              **{c: "--targets" for c in targets}}
     runs = [read_timeseries(d, required=("time_s", *targets, *(candidates or ()), *inputs), named_by=named)
             for d in args.data]
-    params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
+    params = dataclasses.replace(ROBUST, max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                        differences=args.differences, resolution_K=args.resolution_K, cv=args.cv,
                        drift=not args.no_drift)
     lo, hi = _span(args.fit_span)
