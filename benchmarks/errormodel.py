@@ -19,6 +19,8 @@ on those plus their means over the 8 previous samples (32 features; the first 8 
 none).
 Seeds are fixed (``random_state=0``); defaults otherwise (100 trees), 2 threads.
 ``--cv chain`` selects gatetherm's terms by forward chaining instead (docs/errormodel.md).
+``--peers-from benchmarks/results/errormodel.json`` takes the peers' figures of the same splits as
+recorded there (where their environment is missing) and prints the checks against them.
 The column ``in 90 %`` is the share of the test samples inside gatetherm's 90 % interval (as
 ``predict`` writes it, widened where the model extrapolates).
 Prints the table, the acceptance checks of issue 56 and writes ``--json`` (default
@@ -136,6 +138,9 @@ def main() -> None:
     ap.add_argument("--cv", choices=("blocked", "chain"), default=ROBUST.cv,
                     help="gatetherm's held-out error within the fitting span (default: the API's)")
     ap.add_argument("--test-data", help="also fit on all of --data and test on this file (a later part)")
+    ap.add_argument("--peers-from", metavar="JSON",
+                    help="take the peers' rows of these splits from a results file written with the peers (e.g. "
+                         "benchmarks/results/errormodel.json), for the checks, instead of running them")
     ap.add_argument("--json", default=str(Path(__file__).resolve().parent / "results" / "errormodel.json"))
     args = ap.parse_args()
     global PARAMS
@@ -159,17 +164,35 @@ def main() -> None:
         for label, inputs in (("gatetherm", ("spindle_rpm",)), ("gatetherm static", ())):
             print(f"  {label}:")
             result[label] = run_gatetherm(inputs, fit_ts, test_ts, first)
-        for p in () if args.no_peers else PEERS:
+        for p in () if args.no_peers or args.peers_from else PEERS:
             result[p] = (*run_peer(p, fit_ts, test_ts, first), None)
+        if args.peers_from:
+            result.update(recorded_peers(Path(args.peers_from), name))
         for label, (maes, sensors, t_fit, t_pred, inside) in result.items():
             rows.append([name, label, *[round(m, 2) for m in maes], round(float(np.mean(maes)), 2), sensors,
                          round(t_fit, 2), round(t_pred * 1e6, 2), "-" if inside is None else f"{inside:.1%}"])
-        if not args.no_peers:
-            notes.append(check(name, result))
+        if all(p in result for p in PEERS):
+            notes.append(check(name, result) + (f" (peers as recorded in {args.peers_from})" if args.peers_from else ""))
             print(notes[-1])
     notes.append(one_sample_latency(fit_error_model(ts, TARGETS, SENSORS, ("spindle_rpm",), PARAMS), ts))
     print(notes[-1])
     write_table(Path(args.json), columns, rows, notes)
+
+
+def recorded_peers(path: Path, split: str) -> dict:
+    """The peers' results of ``split`` as a results file of this script recorded them (seeds fixed:
+    the same figures a run in their environment gives): label -> (MAE per target, sensors, fit s,
+    predict s per sample, None)."""
+    import json
+
+    data = json.loads(path.read_text())
+    col = {c: k for k, c in enumerate(data["columns"])}
+    out = {r[col["model"]]: ([float(r[col[y]]) for y in TARGETS], r[col["sensors"]], float(r[col["fit s"]]),
+                             float(r[col["predict us/sample"]]) * 1e-6, None)
+           for r in data["rows"] if r[col["split"]] == split and r[col["model"]] in PEERS}
+    if set(out) != set(PEERS):
+        raise SystemExit(f"--peers-from {path}: no peers' rows for the split {split}")
+    return out
 
 
 def one_sample_latency(model, ts) -> str:

@@ -117,7 +117,7 @@ def run_fit(args) -> int:
         save_model(out / "model.json", model)
     held = "leave one run out" if len(runs) >= 3 else args.cv
     print(f"wrote {Path(args.out) / 'model.json'} (fitted on {len(runs)} run(s), {model.fit_span['samples']} samples; "
-          f"held-out error: {held})")
+          f"held-out error: {held}; readings smoothed over {model.settings.get('smooth_s', 0.0):g} s)")
     for m in model.targets:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
         drift = next((f"; drift {b:.3g} um/h" for t, b in zip(m.terms, m.coefficients) if t.kind == "drift"), "")
