@@ -21,6 +21,9 @@ Seeds are fixed (``random_state=0``); defaults otherwise (100 trees), 2 threads.
 ``--cv chain`` selects gatetherm's terms by forward chaining instead (docs/errormodel.md).
 ``--peers-from benchmarks/results/errormodel.json`` takes the peers' figures of the same splits as
 recorded there (where their environment is missing) and prints the checks against them.
+``--smooth-s S`` fixes gatetherm's smoothing of the readings (no choice); ``--inner`` (with
+``--no-peers``) fits on each fitting part's first 75 % and tests on its last 25 %: forward chaining
+inside what the split lets a fit see.
 The column ``in 90 %`` is the share of the test samples inside gatetherm's 90 % interval (as
 ``predict`` writes it, widened where the model extrapolates).
 Prints the table, the acceptance checks of issue 56 and writes ``--json`` (default
@@ -138,6 +141,10 @@ def main() -> None:
     ap.add_argument("--cv", choices=("blocked", "chain"), default=ROBUST.cv,
                     help="gatetherm's held-out error within the fitting span (default: the API's)")
     ap.add_argument("--test-data", help="also fit on all of --data and test on this file (a later part)")
+    ap.add_argument("--smooth-s", type=float, metavar="S",
+                    help="gatetherm's readings smoothed over S s, no choice (default: the API's choice)")
+    ap.add_argument("--inner", action="store_true",
+                    help="forward chaining inside each fitting part: fit on its first 75 %%, test on its last 25 %%")
     ap.add_argument("--peers-from", metavar="JSON",
                     help="take the peers' rows of these splits from a results file written with the peers (e.g. "
                          "benchmarks/results/errormodel.json), for the checks, instead of running them")
@@ -145,12 +152,21 @@ def main() -> None:
     args = ap.parse_args()
     global PARAMS
     PARAMS = dataclasses.replace(PARAMS, cv=args.cv)
+    if args.smooth_s is not None:
+        PARAMS = dataclasses.replace(PARAMS, smooth_s=args.smooth_s, smooth_grid_s=())
+    if args.inner and not args.no_peers:
+        raise SystemExit("--inner: gatetherm only (add --no-peers)")
     ts = read_timeseries(args.data, required=("time_s", "spindle_rpm", *TARGETS, *SENSORS))
     cases = []
     for name in [s for s in args.splits.split(",") if s]:
         a, b, c, d = (f / args.covered for f in parse_split(name))
         if d > 1 + 1e-9:
             raise SystemExit(f"--splits: {name} reaches beyond the file (it holds {args.covered:.0%} of the record)")
+        if args.inner:  # the fitting part's first 75 % -> its last 25 %
+            part = rows_between(ts, a, b)
+            cut = round(0.75 * len(part))
+            cases.append((f"{name} inner", part.slice(slice(0, cut)), part, cut))
+            continue
         cases.append((name, rows_between(ts, a, b), rows_between(ts, 0.0, d), round(c * len(ts))))
     if args.test_data:
         later = read_timeseries(args.test_data, required=("time_s", "spindle_rpm", *TARGETS, *SENSORS))
