@@ -226,3 +226,5 @@ def test_anchor_cuts_the_noise_and_the_held_out_error_refuses_a_smoothing_that_c
     assert out["smooth"][1] == pytest.approx(0.179, abs=0.004)  # worse: the lag costs more than the noise
     assert out["smooth"][3] == pytest.approx(0.164, abs=0.004) and out["anchor"][3] == pytest.approx(0.099, abs=0.003)
     assert out["grid"][2] == 0.0 and out["grid"][:2] == out["anchor"][:2]  # the held-out error chose
+    held = model.settings["smooth_held_out_um"]  # the grid's model, the loop's last: both values recorded
+    assert held["0"] == pytest.approx(out["anchor"][3]) and held["300"] == pytest.approx(out["smooth"][3])
