@@ -19,6 +19,11 @@ on those plus their means over the 8 previous samples (32 features; the first 8 
 none).
 Seeds are fixed (``random_state=0``); defaults otherwise (100 trees), 2 threads.
 ``--cv chain`` selects gatetherm's terms by forward chaining instead (docs/errormodel.md).
+``--peers-from benchmarks/results/errormodel.json`` takes the peers' figures of the same splits as
+recorded there (where their environment is missing) and prints the checks against them.
+``--smooth-s S`` fixes gatetherm's smoothing of the readings (no choice); ``--inner`` (with
+``--no-peers``) fits on each fitting part's first 75 % and tests on its last 25 %: forward chaining
+inside what the split lets a fit see.
 The column ``in 90 %`` is the share of the test samples inside gatetherm's 90 % interval (as
 ``predict`` writes it, widened where the model extrapolates).
 Prints the table, the acceptance checks of issue 56 and writes ``--json`` (default
@@ -136,16 +141,32 @@ def main() -> None:
     ap.add_argument("--cv", choices=("blocked", "chain"), default=ROBUST.cv,
                     help="gatetherm's held-out error within the fitting span (default: the API's)")
     ap.add_argument("--test-data", help="also fit on all of --data and test on this file (a later part)")
+    ap.add_argument("--smooth-s", type=float, metavar="S",
+                    help="gatetherm's readings smoothed over S s, no choice (default: the API's choice)")
+    ap.add_argument("--inner", action="store_true",
+                    help="forward chaining inside each fitting part: fit on its first 75 %%, test on its last 25 %%")
+    ap.add_argument("--peers-from", metavar="JSON",
+                    help="take the peers' rows of these splits from a results file written with the peers (e.g. "
+                         "benchmarks/results/errormodel.json), for the checks, instead of running them")
     ap.add_argument("--json", default=str(Path(__file__).resolve().parent / "results" / "errormodel.json"))
     args = ap.parse_args()
     global PARAMS
     PARAMS = dataclasses.replace(PARAMS, cv=args.cv)
+    if args.smooth_s is not None:
+        PARAMS = dataclasses.replace(PARAMS, smooth_s=args.smooth_s, smooth_grid_s=())
+    if args.inner and not args.no_peers:
+        raise SystemExit("--inner: gatetherm only (add --no-peers)")
     ts = read_timeseries(args.data, required=("time_s", "spindle_rpm", *TARGETS, *SENSORS))
     cases = []
     for name in [s for s in args.splits.split(",") if s]:
         a, b, c, d = (f / args.covered for f in parse_split(name))
         if d > 1 + 1e-9:
             raise SystemExit(f"--splits: {name} reaches beyond the file (it holds {args.covered:.0%} of the record)")
+        if args.inner:  # the fitting part's first 75 % -> its last 25 %
+            part = rows_between(ts, a, b)
+            cut = round(0.75 * len(part))
+            cases.append((f"{name} inner", part.slice(slice(0, cut)), part, cut))
+            continue
         cases.append((name, rows_between(ts, a, b), rows_between(ts, 0.0, d), round(c * len(ts))))
     if args.test_data:
         later = read_timeseries(args.test_data, required=("time_s", "spindle_rpm", *TARGETS, *SENSORS))
@@ -159,17 +180,35 @@ def main() -> None:
         for label, inputs in (("gatetherm", ("spindle_rpm",)), ("gatetherm static", ())):
             print(f"  {label}:")
             result[label] = run_gatetherm(inputs, fit_ts, test_ts, first)
-        for p in () if args.no_peers else PEERS:
+        for p in () if args.no_peers or args.peers_from else PEERS:
             result[p] = (*run_peer(p, fit_ts, test_ts, first), None)
+        if args.peers_from:
+            result.update(recorded_peers(Path(args.peers_from), name))
         for label, (maes, sensors, t_fit, t_pred, inside) in result.items():
             rows.append([name, label, *[round(m, 2) for m in maes], round(float(np.mean(maes)), 2), sensors,
                          round(t_fit, 2), round(t_pred * 1e6, 2), "-" if inside is None else f"{inside:.1%}"])
-        if not args.no_peers:
-            notes.append(check(name, result))
+        if all(p in result for p in PEERS):
+            notes.append(check(name, result) + (f" (peers as recorded in {args.peers_from})" if args.peers_from else ""))
             print(notes[-1])
     notes.append(one_sample_latency(fit_error_model(ts, TARGETS, SENSORS, ("spindle_rpm",), PARAMS), ts))
     print(notes[-1])
     write_table(Path(args.json), columns, rows, notes)
+
+
+def recorded_peers(path: Path, split: str) -> dict:
+    """The peers' results of ``split`` as a results file of this script recorded them (seeds fixed:
+    the same figures a run in their environment gives): label -> (MAE per target, sensors, fit s,
+    predict s per sample, None)."""
+    import json
+
+    data = json.loads(path.read_text())
+    col = {c: k for k, c in enumerate(data["columns"])}
+    out = {r[col["model"]]: ([float(r[col[y]]) for y in TARGETS], r[col["sensors"]], float(r[col["fit s"]]),
+                             float(r[col["predict us/sample"]]) * 1e-6, None)
+           for r in data["rows"] if r[col["split"]] == split and r[col["model"]] in PEERS}
+    if set(out) != set(PEERS):
+        raise SystemExit(f"--peers-from {path}: no peers' rows for the split {split}")
+    return out
 
 
 def one_sample_latency(model, ts) -> str:

@@ -14,7 +14,7 @@ from gatetherm.studies.errormodel import select
 from gatetherm.studies.errormodel.fit import FitParams, fit_error_model
 from gatetherm.studies.errormodel.model import load_model, predict
 from gatetherm.studies.errormodel.trust import trust
-from gatetherm.studies.errormodel.terms import lag
+from gatetherm.studies.errormodel.terms import Term, anchor_value, lag, noise_sd
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
 
 SENSORS = ("s1_degC", "s2_degC", "s3_degC")
@@ -164,3 +164,67 @@ def test_cli_a_run_without_a_column_is_one_line_naming_its_file(tmp_path, capsys
                  "--candidates", "s1_degC,s3_degC", "--out", str(tmp_path / "fit")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bad.csv" in err[0] and "s3_degC" in err[0]
+
+
+def test_anchor_is_the_line_through_the_first_readings_and_averages_their_noise():
+    """A line is its own anchor; the anchor's weights on m equally spaced readings have the
+    squared sum 2 (2m - 1) / (m (m + 1)) (the variance of a fitted line's intercept), 0.345 for m = 10."""
+    t = 60.0 * np.arange(30)
+    assert anchor_value(t, 3.0 + 0.01 * t, 540.0) == pytest.approx(3.0, abs=1e-12)
+    weights = np.array([anchor_value(t, np.eye(30)[k], 540.0) for k in range(30)])  # linear in the readings
+    assert np.count_nonzero(weights) == 10
+    assert weights @ weights == pytest.approx(2 * 19 / 110, rel=1e-12)
+    assert anchor_value(t, t, 0.0) == 0.0  # no window: the first reading
+
+
+def test_smoothed_readings_are_read_alike_by_fit_predict_and_the_stepper():
+    """A model fitted with smooth_s reads its temperatures through that lag in predict, and the
+    one-sample-at-a-time stepper of a control gives the same values to round-off; the noise rule
+    counts the smoothed noise (sqrt((1 - a) / (1 + a)) of a reading's, 0.32 for 300 s at 60 s)."""
+    from gatetherm.studies.control.compensator import CompensatorParams
+    from gatetherm.studies.control.stepwise import ErrorModelStepper
+
+    params = FitParams(smooth_s=300.0)
+    model = fit_error_model(RUNS[0], ["d_um"], SENSORS, ("spindle_rpm",), params)
+    assert model.settings["smooth_s"] == 300.0
+    a = np.exp(-60.0 / 300.0)
+    assert noise_sd(Term("sensor", "s1_degC"), 0.05, 60.0, 300.0) == pytest.approx(0.05 * np.sqrt((1 - a) / (1 + a)))
+    assert np.sqrt((1 - a) / (1 + a)) == pytest.approx(0.3157, abs=1e-4)
+    batch = predict(model, RUNS[0])["d_um"]
+    stepper = ErrorModelStepper(model, "d_um", CompensatorParams(sample_interval_s=60.0))
+    cols = RUNS[0].columns
+    steps = [stepper._value(t, {k: cols[k][i] for k in cols}) for i, t in enumerate(RUNS[0].time_s)]
+    assert np.max(np.abs(np.array(steps) - batch)) < 1e-9
+    plain = predict(fit_error_model(RUNS[0], ["d_um"], SENSORS, ("spindle_rpm",)), RUNS[0])["d_um"]
+    assert np.max(np.abs(plain - batch)) > 0.01  # the smoothing is in use
+
+
+def test_anchor_cuts_the_noise_and_the_held_out_error_refuses_a_smoothing_that_costs():
+    """Fitted on three noise-free runs, applied to the fourth read with 0.05 K of noise. The run's
+    zero taken from one reading offsets the whole run; the anchor on the first 600 s lowers the
+    error on noisy readings. Here the displacement follows the readings at once, so a 300-s
+    smoothing lags it by more than the noise it removes: the held-out error says so, and the grid
+    (the API's default) keeps the readings unsmoothed."""
+    clean = [run(k + 1, s, v, noise_um=0.0) for k, (s, v) in enumerate([(0.0, 4500.0), (3.0, 3000.0), (1.5, 4000.0),
+                                                                         (5.0, 2000.0)])]
+    truth = np.asarray(clean[3]["d_um"]) - clean[3]["d_um"][0]
+    rng = np.random.default_rng(7)
+    draws = [clean[3].with_columns(**{s: clean[3][s] + rng.normal(0.0, 0.05, len(clean[3])) for s in SENSORS})
+             for _ in range(5)]
+    out = {}
+    for name, params in (("plain", FitParams(drift=True, noisy_cv=True)),
+                         ("anchor", FitParams(drift=True, noisy_cv=True, anchor_s=600.0)),
+                         ("smooth", FitParams(drift=True, noisy_cv=True, smooth_s=300.0, anchor_s=600.0)),
+                         ("grid", FitParams(drift=True, noisy_cv=True, smooth_grid_s=(300.0,), anchor_s=600.0))):
+        model = fit_error_model(clean[:3], ["d_um"], SENSORS, (), params)
+        exact = np.mean(np.abs(predict(model, clean[3])["d_um"] - truth))
+        noisy = np.mean([np.mean(np.abs(predict(model, d)["d_um"] - truth)) for d in draws])
+        out[name] = (exact, noisy, model.settings["smooth_s"], model.target("d_um").held_out_mae_um)
+    assert out["plain"][1] == pytest.approx(0.1005, abs=0.002)  # noise-free 0.0024 um
+    assert out["anchor"][1] == pytest.approx(0.0944, abs=0.002)  # band: below plain's
+    assert out["anchor"][1] < out["plain"][1]
+    assert out["smooth"][1] == pytest.approx(0.179, abs=0.004)  # worse: the lag costs more than the noise
+    assert out["smooth"][3] == pytest.approx(0.164, abs=0.004) and out["anchor"][3] == pytest.approx(0.099, abs=0.003)
+    assert out["grid"][2] == 0.0 and out["grid"][:2] == out["anchor"][:2]  # the held-out error chose
+    held = model.settings["smooth_held_out_um"]  # the grid's model, the loop's last: both values recorded
+    assert held["0"] == pytest.approx(out["anchor"][3]) and held["300"] == pytest.approx(out["smooth"][3])

@@ -107,7 +107,7 @@ def run_fit(args) -> int:
              **{c: "--targets" for c in targets}}
     runs = [read_timeseries(d, required=("time_s", *targets, *(candidates or ()), *inputs), named_by=named)
             for d in args.data]
-    params = FitParams(max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
+    params = dataclasses.replace(ROBUST, max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                        differences=args.differences, resolution_K=args.resolution_K, cv=args.cv,
                        drift=not args.no_drift)
     lo, hi = _span(args.fit_span)
@@ -117,7 +117,7 @@ def run_fit(args) -> int:
         save_model(out / "model.json", model)
     held = "leave one run out" if len(runs) >= 3 else args.cv
     print(f"wrote {Path(args.out) / 'model.json'} (fitted on {len(runs)} run(s), {model.fit_span['samples']} samples; "
-          f"held-out error: {held})")
+          f"held-out error: {held}; readings smoothed over {model.settings.get('smooth_s', 0.0):g} s)")
     for m in model.targets:
         taus = ", ".join(f"{t.tau_s:.0f} s" for t in m.terms if t.tau_s is not None) or "none"
         drift = next((f"; drift {b:.3g} um/h" for t, b in zip(m.terms, m.coefficients) if t.kind == "drift"), "")

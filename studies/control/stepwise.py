@@ -240,16 +240,31 @@ class ErrorModelStepper(AheadStepper):
         self.lags: list[float | None] = [None] * len(self.target.terms)
         self.signal: list[float | None] = [None] * len(self.target.terms)
         self.h = params.sample_interval_s
+        self.smooth_s = float(model.settings.get("smooth_s", 0.0))  # the fit's smoothing of the readings
+        self.read: dict[str, tuple[float, float]] = {}  # per temperature column: (smoothed, last reading)
+
+    def _reading(self, name: str, sample) -> float:
+        r = float(sample[name])
+        if self.smooth_s <= 0:
+            return r
+        if name in self.now:  # a column read by two terms is stepped once per sample
+            return self.now[name]
+        x, r0 = self.read.get(name, (r, r))  # steady state at the first sample
+        if name in self.read:
+            a = math.exp(-self.h / self.smooth_s)
+            x = a * x + (1.0 - a) * r0 + (r - r0) * (1.0 - self.smooth_s * (1.0 - a) / self.h)
+        self.read[name], self.now[name] = (x, r), x
+        return x
 
     def _term(self, term, sample) -> float:
         ref = self.model.reference_degC
         if term.kind == "input":
             return (abs(float(sample[term.column])) / term.scale) ** term.exponent
-        s = float(sample[term.column]) - ref[term.column]
-        return s - (float(sample[term.other]) - ref[term.other]) if term.other is not None else s
+        s = self._reading(term.column, sample) - ref[term.column]
+        return s - (self._reading(term.other, sample) - ref[term.other]) if term.other is not None else s
 
     def _value(self, t, sample):
-        m, y = self.target, self.target.intercept_um
+        m, y, self.now = self.target, self.target.intercept_um, {}
         for j, (term, b) in enumerate(zip(m.terms, m.coefficients)):
             s = self._term(term, sample)
             if term.tau_s is not None:
@@ -264,11 +279,12 @@ class ErrorModelStepper(AheadStepper):
         return y
 
     def _own(self):
-        return {**super()._own(), "lags": self.lags, "signal": self.signal}
+        return {**super()._own(), "lags": self.lags, "signal": self.signal, "read": self.read}
 
     def _load(self, s):
         super()._load(s)
         self.lags, self.signal = list(s["lags"]), list(s["signal"])
+        self.read = {k: tuple(v) for k, v in s.get("read", {}).items()}
 
 
 def error_model_stepper(model, target: str, params: CompensatorParams, correction: bool = False) -> Stepper:

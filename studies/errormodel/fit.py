@@ -94,6 +94,20 @@ class FitParams:
     noisy_cv: bool = False
     """Score every candidate by its expected held-out error on readings carrying the sensors' noise
     (``resolution_K``): a term whose noise costs more than it explains is not chosen."""
+    smooth_s: float = 0.0
+    """Time constant of a first-order lag every temperature reading passes before it enters a term,
+    in the fit as in ``predict``, s: white noise of the readings reduced to ``sqrt((1 - a) / (1 + a))``
+    of it (``a = exp(-h / smooth_s)``, h the sample step), which the coefficients' noise rule then
+    counts; 0 = the readings as they are."""
+    smooth_grid_s: tuple[float, ...] = ()
+    """Further values of ``smooth_s`` to try, s: the model is fitted with each (and ``smooth_s``) and
+    the one of the lowest held-out error, summed over the targets, is kept (``settings``:
+    ``smooth_held_out_um``, the sum for each value); empty = ``smooth_s`` only."""
+    anchor_s: float = 0.0
+    """Each run's (and each predicted file's) first reading of a temperature column is replaced by the
+    value there of the straight line through its readings of the first ``anchor_s`` seconds, s: with
+    several runs every term is taken from that reading, and one noisy sample would offset the whole
+    run; the noise rule then counts the reference's noise too. 0 = the first reading as it is."""
     drift: bool = False
     """With several runs, also offer a slow drift, the hours since each run's start (kept only where
     it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with
@@ -114,6 +128,8 @@ class FitParams:
             raise InputError("resolution_K", f"{self.resolution_K} is not >= 0", "e.g. 0.05 (K, a thermocouple)")
         if self.cv not in CV_KINDS:
             raise InputError("cv", f"{self.cv!r} is not one of {', '.join(CV_KINDS)}", "e.g. cv chain")
+        if not all(np.isfinite(v) and v >= 0 for v in (self.smooth_s, self.anchor_s, *self.smooth_grid_s)):
+            raise InputError("smooth_s, anchor_s", "must be >= 0", "e.g. 300 (s), 0 = off")
         if not 0 <= self.min_gain < 1:
             raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
 
@@ -162,6 +178,16 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
         (first valid sample in the span, degC; none for several runs) and the span; see
         :mod:`gatetherm.studies.errormodel.model`.
     """
+    if params.smooth_grid_s:
+        fits = {float(v): fit_error_model(series, targets, candidates, inputs,
+                                          dataclasses.replace(params, smooth_s=float(v), smooth_grid_s=()), span, source)
+                for v in dict.fromkeys((params.smooth_s, *params.smooth_grid_s))}
+        held = {v: float(sum(m.held_out_mae_um for m in f.targets)) for v, f in fits.items()}
+        best = min(held, key=held.get)  # ties: the first listed, smooth_s
+        log.info("readings smoothed over %g s: held-out error %s", best, held)
+        f = fits[best]
+        return dataclasses.replace(f, settings={**f.settings, "smooth_grid_s": list(params.smooth_grid_s),
+                                                "smooth_held_out_um": {f"{v:g}": e for v, e in held.items()}})
     runs = list(series) if isinstance(series, (list, tuple)) else [series]
     if not runs:
         raise InputError("data", "no run given", "give at least one data file")
@@ -181,7 +207,7 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
     spans = span if isinstance(span, list) else [span] * len(runs)
     spans = [s if s is not None else (float(np.asarray(ts["time_s"])[0]), float(np.asarray(ts["time_s"])[-1]))
              for s, ts in zip(spans, runs)]
-    data = Runs(runs, candidates, inputs, spans, params.max_gap_s, sources)
+    data = Runs(runs, candidates, inputs, spans, params.max_gap_s, sources, params.smooth_s, params.anchor_s)
     base = _base_terms(candidates, inputs, data, params)
     B = np.column_stack([np.ones(data.time.size)] + [data.column(b) for b in base])
     models = [_fit_target(data.target(y), y, data, base, B, params) for y in targets]
@@ -216,9 +242,17 @@ def _base_terms(candidates, inputs, data: Runs, params: FitParams) -> list[Term]
 
 
 def _variances(terms, data: Runs, params: FitParams) -> np.ndarray:
-    """Noise variance of the intercept (0) and of each term's values (K^2; 0 for inputs)."""
+    """Noise variance of the intercept (0) and of each term's values (K^2; 0 for inputs); with
+    ``anchor_s`` and several runs also the noise of each run's reference (``2 (2m - 1) / (m (m + 1))``
+    of a reading's, m the samples of the first ``anchor_s``)."""
     step = data.step_s
-    return np.array([0.0] + [noise_sd(term, params.resolution_K, step) ** 2 for term in terms])
+    var = [noise_sd(term, params.resolution_K, step, params.smooth_s) ** 2 for term in terms]
+    if params.anchor_s > 0 and data.anchored:
+        m = int(params.anchor_s // step) + 1
+        share = 2 * (2 * m - 1) / (m * (m + 1))  # 1 for m = 1, 2
+        var = [v + share * noise_sd(dataclasses.replace(term, tau_s=None), params.resolution_K, step) ** 2
+               for v, term in zip(var, terms)]
+    return np.array([0.0] + var)
 
 
 def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:

@@ -23,7 +23,7 @@ import numpy as np
 from gatetherm import InputError, write_text_atomic
 from gatetherm.checks import first_nonfinite, json_text, parse_json
 from gatetherm.files import read_text
-from gatetherm.studies.errormodel.terms import GapReport, Term, evaluate, fill_gaps
+from gatetherm.studies.errormodel.terms import GapReport, Term, evaluate, fill_gaps, readings
 
 log = logging.getLogger(__name__)
 
@@ -135,6 +135,9 @@ def _filled(model: ErrorModel, columns) -> tuple[dict, np.ndarray, dict[str, Gap
             cols[name], long, reports[name] = fill_gaps(t, columns[name], model.max_gap_s)
         except ValueError:
             raise InputError(f"column {name}", "has no valid sample", "give measured values") from None
+        smooth, anchor = (float(model.settings.get(k, 0.0)) for k in ("smooth_s", "anchor_s"))
+        if name not in model.settings.get("inputs", ()) and (smooth > 0 or anchor > 0):
+            cols[name] = readings(t, cols[name], smooth, anchor)  # as the fit read them
         bad |= long
     return cols, bad, reports
 

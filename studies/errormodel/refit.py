@@ -69,7 +69,8 @@ def refit(model: ErrorModel, columns, window_s: float, applied: dict[str, str] |
         if rows.size < 4 * (X.shape[1] + 1):
             raise InputError(f"refit of {m.target}", f"only {rows.size} valid samples in the window",
                              "give a longer window or more data")
-        var = np.array([noise_sd(term, resolution, step) ** 2 for term in m.terms])
+        var = np.array([noise_sd(term, resolution, step, float(model.settings.get("smooth_s", 0.0))) ** 2
+                        for term in m.terms])
         cut = rows[: int(rows.size * (1 - CHECK_SHARE))]
         check = rows[cut.size:]
         c0, c = _solve(X[cut], y[cut], var, not model.run_reference)

@@ -14,7 +14,7 @@ import logging
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps
+from gatetherm.studies.errormodel.terms import Term, evaluate, fill_gaps, readings
 
 log = logging.getLogger(__name__)
 
@@ -22,9 +22,12 @@ log = logging.getLogger(__name__)
 class Runs:
     """The runs' gap-filled columns, their references and the rows a fit may use, concatenated."""
 
-    def __init__(self, series, candidates, inputs, spans, max_gap_s: float, sources=()):
+    def __init__(self, series, candidates, inputs, spans, max_gap_s: float, sources=(), smooth_s: float = 0.0,
+                 anchor_s: float = 0.0):
         """``series``: the runs (mappings or TimeSeries with ``time_s``); ``spans``: per run the
-        fitting span ``(start_s, end_s)``; ``sources``: per run its file (for messages)."""
+        fitting span ``(start_s, end_s)``; ``sources``: per run its file (for messages);
+        ``smooth_s``, ``anchor_s``: how the temperature columns are read
+        (:func:`~gatetherm.studies.errormodel.terms.readings`, s)."""
         self.anchored = len(series) > 1
         self.t, self.cols, self.refs, self.rows, self.series = [], [], [], [], list(series)
         for k, (ts, (lo, hi)) in enumerate(zip(series, spans)):
@@ -38,6 +41,8 @@ class Runs:
                     raise InputError(f"{where}: column {name}", "no valid sample in the fitting span",
                                      "give measured values")
                 cols[name], gap, report = fill_gaps(t, v, max_gap_s)
+                if name in candidates and (smooth_s > 0 or anchor_s > 0):
+                    cols[name] = readings(t, cols[name], smooth_s, anchor_s, int(np.argmax(in_span)))
                 long |= gap
                 if report.filled:
                     log.info("%s: %s: %d missing samples filled (longest gap %.0f s)", where, name, report.filled,

@@ -99,6 +99,33 @@ def lag(t_s: np.ndarray, signal: np.ndarray, tau_s: float) -> np.ndarray:
     return x
 
 
+def anchor_value(t_s: np.ndarray, values: np.ndarray, window_s: float) -> float:
+    """The value at the first sample of the straight line fitted by least squares through the
+    samples of the first ``window_s`` seconds (fewer than three: the first sample): a reference
+    that one noisy reading does not set alone. Its variance is ``2 (2m - 1) / (m (m + 1))`` times
+    a reading's for ``m`` equally spaced samples (0.35 for m = 10). Unit of ``values``."""
+    t = np.asarray(t_s, float)
+    v = np.asarray(values, float)
+    near = (t - t[0] <= window_s) & np.isfinite(v)
+    if window_s <= 0 or near.sum() < 3:
+        return float(v[0])
+    slope, intercept = np.polyfit(t[near] - t[0], v[near], 1)
+    return float(intercept)
+
+
+def readings(t_s: np.ndarray, values: np.ndarray, smooth_s: float = 0.0, anchor_s: float = 0.0,
+             start: int = 0) -> np.ndarray:
+    """A temperature column as the model reads it (gap-free ``values``, degC, at ``t_s``, s): its
+    reading at ``start`` replaced by :func:`anchor_value` over the ``anchor_s`` seconds from there
+    (the run's reference, 0 = the reading itself), then, with ``smooth_s`` > 0, passed through a
+    first-order lag of that time constant, s, in steady state at its first sample: white noise of
+    the readings reduced to ``sqrt((1 - a) / (1 + a))`` of it (``a = exp(-h / smooth_s)``)."""
+    v = np.array(values, float)
+    if anchor_s > 0 and start < v.size:
+        v[start] = anchor_value(t_s[start:], v[start:], anchor_s)
+    return lag(t_s, v, smooth_s) if smooth_s > 0 else v
+
+
 def evaluate(term: Term, t_s: np.ndarray, columns, reference_degC: dict[str, float]) -> np.ndarray:
     """The term's values at the samples ``t_s`` (s) from gap-free ``columns`` (name -> array) and the
     reference temperatures (degC) of the sensors; K for sensors and differences, 1 for inputs, h for
@@ -114,17 +141,19 @@ def evaluate(term: Term, t_s: np.ndarray, columns, reference_degC: dict[str, flo
     return s if term.tau_s is None else lag(t_s, s, term.tau_s)
 
 
-def noise_sd(term: Term, sensor_K: float, step_s: float) -> float:
+def noise_sd(term: Term, sensor_K: float, step_s: float, smooth_s: float = 0.0) -> float:
     """Standard deviation of the term's values when each temperature reading carries independent
     white noise of ``sensor_K`` (K): ``sensor_K`` for a rise, sqrt(2) times that for a difference,
     reduced by a lag of step ``step_s`` (s) to ``sqrt((1 - a) / (1 + a))`` of it, ``a = exp(-h / tau)``
-    (the stationary variance of a first-order lag of white noise); 0 for an input (a commanded value)
-    and a drift."""
+    (the stationary variance of a first-order lag of white noise; of the term's lag or the readings'
+    smoothing ``smooth_s``, whichever reduces more: an upper bound for the two in series); 0 for an
+    input (a commanded value) and a drift."""
     if term.kind in ("input", "drift"):
         return 0.0
     sd = sensor_K * (np.sqrt(2.0) if term.kind == "difference" else 1.0)
-    if term.tau_s is not None:
-        a = np.exp(-step_s / term.tau_s)
+    tau = max(term.tau_s or 0.0, smooth_s)
+    if tau > 0:
+        a = np.exp(-step_s / tau)
         sd *= np.sqrt((1.0 - a) / (1.0 + a))
     return float(sd)
 
