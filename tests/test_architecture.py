@@ -149,7 +149,6 @@ CLI_OFFENDERS = {
     "gatetherm.cli.compensate": "front-a", "gatetherm.cli.diagnose": "front-a",
     "gatetherm.cli.errormodel": "front-b", "gatetherm.cli.sensors": "front-b", "gatetherm.cli.sweep": "front-b",
     "gatetherm.cli.report": "front-b", "gatetherm.cli.validate": "front-b",
-    "gatetherm.cli.live": "live2", "gatetherm.cli.twin": "live2",
 }
 
 

@@ -1,22 +1,20 @@
 """Step-wise compensators: every method's state and a ``step(t, sample) -> Correction`` form.
 
-The batch functions (:func:`~.compensator.predict`, :func:`~.regression.regression_forecast`
-with :func:`~.compensator.external_prediction`, :func:`~gatetherm.studies.errormodel.replay.replay`,
+The batch functions (:func:`~.compensator.predict`, :func:`~.regression.regression_forecast` with
+:func:`~.compensator.external_prediction`, :func:`~gatetherm.studies.errormodel.replay.replay`,
 :func:`~.predictive.rom_prediction`) run over a whole recorded series; a compensator beside a
 machine sees one sample at a time. A stepper here is fed the samples of the controller grid in
 order (``sample_interval_s`` apart, the first at index 0) and after sample ``c`` returns the
-command that the batch form holds from sample ``c + 1`` on (one sample of latency, as in the
-paper). Fed the samples of a series on the grid it gives the batch form's ``Prediction.u_um[1:]``
-and ``delta_pred_um[1:]`` to round-off (``tests/test_stepwise.py``: 1e-9 µm on the C-frame and
-the paper frame).
+command the batch form holds from sample ``c + 1`` on (one sample of latency, as in the paper). Fed
+the samples of a series on the grid it gives the batch form's ``Prediction.u_um[1:]`` and
+``delta_pred_um[1:]`` to round-off (``tests/test_stepwise.py``: 1e-9 µm on the C-frame and the
+paper frame).
 
 Each stepper's state is plain numbers: :meth:`Stepper.state` returns a JSON-ready dict and
-:meth:`Stepper.restore` sets it back, so a service killed between two samples resumes where it
-was (the setup, e.g. K_i, K_C or the reduced model, is rebuilt by the caller from the same inputs).
+:meth:`Stepper.restore` sets it back, so a service killed between two samples resumes where it was
+(the caller rebuilds the setup, K_i, K_C or the reduced model, from the same inputs).
 
-A missing reading (NaN) is the caller's to guard (:mod:`gatetherm.validation.live` holds the last
-correction); the steppers themselves treat it as the batch forms do where they are causal (the
-rom filter skips a missing thermocouple or δ) and otherwise return a NaN prediction.
+A missing reading (NaN): the causal batch forms' treatment, else a NaN prediction (live guards it).
 """
 from __future__ import annotations
 
@@ -226,6 +224,12 @@ class RegressionStepper(AheadStepper):
         self.first = s["first"]
 
 
+def _lag(x: float, s0: float, s: float, h: float, tau: float) -> float:
+    """One step h of the lag τ x' = s − x, exact for s linear from s0 to s."""
+    a = math.exp(-h / tau)
+    return a * x + (1.0 - a) * s0 + (s - s0) * (1.0 - tau * (1.0 - a) / h)
+
+
 class ErrorModelStepper(AheadStepper):
     """A fitted thermal-error model (:mod:`gatetherm.studies.errormodel`) of one target, its lags
     stepped exactly for signals linear between samples, forecast one sample ahead
@@ -251,8 +255,7 @@ class ErrorModelStepper(AheadStepper):
             return self.now[name]
         x, r0 = self.read.get(name, (r, r))  # steady state at the first sample
         if name in self.read:
-            a = math.exp(-self.h / self.smooth_s)
-            x = a * x + (1.0 - a) * r0 + (r - r0) * (1.0 - self.smooth_s * (1.0 - a) / self.h)
+            x = _lag(x, r0, r, self.h, self.smooth_s)
         self.read[name], self.now[name] = (x, r), x
         return x
 
@@ -267,13 +270,8 @@ class ErrorModelStepper(AheadStepper):
         m, y, self.now = self.target, self.target.intercept_um, {}
         for j, (term, b) in enumerate(zip(m.terms, m.coefficients)):
             s = self._term(term, sample)
-            if term.tau_s is not None:
-                if self.lags[j] is None:
-                    x = s  # steady state at the first sample
-                else:
-                    a = math.exp(-self.h / term.tau_s)
-                    c1 = 1.0 - term.tau_s * (1.0 - a) / self.h
-                    x = a * self.lags[j] + (1.0 - a) * self.signal[j] + (s - self.signal[j]) * c1
+            if term.tau_s is not None:  # steady state at the first sample
+                x = s if self.lags[j] is None else _lag(self.lags[j], self.signal[j], s, self.h, term.tau_s)
                 self.lags[j], self.signal[j], s = x, s, x
             y += b * s
         return y
