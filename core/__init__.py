@@ -22,10 +22,12 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
-       "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit", "errormodel_predict",
-       "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule", "place_sensors", "reduce",
-       "run", "schedule_file", "twin", "validate_zoo", "write_placement", "write_reduction")
+API = ("Case", "DriftReport", "ErrorModelFit", "Prediction", "Refit", "Report", "Run", "Schedule", "SensorStudy",
+       "SolverOptions", "SweepResult", "Validation", "beam_coefficients", "check_placement", "check_rom",
+       "check_schedules", "compensate", "condition", "configure", "diagnose", "drift_report", "errormodel_fit",
+       "errormodel_predict", "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule",
+       "place_sensors", "reduce", "report", "run", "schedule_file", "sensor_study", "sweep", "twin", "validate",
+       "validate_zoo", "write_placement", "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 
 

@@ -16,7 +16,8 @@ The paper's frame is a case like any other: ``gt.gate_frame(dim=2)``.
 
 The functions live by task in this package's modules: :mod:`gatetherm.api.run` (cases,
 schedules, runs), :mod:`gatetherm.api.reduction`, :mod:`gatetherm.api.control` (compensation,
-diagnosis), :mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`,
+diagnosis), :mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`, :mod:`gatetherm.api.study`
+(sweeps), :mod:`gatetherm.api.reports`, :mod:`gatetherm.api.validate_study`,
 :mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and :mod:`gatetherm.api.zoo`; every public name is offered here.
 
 ### Errors
@@ -44,18 +45,23 @@ Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
 from gatetherm.api.control import compensate, diagnose
-from gatetherm.api.errormodel import Prediction, errormodel_fit, errormodel_predict, errormodel_refit
+from gatetherm.api.errormodel import ErrorModelFit, Prediction, Refit, errormodel_fit, errormodel_predict, \
+    errormodel_refit
 from gatetherm.api.export import export_ccx
 from gatetherm.api.live import live, twin
 from gatetherm.api.reduction import check_rom, check_schedules, reduce, write_reduction
 from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, \
     gate_frame, load_case, nc_schedule, run, schedule_file
-from gatetherm.api.sensors import check_placement, place_sensors, write_placement
+from gatetherm.api.reports import DriftReport, Report, drift_report, report
+from gatetherm.api.sensors import SensorStudy, check_placement, place_sensors, sensor_study, write_placement
+from gatetherm.api.study import SweepResult, sweep
+from gatetherm.api.validate_study import Validation, validate
 from gatetherm.api.zoo import validate_zoo
 from gatetherm.checks import POSITIVE, Range  # noqa: F401
 
-__all__ = ["Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement",
-           "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
-           "errormodel_predict", "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule",
-           "place_sensors", "reduce", "run", "schedule_file", "twin", "validate_zoo", "write_placement",
-           "write_reduction"]
+__all__ = ["Case", "DriftReport", "ErrorModelFit", "Prediction", "Refit", "Report", "Run", "Schedule",
+           "SensorStudy", "SolverOptions", "SweepResult", "Validation", "beam_coefficients", "check_placement",
+           "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose", "drift_report",
+           "errormodel_fit", "errormodel_predict", "errormodel_refit", "export_ccx", "gate_frame", "live",
+           "load_case", "nc_schedule", "place_sensors", "reduce", "report", "run", "schedule_file", "sensor_study",
+           "sweep", "twin", "validate", "validate_zoo", "write_placement", "write_reduction"]

@@ -151,7 +151,7 @@ def write_placement(out: str | os.PathLike, placement, case: Case, check=None, e
     return placement.write(out, extra=more)
 
 
-def sensors(case, count: int = 3, *, schedules=(), held_out=(), check: bool = False, mesh_factor: float = 1.0,
+def sensor_study(case, count: int = 3, *, schedules=(), held_out=(), check: bool = False, mesh_factor: float = 1.0,
             on_progress=None, **settings) -> SensorStudy:
     """What ``gatetherm sensors`` does: :func:`place_sensors` on a case (or a case file), and
     optionally :func:`check_placement`; the result writes the command's files and its summary.
@@ -202,7 +202,7 @@ OUTPUTS = ("sensors.toml", "model.json", "curve.csv", "curve.png", "machine.png"
 
 @dataclass(frozen=True)
 class SensorStudy:
-    """What :func:`sensors` returns: a placement, its optional FE check, and how long it took."""
+    """What :func:`sensor_study` returns: a placement, its optional FE check, and how long it took."""
 
     placement: object
     """The :func:`place_sensors` result (``.sensors``, ``.curve``, ``.model`` …)."""

@@ -6,7 +6,7 @@ import os
 from pathlib import Path
 
 from gatetherm.api import InputError
-from gatetherm.api.report import DRIFT, PAGE, SECTION_KEYS, drift_report, report
+from gatetherm.api.reports import DRIFT, PAGE, SECTION_KEYS, drift_report, report
 from gatetherm.cli.options import WORKERS, Progress, number
 
 __all__ = ["DRIFT", "PAGE", "register", "run"]

@@ -9,7 +9,7 @@ Writes ``DIR/sensors.toml`` (the chosen points as ``[probes]`` to paste into a c
 from __future__ import annotations
 
 from gatetherm.api import POSITIVE, InputError, Range
-from gatetherm.api.sensors import OUTPUTS, sensors
+from gatetherm.api.sensors import OUTPUTS, sensor_study
 from gatetherm.cli.options import Progress, add_model_options, number, refuse_model_options
 
 __all__ = ["OUTPUTS", "register", "run"]
@@ -99,7 +99,7 @@ def run(args) -> int:
         raise InputError("--mesh-factor", "goes with --case only", "give --config with a finer mesh for the frame")
     else:
         case = gate_frame(args.dim, args.config)
-    study = sensors(case, args.count, schedules=args.schedules or (), held_out=args.held_out or (), check=args.check,
+    study = sensor_study(case, args.count, schedules=args.schedules or (), held_out=args.held_out or (), check=args.check,
                     on_progress=Progress("sensors"), **_settings(args, case.dim))
     study.write(args.out)
     print(study.summary(args.out))
