@@ -60,8 +60,10 @@ def test_errormodel_fit_settings_are_checked_by_name(record):
 
 
 def test_prediction_and_refit_write_and_say_what_the_commands_do(record, tmp_path):
-    model = gt.errormodel_fit(record, ["d_um"]).model
+    fit = gt.errormodel_fit(record, ["d_um"])
+    model = fit.model
     p = gt.errormodel_predict(model, record)
+    assert gt.errormodel_predict(fit, record).scores == p.scores  # a fit's result is a model to predict with
     p.write(tmp_path / "p")
     assert sorted(x.name for x in (tmp_path / "p").iterdir()) == ["prediction.csv", "prediction.png", "summary.json"]
     assert p.summary().splitlines() == ["d_um: MAE 0.0366 um, RMS 0.0476 um over 400 samples, 93% inside the 90 % "
@@ -120,3 +122,19 @@ def test_validate_and_sweep_refuse_bad_arguments_by_name(tmp_path):
     with pytest.raises(InputError, match="^workers: "):
         gt.sweep(tmp_path / "s.toml", tmp_path / "o", workers=0)
     assert not (tmp_path / "o").exists() and not (tmp_path / "v").exists()
+
+
+def test_sweep_reports_progress_and_writes_its_table_again_elsewhere(tmp_path):
+    """Two points of the frame's coefficients on a coarse mesh (the fault table's study)."""
+    (tmp_path / "s.toml").write_text('[study]\ncompute = ["coefficients"]\n[set]\n"mesh.size" = 0.03\n'
+                                     '[grid]\n"geometry.l4" = [0.25, 0.3]\n')
+    calls = []
+    result = gt.sweep(tmp_path / "s.toml", tmp_path / "o", on_progress=lambda i, n: calls.append((i, n)))
+    assert calls[-1] == (2, 2) and [i for i, _ in calls] == sorted(i for i, _ in calls)
+    assert len(result.rows) == 2 and not result.failed and result.skipped == 0
+    assert result.summary(tmp_path / "o") == f"wrote {tmp_path / 'o' / 'table.csv'}: 2 points, 2 done, 0 skipped " \
+                                             "(frame cannot be built), 0 failed"
+    result.raise_failed()  # nothing failed: no exception
+    result.write(tmp_path / "again")
+    assert (tmp_path / "again" / "table.csv").read_text() == (tmp_path / "o" / "table.csv").read_text()
+    assert sorted(p.name for p in (tmp_path / "again").iterdir()) == ["study.json", "table.csv"]

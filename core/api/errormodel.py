@@ -23,6 +23,13 @@ def _read(data, required=("time_s",), named_by=None):
     return read_timeseries(data, required=required, named_by=named_by) if _is_path(data) else data
 
 
+def _model(model) -> ErrorModel:
+    """An ErrorModel from a model, a fit's result or a ``model.json`` path."""
+    if isinstance(model, (ErrorModelFit, Refit)):
+        return model.model
+    return model if isinstance(model, ErrorModel) else load_model(model)
+
+
 ROBUST = FitParams(drift=True, noisy_cv=True)
 """The API's and the command's default fit: blocked cross-validation within a run (forward chaining,
 ``cv="chain"``, measured no better on FL_THERMAL: docs/errormodel.md), leave one run out with three
@@ -104,8 +111,8 @@ def errormodel_predict(model, data) -> Prediction:
 
     Parameters
     ----------
-    model : ErrorModel or path
-        From :func:`errormodel_fit` (its ``.model``) or a ``model.json``.
+    model : ErrorModel, ErrorModelFit or path
+        From :func:`errormodel_fit` or a ``model.json``.
     data : path or TimeSeries
         The columns the model reads; targets where measured are scored.
 
@@ -116,7 +123,7 @@ def errormodel_predict(model, data) -> Prediction:
         (``prediction.csv``, ``summary.json``, ``prediction.png``) and ``.summary()``.
     """
     sources = (str(model) if _is_path(model) else "", str(data) if _is_path(data) else "")
-    model = load_model(model) if not isinstance(model, ErrorModel) else model
+    model = _model(model)
     ts = _read(data)
     check_columns(model, ts, str(data) if not hasattr(data, "names") else "data")
     gaps = input_gaps(model, ts)
@@ -135,7 +142,8 @@ def errormodel_refit(model, data, window_s: float, applied=None, *, named_as: st
 
     Parameters
     ----------
-    model : ErrorModel or path
+    model : ErrorModel, ErrorModelFit or path
+        From :func:`errormodel_fit` or a ``model.json``.
     data : path or TimeSeries
         The run so far: the model's columns and the measured targets, um.
     window_s : float
@@ -155,7 +163,7 @@ def errormodel_refit(model, data, window_s: float, applied=None, *, named_as: st
         and ``.summary()``.
     """
     files = tuple(str(f) for f in (data, model) if _is_path(f))
-    model = load_model(model) if not isinstance(model, ErrorModel) else model
+    model = _model(model)
     if applied is not None and not isinstance(applied, dict):
         applied = tuple(applied)
         if len(applied) != len(model.names):
