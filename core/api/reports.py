@@ -106,7 +106,8 @@ def report(out: str | os.PathLike, *, full: bool = False, sections=None, workers
         sections = [sections] if isinstance(sections, str) else list(sections)
         unknown = [k for k in sections if k not in keys]
         if unknown:
-            raise InputError(f"sections {unknown[0]}", "is not a section of the report", f"choose from {', '.join(keys)}")
+            raise InputError(f"sections {unknown[0]}", "is not a section of the report",
+                             f"choose from {', '.join(keys)}")
     docs = Path(docs) if docs is not None else None
     if docs is not None and not docs.is_dir():
         raise InputError("docs", f"'{docs}' is not a folder", "give the docs folder of a checkout (docs)")

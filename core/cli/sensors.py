@@ -99,8 +99,8 @@ def run(args) -> int:
         raise InputError("--mesh-factor", "goes with --case only", "give --config with a finer mesh for the frame")
     else:
         case = gate_frame(args.dim, args.config)
-    study = sensor_study(case, args.count, schedules=args.schedules or (), held_out=args.held_out or (), check=args.check,
-                    on_progress=Progress("sensors"), **_settings(args, case.dim))
+    study = sensor_study(case, args.count, schedules=args.schedules or (), held_out=args.held_out or (),
+                         check=args.check, on_progress=Progress("sensors"), **_settings(args, case.dim))
     study.write(args.out)
     print(study.summary(args.out))
     return 0
