@@ -139,3 +139,28 @@ def test_sweep_reports_progress_and_writes_its_table_again_elsewhere(tmp_path):
     result.write(tmp_path / "again")
     assert (tmp_path / "again" / "table.csv").read_text() == (tmp_path / "o" / "table.csv").read_text()
     assert sorted(p.name for p in (tmp_path / "again").iterdir()) == ["study.json", "table.csv"]
+
+
+def test_validate_refuses_a_setting_its_study_does_not_take(tmp_path):
+    with pytest.raises(TypeError, match="^dims: not a setting of the beam study; it takes config, dim, workers"):
+        gt.validate("beam", tmp_path / "v", dims=[2])
+    assert not (tmp_path / "v").exists()
+
+
+def test_every_validate_target_of_the_command_passes_settings_its_study_takes(tmp_path, monkeypatch, capsys):
+    """``gatetherm validate TARGET`` calls gt.validate with the target's settings (the studies
+    replaced by a stand-in that records them)."""
+    from gatetherm.api import validate_study
+    from gatetherm.cli import main
+
+    seen = {}
+    for name, (text, _) in list(validate_study.TARGETS.items()):
+        def study(out, options, on_line, on_progress, name=name):
+            seen[name] = set(options)
+            on_line(f"{name} streamed")
+            return f"{name} done\n", None
+        monkeypatch.setitem(validate_study.TARGETS, name, (text, study))
+    for name in validate_study.TARGETS:
+        assert main(["validate", name, "--out", str(tmp_path / name)]) == 0
+        assert capsys.readouterr().out == f"{name} streamed\n{name} done\n"
+    assert seen == {k: set(v) for k, v in validate_study.OPTIONS.items()}

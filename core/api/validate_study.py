@@ -138,6 +138,15 @@ TARGETS = {
 }
 """Study name -> (what it does, its function)."""
 
+OPTIONS = {
+    "beam": ("config", "dim", "workers", "scheduler"), "design": ("config", "dim", "workers", "scheduler"),
+    "paper": ("config", "dims", "reuse"), "compensation": ("config", "dim"), "rom": ("config", "dims"),
+    "hidden-effects": ("workers", "seed", "conditions", "effects", "mesh_size"),
+    "compound": ("workers", "seed", "pairs", "single", "mesh_size"), "case-diagnosis": ("case", "seed"),
+    "zoo": ("machines", "timeout"), "calibrate": ("evals", "mesh_size"),
+}
+"""Study name -> the settings it takes (the keyword arguments of :func:`validate`)."""
+
 
 def validate(target: str, out: str | os.PathLike, *, on_line=None, on_progress=None, **options) -> Validation:
     """Regenerate a validation study (docs/validation.md) into ``out``: its tables, figures and reports.
@@ -176,6 +185,10 @@ def validate(target: str, out: str | os.PathLike, *, on_line=None, on_progress=N
 
     if target not in TARGETS:
         raise InputError("target", f"{target!r} is not a validation study", f"choose from {', '.join(TARGETS)}")
+    unknown = sorted(set(options) - set(OPTIONS[target]))
+    if unknown:
+        raise TypeError(f"{unknown[0]}: not a setting of the {target} study; it takes "
+                        f"{', '.join(OPTIONS[target])}")
     on_line = on_line or (lambda text: None)
     with output_dir(out):
         text, data = TARGETS[target][1](Path(out), options, on_line, on_progress)
