@@ -164,3 +164,21 @@ def test_every_validate_target_of_the_command_passes_settings_its_study_takes(tm
         assert main(["validate", name, "--out", str(tmp_path / name)]) == 0
         assert capsys.readouterr().out == f"{name} streamed\n{name} done\n"
     assert seen == {k: set(v) for k, v in validate_study.OPTIONS.items()}
+
+
+@pytest.mark.parametrize("command", ["errormodel", "sensors", "sweep", "report", "validate"])
+def test_the_command_imports_only_the_api_and_the_standard_library(command):
+    """Issue 52: a command parses, calls gatetherm.api and prints (every import, also inside functions)."""
+    import ast
+    import sys
+
+    path = Path(__file__).parents[1] / "core" / "cli" / f"{command}.py"
+    modules = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            modules |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            modules.add(node.module)
+    others = sorted(m for m in modules if m.split(".")[0] not in sys.stdlib_module_names
+                    and not m.startswith(("gatetherm.api", "gatetherm.cli")))
+    assert others == []

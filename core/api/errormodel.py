@@ -7,7 +7,7 @@ import dataclasses
 from gatetherm import InputError
 from gatetherm.api.errormodel_results import FIT_OUTPUTS, PREDICT_OUTPUTS, ErrorModelFit, Prediction, \
     Refit  # noqa: F401
-from gatetherm.studies.errormodel.fit import CV_KINDS, FIT_FORMS, FitParams, fit_error_model, fraction_span
+from gatetherm.studies.errormodel.fit import CV_KINDS, FIT_FORMS, FitParams, fit_error_model, fraction_span  # noqa: F401
 from gatetherm.studies.errormodel.model import ErrorModel, check_columns, check_leakage, input_gaps, load_model, \
     predict, score
 from gatetherm.studies.errormodel.trust import trust
