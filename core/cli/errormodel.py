@@ -94,7 +94,7 @@ def run_fit(args) -> int:
                          named_as=("--targets", "--candidates", "--inputs"), on_progress=Progress("errormodel fit"),
                          max_sensors=args.max_sensors, max_inputs=args.max_inputs, form=args.form,
                          differences=args.differences, resolution_K=args.resolution_K, cv=args.cv,
-                         drift=not args.no_drift)
+                         drift=not args.no_drift, noisy_cv=False)  # the command's fit as before: not ROBUST's
     fit.write(args.out)
     print(fit.summary(args.out))
     return 0
