@@ -22,12 +22,14 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("BeamCoefficients", "Case", "Export", "FrameFiles", "Prediction", "ReductionRun", "Run", "RunResult",
-       "Schedule", "SolverOptions", "beam_coefficients", "beam_normalised", "check_placement", "check_rom",
-       "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
-       "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live",
-       "load_case", "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "run", "run_case",
-       "schedule_file", "simulate", "twin", "validate_zoo", "write_placement", "write_reduction")
+API = ("BeamCoefficients", "Case", "DriftReport", "ErrorModelFit", "Export", "FrameFiles", "Prediction",
+       "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule", "SensorStudy", "SolverOptions",
+       "SweepResult", "Validation", "beam_coefficients", "beam_normalised", "check_placement", "check_rom",
+       "check_schedules", "compensate", "condition", "configure", "diagnose", "drift_report", "errormodel_fit",
+       "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live", "load_case",
+       "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
+       "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",
+       "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""
 
 

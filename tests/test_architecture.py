@@ -147,8 +147,6 @@ import sys  # noqa: E402
 #: whose commands are being moved onto the API by others (issue 52): empty this as they merge.
 CLI_OFFENDERS = {
     "gatetherm.cli.compensate": "front-a", "gatetherm.cli.diagnose": "front-a",
-    "gatetherm.cli.errormodel": "front-b", "gatetherm.cli.sensors": "front-b", "gatetherm.cli.sweep": "front-b",
-    "gatetherm.cli.report": "front-b", "gatetherm.cli.validate": "front-b",
 }
 
 

@@ -18,6 +18,7 @@ The functions live by task in this package's modules: :mod:`gatetherm.api.case` 
 schedules), :mod:`gatetherm.api.run` (runs), :mod:`gatetherm.api.jobs` (runs written: ``gatetherm
 run``, ``simulate``), :mod:`gatetherm.api.frame` (``mesh``, ``beam``), :mod:`gatetherm.api.reduction`,
 :mod:`gatetherm.api.control` (compensation, diagnosis), :mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`,
+:mod:`gatetherm.api.study` (sweeps), :mod:`gatetherm.api.reports`, :mod:`gatetherm.api.validate_study`,
 :mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and :mod:`gatetherm.api.zoo`; every public name is offered here.
 
 ### Errors
@@ -45,7 +46,8 @@ Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
 from gatetherm.api.control import compensate, diagnose
-from gatetherm.api.errormodel import Prediction, errormodel_fit, errormodel_predict, errormodel_refit
+from gatetherm.api.errormodel import ErrorModelFit, Prediction, Refit, errormodel_fit, errormodel_predict, \
+    errormodel_refit
 from gatetherm.api.export import Export, export_case, export_ccx
 from gatetherm.api.frame import BeamCoefficients, FrameFiles, beam_normalised, mesh_frame
 from gatetherm.api.jobs import RunResult, run_case, simulate
@@ -53,7 +55,10 @@ from gatetherm.api.live import live, twin
 from gatetherm.api.reduction import ReductionRun, check_rom, check_schedules, reduce, reduce_case, write_reduction
 from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, \
     gate_frame, load_case, nc_schedule, run, schedule_file
-from gatetherm.api.sensors import check_placement, place_sensors, write_placement
+from gatetherm.api.reports import DriftReport, Report, drift_report, report
+from gatetherm.api.sensors import SensorStudy, check_placement, place_sensors, sensor_study, write_placement
+from gatetherm.api.study import SweepResult, sweep
+from gatetherm.api.validate_study import Validation, validate
 from gatetherm.api.zoo import validate_zoo
 from gatetherm.checks import POSITIVE, Range  # noqa: F401
 from gatetherm.solvers.errors import SolverError  # noqa: F401 - with these below, for the command line's dispatcher
@@ -61,13 +66,14 @@ from gatetherm.studies.sweeps.runner import PointsFailed  # noqa: F401
 
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
 
-__all__ = ["BeamCoefficients", "Case", "Export", "FrameFiles", "Prediction", "ReductionRun", "Run",
-           "RunResult", "Schedule", "SolverOptions", "beam_coefficients", "beam_normalised",
-           "check_placement", "check_rom", "check_schedules", "compensate", "condition", "configure",
-           "diagnose", "errormodel_fit", "errormodel_predict", "errormodel_refit", "export_case",
-           "export_ccx", "gate_frame", "live", "load_case", "mesh_frame", "nc_schedule", "place_sensors",
-           "reduce", "reduce_case", "run", "run_case", "schedule_file", "simulate", "twin", "validate_zoo",
-           "write_placement", "write_reduction"]
+__all__ = ["BeamCoefficients", "Case", "DriftReport", "ErrorModelFit", "Export", "FrameFiles", "Prediction",
+           "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule", "SensorStudy", "SolverOptions",
+           "SweepResult", "Validation", "beam_coefficients", "beam_normalised", "check_placement", "check_rom",
+           "check_schedules", "compensate", "condition", "configure", "diagnose", "drift_report", "errormodel_fit",
+           "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live", "load_case",
+           "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
+           "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",
+           "write_reduction"]
 
 
 def __getattr__(name: str):

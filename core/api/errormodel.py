@@ -2,38 +2,32 @@
 run or several, predict with a 90 % interval and a drift check, refit as data arrive."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import dataclasses
 
-from gatetherm.studies.errormodel.fit import FitParams, fit_error_model, fraction_span
-from gatetherm.studies.errormodel.model import ErrorModel, check_columns, input_gaps, load_model, predict, score
+from gatetherm import InputError
+from gatetherm.api.errormodel_results import FIT_OUTPUTS, PREDICT_OUTPUTS, ErrorModelFit, Prediction, \
+    Refit  # noqa: F401
+from gatetherm.studies.errormodel.fit import CV_KINDS, FIT_FORMS, FitParams, fit_error_model, fraction_span  # noqa: F401
+from gatetherm.studies.errormodel.model import ErrorModel, check_columns, check_leakage, input_gaps, load_model, \
+    predict, score
 from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.refit import refit
 from gatetherm.studies.run.timeseries import read_timeseries
 
 
-@dataclass(frozen=True)
-class Prediction:
-    """What :func:`errormodel_predict` returns: predictions with their 90 % intervals, scores and drift warnings."""
-
-    predicted: dict
-    """Target -> predicted displacement per sample, um."""
-    lower: dict
-    """Target -> lower end of the 90 % interval per sample, um."""
-    upper: dict
-    """Target -> upper end of the 90 % interval per sample, um."""
-    scores: dict
-    """Per target :func:`~gatetherm.studies.errormodel.model.score` (MAE, RMS where measured, um)
-    with ``share_outside`` (samples beyond the fitted ranges) and ``share_missed`` (measured
-    samples outside the interval)."""
-    gaps: dict = field(default_factory=dict)
-    """Per column with gaps its :class:`~gatetherm.studies.errormodel.terms.GapReport`."""
-    warnings: tuple[str, ...] = ()
-    """One line per target that no longer behaves like the fitting data."""
+def _is_path(data) -> bool:
+    return isinstance(data, (str, bytes)) or hasattr(data, "__fspath__")
 
 
-def _read(data, required=("time_s",)):
-    return read_timeseries(data, required=required) if isinstance(data, (str, bytes)) or hasattr(data, "__fspath__") \
-        else data
+def _read(data, required=("time_s",), named_by=None):
+    return read_timeseries(data, required=required, named_by=named_by) if _is_path(data) else data
+
+
+def _model(model) -> ErrorModel:
+    """An ErrorModel from a model, a fit's result or a ``model.json`` path."""
+    if isinstance(model, (ErrorModelFit, Refit)):
+        return model.model
+    return model if isinstance(model, ErrorModel) else load_model(model)
 
 
 ROBUST = FitParams(drift=True, noisy_cv=True, smooth_grid_s=(300.0,), anchor_s=600.0)
@@ -45,7 +39,8 @@ each run referenced on its first 600 s (docs/errormodel.md, "Sensor noise")."""
 
 
 def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams = ROBUST,
-                   span: tuple[float, float] = (0.0, 1.0)) -> ErrorModel:
+                   span: tuple[float, float] = (0.0, 1.0), *, named_as=("targets", "candidates", "inputs"),
+                   on_progress=None, **settings) -> ErrorModelFit:
     """Fit a thermal-error model per target on one measured run or several.
 
     Parameters
@@ -64,18 +59,52 @@ def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams 
         by the latest held-out blocks, each predicted from the rows before it).
     span : (float, float)
         Fitting span as fractions of each run's duration.
+    named_as : (str, str, str)
+        How messages name ``targets``, ``candidates`` and ``inputs`` (the command: its options).
+    on_progress : callable, optional
+        ``on_progress(i, n)`` after each data file read and after the fit (``i`` up to ``n``, the
+        files plus one).
+    **settings
+        Fields of :class:`~gatetherm.studies.errormodel.fit.FitParams` replacing those of ``params``
+        (``max_sensors``, ``max_inputs``, ``form``, ``differences``, ``resolution_K`` in K, ``cv``,
+        ``drift`` …).
 
     Returns
     -------
-    ErrorModel
-        Save it with ``gatetherm.studies.errormodel.model.save_model``.
+    ErrorModelFit
+        ``.model`` (the :class:`~gatetherm.studies.errormodel.model.ErrorModel`), ``.write(out)``
+        (``out/model.json``) and ``.summary()``.
+
+    Raises
+    ------
+    TypeError
+        A setting that is not a field of FitParams.
+    InputError
+        A target among the candidates or inputs, a missing column, a bad setting.
     """
+    fields = {f.name for f in dataclasses.fields(FitParams)}
+    unknown = sorted(set(settings) - fields)
+    if unknown:
+        raise TypeError(f"{unknown[0]}: not a setting of the fit; choose from {', '.join(sorted(fields))}")
+    params = dataclasses.replace(params, **settings) if settings else params
+    targets, inputs = tuple(targets), tuple(inputs or ())
+    check_leakage(targets, candidates, inputs, tuple(named_as))
+    named = {**{c: named_as[2] for c in inputs}, **{c: named_as[1] for c in candidates or ()},
+             **{c: named_as[0] for c in targets}}
     runs = list(data) if isinstance(data, (list, tuple)) else [data]
     required = ("time_s", *targets, *(candidates or ()), *inputs)
-    series = [_read(r, required) for r in runs]
+    series = []
+    for r in runs:
+        series.append(_read(r, required, named))
+        if on_progress is not None:
+            on_progress(len(series), len(runs) + 1)
     spans = [fraction_span(ts["time_s"], *span) for ts in series]
     source = ", ".join(str(r) for r in runs if not hasattr(r, "names"))
-    return fit_error_model(series, targets, candidates, inputs, params, spans, source=source)
+    model = fit_error_model(series, targets, candidates, inputs, params, spans, source=source)
+    if on_progress is not None:
+        on_progress(len(runs) + 1, len(runs) + 1)
+    return ErrorModelFit(model, len(runs), "leave one run out" if len(runs) >= 3 else params.cv,
+                         tuple(str(r) for r in runs if _is_path(r)))
 
 
 def errormodel_predict(model, data) -> Prediction:
@@ -83,7 +112,7 @@ def errormodel_predict(model, data) -> Prediction:
 
     Parameters
     ----------
-    model : ErrorModel or path
+    model : ErrorModel, ErrorModelFit or path
         From :func:`errormodel_fit` or a ``model.json``.
     data : path or TimeSeries
         The columns the model reads; targets where measured are scored.
@@ -91,9 +120,11 @@ def errormodel_predict(model, data) -> Prediction:
     Returns
     -------
     Prediction
-        Predictions and intervals (um), scores, filled gaps and the drift warnings.
+        Predictions and intervals (um), scores, filled gaps and the drift warnings; ``.write(out)``
+        (``prediction.csv``, ``summary.json``, ``prediction.png``) and ``.summary()``.
     """
-    model = load_model(model) if not isinstance(model, ErrorModel) else model
+    sources = (str(model) if _is_path(model) else "", str(data) if _is_path(data) else "")
+    model = _model(model)
     ts = _read(data)
     check_columns(model, ts, str(data) if not hasattr(data, "names") else "data")
     gaps = input_gaps(model, ts)
@@ -103,28 +134,42 @@ def errormodel_predict(model, data) -> Prediction:
     for name, c in checks.items():
         scores[name].update(share_outside=c["share_outside"], share_missed=c["share_missed"])
     return Prediction(pred, {k: c["lower"] for k, c in checks.items()}, {k: c["upper"] for k, c in checks.items()},
-                      scores, gaps, tuple(c["warning"] for c in checks.values() if c["warning"]))
+                      scores, gaps, tuple(c["warning"] for c in checks.values() if c["warning"]), model, ts, sources)
 
 
-def errormodel_refit(model, data, window_s: float, applied: dict[str, str] | None = None):
+def errormodel_refit(model, data, window_s: float, applied=None, *, named_as: str = "applied") -> Refit:
     """Refit a model's coefficients on the last ``window_s`` of new data, guarded against fitting its
     own corrections and never silently worse (:mod:`gatetherm.studies.errormodel.refit`).
 
     Parameters
     ----------
-    model : ErrorModel or path
+    model : ErrorModel, ErrorModelFit or path
+        From :func:`errormodel_fit` or a ``model.json``.
     data : path or TimeSeries
         The run so far: the model's columns and the measured targets, um.
     window_s : float
         Length of the refit window at the end of the data, s.
-    applied : dict, optional
+    applied : dict or sequence of str, optional
         Target -> column holding the correction the control applied, um (the refit fits
-        measured + applied); none: the data are uncompensated.
+        measured + applied), or the columns in the order of the model's targets; none: the data
+        are uncompensated.
+    named_as : str
+        How messages name ``applied`` (the command: ``--applied``).
 
     Returns
     -------
-    (ErrorModel, dict)
-        The refitted model and per target ``kept``, ``current_mae_um``, ``refit_mae_um``, ``samples``.
+    Refit
+        Unpacks as ``(model, report)``: the refitted model and per target ``kept``,
+        ``current_mae_um``, ``refit_mae_um``, ``samples``; ``.write(out)`` (``out/model.json``)
+        and ``.summary()``.
     """
-    model = load_model(model) if not isinstance(model, ErrorModel) else model
-    return refit(model, _read(data), window_s, applied)
+    files = tuple(str(f) for f in (data, model) if _is_path(f))
+    model = _model(model)
+    if applied is not None and not isinstance(applied, dict):
+        applied = tuple(applied)
+        if len(applied) != len(model.names):
+            raise InputError(named_as, f"{len(applied)} columns for {len(model.names)} targets",
+                             f"one per target, in the order {', '.join(model.names)}")
+        applied = dict(zip(model.names, applied))
+    new, report = refit(model, _read(data), window_s, applied)
+    return Refit(new, report, window_s, files)

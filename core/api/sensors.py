@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import os
+import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
@@ -12,7 +14,7 @@ SPAN = Range(-1e9, 1e9)
 """What a bound of ``ranges`` may be, in the input's unit (°C, W, 1/min …)."""
 
 
-def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, **settings):
+def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, on_progress=None, **settings):
     """Where to put ``count`` thermocouples on ``case``: the surface points whose temperatures
     predict every relative displacement best on held-out duty cycles (docs/sensors.md).
 
@@ -45,6 +47,8 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
         ``states``, ``neighbours`` (of each screening pivot; None: no screening): the fields of
         :class:`gatetherm.studies.sensors.place.PlacementSettings`; and ``form`` (``auto``,
         ``static``, ``dynamic``), ``max_inputs``, ``min_gain`` of the error-model family.
+    on_progress : callable, optional
+        ``on_progress(i, n)`` after the reduction, each load marched and the selection (``i`` up to ``n``).
 
     Returns
     -------
@@ -79,7 +83,10 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
     if "boundaries" in settings:
         b = settings["boundaries"]
         settings["boundaries"] = (b,) if isinstance(b, str) else tuple(b)
-    return place(case, PlacementSettings(count=count, fit=FitParams(**fit), **settings), schedules, held_out)
+    if on_progress is not None and not callable(on_progress):
+        raise TypeError(f"on_progress: got {type(on_progress).__name__}, expected a callable on_progress(i, n) or None")
+    return place(case, PlacementSettings(count=count, fit=FitParams(**fit), **settings), schedules, held_out,
+                 on_progress=on_progress)
 
 
 def check_placement(case: Case, placement):
@@ -142,3 +149,113 @@ def write_placement(out: str | os.PathLike, placement, case: Case, check=None, e
     save(sensors(placement, case, ax=figure((6.0, 5.0))), out / "machine.png")
     more = {"mesh_nodes": len(case.mesh.points), **(extra or {}), **({"fe_check": check.summary()} if check else {})}
     return placement.write(out, extra=more)
+
+
+def sensor_study(case, count: int = 3, *, schedules=(), held_out=(), check: bool = False, mesh_factor: float = 1.0,
+            on_progress=None, **settings) -> SensorStudy:
+    """What ``gatetherm sensors`` does: :func:`place_sensors` on a case (or a case file), and
+    optionally :func:`check_placement`; the result writes the command's files and its summary.
+
+    Parameters
+    ----------
+    case : Case or path
+        A case (:func:`load_case`, :func:`gate_frame`) or a case file's path (read with ``mesh_factor``).
+    count : int
+        Sensors to place.
+    schedules, held_out : sequence of Schedule or path
+        Training and held-out duty cycles (paths are read with :func:`schedule_file`).
+    check : bool
+        Also check the placement by full FE runs (:func:`check_placement`).
+    mesh_factor : float
+        With a case file's path: its element sizes times this.
+    on_progress : callable, optional
+        ``on_progress(i, n)`` as the placement goes (``i`` up to ``n``).
+    **settings
+        As :func:`place_sensors`.
+
+    Returns
+    -------
+    SensorStudy
+        ``.placement``, ``.check``, ``.seconds`` (s); ``.write(out)`` writes :data:`OUTPUTS`,
+        ``.summary(out)`` the command's lines.
+    """
+    from gatetherm.api.run import load_case, schedule_file
+
+    path = isinstance(case, (str, os.PathLike))
+    case = load_case(case, mesh_factor) if path else case
+    _case(case)
+    names = [str(f) for f in (*schedules, *held_out) if isinstance(f, (str, os.PathLike))]
+    schedules = [schedule_file(f, case) if isinstance(f, (str, os.PathLike)) else f for f in schedules or ()]
+    held_out = [schedule_file(f, case) if isinstance(f, (str, os.PathLike)) else f for f in held_out or ()]
+    t0 = time.perf_counter()
+    placement = place_sensors(case, count, schedules=schedules or None, held_out=held_out or None,
+                              on_progress=on_progress, **settings)
+    seconds = time.perf_counter() - t0
+    fe = check_placement(case, placement) if check else None
+    config = [] if path or not case.source or case.files else [case.source]
+    return SensorStudy(placement, case, fe, seconds, tuple(config + [str(f) for f in case.files] + names))
+
+
+OUTPUTS = ("sensors.toml", "model.json", "curve.csv", "curve.png", "machine.png", "summary.json")
+"""What :meth:`SensorStudy.write` (``gatetherm sensors``) writes into its output directory."""
+
+
+@dataclass(frozen=True)
+class SensorStudy:
+    """What :func:`sensor_study` returns: a placement, its optional FE check, and how long it took."""
+
+    placement: object
+    """The :func:`place_sensors` result (``.sensors``, ``.curve``, ``.model`` …)."""
+    case: Case
+    """The case it was made for."""
+    check: object = None
+    """The :func:`check_placement` result, or None."""
+    seconds: float = 0.0
+    """Wall time of the placement, s."""
+    files: tuple[str, ...] = ()
+    """The input files (kept by :meth:`write`: never overwritten)."""
+
+    def write(self, out: str | os.PathLike) -> dict:
+        """Write :data:`OUTPUTS` into ``out`` (:func:`write_placement`), replacing the previous
+        run's only on success; returns the summary."""
+        from gatetherm.outdir import output_dir
+
+        with output_dir(out, OUTPUTS, keep=self.files) as stage:
+            summary = write_placement(stage, self.placement, self.case, self.check,
+                                      {"seconds_total": round(self.seconds, 2)})
+        return summary
+
+    def summary(self, out: str | os.PathLike | None = None) -> str:
+        """What ``gatetherm sensors`` prints: the sensors per count with their held-out errors (µm),
+        the stop, notes, the loss of each sensor, the case's own thermocouples, the FE check;
+        ``out``: the folder written, for the first line."""
+        p, check = self.placement, self.check
+        excluded = dict(getattr(p.candidates, "excluded", None) or {})
+        lines = [f"{len(p.sensors)} sensors of {len(p.candidates)} candidates ({len(p.shortlist)} "
+                 f"screened) on a mesh of {len(self.case.mesh.points)} nodes, placed in {self.seconds:.1f} s from "
+                 f"{len(p.training)} training loads, judged on {len(p.held_out)} held-out loads; wrote {out}/"
+                 "sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json"]
+        if excluded:
+            lines.append("excluded ([sensors] exclude, cannot carry a sensor): "
+                         + ", ".join(f"{k} ({v} candidate nodes left out)" for k, v in excluded.items()))
+        for c in p.curve:
+            errs = ", ".join(f"{k} {v:.3g}" for k, v in c.held_out_mae_um.items())
+            where = "; ".join(f"{s.name} ({', '.join(f'{v:.3f}' for v in s.xyz)}) on {s.boundary}" for s in c.sensors)
+            lines.append(f"K={c.count} {c.form}: held-out MAE {errs} um (leave-one-load-out {c.cv_mean_um:.3g} um); "
+                         f"{where}")
+        if p.stopped:
+            lines.append(f"stopped: {p.stopped}")
+        lines += [f"note: {note}" for note in p.notes]
+        for name, errs in p.failed.items():
+            lines.append(f"{name} failed (model refitted without it): held-out MAE "
+                         + ", ".join(f"{k} {v:.3g}" for k, v in errs.items()) + " um")
+        if p.signals:
+            sig = p.signals
+            lines.append(f"the case's thermocouples θ_A, θ_B, θ_C ({sig['form']}): held-out MAE "
+                         + ", ".join(f"{k} {v:.3g}" for k, v in sig["held_out_mae_um"].items()) + " um")
+        if check:
+            lines.append(f"FE check ({check.runs} runs, {check.seconds:.1f} s): held-out MAE "
+                         + ", ".join(f"{k} {v:.3g} um ({check.ratio[k]:.3f} of the reduced model's)"
+                                     for k, v in check.held_out_mae_um.items())
+                         + f"; sensor temperatures within {check.temperature_error_K:.2g} K of FE")
+        return "\n".join(lines)

@@ -8,13 +8,11 @@ Writes ``DIR/sensors.toml`` (the chosen points as ``[probes]`` to paste into a c
 """
 from __future__ import annotations
 
-import time
+from gatetherm.api import POSITIVE, InputError, Range
+from gatetherm.api.sensors import OUTPUTS, sensor_study
+from gatetherm.cli.options import Progress, add_model_options, number, refuse_model_options
 
-from gatetherm import InputError
-from gatetherm.checks import POSITIVE, Range
-from gatetherm.cli.options import add_model_options, number, refuse_model_options
-
-OUTPUTS = ("sensors.toml", "model.json", "curve.csv", "curve.png", "machine.png", "summary.json")
+__all__ = ["OUTPUTS", "register", "run"]
 COUNT, LOADS, STATES = Range(1, 50, whole=True), Range(0, 500, whole=True), Range(2, 200, whole=True)
 NOISE, LENGTH = Range(0.0, unit="K"), Range(0.0, unit="m")
 SEED = Range(0, 2**32 - 1, whole=True)
@@ -92,56 +90,17 @@ def _settings(args, dim: int) -> dict:
 
 
 def run(args) -> int:
-    import gatetherm as gt
-    from gatetherm.outdir import output_dir
+    from gatetherm.api import gate_frame, load_case
 
     if args.case is not None:
         refuse_model_options(args)
-        case = gt.load_case(args.case, args.mesh_factor or 1.0)
+        case = load_case(args.case, args.mesh_factor or 1.0)
     elif args.mesh_factor is not None:
         raise InputError("--mesh-factor", "goes with --case only", "give --config with a finer mesh for the frame")
     else:
-        case = gt.gate_frame(args.dim, args.config)
-    settings = _settings(args, case.dim)
-    schedules = [gt.schedule_file(f, case) for f in args.schedules or ()]
-    held = [gt.schedule_file(f, case) for f in args.held_out or ()]
-    files = (args.config, *case.files, *(args.schedules or ()), *(args.held_out or ()))
-    with output_dir(args.out, OUTPUTS, keep=files) as out:
-        t0 = time.perf_counter()
-        placement = gt.place_sensors(case, args.count, schedules=schedules or None, held_out=held or None, **settings)
-        seconds = time.perf_counter() - t0
-        check = gt.check_placement(case, placement) if args.check else None
-        summary = gt.write_placement(out, placement, case, check, {"seconds_total": round(seconds, 2)})
-    _report(placement, summary, check, args.out, seconds)
+        case = gate_frame(args.dim, args.config)
+    study = sensor_study(case, args.count, schedules=args.schedules or (), held_out=args.held_out or (),
+                         check=args.check, on_progress=Progress("sensors"), **_settings(args, case.dim))
+    study.write(args.out)
+    print(study.summary(args.out))
     return 0
-
-
-def _report(placement, summary, check, out, seconds) -> None:
-    print(f"{len(placement.sensors)} sensors of {len(placement.candidates)} candidates ({len(placement.shortlist)} "
-          f"screened) on a mesh of {summary['mesh_nodes']} nodes, placed in {seconds:.1f} s from "
-          f"{len(placement.training)} training loads, judged on {len(placement.held_out)} held-out loads; wrote {out}/"
-          "sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json")
-    if summary.get("excluded"):
-        print("excluded ([sensors] exclude, cannot carry a sensor): "
-              + ", ".join(f"{k} ({v} candidate nodes left out)" for k, v in summary["excluded"].items()))
-    for c in placement.curve:
-        errs = ", ".join(f"{k} {v:.3g}" for k, v in c.held_out_mae_um.items())
-        where = "; ".join(f"{s.name} ({', '.join(f'{v:.3f}' for v in s.xyz)}) on {s.boundary}" for s in c.sensors)
-        print(f"K={c.count} {c.form}: held-out MAE {errs} um (leave-one-load-out {c.cv_mean_um:.3g} um); {where}")
-    if placement.stopped:
-        print(f"stopped: {placement.stopped}")
-    for note in placement.notes:
-        print(f"note: {note}")
-    for name, errs in placement.failed.items():
-        print(f"{name} failed (model refitted without it): held-out MAE "
-              + ", ".join(f"{k} {v:.3g}" for k, v in errs.items()) + " um")
-    if placement.signals:
-        sig = placement.signals
-        print(f"the case's thermocouples θ_A, θ_B, θ_C ({sig['form']}): held-out MAE "
-              + ", ".join(f"{k} {v:.3g}" for k, v in sig["held_out_mae_um"].items()) + " um")
-    if check:
-        print(f"FE check ({check.runs} runs, {check.seconds:.1f} s): held-out MAE "
-              + ", ".join(f"{k} {v:.3g} um ({check.ratio[k]:.3f} of the reduced model's)"
-                          for k, v in check.held_out_mae_um.items())
-              + f"; sensor temperatures within {check.temperature_error_K:.2g} K of FE")
-

@@ -6,15 +6,12 @@ from the point files after every run), ``DIR/study.json`` and the PNGs of the st
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-from gatetherm import InputError, write_text_atomic
+from gatetherm.api.study import OUTPUTS, sweep
 from gatetherm.cli.options import Progress, add_parallel_options
 
-#: What a run writes into --out besides the point files (kept: a rerun resumes from them);
-#: a rerun replaces all of it.
-OUTPUTS = ("table.csv", "study.json", "*_vs_*.png")
+__all__ = ["OUTPUTS", "register", "run"]
 
 
 def register(sub) -> None:
@@ -30,44 +27,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from gatetherm.outdir import output_dir
-    from gatetherm.studies.sweeps.runner import PointsFailed
-    from gatetherm.studies.sweeps.studyfile import load_study
-    from gatetherm.studies.sweeps.sweep import plan
-
-    study = load_study(args.study)
-    try:
-        tasks = plan(study)
-    except InputError as err:
-        raise err.at(args.study) from None
-    with output_dir(args.out, OUTPUTS, keep=(args.study,)) as out:
-        failed = _sweep(args, study, tasks, out)
-    if failed:
-        raise PointsFailed(failed, len(tasks))
+    result = sweep(args.study, args.out, workers=args.workers, scheduler=args.scheduler, plots=not args.no_plots,
+                   on_progress=Progress(f"sweep {Path(args.study).stem}"))
+    print(result.summary(args.out))
+    result.raise_failed()
     return 0
-
-
-def _sweep(args, study, tasks, out) -> list:
-    from gatetherm.studies.sweeps.runner import PointStore, run_studies, write_table
-    from gatetherm.studies.sweeps.sweep import table
-
-    (records,), failed = run_studies([(tasks, PointStore(Path(args.out)))], args.workers, args.scheduler,
-                                     Progress(f"sweep {study.name}"))
-    columns, rows = table(tasks, records, study.columns)
-    write_table(out / "table.csv", columns, rows)
-    write_text_atomic(out / "study.json", json.dumps(
-        {"name": study.name, "dim": study.dim, "config": study.case or study.base.source, "compute": list(study.compute),
-         "set": dict(study.fixed), "grid": {k: list(v) for k, v in study.grid}}, indent=2) + "\n")
-    n_skip = sum(r["status"] == "skipped" for r in rows)
-    print(f"wrote {Path(args.out) / 'table.csv'}: {len(rows)} points, {len(rows) - n_skip - len(failed)} done, "
-          f"{n_skip} skipped (frame cannot be built), {len(failed)} failed")
-    if not args.no_plots and study.plots:
-        from gatetherm.validation.plots import save
-        from gatetherm.validation.plots.sweep import plot_xy
-
-        for spec in study.plots:
-            path = out / f"{spec.y}_vs_{spec.x}{'_by_' + spec.hue if spec.hue else ''}.png".replace("/", "_")
-            others = [k for k, _ in study.grid if k not in (spec.x, spec.hue)]
-            save(plot_xy(rows, spec.x, spec.y, spec.hue, study.name, lines_by=others), path)
-            print(f"wrote {Path(args.out) / path.name}")  # the final file, not the stage's
-    return failed

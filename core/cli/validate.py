@@ -7,10 +7,9 @@ arguments and prints what they return.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from gatetherm import InputError
-from gatetherm.checks import POSITIVE, Range
+from gatetherm.api import POSITIVE, InputError, Range
+from gatetherm.api.validate_study import TARGETS as STUDIES, validate
 from gatetherm.cli.options import WORKERS, Progress, add_model_options, add_parallel_options, number
 
 
@@ -22,18 +21,16 @@ def register(sub) -> None:
         t = targets.add_parser(name, help=text, description=text)
         add_arguments(t)
         t.add_argument("--out", required=True, metavar="DIR", help="output directory")
-        t.set_defaults(func=_in_output_dir(run))
+        t.set_defaults(func=run)
 
 
-def _in_output_dir(run):
-    """A target's run(args) inside its output directory (checked, locked, stale temporaries
-    removed; a study's own files are rewritten or resumed by the study)."""
-    def wrapped(args) -> int:
-        from gatetherm.outdir import output_dir
-
-        with output_dir(args.out):
-            return run(args)
-    return wrapped
+def _call(args, progress=None, **options) -> int:
+    """``gt.validate(args.target, args.out, **options)`` (in its output directory, locked, stale
+    temporaries removed), its lines printed as they come, then its summary."""
+    result = validate(args.target, args.out, on_line=lambda text: print(text, flush=True), on_progress=progress,
+                      **options)
+    print(result.summary(), end="")
+    return 0
 
 
 def _swept(p) -> None:
@@ -42,22 +39,13 @@ def _swept(p) -> None:
 
 
 def run_beam(args) -> int:
-    from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.beam_study import write_beam_study
-
-    s = write_beam_study(Path(args.out), load_config(args.config), args.dim, args.workers, args.scheduler,
-                         Progress(f"validate beam {args.dim}-D"))
-    print("\n".join(s["lines"]))
-    return 0
+    return _call(args, Progress(f"validate beam {args.dim}-D"), config=args.config, dim=args.dim,
+                 workers=args.workers, scheduler=args.scheduler)
 
 
 def run_design(args) -> int:
-    from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.design_study import write_design_study
-
-    print("\n".join(write_design_study(Path(args.out), load_config(args.config), args.dim, args.workers,
-                                       args.scheduler, Progress("validate design"))))
-    return 0
+    return _call(args, Progress("validate design"), config=args.config, dim=args.dim, workers=args.workers,
+                 scheduler=args.scheduler)
 
 
 def _paper_arguments(p) -> None:
@@ -67,19 +55,11 @@ def _paper_arguments(p) -> None:
 
 
 def run_paper(args) -> int:
-    from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.paper_table import write_paper_table
-
-    print(write_paper_table(Path(args.out), load_config(args.config), args.dims, args.reuse), end="")
-    return 0
+    return _call(args, config=args.config, dims=args.dims, reuse=args.reuse)
 
 
 def run_compensation(args) -> int:
-    from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.compensation_study import markdown, write_compensation_study
-
-    print(markdown(write_compensation_study(Path(args.out), load_config(args.config), args.dim)), end="")
-    return 0
+    return _call(args, config=args.config, dim=args.dim)
 
 
 def _conditions(text: str) -> tuple[int, ...]:
@@ -96,14 +76,7 @@ def _rom_arguments(p) -> None:
 
 
 def run_rom(args) -> int:
-    from gatetherm.studies.run.config import load_config
-    from gatetherm.validation.rom_study import write_rom_study
-
-    print(write_rom_study(Path(args.out), load_config(args.config), args.dims,
-                          on_row=lambda r: print(f"{r.case}, condition {r.condition}, {r.data}: paper {r.paper_um:.2f}, "
-                                                 f"MLR {r.mlr_um:.2f}, rom {r.rom_5min_um:.2f} / {r.rom_event_um:.2f} "
-                                                 f"µm ({r.rom_updates} updates)", flush=True)).markdown, end="")
-    return 0
+    return _call(args, config=args.config, dims=args.dims)
 
 
 def _hidden_arguments(p) -> None:
@@ -118,17 +91,13 @@ def _hidden_arguments(p) -> None:
 
 
 def run_hidden(args) -> int:
-    from gatetherm.validation.hidden_effects import ALL_CASES, row_line, write_hidden_effects
-
-    effects = set(args.effects.split(",")) if args.effects else set(ALL_CASES)
-    if effects - set(ALL_CASES):
-        raise InputError("--effects", f"unknown {', '.join(sorted(effects - set(ALL_CASES)))}",
-                         f"choose from {', '.join(ALL_CASES)}")
-    acc, _ = write_hidden_effects(Path(args.out), args.workers, args.seed, args.conditions, effects,
-                               args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
-    for k, v in acc.items():
-        print(f"{k}: {v}")
-    return 0
+    try:
+        return _call(args, workers=args.workers, seed=args.seed, conditions=args.conditions,
+                     effects=args.effects.split(",") if args.effects else None, mesh_size=args.mesh_size)
+    except InputError as err:
+        if err.field != "effects":
+            raise
+        raise InputError("--effects", err.problem, err.fix) from None
 
 
 def _compound_arguments(p) -> None:
@@ -140,13 +109,8 @@ def _compound_arguments(p) -> None:
 
 
 def run_compound(args) -> int:
-    from gatetherm.validation.compound_study import row_line, write_compound
-
-    figures, _ = write_compound(Path(args.out), args.workers, args.seed, args.pairs, not args.no_single,
-                             args.mesh_size, on_row=lambda row: print(row_line(row), flush=True))
-    for k, v in figures.items():
-        print(f"{k}: {v}")
-    return 0
+    return _call(args, workers=args.workers, seed=args.seed, pairs=args.pairs, single=not args.no_single,
+                 mesh_size=args.mesh_size)
 
 
 def _case_diagnosis_arguments(p) -> None:
@@ -155,13 +119,7 @@ def _case_diagnosis_arguments(p) -> None:
 
 
 def run_case_diagnosis(args) -> int:
-    from gatetherm.validation.case_diagnosis import C_FRAME, write_case_diagnosis
-
-    line, _ = write_case_diagnosis(Path(args.out), Path(args.case) if args.case else C_FRAME, args.seed,
-                                   on_row=lambda r: print(f"{r['scenario']}: {r['verdict']}, "
-                                                          f"{' + '.join(r['pieces']) or 'nothing'} named", flush=True))
-    print(line)
-    return 0
+    return _call(args, case=args.case, seed=args.seed)
 
 
 def _calibrate_arguments(p) -> None:
@@ -172,12 +130,7 @@ def _calibrate_arguments(p) -> None:
 
 
 def run_calibrate(args) -> int:
-    from gatetherm.validation.calibrate_paper import calibrate
-
-    best = calibrate(args.evals, args.mesh_size, on_better=lambda line: print(line, flush=True))
-    print("\n# best parameters (to paste into studies/data/paper.toml)")
-    print("\n".join(best))
-    return 0
+    return _call(args, evals=args.evals, mesh_size=args.mesh_size)
 
 
 def _zoo_arguments(p) -> None:
@@ -187,36 +140,16 @@ def _zoo_arguments(p) -> None:
 
 
 def run_zoo(args) -> int:
-    import gatetherm as gt
-
     machines = [m.strip() for m in args.machines.split(",") if m.strip()] if args.machines else None
-    matrix = gt.validate_zoo(args.out, machines, timeout_s=args.timeout,
-                             on_cell=lambda m, c, cell: print(f"{m}, {c}: {cell['text']}", flush=True))
-    cells = [c for row in matrix.values() for c in row.values()]
-    print(f"wrote {args.out}/zoo.md and zoo.json: {len(matrix)} machines x {len(next(iter(matrix.values())))} "
-          f"capabilities, {sum(c['status'] == 'ok' for c in cells)} numbers, "
-          f"{sum(c['status'] == 'refused' for c in cells)} refusals, {sum(c['status'] == 'failed' for c in cells)} failed")
-    return 0
+    return _call(args, machines=machines, timeout=args.timeout)
 
 
-TARGETS = {
-    "beam": ("beam theory vs FE: K_i, K_C over l/l4 and beta, error table, series, report", _swept, run_beam),
-    "design": ("tie-bar position minimising the 5-h swing of delta; a second tie bar above the arms",
-               _swept, run_design),
-    "paper": ("the paper's conditions 1-3 in 2-D and 3-D against its reported figures", _paper_arguments,
-              run_paper),
-    "compensation": ("the paper's compensator, the regression baseline and the piezo on conditions 1-3",
-                     add_model_options, run_compensation),
-    "rom": ("paper vs regression vs reduced-model compensation: conditions 1-3 in 2-D/3-D, hidden effects",
-            _rom_arguments, run_rom),
-    "hidden-effects": ("diagnose runs with a hidden catalogue effect, noise only, outside effects, mismatches",
-                       _hidden_arguments, run_hidden),
-    "compound": ("diagnose runs with two hidden pieces at once (effects, parameters off, sensor faults), "
-                 "then the hidden-effect cases", _compound_arguments, run_compound),
-    "case-diagnosis": ("diagnose runs of a case file's frame (the C-frame) with hidden pieces of the case",
-                       _case_diagnosis_arguments, run_case_diagnosis),
-    "zoo": ("every capability on every shipped machine (validation/examples): the matrix zoo.md, zoo.json",
-            _zoo_arguments, run_zoo),
-    "calibrate": ("refit the default paper model to the paper's figures (a record of the procedure)",
-                  _calibrate_arguments, run_calibrate),
+_ARGUMENTS = {
+    "beam": (_swept, run_beam), "design": (_swept, run_design), "paper": (_paper_arguments, run_paper),
+    "compensation": (add_model_options, run_compensation), "rom": (_rom_arguments, run_rom),
+    "hidden-effects": (_hidden_arguments, run_hidden), "compound": (_compound_arguments, run_compound),
+    "case-diagnosis": (_case_diagnosis_arguments, run_case_diagnosis), "zoo": (_zoo_arguments, run_zoo),
+    "calibrate": (_calibrate_arguments, run_calibrate),
 }
+TARGETS = {name: (STUDIES[name][0], *_ARGUMENTS[name]) for name in STUDIES}
+"""Target -> (help, add_arguments, run): the studies of :data:`gatetherm.api.validate_study.TARGETS`."""

@@ -132,8 +132,20 @@ def _signal_columns(case):
             "theta_C_degC": [(column(p, ("T", c))[0], c) for c in s.theta_C]}
 
 
+def _ticker(on_progress, n: int):
+    """A pass-through ``tick(x) -> x`` that reports the next of ``n`` steps to ``on_progress``."""
+    done = [0]
+
+    def tick(x):
+        if on_progress is not None:
+            done[0] += 1
+            on_progress(done[0], n)
+        return x
+    return tick
+
+
 def place_sensors(case, settings: PlacementSettings = PlacementSettings(), schedules=None, held_out=None,
-                  cache: ScenarioCache | None = None) -> Placement:
+                  cache: ScenarioCache | None = None, on_progress=None) -> Placement:
     """Choose ``settings.count`` thermocouple locations of ``case`` (module docstring).
 
     Parameters
@@ -148,6 +160,8 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
         Loads to judge on (default: the paper's conditions 1-3 for the frame's inputs, else generated).
     cache : ScenarioCache, optional
         Reuses the assembled model.
+    on_progress : callable, optional
+        ``on_progress(i, n)`` after the reduction, each load marched and the selection (``i`` up to ``n``).
 
     Returns
     -------
@@ -164,17 +178,18 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
         log.info("no sensor on %s ([sensors] exclude): %s candidate nodes left out", ", ".join(case.unmountable),
                  cand.excluded)
     train, held, ranges = _loads(case, s, schedules, held_out)
+    tick = _ticker(on_progress, len(train) + len(held) + 2)
     t0 = time.perf_counter()
     cache = cache or ScenarioCache()
-    red = build_rom(case, s.states, cache)
+    red = tick(build_rom(case, s.states, cache))
     rom = red.rom
     rows, ok = candidate_rows(prepare(case, cache=cache).model, red.basis, cand.nodes)
     cand = cand.subset(ok)
     secs["reduced_model"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     names, steps = sorted(case.inputs()), {}
-    tr = [simulate(rom, x, names, load_key("training", i), case.defaults, steps) for i, x in enumerate(train)]
-    ho = [simulate(rom, x, names, load_key("held-out", i), case.defaults, steps) for i, x in enumerate(held)]
+    tr = [tick(simulate(rom, x, names, load_key("training", i), case.defaults, steps)) for i, x in enumerate(train)]
+    ho = [tick(simulate(rom, x, names, load_key("held-out", i), case.defaults, steps)) for i, x in enumerate(held)]
     ti = [rom.output(t) for t in targets]
     X, Y = np.vstack([x.states for x in tr]), np.vstack([x.outputs[:, ti] for x in tr])
     edges = np.cumsum([0] + [len(x.states) for x in tr])
@@ -196,6 +211,7 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
     forms = tuple(f for f in forms if f == "static" or terms) or ("static",)
     paths = {f: greedy.path(design, s.count, f, fit, cand.xyz[sl], s.min_distance_m) for f in forms}
     secs["selection"] = time.perf_counter() - t0
+    tick(None)
 
     t0 = time.perf_counter()
     sensor_names = _names(case, s.count)
