@@ -44,7 +44,7 @@ def test_errormodel_fit_reports_progress_and_writes_what_the_command_writes(reco
     assert fit.runs == 1 and fit.held_out == "blocked" and fit.files == (str(record),)
     lines = fit.summary(tmp_path / "o").splitlines()
     assert lines[0] == (f"wrote {tmp_path / 'o' / 'model.json'} (fitted on 1 run(s), 400 samples; "
-                        "held-out error: blocked)")
+                        "held-out error: blocked; readings smoothed over 0 s)")
     assert lines[1].startswith("d_um: static; sensors s1_degC; time constants none; held-out MAE 0.0883 um")
     assert fit.write(tmp_path / "o") == tmp_path / "o" / "model.json"
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["model.json"]

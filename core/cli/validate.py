@@ -21,16 +21,27 @@ def register(sub) -> None:
         t = targets.add_parser(name, help=text, description=text)
         add_arguments(t)
         t.add_argument("--out", required=True, metavar="DIR", help="output directory")
-        t.set_defaults(func=run)
+        t.set_defaults(func=run_target)
 
 
-def _call(args, progress=None, **options) -> int:
-    """``gt.validate(args.target, args.out, **options)`` (in its output directory, locked, stale
-    temporaries removed), its lines printed as they come, then its summary."""
-    result = validate(args.target, args.out, on_line=lambda text: print(text, flush=True), on_progress=progress,
-                      **options)
+def run_target(args):
+    """``gt.validate(args.target, args.out, **options)`` with the target's options from the command
+    line (in its output directory, locked, stale temporaries removed), its lines printed as they
+    come, then its summary; an option the study refuses is named as the command line's."""
+    options, progress = TARGETS[args.target][2](args)
+    try:
+        result = validate(args.target, args.out, on_line=lambda text: print(text, flush=True),
+                          on_progress=progress, **options)
+    except InputError as err:
+        if err.field not in options:
+            raise
+        raise InputError(f"--{err.field.replace('_', '-')}", err.problem, err.fix) from None
     print(result.summary(), end="")
     return 0
+
+
+def _options(progress=None, **options):
+    return options, progress
 
 
 def _swept(p) -> None:
@@ -38,13 +49,13 @@ def _swept(p) -> None:
     add_parallel_options(p)
 
 
-def run_beam(args) -> int:
-    return _call(args, Progress(f"validate beam {args.dim}-D"), config=args.config, dim=args.dim,
+def run_beam(args):
+    return _options(Progress(f"validate beam {args.dim}-D"), config=args.config, dim=args.dim,
                  workers=args.workers, scheduler=args.scheduler)
 
 
-def run_design(args) -> int:
-    return _call(args, Progress("validate design"), config=args.config, dim=args.dim, workers=args.workers,
+def run_design(args):
+    return _options(Progress("validate design"), config=args.config, dim=args.dim, workers=args.workers,
                  scheduler=args.scheduler)
 
 
@@ -54,12 +65,12 @@ def _paper_arguments(p) -> None:
     p.add_argument("--reuse", action="store_true", help="keep a run whose summary.json exists")
 
 
-def run_paper(args) -> int:
-    return _call(args, config=args.config, dims=args.dims, reuse=args.reuse)
+def run_paper(args):
+    return _options(config=args.config, dims=args.dims, reuse=args.reuse)
 
 
-def run_compensation(args) -> int:
-    return _call(args, config=args.config, dim=args.dim)
+def run_compensation(args):
+    return _options(config=args.config, dim=args.dim)
 
 
 def _conditions(text: str) -> tuple[int, ...]:
@@ -75,8 +86,8 @@ def _rom_arguments(p) -> None:
     p.add_argument("--dims", type=int, nargs="+", choices=(2, 3), default=[2, 3], help="dimensions (default 2 3)")
 
 
-def run_rom(args) -> int:
-    return _call(args, config=args.config, dims=args.dims)
+def run_rom(args):
+    return _options(config=args.config, dims=args.dims)
 
 
 def _hidden_arguments(p) -> None:
@@ -90,14 +101,9 @@ def _hidden_arguments(p) -> None:
                    help="diagnosis element size, m (default: the model's)")
 
 
-def run_hidden(args) -> int:
-    try:
-        return _call(args, workers=args.workers, seed=args.seed, conditions=args.conditions,
-                     effects=args.effects.split(",") if args.effects else None, mesh_size=args.mesh_size)
-    except InputError as err:
-        if err.field != "effects":
-            raise
-        raise InputError("--effects", err.problem, err.fix) from None
+def run_hidden(args):
+    return _options(workers=args.workers, seed=args.seed, conditions=args.conditions,
+                    effects=args.effects.split(",") if args.effects else None, mesh_size=args.mesh_size)
 
 
 def _compound_arguments(p) -> None:
@@ -108,8 +114,8 @@ def _compound_arguments(p) -> None:
     p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M", help="diagnosis element size, m (default: the model's)")
 
 
-def run_compound(args) -> int:
-    return _call(args, workers=args.workers, seed=args.seed, pairs=args.pairs, single=not args.no_single,
+def run_compound(args):
+    return _options(workers=args.workers, seed=args.seed, pairs=args.pairs, single=not args.no_single,
                  mesh_size=args.mesh_size)
 
 
@@ -118,8 +124,8 @@ def _case_diagnosis_arguments(p) -> None:
     p.add_argument("--seed", type=int, default=10, help="seed of the noise (default 10)")
 
 
-def run_case_diagnosis(args) -> int:
-    return _call(args, case=args.case, seed=args.seed)
+def run_case_diagnosis(args):
+    return _options(case=args.case, seed=args.seed)
 
 
 def _calibrate_arguments(p) -> None:
@@ -129,8 +135,8 @@ def _calibrate_arguments(p) -> None:
                    help="element size, m (default 0.012)")
 
 
-def run_calibrate(args) -> int:
-    return _call(args, evals=args.evals, mesh_size=args.mesh_size)
+def run_calibrate(args):
+    return _options(evals=args.evals, mesh_size=args.mesh_size)
 
 
 def _zoo_arguments(p) -> None:
@@ -139,9 +145,9 @@ def _zoo_arguments(p) -> None:
                    help="time limit of one cell, s (default 300)")
 
 
-def run_zoo(args) -> int:
+def run_zoo(args):
     machines = [m.strip() for m in args.machines.split(",") if m.strip()] if args.machines else None
-    return _call(args, machines=machines, timeout=args.timeout)
+    return _options(machines=machines, timeout=args.timeout)
 
 
 _ARGUMENTS = {
@@ -152,4 +158,4 @@ _ARGUMENTS = {
     "calibrate": (_calibrate_arguments, run_calibrate),
 }
 TARGETS = {name: (STUDIES[name][0], *_ARGUMENTS[name]) for name in STUDIES}
-"""Target -> (help, add_arguments, run): the studies of :data:`gatetherm.api.validate_study.TARGETS`."""
+"""Target -> (help, add_arguments, options from the parsed arguments): the studies of :data:`gatetherm.api.validate_study.TARGETS`."""
