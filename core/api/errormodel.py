@@ -2,13 +2,15 @@
 run or several, predict with a 90 % interval and a drift check, refit as data arrive."""
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 
+from gatetherm.checks import argument
 from gatetherm.studies.errormodel.fit import FitParams, fit_error_model, fraction_span
 from gatetherm.studies.errormodel.model import ErrorModel, check_columns, input_gaps, load_model, predict, score
 from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.refit import refit
-from gatetherm.studies.run.timeseries import read_timeseries
+from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
 
 
 @dataclass(frozen=True)
@@ -34,6 +36,11 @@ class Prediction:
 def _read(data, required=("time_s",)):
     return read_timeseries(data, required=required) if isinstance(data, (str, bytes)) or hasattr(data, "__fspath__") \
         else data
+
+
+def _model_argument(model):
+    argument("model", model, (ErrorModel, str, os.PathLike), "an ErrorModel or a model.json's path",
+             "from errormodel_fit, or 'gatetherm errormodel fit'")
 
 
 ROBUST = FitParams(drift=True, noisy_cv=True)
@@ -70,6 +77,13 @@ def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams 
         Save it with ``gatetherm.studies.errormodel.model.save_model``.
     """
     runs = list(data) if isinstance(data, (list, tuple)) else [data]
+    for i, r in enumerate(runs):
+        argument(f"data[{i}]" if isinstance(data, (list, tuple)) else "data", r, (str, os.PathLike, TimeSeries),
+                 "a time-series file's path or a TimeSeries", "e.g. errormodel_fit('run.csv', ['delta_um'])")
+    for name, names in (("targets", targets), ("candidates", candidates), ("inputs", inputs)):
+        if isinstance(names, str) or not (names is None and name == "candidates" or isinstance(names, (list, tuple))):
+            raise TypeError(f"{name}: got {type(names).__name__} {str(names)[:40]!r}, expected a list of column "
+                            f"names; e.g. {name}=['delta_um']")
     required = ("time_s", *targets, *(candidates or ()), *inputs)
     series = [_read(r, required) for r in runs]
     spans = [fraction_span(ts["time_s"], *span) for ts in series]
@@ -92,6 +106,7 @@ def errormodel_predict(model, data) -> Prediction:
     Prediction
         Predictions and intervals (um), scores, filled gaps and the drift warnings.
     """
+    _model_argument(model)
     model = load_model(model) if not isinstance(model, ErrorModel) else model
     ts = _read(data)
     check_columns(model, ts, str(data) if not hasattr(data, "names") else "data")
@@ -125,5 +140,6 @@ def errormodel_refit(model, data, window_s: float, applied: dict[str, str] | Non
     (ErrorModel, dict)
         The refitted model and per target ``kept``, ``current_mae_um``, ``refit_mae_um``, ``samples``.
     """
+    _model_argument(model)
     model = load_model(model) if not isinstance(model, ErrorModel) else model
     return refit(model, _read(data), window_s, applied)

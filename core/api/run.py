@@ -131,8 +131,12 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
     from gatetherm.studies.run.ncprogram import nc_series
     from gatetherm.studies.run.timeseries import write_timeseries
 
-    if not (np.isfinite(step_s) and step_s > 0) or not (np.isfinite(rapid) and rapid > 0):
-        raise InputError("step_s" if not step_s > 0 else "rapid", "must be a positive number", "e.g. 1.0")
+    argument("path", path, PATH, "the path of an NC program")
+    step_s, rapid = number_argument("step_s", step_s, POSITIVE, "e.g. 1.0"), number_argument("rapid", rapid, POSITIVE,
+                                                                                             "e.g. 30.0")
+    if out is not None and Path(argument("out", out, PATH, "a file's path or None")).resolve() == Path(path).resolve():
+        raise InputError("out", f"{out} is the program itself: writing the schedule would destroy it",
+                         "give another file, e.g. program.csv")
     if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
         raise InputError("repeat", f"{repeat!r} is not a whole number of runs", "give 1 or more")
     ts = nc_series(read_text(path, "", "give an NC program (a text file)"), step_s, str(path), rapid, repeat)

@@ -127,6 +127,9 @@ class Case:
         """The case made again with ``overrides`` ({dotted key: value} of its file: ``materials.column.k``,
         ``thermal.free.film``, ``mesh.parameters.h``, ``geometry.l4`` …); effects and sensor faults kept.
         The mesh is reused when nothing it depends on changed."""
+        if not isinstance(overrides, (dict, type(None))):
+            raise TypeError(f"overrides: got {type(overrides).__name__}, expected a dict {{dotted key: value}}; "
+                            'e.g. {"thermal.free.film": 8.0}')
         if not overrides:
             return self
         made = self.origin.remake(overrides, self)

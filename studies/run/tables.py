@@ -65,11 +65,11 @@ class Table:
             self.fail(k, f"'{v}' is not a {what} of the mesh", f"{what}s: {', '.join(valid) or 'none'}")
         return v
 
-    def value(self, k: str, names, default=None, unit: str = "") -> Value:
-        """The value at ``k``: a number or an expression of ``names``, in the range of its
-        ``unit`` (°C: a temperature, else finite), checked now if it reads no input, else
+    def value(self, k: str, names, default=None, unit: str = "", rng: Range | None = None) -> Value:
+        """The value at ``k``: a number or an expression of ``names``, in ``rng`` (default the range
+        of its ``unit``: °C a temperature, else finite), checked now if it reads no input, else
         wherever it is evaluated."""
-        rng = CELSIUS if unit == "°C" else FINITE
+        rng = rng or (CELSIUS if unit == "°C" else FINITE)
         if k not in self.data and default is not None:
             return Value(default, "", self.key(k), rng)
         if k not in self.data:
