@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from gatetherm.api.run import Case
+from gatetherm.api.run import PATH, Case
+from gatetherm.checks import argument
 
 log = logging.getLogger(__name__)
 
@@ -178,7 +179,7 @@ def live(case: Case | None = None, method: str = "rom", *, endpoint: str, out, m
     every = update if update is not None else (300.0 if abs(300.0 / period - round(300.0 / period)) < 1e-9
                                                and period <= 300.0 else period)
     cp = CompensatorParams(sample_interval_s=float(period), update_interval_s=float(every))
-    out = Path(out)
+    out = Path(argument("out", out, PATH, "a folder's path"))
     fd = jr.lock(out)
     try:
         sched = _schedule(case, schedule) if case is not None else None

@@ -110,15 +110,18 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
     ----------
     path : str or path
         The program: G0/G1 moves with F (mm/min, or inch/min after G20), G4 dwells (X in s, P in
-        ms), M3/M4/M5 with S (1/min), G90/G91; anything else (arcs, cycles) is refused by line.
+        ms), M3/M4/M5 with S (1/min), G90/G91; anything else (arcs, cycles), an M3/M4 before any S,
+        a negative S or F and contradicting G codes in one block are refused by line.
     step_s : float
         Sample interval, s (the program's end is the last sample).
     rapid : float
         The rapid rate of G0 moves, m/min.
     out : str or path, optional
-        Also write the schedule there (the data format: a case's ``[time] schedule``).
+        Also write the schedule there (the data format: a case's ``[time] schedule``); never the
+        program itself.
     repeat : int
-        Run the program this many times back to back (each from where the last ended).
+        Run the program this many times back to back (each from where the last ended); at most
+        ``MAX_STEPS`` (10⁶) samples in all.
 
     Returns
     -------

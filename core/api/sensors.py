@@ -5,7 +5,7 @@ import os
 from pathlib import Path
 from typing import Mapping
 
-from gatetherm.api.run import Case, _case
+from gatetherm.api.run import Case, Schedule, _case
 from gatetherm.checks import Range, argument, number_argument, settings_argument, whole_argument
 
 SPAN = Range(-1e9, 1e9)
@@ -67,6 +67,10 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
 
     _case(case)
     count = whole_argument("count", count, Range(1, 50), "e.g. 3")
+    for name, given in (("schedules", schedules), ("held_out", held_out)):
+        if given is not None and not (isinstance(given, (list, tuple)) and all(isinstance(x, Schedule) for x in given)):
+            raise TypeError(f"{name}: got {type(given).__name__}, expected a list of Schedule or None; make them with "
+                            "gt.schedule_file(path, case)")
     if "seed" in settings:
         settings["seed"] = whole_argument("seed", settings["seed"], Range(0, 2**32 - 1), "e.g. 0")
     fit = {k: settings.pop(k) for k in ("form", "max_inputs", "min_gain") if k in settings}
