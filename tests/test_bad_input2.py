@@ -52,6 +52,12 @@ def test_a_case_value_the_physics_cannot_have_is_refused_where_read(tmp_path, ol
     assert needle in str(info.value) and "\n" not in str(info.value), str(info.value)
 
 
+def test_an_element_larger_than_the_body_is_read_with_a_warning(tmp_path, caplog):
+    with caplog.at_level(logging.WARNING):
+        gt.load_case(spindle(tmp_path, "dm = 0.0825", "dm = 82.5"))  # mm meant
+    assert "sources.front_bearing.dm: 82.5 m is larger than the whole body (0.4 m)" in caplog.text
+
+
 def test_a_guide_friction_above_one_is_refused():
     from gatetherm.studies.run.case_sources import FRICTION
     assert FRICTION.admits(0.003) and not FRICTION.admits(3.0) and not FRICTION.admits(-0.001)

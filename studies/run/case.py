@@ -330,6 +330,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                 lambda r=r: case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else
                 region_volume(fm, r, thickness.get(r, 1.0)), fm.dim, r not in fm.regions))
         kw["sources"] = tuple(sources)
+        case_sources.warn_sizes(src, float(np.ptp(fm.points, axis=0).max()))
         if "faces" in data:
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")

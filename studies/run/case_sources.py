@@ -8,6 +8,7 @@ evenly over the region, and is reported over time as the output column ``P_REGIO
 """
 from __future__ import annotations
 
+import logging
 import math
 from typing import Callable
 
@@ -16,6 +17,8 @@ from gatetherm.solvers import elements
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.problem import Source
 from gatetherm.studies.run.tables import Table
+
+log = logging.getLogger(__name__)
 
 ELEMENT_KEYS = {
     "bearing": ("type", "speed", "dm", "f0", "f1", "viscosity", "load"),
@@ -85,6 +88,21 @@ def element_loss(t: Table, names) -> Value:
     if kind == "motor" and t.data.get("efficiency") is not None and not isinstance(t.data["efficiency"], str):
         Range(0.0, 1.0, lo_open=True, unit="1").check(t.key("efficiency"), t.data["efficiency"])
     return Value.of(READERS[kind](t, names), t.key("kind"), LOSS)
+
+
+SIZES = ("dm", "diameter", "lead", "length")
+"""Lengths of an element (m) that cannot exceed the body they sit in: a larger one is a unit slip (mm)."""
+
+
+def warn_sizes(src: Table, extent: float) -> None:
+    """Warn of an element length of ``[sources]`` larger than the body's largest extent (m): the
+    value was most likely meant in mm."""
+    for r, data in src.data.items():
+        for k in SIZES:
+            v = data.get(k) if isinstance(data, dict) else None
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and v > extent > 0:
+                log.warning("%s: %g m is larger than the whole body (%.3g m); lengths are in m (%g mm = %g m)",
+                            src.sub(r).key(k), v, extent, v, v / 1000.0)
 
 
 def moving(t: Table, names, dim: int) -> dict:
