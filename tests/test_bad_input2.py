@@ -58,6 +58,24 @@ def test_an_element_larger_than_the_body_is_read_with_a_warning(tmp_path, caplog
     assert "sources.front_bearing.dm: 82.5 m is larger than the whole body (0.4 m)" in caplog.text
 
 
+def test_the_read_limit_holds_under_a_callers_alarm_handler(tmp_path, monkeypatch):
+    """A script that loops for ever is refused after READ_LIMIT_S even where the caller (a notebook,
+    a service) has its own SIGALRM handler, which the forked child inherits and gmsh would never let run."""
+    import signal
+    from gatetherm.geometry import isolate
+    monkeypatch.setattr(isolate, "READ_LIMIT_S", 2)
+    monkeypatch.setattr("gatetherm.geometry.gmshfile.READ_LIMIT_S", 2)
+    case = spindle(tmp_path, 'file = "spindle.geo"', 'file = "loop.geo"')
+    (case.parent / "loop.geo").write_text("For i In {1:1000000000}\n  x = i;\nEndFor\n")
+    old = signal.signal(signal.SIGALRM, lambda *a: None)
+    try:
+        with pytest.raises(InputError) as info:
+            gt.load_case(case)
+    finally:
+        signal.signal(signal.SIGALRM, old)
+    assert "gmsh was still reading it after 2 s" in str(info.value)
+
+
 def test_a_guide_friction_above_one_is_refused():
     from gatetherm.studies.run.case_sources import FRICTION
     assert FRICTION.admits(0.003) and not FRICTION.admits(3.0) and not FRICTION.admits(-0.001)
@@ -146,6 +164,11 @@ BAD = {
     "errormodel_fit(targets='x_um')": (lambda c: gt.errormodel_fit("d.csv", "x_um"), TypeError,
                                        "targets: got str 'x_um', expected a list of column names"),
     "errormodel_predict(3)": (lambda c: gt.errormodel_predict(3, "d.csv"), TypeError, "model: got int 3, expected"),
+    "errormodel_predict(data=5)": (lambda c: gt.errormodel_predict("m.json", 5), TypeError, "data: got int 5"),
+    "errormodel_refit(window_s='1')": (lambda c: gt.errormodel_refit("m.json", "d.csv", "1"), TypeError,
+                                       "window_s: got str '1', expected a number"),
+    "errormodel_refit(applied=[])": (lambda c: gt.errormodel_refit("m.json", "d.csv", 3600.0, ["x_um"]), TypeError,
+                                     "applied: got list ['x_um'], expected a dict"),
     "validate_zoo(machines='c_frame')": (lambda c: gt.validate_zoo("o", machines="c_frame"), TypeError,
                                          "machines: got str 'c_frame', expected a list of names"),
     "validate_zoo(machines=[])": (lambda c: gt.validate_zoo("o", machines=[]), InputError, "machines: is empty"),

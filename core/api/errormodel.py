@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 
-from gatetherm.checks import argument
+from gatetherm.checks import POSITIVE, argument, number_argument
 from gatetherm.studies.errormodel.fit import FitParams, fit_error_model, fraction_span
 from gatetherm.studies.errormodel.model import ErrorModel, check_columns, input_gaps, load_model, predict, score
 from gatetherm.studies.errormodel.trust import trust
@@ -34,6 +34,7 @@ class Prediction:
 
 
 def _read(data, required=("time_s",)):
+    argument("data", data, (str, bytes, os.PathLike, TimeSeries), "a time-series file's path or a TimeSeries")
     return read_timeseries(data, required=required) if isinstance(data, (str, bytes)) or hasattr(data, "__fspath__") \
         else data
 
@@ -107,8 +108,8 @@ def errormodel_predict(model, data) -> Prediction:
         Predictions and intervals (um), scores, filled gaps and the drift warnings.
     """
     _model_argument(model)
-    model = load_model(model) if not isinstance(model, ErrorModel) else model
     ts = _read(data)
+    model = load_model(model) if not isinstance(model, ErrorModel) else model
     check_columns(model, ts, str(data) if not hasattr(data, "names") else "data")
     gaps = input_gaps(model, ts)
     pred = predict(model, ts)
@@ -141,5 +142,7 @@ def errormodel_refit(model, data, window_s: float, applied: dict[str, str] | Non
         The refitted model and per target ``kept``, ``current_mae_um``, ``refit_mae_um``, ``samples``.
     """
     _model_argument(model)
+    window_s = number_argument("window_s", window_s, POSITIVE, "e.g. 86400 (a day)")
+    argument("applied", applied, (dict, type(None)), "a dict {target: column} or None", 'e.g. {"x_um": "corr_um"}')
     model = load_model(model) if not isinstance(model, ErrorModel) else model
     return refit(model, _read(data), window_s, applied)
