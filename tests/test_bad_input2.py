@@ -38,6 +38,8 @@ def spindle(tmp_path: Path, old: str, new: str) -> Path:
 @pytest.mark.parametrize("old, new, needle", [
     ("viscosity = 22.0", "viscosity = -22.0",
      "sources.front_bearing.viscosity: got -22, must be a finite number > 0 mm²/s"),
+    ("viscosity = 22.0", 'viscosity = "22 - n_spindle/100"',  # a column: checked at the schedule's samples
+     "sources.front_bearing.viscosity: '22 - n_spindle/100' is -18 at t = 0 s, n_spindle = 4000, must be a finite"),
     ("reference = 40.0", "reference = 0.0", "thermal.nose.film.reference: got 0, must be a finite number > 0"),
     ('load = 2000.0', 'load = 2000.0\nposition = 0.1\ndirection = [nan, 1]\nlength = 0.05',
      "sources.front_bearing.direction: expected 2 numbers, not all zero, got [nan, 1]"),
@@ -169,6 +171,8 @@ BAD = {
                                        "window_s: got str '1', expected a number"),
     "errormodel_refit(applied=[])": (lambda c: gt.errormodel_refit("m.json", "d.csv", 3600.0, ["x_um"]), TypeError,
                                      "applied: got list ['x_um'], expected a dict"),
+    "twin('case.toml')": (lambda c: gt.twin("case.toml", "opc.tcp://127.0.0.1:4840"), TypeError,
+                          "case: got str 'case.toml', expected a Case"),
     "validate_zoo(machines='c_frame')": (lambda c: gt.validate_zoo("o", machines="c_frame"), TypeError,
                                          "machines: got str 'c_frame', expected a list of names"),
     "validate_zoo(machines=[])": (lambda c: gt.validate_zoo("o", machines=[]), InputError, "machines: is empty"),

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gatetherm.api.run import PATH, Case
+from gatetherm.api.run import PATH, Case, _case
 from gatetherm.checks import argument
 
 log = logging.getLogger(__name__)
@@ -70,6 +70,7 @@ def twin(case: Case, endpoint: str, speed: float = 1.0, *, schedule=None, until:
     from gatetherm.studies.run.reduce import build_rom
     from gatetherm.validation.live.twin import TwinParams, serve
 
+    _case(case)
     params = TwinParams(speed=speed, start_s=start, until_s=until, seed=seed, **noise)
     if actuator and case.actuator is None:
         from gatetherm import InputError

@@ -138,8 +138,10 @@ def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: 
     if on_boundary:
         band["on_boundary"] = True
     if "kind" in t.data:
+        parts = tuple(t.value(k, names, unit="mm²/s", rng=VISCOSITY) for k in ("viscosity",)
+                      if isinstance(t.data.get(k), str))
         return Source(region, element_loss(t, names), 1.0 if on_boundary else 1.0 / volume(), loss=f"P_{region}_W",
-                      **band)
+                      parts=parts, **band)
     extra = next((k for k in t.data if k not in ("density", "power", *MOVING)), None)
     if extra:
         t.fail(extra, "goes with kind only", f"give kind ({', '.join(ELEMENT_KEYS)}) or remove it")
