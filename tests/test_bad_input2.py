@@ -132,6 +132,16 @@ def test_a_model_file_number_that_is_a_string_is_refused_on_load(tmp_path):
     assert "m.json: fit_span.start_s: got 'abc', must be a finite number" in str(info.value)
 
 
+def test_an_error_model_of_nothing_says_so(caplog):
+    t = np.arange(0.0, 6 * 3600.0, 60.0)
+    flat = TimeSeries({"time_s": t, "t1_degC": np.full(t.size, 20.0), "t2_degC": np.full(t.size, 20.0),
+                       "x_um": np.sin(t / 3000.0)}, {})
+    with caplog.at_level(logging.WARNING):
+        model = gt.errormodel_fit(flat, ["x_um"])
+    assert model.targets[0].terms == ()
+    assert "x_um: no candidate column explains it" in caplog.text
+
+
 @pytest.mark.parametrize("targets, needle", [(("x_um", "x_um"), "targets x_um: is named twice"),
                                              (("time_s",), "targets time_s: is the time, not a displacement")])
 def test_an_error_model_target_named_twice_or_the_time_is_refused(targets, needle):
