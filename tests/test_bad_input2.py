@@ -218,3 +218,57 @@ def test_a_wrong_object_is_named_in_one_line(joint, tmp_path, monkeypatch, call,
     message = str(info.value)
     assert message.startswith(start) and "\n" not in message, message
     assert not (tmp_path / "o").exists()  # refused before anything is written
+
+
+class _Stopped(Exception):
+    pass
+
+
+def test_a_signal_during_the_commit_waits_for_it(tmp_path, monkeypatch):
+    """A SIGTERM (or Ctrl-C) while the staged files move into --out is held until they all have:
+    never half the new files beside half the old (a rerun killed near its end, issue 55)."""
+    import os
+    import signal
+    from gatetherm import outdir
+
+    real = outdir._commit
+
+    def commit(stage, out, owns, keep):
+        os.kill(os.getpid(), signal.SIGTERM)  # arrives as the files move
+        real(stage, out, owns, keep)
+
+    def stop(*_):
+        raise _Stopped
+
+    monkeypatch.setattr(outdir, "_commit", commit)
+    old = signal.signal(signal.SIGTERM, stop)
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "a.txt").write_text("old")
+    try:
+        with pytest.raises(_Stopped):
+            with outdir.output_dir(out, ("a.txt", "b.txt")) as stage:
+                (stage / "a.txt").write_text("new")
+                (stage / "b.txt").write_text("new")
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert [(out / n).read_text() for n in ("a.txt", "b.txt")] == ["new", "new"]
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".gatetherm")]
+
+
+def test_a_zoo_cell_ends_quietly_on_the_commands_signal():
+    """A cell's child ends on SIGINT/SIGTERM by the default action: not by the command's handlers
+    it inherited through the fork, whose exception multiprocessing printed as a traceback."""
+    import multiprocessing
+    import signal
+    from gatetherm.validation import zoo
+
+    saved = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    here, there = multiprocessing.Pipe()
+    try:
+        zoo._child(there, lambda: (0.0, f"{signal.getsignal(signal.SIGINT)} {signal.getsignal(signal.SIGTERM)}"), ())
+        cell = here.recv()
+    finally:
+        for s, h in saved.items():
+            signal.signal(s, h)
+    assert cell["text"] == f"{signal.SIG_DFL} {signal.SIG_DFL}"
