@@ -78,6 +78,12 @@ def test_the_read_limit_holds_under_a_callers_alarm_handler(tmp_path, monkeypatc
     assert "gmsh was still reading it after 2 s" in str(info.value)
 
 
+def test_a_temperature_in_kelvins_is_read_with_a_warning(tmp_path, caplog):
+    with caplog.at_level(logging.WARNING):
+        gt.load_case(spindle(tmp_path, "ambient = 20.0", "ambient = 293.15"))
+    assert "thermal.jacket.ambient: 293.15 °C reads like a temperature in kelvins (20 °C)" in caplog.text
+
+
 def test_a_guide_friction_above_one_is_refused():
     from gatetherm.studies.run.case_sources import FRICTION
     assert FRICTION.admits(0.003) and not FRICTION.admits(3.0) and not FRICTION.admits(-0.001)
