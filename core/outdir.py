@@ -16,6 +16,8 @@ import contextlib
 import logging
 import os
 import shutil
+import signal
+import threading
 from pathlib import Path
 
 from gatetherm import TEMP_PREFIX, InputError, _new_temporary
@@ -161,9 +163,10 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
         _stage(out, stage)
         yield stage
         _refuse_staged_inputs(stage, out, keep, option)
-        _commit(stage, out, owns, keep)
+        with _signals_held():  # a Ctrl-C now would leave half the new files beside half the old
+            _commit(stage, out, owns, keep)
     except BaseException as err:
-        with contextlib.suppress(OSError):
+        with contextlib.suppress(OSError), _signals_held():  # a second signal cannot cut the cleanup short
             _clean(out)  # the stage, and temporaries of writers cut short (a worker terminated mid-write)
         _unlock(out, fd)
         fd = None
@@ -176,6 +179,25 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
         raise
     finally:
         _unlock(out, fd)
+
+
+@contextlib.contextmanager
+def _signals_held():
+    """SIGINT and SIGTERM held until the block ends, then delivered to the handlers in force
+    before it (a signal mask would not do: a process-directed signal goes to any thread not
+    masking it, the BLAS threads). Only the main thread can; elsewhere nothing is held."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    got: list[int] = []
+    old = {s: signal.signal(s, lambda n, _: got.append(n)) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h if h is not None else signal.SIG_DFL)
+        if got:
+            signal.raise_signal(got[0])
 
 
 def _refuse_staged_inputs(stage: Path, out: Path, keep, option: str) -> None:

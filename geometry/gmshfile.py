@@ -126,7 +126,9 @@ def _read(gmsh, spec: MeshSpec) -> int:
         gmsh.parser.setNumber(k, [float(v)])
     try:
         if spec.path.suffix.lower() == SCRIPT:
-            signal.alarm(READ_LIMIT_S)  # an endless loop: the child ends on SIGALRM (isolate._result)
+            signal.signal(signal.SIGALRM, signal.SIG_DFL)  # not a handler the caller set (inherited by the
+            signal.alarm(READ_LIMIT_S)  # fork: gmsh holds the GIL, it would never run); an endless loop: the child
+            # ends on SIGALRM (isolate._result)
             verbosity = gmsh.option.getNumber("General.Verbosity")
             gmsh.option.setNumber("General.Verbosity", min(verbosity, 1))  # the script's Printf: not shown
             gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)

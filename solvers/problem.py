@@ -70,6 +70,10 @@ class Source:
     """Unit vector along which :attr:`position` and :attr:`length` are measured."""
     length: float = 0.0
     """Extent of the band along the direction, m."""
+    parts: tuple = ()
+    """Values inside a machine element's loss that read the schedule and have a range of their own
+    (a viscosity > 0), checked at the schedule's samples as every value is: the loss's formula
+    alone would hide them (|ν n|)."""
 
 
 @dataclass(frozen=True)
@@ -269,6 +273,7 @@ def values(problem: Problem) -> list[Value]:
     """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
     out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
     out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
+    out += [v for s in problem.sources for v in s.parts]
     out += [s.position for s in problem.sources if s.position is not None]
     out += [f.law.speed for f in problem.films if f.law is not None]  # a correlation's speed
     out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]

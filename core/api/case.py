@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 from typing import Mapping
 
-import numpy as np
 
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE, Range, argument, number_argument, whole_argument
@@ -93,15 +93,18 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
     ----------
     path : str or path
         The program: G0/G1 moves with F (mm/min, or inch/min after G20), G4 dwells (X in s, P in
-        ms), M3/M4/M5 with S (1/min), G90/G91; anything else (arcs, cycles) is refused by line.
+        ms), M3/M4/M5 with S (1/min), G90/G91; anything else (arcs, cycles), an M3/M4 before any S,
+        a negative S or F and contradicting G codes in one block are refused by line.
     step_s : float
         Sample interval, s (the program's end is the last sample).
     rapid : float
         The rapid rate of G0 moves, m/min.
     out : str or path, optional
-        Also write the schedule there (the data format: a case's ``[time] schedule``).
+        Also write the schedule there (the data format: a case's ``[time] schedule``); never the
+        program itself.
     repeat : int
-        Run the program this many times back to back (each from where the last ended).
+        Run the program this many times back to back (each from where the last ended); at most
+        ``MAX_STEPS`` (10⁶) samples in all.
 
     Returns
     -------
@@ -114,8 +117,12 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
     from gatetherm.studies.run.ncprogram import nc_series
     from gatetherm.studies.run.timeseries import write_timeseries
 
-    if not (np.isfinite(step_s) and step_s > 0) or not (np.isfinite(rapid) and rapid > 0):
-        raise InputError("step_s" if not step_s > 0 else "rapid", "must be a positive number", "e.g. 1.0")
+    argument("path", path, PATH, "the path of an NC program")
+    step_s, rapid = number_argument("step_s", step_s, POSITIVE, "e.g. 1.0"), number_argument("rapid", rapid, POSITIVE,
+                                                                                             "e.g. 30.0")
+    if out is not None and Path(argument("out", out, PATH, "a file's path or None")).resolve() == Path(path).resolve():
+        raise InputError("out", f"{out} is the program itself: writing the schedule would destroy it",
+                         "give another file, e.g. program.csv")
     if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
         raise InputError("repeat", f"{repeat!r} is not a whole number of runs", "give 1 or more")
     ts = nc_series(read_text(path, "", "give an NC program (a text file)"), step_s, str(path), rapid, repeat)

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from gatetherm.api.run import PATH, Case, Run, _case
-from gatetherm.checks import argument
+from gatetherm.checks import argument, settings_argument
 
 
 def compensate(series, case: Case | None = None, method: str = "paper", *, actuator="case", **settings):
@@ -45,13 +45,16 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
         the thermocouples' noise adds to the prediction, one standard deviation, um).
     """
     from gatetherm.studies.control.methods import Settings, compensate as methods_compensate
+    from gatetherm.studies.run.timeseries import TimeSeries
 
     argument("case", case, (Case, type(None)), "a Case or None", "make one with gt.load_case(path) or gt.gate_frame()")
+    argument("series", series, (Run, TimeSeries), "a Run or a TimeSeries", "gt.run(case), or read_timeseries(path)")
     if isinstance(series, Run):
         case = case or series.case
         series = series.scenario.series({"source": "gatetherm.api.compensate"})
     rom = settings.pop("rom", None)
     chosen = (case.actuator if case is not None else None) if actuator == "case" else actuator
+    settings_argument(Settings, settings, "compensate")
     return methods_compensate(series, case, Settings(method=method, **settings), chosen, rom=rom)
 
 
@@ -83,5 +86,6 @@ def diagnose(case: Case, measured, **settings):
 
     _case(case)
     argument("measured", measured, (TimeSeries, *PATH), "a TimeSeries or a time-series file's path")
+    settings_argument(Settings, settings, "diagnose")
     ts = measured if isinstance(measured, TimeSeries) else read_timeseries(measured, required=("time_s",))
     return run_diagnosis(case, ts, Settings(**settings))

@@ -3,16 +3,18 @@ run or several, predict with a 90 % interval and a drift check, refit as data ar
 from __future__ import annotations
 
 import dataclasses
+import os
 
 from gatetherm import InputError
 from gatetherm.api.errormodel_results import FIT_OUTPUTS, PREDICT_OUTPUTS, ErrorModelFit, Prediction, \
     Refit  # noqa: F401
+from gatetherm.checks import POSITIVE, argument, number_argument
 from gatetherm.studies.errormodel.fit import CV_KINDS, FIT_FORMS, FitParams, fit_error_model, fraction_span  # noqa: F401
 from gatetherm.studies.errormodel.model import ErrorModel, check_columns, check_leakage, input_gaps, load_model, \
     predict, score
 from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.refit import refit
-from gatetherm.studies.run.timeseries import read_timeseries
+from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
 
 
 def _is_path(data) -> bool:
@@ -20,6 +22,7 @@ def _is_path(data) -> bool:
 
 
 def _read(data, required=("time_s",), named_by=None):
+    argument("data", data, (str, bytes, os.PathLike, TimeSeries), "a time-series file's path or a TimeSeries")
     return read_timeseries(data, required=required, named_by=named_by) if _is_path(data) else data
 
 
@@ -27,6 +30,8 @@ def _model(model) -> ErrorModel:
     """An ErrorModel from a model, a fit's result or a ``model.json`` path."""
     if isinstance(model, (ErrorModelFit, Refit)):
         return model.model
+    argument("model", model, (ErrorModel, str, os.PathLike), "an ErrorModel or a model.json's path",
+             "from errormodel_fit, or 'gatetherm errormodel fit'")
     return model if isinstance(model, ErrorModel) else load_model(model)
 
 
@@ -87,11 +92,18 @@ def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams 
     if unknown:
         raise TypeError(f"{unknown[0]}: not a setting of the fit; choose from {', '.join(sorted(fields))}")
     params = dataclasses.replace(params, **settings) if settings else params
+    for name, names in (("targets", targets), ("candidates", candidates), ("inputs", inputs)):
+        if isinstance(names, str) or not (names is None and name != "targets" or isinstance(names, (list, tuple))):
+            raise TypeError(f"{name}: got {type(names).__name__} {str(names)[:40]!r}, expected a list of column "
+                            f"names; e.g. {name}=['delta_um']")
     targets, inputs = tuple(targets), tuple(inputs or ())
     check_leakage(targets, candidates, inputs, tuple(named_as))
     named = {**{c: named_as[2] for c in inputs}, **{c: named_as[1] for c in candidates or ()},
              **{c: named_as[0] for c in targets}}
     runs = list(data) if isinstance(data, (list, tuple)) else [data]
+    for i, r in enumerate(runs):
+        argument(f"data[{i}]" if isinstance(data, (list, tuple)) else "data", r, (str, os.PathLike, TimeSeries),
+                 "a time-series file's path or a TimeSeries", "e.g. errormodel_fit('run.csv', ['delta_um'])")
     required = ("time_s", *targets, *(candidates or ()), *inputs)
     series = []
     for r in runs:
@@ -165,6 +177,7 @@ def errormodel_refit(model, data, window_s: float, applied=None, *, named_as: st
     """
     files = tuple(str(f) for f in (data, model) if _is_path(f))
     model = _model(model)
+    window_s = number_argument("window_s", window_s, POSITIVE, "e.g. 86400 (a day)")
     if applied is not None and not isinstance(applied, dict):
         applied = tuple(applied)
         if len(applied) != len(model.names):

@@ -5,9 +5,9 @@ import dataclasses
 import os
 from pathlib import Path
 
-from gatetherm import write_text_atomic
-from gatetherm.checks import json_text
-from gatetherm.api.run import Case, Schedule
+from gatetherm import InputError, write_text_atomic
+from gatetherm.checks import argument, json_text
+from gatetherm.api.run import PATH, Case, Schedule, _case
 
 
 def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *, schedule: Schedule | None = None,
@@ -56,10 +56,19 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
     """
     from gatetherm.studies.run.ccx import check_time, export_state
 
+    _case(case)
+    out = Path(argument("out", out, PATH, "a folder's path"))
+    if out.exists() and not out.is_dir():
+        raise InputError("out", f"{out} is a file, not a folder", "give the folder to write job.inp into")
+    argument("schedule", schedule, (Schedule, type(None)), "a Schedule or None", "gt.condition(n) or gt.schedule_file")
+    argument("title", title, (str, type(None)), "a string or None")
+    if title is not None and ("\n" in title or "\r" in title or title.lstrip().startswith("*")):
+        raise InputError("title", f"{title[:40]!r} is not one line of text: CalculiX would read what follows a line "
+                         "break or a leading '*' as a keyword", "give one line not starting with '*'")
+    argument("run", run, bool, "True or False")
     schedule = case.schedule if schedule is None else schedule
     t = check_time(schedule, float(schedule.times[-1]) if time is None else float(time))
     inp, info = export_state(case, schedule, t, title or f"gatetherm {case.name}, t = {t / 60:g} min", on_step)
-    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     return _write_deck(out, inp, info, run)
 

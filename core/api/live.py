@@ -10,7 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gatetherm.api.run import Case
+from gatetherm.api.run import PATH, Case
+from gatetherm.api.run import _case as _a_case
+from gatetherm.checks import argument
 
 log = logging.getLogger(__name__)
 
@@ -88,13 +90,13 @@ def twin(case: Case | str | Path, endpoint: str, speed: float = 1.0, *, schedule
     return asyncio.run(serve(rom, sched, endpoint, params, published, stopped, case.actuator if actuator else None))
 
 
-def _case(case):
-    """``case``, read if it is a path."""
+def _case(case) -> Case:
+    """``case``, read if it is a path; else it must be a Case."""
     if isinstance(case, (str, Path)):
         from gatetherm.api.run import load_case
 
         return load_case(case)
-    return case
+    return _a_case(case)
 
 
 def _stepper(case, method, model, target, params, states, out, sched, axis=None):
@@ -225,7 +227,7 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
     every = update if update is not None else (300.0 if abs(300.0 / period - round(300.0 / period)) < 1e-9
                                                and period <= 300.0 else period)
     cp = CompensatorParams(sample_interval_s=float(period), update_interval_s=float(every))
-    out = Path(out)
+    out = Path(argument("out", out, PATH, "a folder's path"))
     fd = jr.lock(out)
     try:
         sched = _schedule(case, schedule) if case is not None else None

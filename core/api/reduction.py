@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Callable
 
 from gatetherm.api.run import Case, Schedule, _case, condition
-from gatetherm.checks import Range, whole_argument
+from gatetherm.checks import Range, argument, whole_argument
 
 STATES = Range(2, 200, whole=True)
 """States a reduced model may have (``gatetherm reduce --states``)."""
@@ -51,6 +51,7 @@ def check_schedules(case: Case) -> list[Schedule]:
     """
     from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
 
+    _case(case)
     out = [case.schedule] if len(case.schedule.times) > 1 else []
     if case.inputs() and case.inputs() <= {SUPPLY, PUMP, AMBIENT}:
         out += [condition(n, case) for n in (1, 2, 3) if condition(n, case).label != case.schedule.label]
@@ -75,8 +76,11 @@ def check_rom(case: Case, rom, schedules=None) -> list:
         Per schedule, the largest error of every output (δ in µm, temperatures in K).
     """
     from gatetherm.studies.run.reduce import check
+    from gatetherm.solvers.rom import ReducedModel
     from gatetherm.studies.run.scenario import ScenarioCache
 
+    _case(case)
+    argument("rom", rom, ReducedModel, "a ReducedModel", "gt.reduce(case).rom, or one read with load_rom")
     return check(case, rom, check_schedules(case) if schedules is None else schedules, ScenarioCache())
 
 
@@ -104,8 +108,11 @@ def write_reduction(out: str | os.PathLike, red, checks, case: Case, states: int
         The summary: states, bounds (µm), the static-gain error, timings and checks.
     """
     from gatetherm.studies.run.output import write_json
+    from gatetherm.solvers.rom import Reduction
     from gatetherm.studies.run.reduce import rom_key, save_rom
 
+    argument("red", red, Reduction, "a Reduction", "what gt.reduce(case, states) returns")
+    _case(case)
     out = Path(out)
     save_rom(red.rom, rom_key(case, states), out)
     summary = {"states": red.rom.states, "dim": case.dim, "model": case.source, "nodes_full": int(red.basis.shape[0]),

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
-from gatetherm.api.run import Case, _case
-from gatetherm.checks import Range, number_argument, whole_argument
+from gatetherm.api.run import Case, Schedule, _case
+from gatetherm.checks import Range, argument, number_argument, settings_argument, whole_argument
 
 SPAN = Range(-1e9, 1e9)
 """What a bound of ``ranges`` may be, in the input's unit (°C, W, 1/min …)."""
@@ -71,12 +71,23 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
 
     _case(case)
     count = whole_argument("count", count, Range(1, 50), "e.g. 3")
+    for name, given in (("schedules", schedules), ("held_out", held_out)):
+        if given is not None and not (isinstance(given, (list, tuple)) and all(isinstance(x, Schedule) for x in given)):
+            raise TypeError(f"{name}: got {type(given).__name__}, expected a list of Schedule or None; make them with "
+                            "gt.schedule_file(path, case)")
+    if "seed" in settings:
+        settings["seed"] = whole_argument("seed", settings["seed"], Range(0, 2**32 - 1), "e.g. 0")
     fit = {k: settings.pop(k) for k in ("form", "max_inputs", "min_gain") if k in settings}
+    settings_argument(PlacementSettings, {k: v for k, v in settings.items() if k != "fit"}, "place_sensors")
     if isinstance(settings.get("ranges"), Mapping):
         settings["ranges"] = tuple((k, *(number_argument(f"ranges[{k!r}]", v, SPAN, "give LO, HI in the input's unit")
                                          for v in (lo, hi))) for k, (lo, hi) in settings["ranges"].items())
     if "exclude" in settings:
-        settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
+        try:
+            settings["exclude"] = tuple(b if isinstance(b, Box) else Box(*map(tuple, b)) for b in settings["exclude"])
+        except TypeError:
+            raise TypeError(f"exclude: got {settings['exclude']!r:.60}, expected (low corner, high corner) pairs; "
+                            "e.g. exclude=[((0, 0), (0.1, 0.2))]") from None
         for i, box in enumerate(settings["exclude"]):
             for v in (*box.lo, *box.hi):
                 number_argument(f"exclude[{i}]", v, fix="give a box's low and high corners, m")
@@ -110,7 +121,10 @@ def check_placement(case: Case, placement):
         loads (``.temperature_error_K``, K), ``.runs``, ``.seconds``.
     """
     from gatetherm.studies.sensors.check import fe_check
+    from gatetherm.studies.sensors.result import Placement
 
+    _case(case)
+    argument("placement", placement, Placement, "a Placement", "what gt.place_sensors(case) returns")
     return fe_check(case, placement)
 
 
@@ -141,8 +155,11 @@ def write_placement(out: str | os.PathLike, placement, case: Case, check=None, e
         The summary.
     """
     from gatetherm.validation.plots import figure, save
+    from gatetherm.studies.sensors.result import Placement
     from gatetherm.validation.plots.api import sensor_curve, sensors
 
+    argument("placement", placement, Placement, "a Placement", "what gt.place_sensors(case) returns")
+    _case(case)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     save(sensor_curve(placement, ax=figure((6.0, 3.6))), out / "curve.png")

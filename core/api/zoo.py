@@ -4,6 +4,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from gatetherm import InputError
+from gatetherm.checks import POSITIVE, argument, number_argument
+
 
 def validate_zoo(out: str | os.PathLike, machines=None, *, capabilities=None, timeout_s: float | None = None,
                  on_cell=None) -> dict:
@@ -40,5 +43,14 @@ def validate_zoo(out: str | os.PathLike, machines=None, *, capabilities=None, ti
     """
     from gatetherm.validation.zoo import CAPABILITIES, TIMEOUT_S, write_zoo
 
+    for name, names in (("machines", machines), ("capabilities", capabilities)):
+        argument(name, names, (list, tuple, type(None)), "a list of names or None", f"e.g. {name}=[...]")
+        if names is not None and not names:
+            raise InputError(name, "is empty: nothing to run", "give at least one, or None for all")
+    if timeout_s is not None:
+        timeout_s = number_argument("timeout_s", timeout_s, POSITIVE, "e.g. 600")
+    if on_cell is not None and not callable(on_cell):
+        raise TypeError(f"on_cell: got {type(on_cell).__name__}, expected a function on_cell(machine, capability, "
+                        "cell) or None")
     return write_zoo(Path(out), machines, CAPABILITIES if capabilities is None else tuple(capabilities),
                      TIMEOUT_S if timeout_s is None else timeout_s, on_cell)

@@ -211,6 +211,11 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
     base = _base_terms(candidates, inputs, data, params)
     B = np.column_stack([np.ones(data.time.size)] + [data.column(b) for b in base])
     models = [_fit_target(data.target(y), y, data, base, B, params) for y in targets]
+    for m in models:
+        if not m.terms:  # nothing chosen: a constant is no model of a thermal error, and says so
+            log.warning("%s: no candidate column explains it (none varies beyond %g resolutions of %g K, or none "
+                        "lowers the held-out error): the model is a constant; give temperatures that change over the "
+                        "run", m.target, SPAN_RESOLUTIONS, params.resolution_K)
     used = {s for m in models for s in m.sensors}
     reference = data.reference()
     lo, hi = spans[0] if len(runs) == 1 else (spans[0][0], spans[-1][1])

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.checks import first_nonfinite, json_text, parse_json
+from gatetherm.checks import FINITE, first_nonfinite, json_text, parse_json
 from gatetherm.files import read_text
 from gatetherm.studies.errormodel.terms import GapReport, Term, evaluate, fill_gaps, readings
 
@@ -251,6 +251,9 @@ def from_dict(data: dict, where: str = "model") -> ErrorModel:
     except (KeyError, TypeError, ValueError, AttributeError) as err:
         raise InputError(where, f"malformed model ({type(err).__name__}: {err})",
                          "give a model.json from 'gatetherm errormodel fit'") from None
+    for key in ("start_s", "end_s"):  # read back as numbers by predict: a string would fail there
+        if key in model.fit_span:
+            FINITE.check(f"{where}: fit_span.{key}", model.fit_span[key], "give a model.json from 'gatetherm errormodel fit'")
     missing = [s for m in model.targets for s in m.sensors if s not in ref]
     if missing and not model.run_reference:
         raise InputError(f"{where}: reference_degC", f"no reference for {missing[0]}", "add its reference temperature")
@@ -268,7 +271,13 @@ def from_dict(data: dict, where: str = "model") -> ErrorModel:
 def check_leakage(targets, candidates=(), inputs=(), names=("targets", "candidates", "inputs")) -> None:
     """InputError if a target is among the candidate sensors or the inputs (``names``: how the
     caller calls the three): a model of a channel that reads the channel itself predicts nothing
-    (its held-out error would be round-off) and would be silently wrong."""
+    (its held-out error would be round-off) and would be silently wrong; also a target named
+    twice, or the time column as a target."""
+    twice = next((t for i, t in enumerate(targets) if t in targets[:i]), None)
+    if twice is not None:
+        raise InputError(f"{names[0]} {twice}", "is named twice", f"name {twice} once")
+    if "time_s" in targets:
+        raise InputError(f"{names[0]} time_s", "is the time, not a displacement", "name displacement columns, um")
     for field, given in zip(names[1:], (candidates or (), inputs or ())):
         leak = [c for c in given if c in set(targets)]
         if leak:

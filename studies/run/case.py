@@ -127,6 +127,9 @@ class Case:
         """The case made again with ``overrides`` ({dotted key: value} of its file: ``materials.column.k``,
         ``thermal.free.film``, ``mesh.parameters.h``, ``geometry.l4`` …); effects and sensor faults kept.
         The mesh is reused when nothing it depends on changed."""
+        if not isinstance(overrides, (dict, type(None))):
+            raise TypeError(f"overrides: got {type(overrides).__name__}, expected a dict {{dotted key: value}}; "
+                            'e.g. {"thermal.free.film": 8.0}')
         if not overrides:
             return self
         made = self.origin.remake(overrides, self)
@@ -327,6 +330,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                 lambda r=r: case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else
                 region_volume(fm, r, thickness.get(r, 1.0)), fm.dim, r not in fm.regions))
         kw["sources"] = tuple(sources)
+        case_sources.warn_sizes(src, float(np.ptp(fm.points, axis=0).max()))
         if "faces" in data:
             if fm.dim != 2:
                 top.fail("faces", "applies to 2-D sections only", "remove it")

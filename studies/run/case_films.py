@@ -38,5 +38,5 @@ def film(t: Table, boundary: str, names) -> Film:
     if "reference" not in f.data and not speed.is_constant:
         f.fail("reference", "missing: the coefficient follows the schedule's speed",
                "give the coefficient (W/(m² K)) near the largest the run reaches")
-    reference = f.number("reference", FILM) if "reference" in f.data else law(*REFERENCE_POINT, {})
+    reference = f.number("reference", Range(0.0, lo_open=True, unit="W/(m² K)")) if "reference" in f.data else law(*REFERENCE_POINT, {})
     return Film(boundary, reference, ambient, law)

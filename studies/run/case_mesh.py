@@ -2,7 +2,9 @@
 through gmsh with its parameters, refinements, named groups and included files."""
 from __future__ import annotations
 
+import logging
 import math
+import re
 from pathlib import Path
 
 from gatetherm import InputError
@@ -11,6 +13,8 @@ from gatetherm.geometry.gmshfile import CAD, SCRIPT, MeshSpec, Refinement, mesh_
 from gatetherm.geometry.groups import NORMAL_TOLERANCE, GroupRule
 from gatetherm.geometry.mesh import FrameMesh, load_mesh
 from gatetherm.studies.run.tables import Table
+
+log = logging.getLogger(__name__)
 
 KEYS = {"mesh": ("file", "size", "parameters", "refine", "groups", "include"),
         "mesh.refine": ("near", "size", "distance"),
@@ -51,8 +55,24 @@ def read_mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
     groups = tuple(_group(m.sub("groups").sub(name, KEYS["mesh.groups.NAME"]), name)
                    for name in m.data.get("groups", {}))
     size = factor * m.number("size", METRES, 0.0) or None
+    if suffix == SCRIPT and params.data:
+        _parameters_read(params, [path, *(base / f for f in include)])
+    for i, r in enumerate(refine):
+        if size and r.size >= size:
+            log.warning("%s: mesh.refine[%d].size %g m is not finer than [mesh] size %g m: it changes nothing; give a "
+                        "smaller size, or remove the refinement", top.file, i + 1, r.size / factor, size / factor)
     return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
                                                  tuple(refine), groups, tuple(base / f for f in include), base, factor))
+
+
+def _parameters_read(params: Table, scripts) -> None:
+    """InputError for a ``[mesh.parameters]`` name that no script (the .geo, its included files)
+    mentions: a misspelt parameter would leave the geometry at its default without a word."""
+    text = "\n".join(f.read_text(encoding="utf-8", errors="replace") for f in scripts)
+    for name in params.data:
+        if not re.search(rf"(?<![A-Za-z0-9_]){re.escape(name)}(?![A-Za-z0-9_])", text):
+            params.fail(name, f"is not a variable of {scripts[0].name}{' or its includes' if len(scripts) > 1 else ''}"
+                        ": the geometry would not change", "name a variable the script reads (check the spelling)")
 
 
 def _in_case(top: Table, read, arg) -> FrameMesh:

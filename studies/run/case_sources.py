@@ -8,6 +8,8 @@ evenly over the region, and is reported over time as the output column ``P_REGIO
 """
 from __future__ import annotations
 
+import logging
+import math
 from typing import Callable
 
 from gatetherm.checks import Range
@@ -15,6 +17,8 @@ from gatetherm.solvers import elements
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.problem import Source
 from gatetherm.studies.run.tables import Table
+
+log = logging.getLogger(__name__)
 
 ELEMENT_KEYS = {
     "bearing": ("type", "speed", "dm", "f0", "f1", "viscosity", "load"),
@@ -31,18 +35,22 @@ KEYS = {"sources.REGION": ("density", "power", "kind",
 """The keys of ``[sources.REGION]`` (as :data:`gatetherm.studies.run.case.KEYS`)."""
 POSITIVE_M = Range(0.0, lo_open=True, unit="m")
 FACTOR = Range(0.0, unit="1")
+VISCOSITY = Range(0.0, lo_open=True, unit="mm²/s")
+"""A lubricant's kinematic viscosity (Palmgren's law reads only |ν n|: a negative one would pass unseen)."""
+FRICTION = Range(0.0, 1.0, unit="1")
+"""A guide's rolling friction coefficient (typically 0.002 to 0.005; above 1 is no rolling guide)."""
 LOSS = Range(0.0, unit="W")
 """An element's loss: never negative (an efficiency above 1 is refused where it is evaluated)."""
 
 
-def _text(t: Table, k: str, names, default=None, unit: str = "") -> str:
-    v = t.value(k, names, default, unit)
+def _text(t: Table, k: str, names, default=None, unit: str = "", rng: Range | None = None) -> str:
+    v = t.value(k, names, default, unit, rng)
     return v.text or repr(v.constant)
 
 
 def _bearing(t: Table, names) -> str:
     f0, f1 = elements.BEARING_TYPES[t.string("type", "angular_contact_oil", tuple(elements.BEARING_TYPES))]
-    return elements.bearing_text(_text(t, "speed", names, unit="1/min"), _text(t, "viscosity", names, unit="mm²/s"),
+    return elements.bearing_text(_text(t, "speed", names, unit="1/min"), _text(t, "viscosity", names, unit="mm²/s", rng=VISCOSITY),
                                  t.number("dm", POSITIVE_M), t.number("f0", FACTOR, f0), t.number("f1", FACTOR, f1),
                                  _text(t, "load", names, 0.0, "N"))
 
@@ -56,7 +64,7 @@ def _nut(t: Table, names) -> str:
 
 def _guide(t: Table, names) -> str:
     return elements.guide_text(_text(t, "speed", names, unit="m/s"), _text(t, "load", names, 0.0, "N"),
-                               t.number("friction", FACTOR, 0.003), t.number("seal", Range(0.0, unit="N"), 0.0))
+                               t.number("friction", FRICTION, 0.003), t.number("seal", Range(0.0, unit="N"), 0.0))
 
 
 def _motor(t: Table, names) -> str:
@@ -82,6 +90,21 @@ def element_loss(t: Table, names) -> Value:
     return Value.of(READERS[kind](t, names), t.key("kind"), LOSS)
 
 
+SIZES = ("dm", "diameter", "lead", "length")
+"""Lengths of an element (m) that cannot exceed the body they sit in: a larger one is a unit slip (mm)."""
+
+
+def warn_sizes(src: Table, extent: float) -> None:
+    """Warn of an element length of ``[sources]`` larger than the body's largest extent (m): the
+    value was most likely meant in mm."""
+    for r, data in src.data.items():
+        for k in SIZES:
+            v = data.get(k) if isinstance(data, dict) else None
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and v > extent > 0:
+                log.warning("%s: %g m is larger than the whole body (%.3g m); lengths are in m (%g mm = %g m)",
+                            src.sub(r).key(k), v, extent, v, v / 1000.0)
+
+
 def moving(t: Table, names, dim: int) -> dict:
     """``position``, ``direction`` and ``length`` of a source that moves, as Source's fields ({}: none)."""
     given = [k for k in MOVING if k in t.data]
@@ -95,7 +118,7 @@ def moving(t: Table, names, dim: int) -> dict:
         t.fail("density", "cannot move (a band takes a power)", "give power (W) or kind")
     d = t.data["direction"]
     if not (isinstance(d, list) and len(d) == dim and all(isinstance(x, (int, float)) and not isinstance(x, bool)
-                                                          for x in d) and any(d)):
+                                                          and math.isfinite(x) for x in d) and any(d)):
         t.fail("direction", f"expected {dim} numbers, not all zero, got {d!r}",
                f"e.g. direction = {[1] + [0] * (dim - 1)}")
     d = [float(x) for x in d]
@@ -115,8 +138,10 @@ def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: 
     if on_boundary:
         band["on_boundary"] = True
     if "kind" in t.data:
+        parts = tuple(t.value(k, names, unit="mm²/s", rng=VISCOSITY) for k in ("viscosity",)
+                      if isinstance(t.data.get(k), str))
         return Source(region, element_loss(t, names), 1.0 if on_boundary else 1.0 / volume(), loss=f"P_{region}_W",
-                      **band)
+                      parts=parts, **band)
     extra = next((k for k in t.data if k not in ("density", "power", *MOVING)), None)
     if extra:
         t.fail(extra, "goes with kind only", f"give kind ({', '.join(ELEMENT_KEYS)}) or remove it")

@@ -193,7 +193,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool =
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
                    'e.g. point = "A" or point = [0.1, 0.2]')
         q = t.data.get("quantities", list(quantities))
-        if not (isinstance(q, list) and all(x in quantities for x in q)):
+        if not (isinstance(q, list) and q and all(x in quantities for x in q)):
             t.fail("quantities", f"{q!r} is not admissible", f"choose from {', '.join(quantities)}")
         region = t.name("region", fm.regions, "region", default="") or None
         out.append(Probe(name, xyz, tuple(q), region))
@@ -221,8 +221,11 @@ def relative(top: Table, probes, dim: int) -> tuple:
     out = []
     for name in rel.data:
         t = rel.sub(name, KEYS["relative.NAME"])
-        out.append(Relative(name, t.name("a", names, "probe"), t.name("b", names, "probe"),
-                            AXES.index(t.string("axis", choices=tuple(AXES[:dim])))))
+        a, b = t.name("a", names, "probe"), t.name("b", names, "probe")
+        if a == b:  # its displacement is zero at every time: a δ that can never say anything
+            t.fail("b", f"is {b!r}, the same probe as a: the relative displacement would be 0 at all times",
+                   "give two different probes")
+        out.append(Relative(name, a, b, AXES.index(t.string("axis", choices=tuple(AXES[:dim])))))
     return tuple(out)
 
 
@@ -231,7 +234,7 @@ def signals(top: Table, probes, relative) -> Signals:
     temps = [p.name for p in probes if "T" in p.quantities]
     c = s.data.get("theta_C", [])
     c = [c] if isinstance(c, str) else c
-    if not (isinstance(c, list) and all(x in temps for x in c)):
+    if not (isinstance(c, list) and all(x in temps for x in c)) or ("theta_C" in s.data and not c):
         s.fail("theta_C", f"{c!r} is not a list of probes with T", f"probes: {', '.join(temps)}")
     return Signals(s.name("theta_A", temps, "probe", "") or None, s.name("theta_B", temps, "probe", "") or None,
                    tuple(c), s.name("delta", [r.name for r in relative], "relative displacement", "") or None)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.studies.run.timeseries import TimeSeries
+from gatetherm.studies.run.timeseries import MAX_STEPS, TimeSeries, check_steps
 
 AXES = "XYZ"
 WORD = re.compile(r"([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
@@ -58,6 +58,10 @@ def segments(text: str, where: str = "program", rapid: float = 30.0, start=(0.0,
         m = [float(v) for k, v in words if k == "M"]
         vals = {k: float(v) for k, v in words if k not in "GMN"}
         dwell = 4.0 in g
+        for group in ({0.0, 1.0}, {20.0, 21.0}, {90.0, 91.0}):
+            if len(group & set(g)) > 1:
+                raise InputError(here, f"{' and '.join(f'G{c:g}' for c in sorted(group))} in one block contradict",
+                                 "keep the one meant")
         for code in g:
             if code in (0.0, 1.0):
                 motion = int(code)
@@ -71,11 +75,18 @@ def segments(text: str, where: str = "program", rapid: float = 30.0, start=(0.0,
         unknown = sorted(set(vals) - set("XYZFSPTU"))
         if unknown:
             raise InputError(here, f"the word {unknown[0]} is not read", "give G0/G1 moves, G4 dwells, F, S, M3/M4/M5")
+        for k in ("S", "F"):
+            if vals.get(k, 0.0) < 0:
+                raise InputError(here, f"{k}{vals[k]:g} is negative", "give the speed as a number >= 0 (M4 turns the "
+                                 "spindle backwards)" if k == "S" else "give the feed as a number > 0")
         if "S" in vals:
             s_word = vals["S"]
             spindle = abs(s_word) * np.sign(spindle) if spindle else spindle
         for code in m:
             if code in (3.0, 4.0):
+                if not s_word:
+                    raise InputError(here, f"M{code:g} starts the spindle without a speed",
+                                     "give S (1/min) on or before it, e.g. M3 S8000")
                 spindle = abs(s_word) * (1.0 if code == 3.0 else -1.0)
             elif code == 5.0:
                 spindle = 0.0
@@ -119,8 +130,15 @@ def nc_series(text: str, step_s: float = 1.0, where: str = "program", rapid: flo
     the value at that instant (velocities: of the block then running, a block's start belonging
     to it)."""
     segs: list[Segment] = []
-    for _ in range(repeat):
+    for i in range(repeat):
         segs += segments(text, where, rapid, segs[-1].end if segs else (0.0, 0.0, 0.0))
+        if i == 0:  # the budget before the repeats are parsed: a program run 10^9 times is no hang
+            once = sum(s.duration for s in segs)
+            if once > 0:
+                check_steps(once * repeat, step_s, f"{where} run {repeat} times")
+            if len(segs) * repeat > MAX_STEPS:
+                raise InputError(f"{where} run {repeat} times", f"{len(segs) * repeat} blocks, more than {MAX_STEPS}",
+                                 "give fewer repeats")
     segs = [s for s in segs if s.duration > 0]
     if not segs:
         raise InputError(where, "has no move or dwell", "give G0/G1 moves or G4 dwells")

@@ -3,12 +3,19 @@ one :class:`~gatetherm.InputError` line naming the file, the key and what is adm
 (ranges from :mod:`gatetherm.checks`)."""
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, FINITE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
 from gatetherm.studies.run.timeseries import alike
+
+log = logging.getLogger(__name__)
+
+KELVIN_LIKE = (253.15, 373.15)
+"""Temperatures in °C that are a machine's surroundings written in kelvins (-20 … 100 °C in K):
+read, with a warning."""
 
 
 class Inputs(tuple):
@@ -47,7 +54,16 @@ class Table:
             if default is None:
                 self.fail(k, "missing", f"give {rng}")
             return default
-        return float(rng.check(self.key(k), self.data[k]))
+        value = float(rng.check(self.key(k), self.data[k]))
+        if rng is CELSIUS:
+            self._kelvin(k, value)
+        return value
+
+    def _kelvin(self, k: str, celsius: float) -> None:
+        """Warn of a temperature in °C that reads as one in K (a room at 293.15 °C)."""
+        if KELVIN_LIKE[0] <= celsius <= KELVIN_LIKE[1]:
+            log.warning("%s: %g °C reads like a temperature in kelvins (%g °C); temperatures are in °C",
+                        self.key(k), celsius, celsius - 273.15)
 
     def string(self, k: str, default=None, choices=None) -> str:
         if k not in self.data:
@@ -65,11 +81,11 @@ class Table:
             self.fail(k, f"'{v}' is not a {what} of the mesh", f"{what}s: {', '.join(valid) or 'none'}")
         return v
 
-    def value(self, k: str, names, default=None, unit: str = "") -> Value:
-        """The value at ``k``: a number or an expression of ``names``, in the range of its
-        ``unit`` (°C: a temperature, else finite), checked now if it reads no input, else
+    def value(self, k: str, names, default=None, unit: str = "", rng: Range | None = None) -> Value:
+        """The value at ``k``: a number or an expression of ``names``, in ``rng`` (default the range
+        of its ``unit``: °C a temperature, else finite), checked now if it reads no input, else
         wherever it is evaluated."""
-        rng = CELSIUS if unit == "°C" else FINITE
+        rng = rng or (CELSIUS if unit == "°C" else FINITE)
         if k not in self.data and default is not None:
             return Value(default, "", self.key(k), rng)
         if k not in self.data:
@@ -78,6 +94,8 @@ class Table:
             v = Value.of(self.data[k], self.key(k), rng)
         except ExpressionError as err:
             self.fail(k, str(err), "write a number or an expression such as \"100*sin(pi*t/40)\"")
+        if rng is CELSIUS and v.is_constant:
+            self._kelvin(k, float(v.constant))
         unknown = sorted(v.names() - set(names))
         if unknown and isinstance(names, Inputs):
             u, columns = unknown[0], [n for n in names if n != "t"]

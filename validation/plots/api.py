@@ -17,6 +17,7 @@ same functions on bare figures (:mod:`gatetherm.validation.plots`).
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 
@@ -84,8 +85,14 @@ def series(run, *columns: str, ax=None, hours: bool = True):
     matplotlib.axes.Axes
         One line per column, labelled with its name.
     """
-    ax = _axes(ax)
     cols = run.columns if hasattr(run, "columns") else run
+    if not hasattr(cols, "keys"):
+        argument("run", run, (), "a Run, a time series or a mapping of columns", "make one with gt.run(case)")
+    missing = [c for c in ("time_s", *columns) if c not in cols.keys()]
+    if missing:
+        raise InputError("columns", f"{', '.join(map(repr, missing))} not among the run's columns",
+                         f"choose from {', '.join(list(cols.keys())[:12])}")
+    ax = _axes(ax)
     t = cols["time_s"] / (3600.0 if hours else 60.0)
     for c in columns:
         ax.plot(t, cols[c], label=c)
@@ -301,6 +308,8 @@ def sweep(rows, x: str, y: str, hue: str | None = None, ax=None, **options):
     if isinstance(rows, (str, os.PathLike)):
         import csv
 
+        if not Path(rows).is_file():
+            raise InputError("rows", f"no such file {str(rows)!r}", "give a sweep's table.csv or its rows")
         with open(rows, newline="", encoding="utf-8") as f:
             rows = list(csv.DictReader(f))
     return plot_xy(rows, x, y, hue, ax=_axes(ax), **options)

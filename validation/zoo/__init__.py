@@ -43,6 +43,7 @@ import json
 import logging
 import math
 import multiprocessing
+import signal
 import time
 import traceback
 from dataclasses import dataclass
@@ -117,6 +118,10 @@ def _outcome(fn, *args) -> dict:
 
 
 def _child(conn, fn, args) -> None:
+    # A kill of the command (Ctrl-C reaches the whole process group) ends a cell quietly: not the
+    # command's handlers, inherited by the fork, whose exception multiprocessing prints as a traceback.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     logging.getLogger().setLevel(logging.ERROR)
     try:
         conn.send(_outcome(fn, *args))
