@@ -136,6 +136,7 @@ def errormodel_predict(model, data) -> Prediction:
         (``prediction.csv``, ``summary.json``, ``prediction.png``) and ``.summary()``.
     """
     sources = (str(model) if _is_path(model) else "", str(data) if _is_path(data) else "")
+    argument("data", data, (str, bytes, os.PathLike, TimeSeries), "a time-series file's path or a TimeSeries")
     model = _model(model)
     ts = _read(data)
     check_columns(model, ts, str(data) if not hasattr(data, "names") else "data")
@@ -176,8 +177,10 @@ def errormodel_refit(model, data, window_s: float, applied=None, *, named_as: st
         and ``.summary()``.
     """
     files = tuple(str(f) for f in (data, model) if _is_path(f))
-    model = _model(model)
     window_s = number_argument("window_s", window_s, POSITIVE, "e.g. 86400 (a day)")
+    argument("applied", applied, (dict, list, tuple, type(None)), "a dict {target: column}, a column per target or None",
+             'e.g. {"x_um": "corr_um"}')
+    model = _model(model)
     if applied is not None and not isinstance(applied, dict):
         applied = tuple(applied)
         if len(applied) != len(model.names):
