@@ -271,7 +271,6 @@ LONG_MODULES = {
     "gatetherm.solvers.linsolve": 335, "gatetherm.solvers.model": 393, "gatetherm.solvers.rom": 361,
     "gatetherm.studies.control.methods": 325, "gatetherm.studies.diagnosis.calibrate": 303,
     "gatetherm.studies.diagnosis.discrepancy": 366, "gatetherm.studies.diagnosis.select": 342,
-    "gatetherm.studies.errormodel.fit": 351, "gatetherm.studies.errormodel.model": 306,
     "gatetherm.studies.run.case": 425, "gatetherm.studies.sweeps.sweep": 331, "gatetherm.validation.plots.api": 354,
     "gatetherm.validation.verification": 321,
 }
