@@ -38,7 +38,8 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.studies.errormodel import select
-from gatetherm.studies.errormodel.fitparams import CV_KINDS, FIT_FORMS, SPAN_RESOLUTIONS, FitParams  # noqa: F401 (re-exported)
+from gatetherm.studies.errormodel.fitparams import (  # noqa: F401 (re-exported)
+    CV_KINDS, FIT_FORMS, SPAN_RESOLUTIONS, FitParams)
 from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, check_leakage, residual_stats
 from gatetherm.studies.errormodel.paper import fit_paper_form
 from gatetherm.studies.errormodel.runs import Runs

@@ -15,7 +15,8 @@ from pathlib import Path
 from gatetherm import InputError, write_text_atomic
 from gatetherm.checks import first_nonfinite, json_text, parse_json
 from gatetherm.files import read_text
-from gatetherm.studies.errormodel.fitted import FORMS, ErrorModel, TargetModel, residual_stats  # noqa: F401 (re-exported)
+from gatetherm.studies.errormodel.fitted import (  # noqa: F401 (re-exported)
+    FORMS, ErrorModel, TargetModel, residual_stats)
 from gatetherm.studies.errormodel.prediction import (  # noqa: F401 (re-exported)
     _term_values, check_columns, input_gaps, predict, score)
 from gatetherm.studies.errormodel.terms import Term
