@@ -1,13 +1,13 @@
 """A solver set up and run in a helper process beside the caller, and values still being made.
 
-:class:`SolveHelper` forks a process that makes a solver (an AMG hierarchy: seconds of set-up)
-and then solves each right-hand side it is given, in turn, while the caller goes on: on the
-3-D frame the elastic hierarchy, the adjoint read-out and the fields at the output times are
-solved on the second core while the first marches the heat equation
-(``benchmarks/peer.py``). :meth:`SolveHelper.submit` returns a :class:`Pending`
-(:mod:`gatetherm.solvers.pending`), whose :meth:`~Pending.result` waits for the solution.
-:func:`forked` makes one value in a process of its own (a mesh's METIS order beside the set-up before the first factor; the later half of an
-AMG-CG call's right-hand sides).
+:class:`SolveHelper` forks a process that makes a solver (an AMG hierarchy: seconds of set-up) and
+then solves each right-hand side it is given, in turn, while the caller goes on: on the 3-D frame
+the elastic hierarchy, the adjoint read-out and the fields at the output times are solved on the
+second core while the first marches the heat equation (``benchmarks/peer.py``).
+:meth:`SolveHelper.submit` returns a :class:`Pending` (:mod:`gatetherm.solvers.pending`), whose
+:meth:`~Pending.result` waits for the solution. :func:`forked` makes one value in a process of its
+own (a mesh's METIS order beside the set-up before the first factor; the later half of an AMG-CG
+call's right-hand sides).
 
 The arrays go through files in a private temporary folder (``/dev/shm`` where there is one),
 the pipes carry only their names: neither side ever waits on the other to read a large
