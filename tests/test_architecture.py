@@ -269,7 +269,6 @@ LONG_MODULES = {
     "gatetherm.studies.control.methods": 325, "gatetherm.studies.diagnosis.calibrate": 303,
     "gatetherm.studies.diagnosis.discrepancy": 366, "gatetherm.studies.diagnosis.select": 342,
     "gatetherm.studies.run.case": 425,
-    "gatetherm.validation.verification": 321,
 }
 
 
