@@ -1,22 +1,21 @@
 """gmsh in a child process: sandboxed, interruptible, its result back through a pipe.
 
-:func:`run_isolated` forks: 0.01 to 0.15 s more than meshing in the process (the paper's 2-D
-frame, medians of 7 interleaved runs on a loaded machine); a new interpreter costs 0.3 s more
-still, so one is started only once gmsh has run threads in this process (:data:`THREADS_STARTED`).
-The child imports and initialises gmsh, installs the seccomp sandbox
-(:mod:`gatetherm.geometry.sandbox`) and only then, once the parent agrees, runs the work on
-the user's file; the result (a JSON header and numpy arrays, :func:`unpack`) comes
-back through a pipe opened before the fork, never through a file. The parent holds the
-sandbox's listener: the first program run or file written ends the child, and the run
-with one line. Where the kernel cannot report denials (or refuses the filter), the parent
-checks the ``.geo`` by the text scan of :mod:`gatetherm.geometry.geoscan` before the child
-reads it. A signal (Ctrl-C, SIGTERM) reaches the parent at once, which kills the child on
-its way out; an ``Exit`` in a script ends the child only. gmsh's messages are read from the
-child's output: every few seconds one is logged (``-v``), and the last error names a failure.
+:func:`run_isolated` forks: 0.01 to 0.15 s more than meshing in the process (the paper's 2-D frame,
+medians of 7 interleaved runs on a loaded machine); a new interpreter costs 0.3 s more still, so one
+is started only once gmsh has run threads in this process (:data:`THREADS_STARTED`). The child
+imports and initialises gmsh, installs the seccomp sandbox (:mod:`gatetherm.geometry.sandbox`) and
+only then, once the parent agrees, runs the work on the user's file; the result (a JSON header and
+numpy arrays, :func:`~gatetherm.geometry.records.unpack`) comes back through a pipe opened before
+the fork, never through a file. The parent holds the sandbox's listener: the first program run or
+file written ends the child, and the run with one line. Where the kernel cannot report denials (or
+refuses the filter), the parent checks the ``.geo`` by the text scan of
+:mod:`gatetherm.geometry.geoscan` before the child reads it. A signal (Ctrl-C, SIGTERM) reaches the
+parent at once, which kills the child on its way out; an ``Exit`` in a script ends the child only.
+gmsh's messages are read from the child's output: every few seconds one is logged (``-v``), and the
+last error names a failure.
 """
 from __future__ import annotations
 
-import contextlib
 import json
 import logging
 import os
@@ -27,7 +26,6 @@ import signal
 import socket
 import struct
 import sys
-import threading
 import time
 from collections import deque
 from pathlib import Path
@@ -36,6 +34,8 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry import sandbox
+from gatetherm.geometry.records import _CRASH, _ERROR, _record, pack, unpack
+from gatetherm.geometry.session import THREADS_STARTED, gmsh_session  # re-exported: isolate.THREADS_STARTED
 from gatetherm.process import die_with_parent, fork
 
 log = logging.getLogger(__name__)
@@ -43,73 +43,9 @@ log = logging.getLogger(__name__)
 FORBIDDEN = "the geometry script tried to run a program / write a file; gatetherm does not allow it"
 PROGRESS_S = 3.0
 """Interval of the progress lines of gmsh's log (``-v``), s."""
-_DTYPES = {"<f8", "<i8", "<i4", "|i1", "|b1"}
-_RESULT, _ERROR, _CRASH = b"R", b"E", b"X"
-
-
-THREADS_STARTED = {"here": False}
-"""Whether gmsh has started threads in this process (a 3-D mesh made here, in
-:func:`gmsh_session`): they would be missing in a forked child, which then waits for them
-for ever; gmsh's processes are then started afresh (a new interpreter, ~0.3 s more)."""
-
-
-@contextlib.contextmanager
-def gmsh_session(name: str = "frame", verbosity: int = 0):
-    """Initialise gmsh for the duration of the block (without the user's option files),
-    printing its messages from ``verbosity`` 1 on (1 errors, 2 warnings, 5 progress), and
-    finalise it."""
-    import gmsh
-
-    threads = sandbox.threads()
-    if gmsh.isInitialized():
-        gmsh.finalize()
-    gmsh.initialize(readConfigFiles=False, interruptible=False)
-    if threading.current_thread() is threading.main_thread():  # gmsh resets SIGTERM: Python's handler back
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            if signal.getsignal(sig) is not None:
-                signal.signal(sig, signal.getsignal(sig))
-    try:
-        gmsh.option.setNumber("General.Terminal", int(verbosity > 0))
-        gmsh.option.setNumber("General.Verbosity", verbosity)
-        gmsh.model.add(name)
-        yield gmsh
-    finally:
-        gmsh.finalize()
-        THREADS_STARTED["here"] |= sandbox.threads() > threads
-
-
 READ_LIMIT_S = 30
 """Longest a geometry script may take to run, before meshing, s: a script that runs longer (an
 endless loop) is refused (the child ends on SIGALRM). Meshing itself has no time limit."""
-
-
-def _record(kind: bytes, payload: bytes) -> bytes:
-    return kind + struct.pack("<Q", len(payload)) + payload
-
-
-def pack(meta: dict, arrays: dict[str, np.ndarray]) -> bytes:
-    """A result record: ``meta`` (JSON) and the arrays (numeric, C order)."""
-    arrays = {k: np.ascontiguousarray(v) for k, v in arrays.items()}
-    head = json.dumps({"meta": meta, "arrays": [[k, v.dtype.str, list(v.shape)] for k, v in arrays.items()]}).encode()
-    return _record(_RESULT, struct.pack("<Q", len(head)) + head + b"".join(v.tobytes() for v in arrays.values()))
-
-
-def unpack(payload: bytes) -> tuple[dict, dict[str, np.ndarray]]:
-    """Read a result record's payload (from a sandboxed child: checked, no pickle)."""
-    (n,) = struct.unpack_from("<Q", payload)
-    head = json.loads(payload[8:8 + n])
-    buf, at, arrays = memoryview(payload), 8 + n, {}
-    for name, dtype, shape in head["arrays"]:
-        if dtype not in _DTYPES or not all(isinstance(s, int) and s >= 0 for s in shape):
-            raise ValueError(f"bad array {name!r} in the result of gmsh's process")
-        size = int(np.prod(shape)) * np.dtype(dtype).itemsize
-        if at + size > len(payload):
-            raise ValueError("truncated result from gmsh's process")
-        arrays[name] = np.frombuffer(buf[at:at + size], dtype=dtype).reshape(shape).copy()
-        at += size
-    if at != len(payload):
-        raise ValueError("truncated result from gmsh's process")
-    return head["meta"], arrays
 
 
 def _child(work, out: int, logfd: int, sock: socket.socket, go: int, verbose: bool, parent: int) -> None:

@@ -1,196 +1,36 @@
-"""Heat conduction in a solid, with lumped fluid volumes on its boundaries.
+"""Marching the heat system in time: :class:`HeatSolver` (the step solvers of one system) and
+:func:`march` (Crank–Nicolson, each switch of the pumps started by Rannacher's backward-Euler half
+steps: :class:`~gatetherm.solvers.scheme.TimeScheme`), with Picard iterations for the films whose
+coefficient follows the temperature (:func:`picard`).
 
-Unknowns are the nodal temperatures of the solid (°C) followed by one temperature per
-lumped fluid volume and per supply hose (:class:`~gatetherm.solvers.problem.Fluid`).
-Per unit of the 2-D out-of-plane thickness ``t`` (``t = 1`` in 3-D) the weak form is
-
-    ∫ t ρc Ṫ v + ∫ t k ∇T·∇v + Σ_films ∫ t h (T − T_amb) v + ∫ h_f (T − T_amb) v
-        + Σ_fluids ∫_wall t h_p (T − T_oil) v = ∫ t q v + Σ_flux ∫ t q_n v
-    C_oil Ṫ_oil + ∫_wall t h_p (T_oil − T) + G_p (T_oil − T_in) = 0
-    C_hose Ṫ_hose + G_p (T_hose − T_supply) + UA (T_hose − T_amb) = 0
-
-with ``h_f`` the loss of the front and back faces of a 2-D section (2 h per unit of
-section area), the wall film ``h_p`` and the supply's enthalpy flow ``G_p = ρc Q``
-following the fluid's pump state ``p``, and ``T_in`` the fluid entering the volume: the
-hose, or the supply without one. Fixed temperatures are Dirichlet conditions. The
-matrix of the system depends only on the pump states (the *mode*); the right-hand side
-is a sum of fixed vectors times input values.
+The system and its weak form are :mod:`gatetherm.solvers.heat_system`, its assembly
+:mod:`gatetherm.solvers.heat_assembly`; their names are importable from here too.
 """
 from __future__ import annotations
 
-import functools
 import logging
 import time
 from collections import Counter
-from dataclasses import dataclass
 from typing import Callable, Iterator, Mapping
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import BilinearForm, CellBasis, FacetBasis, LinearForm, asm
-from skfem.helpers import dot, grad
 
 from gatetherm import InputError
-from gatetherm.solvers import p1
-from gatetherm.solvers.expr import Value
-from gatetherm.solvers.convection import VaryingFilm
-from gatetherm.solvers.fem import Field, complement, dof_basis, element
+from gatetherm.solvers.fem import complement
+from gatetherm.solvers.heat_assembly import assemble_heat, bordered, boundary_terms  # noqa: F401 (re-exported)
+from gatetherm.solvers.heat_system import (  # noqa: F401 (re-exported)
+    Drive, HeatSystem, Load, Mode, Pumped, capacity, conduction, environment, film, film_load)
 from gatetherm.solvers.linsolve import Bordered, nd_order, planned_solver, restrict_order
-from gatetherm.solvers.moving import MovingLoad, moving_load
 from gatetherm.solvers.pardiso import Analyses
 from gatetherm.solvers.scheme import TimeScheme
 
 log = logging.getLogger(__name__)
 
-Drive = Callable[[float], Mapping[str, float]]
-"""The inputs of a run (schedule columns by name) at a time in s."""
-Mode = tuple[bool, ...]
-"""Pump state of every fluid."""
-
-
-@BilinearForm
-def capacity(u, v, w):
-    return w.rc * w.t * u * v
-
-
-@BilinearForm
-def conduction(u, v, w):
-    return w.k * w.t * dot(grad(u), grad(v))
-
-
-@BilinearForm
-def film(u, v, w):
-    return w.h * w.t * u * v
-
-
-@LinearForm
-def film_load(v, w):
-    return w.h * w.t * v
-
-
-def environment(drive: Drive, t: float) -> dict[str, float]:
-    """The variables an input expression sees at time ``t``: ``t`` and the drive's inputs."""
-    return {"t": t, **drive(t)}
-
-
-@dataclass(frozen=True)
-class Load:
-    """A term ``vector · value(env)`` of the right-hand side."""
-
-    vector: np.ndarray
-    value: Value
-    kind: str
-    """"film", "flux", "faces", "source" or "hose" (the hose's loss): for energy accounts."""
-
-
-@dataclass(frozen=True)
-class Pumped:
-    """The part of the conductance and the load that follows one fluid's pump."""
-
-    wall: sp.csr_matrix
-    """Coupling of the wetted boundary and the fluid unknown for a unit film coefficient."""
-    film_on: float
-    film_off: float
-    flow: sp.csr_matrix
-    """Coupling of fluid and inlet unknowns by the supply for a unit conductance."""
-    conductance: float
-    """Enthalpy flow while pumping, W/K."""
-    inlet: int
-    """Index of the unknown the supply enters (the hose, or the fluid)."""
-    pump: Value
-    supply: Value
-
-    def on(self, env) -> bool:
-        return bool(self.pump(env) > 0.5)
-
-    def coefficients(self, on: bool) -> tuple[float, float]:
-        """(wall film coefficient, conductance) for a pump state."""
-        return (self.film_on, self.conductance) if on else (self.film_off, 0.0)
-
-
 PICARD_TOL = 1e-10
 """Change of every varying film's boundary-mean temperature, K, at which the Picard iterations stop."""
 PICARD_MAX = 200
 """Most Picard iterations of one step (or of a steady state)."""
-
-
-@dataclass(frozen=True)
-class HeatSystem:
-    """Assembled operators: ``M U' + K(mode) U = f(env, mode)`` with ``U[fixed]`` given.
-    Immutable: the factorisations of its step matrices live in a :class:`HeatSolver`."""
-
-    basis: CellBasis
-    M: sp.csr_matrix
-    K0: sp.csr_matrix
-    """Conductance that does not depend on the pumps."""
-    pumped: tuple[Pumped, ...]
-    loads: tuple[Load, ...]
-    """``f = Σ vector · value(env)`` (+ the supplies of the pumped fluids)."""
-    fixed: tuple[tuple[np.ndarray, Value], ...]
-    """Dirichlet conditions: solid dofs and their temperature."""
-    n_solid: int
-    lumped: dict[str, int]
-    """Index of every fluid and hose unknown, by name."""
-    T0: float
-    """Initial temperature, °C."""
-    simplices: p1.Simplices | None = None
-    """The linear mesh's :class:`~gatetherm.solvers.p1.Simplices`: their METIS node order, found
-    when a step matrix is first factorised, is the one every factor on the mesh shares (None: an
-    order found from that step matrix)."""
-    varying: tuple[VaryingFilm, ...] = ()
-    """Films whose coefficient follows the temperature (Picard iterations: :func:`picard`)."""
-    moving: tuple[MovingLoad, ...] = ()
-    """Sources that follow a position."""
-
-    @property
-    def n(self) -> int:
-        return self.M.shape[0]
-
-    @functools.cached_property
-    def fixed_dofs(self) -> np.ndarray:
-        return np.unique(np.concatenate([d for d, _ in self.fixed])) if self.fixed else np.zeros(0, int)
-
-    def mode(self, env) -> Mode:
-        return tuple(p.on(env) for p in self.pumped)
-
-    def K(self, mode: Mode) -> sp.csr_matrix:
-        """Conductance matrix for a mode."""
-        K = self.K0
-        for p, on in zip(self.pumped, mode):
-            h, G = p.coefficients(on)
-            K = K + h * p.wall + G * p.flow
-        return K.tocsr()
-
-    def f(self, env, mode: Mode) -> np.ndarray:
-        out = np.zeros(self.n)
-        for load in self.loads:
-            out += load.vector * load.value(env)
-        for m in self.moving:
-            out[:len(m.weights)] += m.vector(env) * m.value(env)
-        for p, on in zip(self.pumped, mode):
-            out[p.inlet] += p.coefficients(on)[1] * p.supply(env)
-        return out
-
-    def boundary_values(self, env) -> np.ndarray:
-        """Temperatures of :attr:`fixed_dofs` (a later condition wins at shared nodes)."""
-        out = np.zeros(self.n)
-        for dofs, value in self.fixed:
-            out[dofs] = value(env)
-        return out[self.fixed_dofs]
-
-    def correction(self, U: np.ndarray, env) -> np.ndarray:
-        """The varying films' parts beyond the matrix (on the left-hand side), on all unknowns."""
-        out = np.zeros(self.n)
-        for v in self.varying:
-            out[:len(v.a)] += v.correction(U, env)
-        return out
-
-    def surfaces(self, U: np.ndarray) -> np.ndarray:
-        return np.array([v.surface(U) for v in self.varying])
-
-    def initial(self, T0: float | None = None) -> np.ndarray:
-        return np.full(self.n, self.T0 if T0 is None else T0)
-
 
 HEAT_RTOL = 1e-7
 """Relative residual of a heat step solved iteratively: on the 3-D frame δ's first peak and
@@ -397,128 +237,3 @@ def march(system: HeatSystem | HeatSolver, drive: Drive, times: np.ndarray, sche
         U = theta_step(solver, drive, U, a, b, theta, mode)
         if last:
             yield b, U
-
-
-def boundary_terms(mesh, name: str, e, q: int, thickness: Field) -> tuple[sp.csr_matrix, np.ndarray]:
-    """``(∫ t u v, ∫ t v)`` over the named boundary (``t`` the 2-D thickness of the element
-    beside each facet): a film of unit coefficient and its load. Linear elements in numpy
-    (:func:`~gatetherm.solvers.p1.facet_terms`), others by scikit-fem's facet basis."""
-    facets = mesh.boundaries[name]
-    if e.maxdeg == 1:
-        t = thickness.values[mesh.f2t[0, facets]] if np.ptp(thickness.values) else np.full(len(facets),
-                                                                                           thickness.values[0])
-        return p1.facet_terms(mesh.p.T, mesh.facets[:, facets].T, t, mesh.nvertices)
-    fb = FacetBasis(mesh, e, facets=facets, intorder=q)
-    tf = thickness.at(fb)
-    return asm(film, fb, h=1.0, t=tf), asm(film_load, fb, h=1.0, t=tf)
-
-
-def bordered(A: sp.spmatrix, d) -> sp.csr_matrix:
-    """``[[A, 0], [0, diag(d)]]`` (CSR, no entry where ``d`` is 0): ``A``'s arrays extended, not
-    made anew through triplets as ``sp.block_diag`` makes them."""
-    A, d = A.tocsr(), np.asarray(d, dtype=float)
-    n, on = A.shape[0], np.flatnonzero(d)
-    indptr = np.r_[A.indptr, A.indptr[-1] + np.cumsum(d != 0)].astype(A.indptr.dtype)
-    if not on.size:  # the same entries: A's arrays shared
-        return sp.csr_matrix((A.data, A.indices, indptr), shape=(n + len(d),) * 2)
-    return sp.csr_matrix((np.r_[A.data, d[on]], np.r_[A.indices, n + on].astype(A.indices.dtype), indptr),
-                         shape=(n + len(d),) * 2)
-
-
-def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None = None,
-                  simplices: p1.Simplices | None = None) -> HeatSystem:
-    """Assemble the heat system of ``problem`` (a :class:`~gatetherm.solvers.problem.Problem`)
-    on a scikit-fem ``mesh`` with its named boundaries and subdomains; ``fields`` holds the
-    element-wise ``k``, ``rho_c`` and ``thickness``. Linear elements use ``simplices``
-    (:func:`~gatetherm.solvers.p1.simplices` of the mesh, found if not given)."""
-    order = problem.order
-    e = element(mesh.dim(), order)
-    q = intorder or 2 * order
-    th = fields["thickness"]
-    s = None
-    if order == 1 and problem.plane != "axisymmetric":  # the same matrices, vectorised (solvers/p1.py)
-        s = simplices or p1.simplices(mesh)
-        M = s.pattern.scalar(p1.mass, s.G, s.vol, fields["rho_c"].values * th.values)
-        K = s.pattern.scalar(p1.conduction, s.G, s.vol, fields["k"].values * th.values)
-        basis = dof_basis(mesh, e)
-    else:
-        basis = CellBasis(mesh, e, intorder=q)
-        M = asm(capacity, basis, rc=fields["rho_c"].at(basis), t=th.at(basis))
-        K = asm(conduction, basis, k=fields["k"].at(basis), t=th.at(basis))
-
-    if problem.contacts:  # thermal contact layers (on a mesh cut open along them)
-        from gatetherm.solvers.contact import conductances
-
-        Kc = conductances(basis, mesh, problem.contacts, th)
-        K = K if Kc is None else K + Kc
-
-    def cells():  # a basis with quadrature, made only where a volume integral needs it
-        return CellBasis(mesh, e, intorder=q) if order == 1 else basis
-
-    loads: list[tuple[np.ndarray, Value, str]] = []
-    varying = []
-    for fl in problem.films:
-        A_f, a_f = boundary_terms(mesh, fl.boundary, e, q, th)
-        K = K + fl.h * A_f
-        loads.append((fl.h * a_f, fl.ambient, "film"))
-        if fl.law is not None:
-            varying.append(VaryingFilm(fl.boundary, A_f.tocsr(), a_f, fl.h, fl.law, fl.ambient))
-    for fx in problem.fluxes:
-        loads.append((boundary_terms(mesh, fx.boundary, e, q, th)[1], fx.value, "flux"))
-    if problem.faces is not None and mesh.dim() == 2:
-        cb = cells()
-        K = K + asm(film, cb, h=problem.faces.h, t=2.0)
-        loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
-    moving = []
-    for src in problem.sources:
-        if src.on_boundary:  # a power on a surface: ∫ t v over the boundary, normalised to it
-            vec = boundary_terms(mesh, src.region, e, q, th)[1]
-        else:
-            cb = cells()
-            on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
-            vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
-        if src.position is not None:
-            moving.append(moving_load(mesh, basis, src, vec, order))
-            continue
-        if src.on_boundary:
-            loads.append((vec / vec.sum(), src.density, "source"))
-            continue
-        loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
-    n_solid = basis.N
-    caps, losses, lumped, couplings = [], [], {}, []
-    for fluid in problem.fluids:
-        lumped[fluid.name] = n_solid + len(caps)
-        caps.append(fluid.capacity)
-        losses.append((0.0, None))
-        couplings.append(boundary_terms(mesh, fluid.boundary, e, q, th))
-        if fluid.hose_capacity > 0:
-            lumped[fluid.hose_name or f"{fluid.name}_hose"] = n_solid + len(caps)
-            caps.append(fluid.hose_capacity)
-            losses.append((fluid.hose_loss, fluid.ambient))
-    n = n_solid + len(caps)
-
-    pumped = []
-    for fluid, (A_ww, c) in zip(problem.fluids, couplings):
-        o = lumped[fluid.name]
-        i = lumped.get(fluid.hose_name or f"{fluid.name}_hose", o) if fluid.hose_capacity > 0 else o
-        A, idx = A_ww.tocoo(), np.flatnonzero(c)
-        oo = np.full(len(idx), o)
-        wall = sp.csr_matrix((np.r_[A.data, -c[idx], -c[idx], c.sum()],
-                              (np.r_[A.row, idx, oo, o], np.r_[A.col, oo, idx, o])), shape=(n, n))
-        flow = sp.csr_matrix(([1.0, -1.0, 1.0], ([o, o, i], [o, i, i])), shape=(n, n))
-        pumped.append(Pumped(wall, fluid.film_on, fluid.film_off, flow, fluid.conductance, i,
-                             fluid.pump, fluid.supply))
-        log.info("heat system: fluid %s on %s, wall area %.4g m²", fluid.name, fluid.boundary, c.sum())
-    M, K0 = bordered(M, caps), bordered(K, [ua for ua, _ in losses])  # K0: the hoses' losses on its border
-    loads = [Load(np.r_[v, np.zeros(len(caps))], value, kind) for v, value, kind in loads]
-    for k, (ua, ambient) in enumerate(losses):
-        if ua:
-            v = np.zeros(n)
-            v[n_solid + k] = ua
-            loads.append(Load(v, ambient, "hose"))
-    fixed = tuple((basis.get_dofs(mesh.boundaries[c.boundary]).all(), c.value) for c in problem.fixed)
-    log.info("heat system: %d unknowns (P%d), %d fixed", n, order, len(np.unique(np.concatenate(
-        [d for d, _ in fixed]))) if fixed else 0)
-    return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, s,
-                      tuple(varying), tuple(moving))
-

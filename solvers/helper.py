@@ -1,13 +1,13 @@
 """A solver set up and run in a helper process beside the caller, and values still being made.
 
-:class:`SolveHelper` forks a process that makes a solver (an AMG hierarchy: seconds of set-up)
-and then solves each right-hand side it is given, in turn, while the caller goes on: on the
-3-D frame the elastic hierarchy, the adjoint read-out and the fields at the output times are
-solved on the second core while the first marches the heat equation
-(``benchmarks/peer.py``). :meth:`SolveHelper.submit` returns a :class:`Pending`, whose
-:meth:`~Pending.result` waits for the solution. :func:`forked` makes one value in a process of
-its own (a mesh's METIS order beside the set-up before the first factor; the later half of an
-AMG-CG call's right-hand sides).
+:class:`SolveHelper` forks a process that makes a solver (an AMG hierarchy: seconds of set-up) and
+then solves each right-hand side it is given, in turn, while the caller goes on: on the 3-D frame
+the elastic hierarchy, the adjoint read-out and the fields at the output times are solved on the
+second core while the first marches the heat equation (``benchmarks/peer.py``).
+:meth:`SolveHelper.submit` returns a :class:`Pending` (:mod:`gatetherm.solvers.pending`), whose
+:meth:`~Pending.result` waits for the solution. :func:`forked` makes one value in a process of its
+own (a mesh's METIS order beside the set-up before the first factor; the later half of an AMG-CG
+call's right-hand sides).
 
 The arrays go through files in a private temporary folder (``/dev/shm`` where there is one),
 the pipes carry only their names: neither side ever waits on the other to read a large
@@ -33,44 +33,11 @@ import numpy as np
 
 from gatetherm.process import die_with_parent, end_with_parent, fork, give_back, receive, send
 from gatetherm.solvers.errors import SolverError
+from gatetherm.solvers.pending import Pending  # re-exported: helper.Pending
 
 log = logging.getLogger(__name__)
 
 ENDED = "the helper process ended without its solutions"
-
-
-class Pending:
-    """A value being made elsewhere: :meth:`result` waits for it (once), :meth:`done` asks."""
-
-    def __init__(self, wait: Callable[[], Any], poll: Callable[[], bool] = lambda: True):
-        self._wait, self._poll, self._value, self._has = wait, poll, None, False
-
-    @classmethod
-    def of(cls, value) -> "Pending":
-        """A value made already."""
-        p = cls(lambda: value)
-        p._value, p._has = value, True
-        return p
-
-    def done(self) -> bool:
-        return self._has or self._poll()
-
-    def result(self):
-        if not self._has:
-            self._value, self._has = self._wait(), True
-            self._wait = self._poll = None
-        return self._value
-
-    def then(self, f: Callable[[Any], Any]) -> "Pending":
-        """The pending ``f(value)``."""
-        return Pending(lambda: f(self.result()), self.done)
-
-    def __reduce__(self):  # pickled (to another process) as the value itself
-        return _identity, (self.result(),)
-
-
-def _identity(value):
-    return value
 
 
 def forked(make: Callable[[], Any], what: str) -> Pending:

@@ -7,6 +7,9 @@ temperatures and boundary means (sparse rows on the state), and displacements,
 relative displacements and stresses at probes (dense weight rows on the temperature
 rise, one adjoint elastic solve each). A problem with a prescribed temperature field
 has no heat state: it is solved once (:meth:`Model.static`).
+
+The read-outs are :mod:`gatetherm.solvers.readout`, the fields of a problem without a heat solve
+:mod:`gatetherm.solvers.static`; their names are importable from here too.
 """
 from __future__ import annotations
 
@@ -16,27 +19,26 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from skfem import CellBasis, asm
 
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.solvers.axisym import Revolution
 from gatetherm.solvers.contact import split_contacts
-from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, moduli, support_dofs, thermal_load_at
+from gatetherm.solvers.elasticity import ElasticSystem, assemble_elastic, support_dofs
 from gatetherm.solvers.loads import Terms, mechanical_terms, unit_responses
 from gatetherm.solvers import p1
 from gatetherm.solvers.fem import Field, dof_basis, element, to_skfem
-from gatetherm.solvers.heat import HeatSystem, assemble_heat, boundary_terms
+from gatetherm.solvers.heat import HeatSystem, assemble_heat
 from gatetherm.solvers.helper import Pending
 from gatetherm.solvers.plan import plan
 from gatetherm.solvers.problem import AXES, Problem
-from gatetherm.solvers.stress import Recovery, recovery, von_mises
+from gatetherm.solvers.readout import (  # noqa: F401 (re-exported)
+    Key, Readout, Rows, adjoint_weights, boundary_mean, build_readout, mechanical_rows, recovery_over)
+from gatetherm.solvers.static import (  # noqa: F401 (re-exported)
+    prescribed_at, prescribed_rise, static_displacement, static_fields)
+from gatetherm.solvers.stress import Recovery, von_mises
 
 log = logging.getLogger(__name__)
 
-Key = tuple
-"""An output: ("T", probe), ("u", probe, axis), ("sigma", probe, component), ("relative", name),
-("fluid", name), ("mean", name)."""
 ORDER_BESIDE = {"nodes": 20_000, "steps": 100}
 """A mesh's METIS order is found in a process beside the set-up (:meth:`~gatetherm.solvers.p1.
 Simplices.find_order_beside`) from this many nodes (below, it takes under 0.1 s), where the plan
@@ -55,41 +57,6 @@ def region_fields(problem: Problem, mesh) -> dict[str, Field]:
     if not problem.thermal:  # no thermal strain
         out["alpha"] = Field(np.zeros(mesh.nelements))
     return out
-
-
-def boundary_mean(mesh, basis: CellBasis, name: str, thickness: Field) -> np.ndarray:
-    """Weights giving the area-mean of a nodal field over a named boundary."""
-    a = boundary_terms(mesh, name, basis.elem, 2 * basis.elem.maxdeg, thickness)[1]
-    return a / a.sum()
-
-
-@dataclass(frozen=True)
-class Readout:
-    """``y = L @ U + W @ (U_solid − T_ref) + R @ loads(env)``: the outputs :attr:`keys` of a
-    heat state and the mechanical loads' values (:class:`~gatetherm.solvers.loads.Terms`)."""
-
-    keys: tuple[Key, ...]
-    L: sp.csr_matrix
-    """Rows on the whole state (temperatures, °C)."""
-    weights: Pending
-    """:attr:`W`, solved beside the caller where the elastic solver runs in a helper process."""
-    n_L: int
-    """The first ``n_L`` keys are rows of ``L``, the rest rows of ``W``."""
-    R: np.ndarray | None = None
-    """Rows of ``W``'s outputs on the mechanical loads' values (None: no loads)."""
-    terms: Terms | None = None
-
-    @property
-    def W(self) -> np.ndarray:
-        """Rows on the solid's temperature rise (displacements in m, stresses in Pa)."""
-        return self.weights.result()
-
-    def __call__(self, U: np.ndarray, n_solid: int, T_ref: float, env=None) -> np.ndarray:
-        y = self.L @ U
-        if len(self.keys) == self.n_L:
-            return y
-        mech = self.R @ self.terms.at(env or {}) if self.R is not None else 0.0
-        return np.concatenate([y, self.W @ (U[:n_solid] - T_ref) + mech])
 
 
 @dataclass(frozen=True)
@@ -202,71 +169,9 @@ class Model:
         return out
 
 
-def static_displacement(model: Model, env=None, loads: bool = True) -> np.ndarray:
-    """The displacement (m) of a problem without a heat solve for the inputs ``env`` (only
-    the prescribed temperature's if not ``loads``)."""
-    p, el = model.problem, model.elastic
-    u = el.from_load(_prescribed_load(model)) if p.thermal else np.zeros(el.basis.N)
-    return u + model.loads_displacement(env) if loads else u
-
-
-def static_fields(model: Model, env=None) -> dict[str, np.ndarray]:
-    """Nodal temperature (°C, interpolated at the nodes; none without a temperature),
-    displacement (m, 3 components) and stress (Pa) of a problem without a heat solve."""
-    X = model.fmesh.points.T
-    out = {"T": prescribed_at(model, X)} if model.problem.thermal else {}
-    if model.elastic is not None:
-        u_dofs = static_displacement(model, env)
-        u = np.zeros((X.shape[1], 3))
-        u[:, :model.dim] = u_dofs[model.elastic.basis.nodal_dofs].T
-        out["u"] = u
-        out.update({f"sigma_{k}" if k != "von_mises" else k: v for k, v in model.stress_field(u_dofs).items()})
-    return out
-
-
-def prescribed_at(model: Model, X: np.ndarray) -> np.ndarray:
-    """The prescribed temperature (°C) at points ``X`` (dim, n)."""
-    p = model.problem
-    if p.prescribed is not None:
-        return np.broadcast_to(p.prescribed(dict(zip("xyz", X))), X.shape[1:]).astype(float)
-    cells = model.mesh.element_finder()(*X)
-    regions = {int(e): r for r, els in model.mesh.subdomains.items() for e in els}
-    return np.array([p.prescribed_regions.get(regions.get(int(c)), 0.0) for c in cells])
-
-
-def _prescribed_rise(model: Model):
-    """``basis -> prescribed rise above T_ref`` at the basis's quadrature points."""
-    p = model.problem
-
-    def at(basis):
-        if p.prescribed is not None:
-            X = basis.global_coordinates().value
-            return np.broadcast_to(p.prescribed(dict(zip("xyz", X))), X.shape[1:]) - p.T_ref
-        per = Field.by_region(model.mesh, p.prescribed_regions, np.nan)
-        return per.at(basis) - p.T_ref
-    return at
-
-
-def _prescribed_load(model: Model) -> np.ndarray:
-    from gatetherm.solvers import axisym
-
-    el, f, p = model.elastic, model.fields, model.problem
-    vb = CellBasis(model.mesh, el.basis.elem, intorder=2 * p.order + p.axisymmetric)
-    b = moduli(f["E"].values, f["nu"].values, f["alpha"].values, model.dim, p.plane)[2]
-    return asm(axisym.thermal_load_at if p.axisymmetric else thermal_load_at, vb, b=Field(b).at(vb),
-               t=f["thickness"].at(vb), T=_prescribed_rise(model)(vb))
-
-
 def _recovery_for(model: Model, elements) -> Recovery:
-    T_at = None if model.heat is not None else _prescribed_rise(model)
-    return _recovery(model.problem, model.mesh, model.fields, model.simplices, elements, T_at)
-
-
-def _recovery(p: Problem, mesh, fields, simplices, elements, T_at=None) -> Recovery:
-    """The stress projection over ``elements`` (None: all) of a problem's mesh; the temperature
-    on the heat basis where there is a heat solve, else ``T_at``."""
-    T_elem = element(p.dim, p.order) if p.heat else None
-    return recovery(mesh, p.order, fields, p.dim, p.plane, T_elem, elements, T_at, simplices)
+    T_at = None if model.heat is not None else prescribed_rise(model)
+    return recovery_over(model.problem, model.mesh, model.fields, model.simplices, elements, T_at)
 
 
 def _probe_recovery(model: Model, region: str | None) -> Recovery:
@@ -276,76 +181,6 @@ def _probe_recovery(model: Model, region: str | None) -> Recovery:
 def field_recovery(model: Model) -> Recovery:
     """The stress projection over the whole mesh (set up once, used for every field state)."""
     return _recovery_for(model, None)
-
-
-@dataclass(frozen=True)
-class _Rows:
-    """The outputs of a displacement field: their keys, rows ``G`` on the displacement and
-    rows ``GT`` (or None) on the temperature rise (a stress's thermal part)."""
-
-    keys: list
-    G: list
-    GT: list
-
-
-def _mechanical_rows(problem: Problem, mesh, fields, el: ElasticSystem, simplices) -> _Rows:
-    """The relative displacements, displacements and stresses at probes, as rows."""
-    keys, G, GT, recoveries = [], [], [], {}
-    xyz = {pr.name: pr.xyz for pr in problem.probes}
-    for r in problem.relative:
-        keys.append(("relative", r.name))
-        G.append(el.point_functional(xyz[r.a], r.axis) - el.point_functional(xyz[r.b], r.axis))
-        GT.append(None)
-    for pr in problem.probes:
-        if "u" in pr.quantities:
-            for c in range(problem.dim):
-                keys.append(("u", pr.name, AXES[c]))
-                G.append(el.point_functional(pr.xyz, c))
-                GT.append(None)
-        if "sigma" in pr.quantities:
-            if pr.region not in recoveries:
-                recoveries[pr.region] = _recovery(problem, mesh, fields, simplices,
-                                                  None if pr.region is None else mesh.subdomains[pr.region])
-            for c, (gu, gT) in recoveries[pr.region].point(pr.xyz).items():
-                keys.append(("sigma", pr.name, c))
-                G.append(gu)
-                GT.append(gT)
-    return _Rows(keys, G, GT)
-
-
-def _weights(el: ElasticSystem, mech: _Rows, n_T: int) -> Pending:
-    """The rows of :attr:`Readout.W`, from one adjoint solve of all outputs (beside the caller
-    where the elastic solver runs in a helper)."""
-    if not mech.G:
-        return Pending.of(np.zeros((0, n_T)))
-
-    def add_thermal(W):
-        for i, gT in enumerate(mech.GT):
-            if gT is not None:
-                W[i] += gT
-        return W
-    return el.weights_later(np.array(mech.G)).then(add_thermal)
-
-
-def _readout(model: Model, mech: _Rows, weights: Pending) -> Readout:
-    """Sparse rows (temperatures) and the adjoint weight rows ``weights`` (mechanics) of every output."""
-    p, heat = model.problem, model.heat
-    keys, rows = [], []
-    probes = [pr for pr in p.probes if "T" in pr.quantities]
-    if probes:
-        P = p1.probes(heat.basis, np.array([pr.xyz for pr in probes]).T)
-        keys += [("T", pr.name) for pr in probes]
-        rows.append(sp.hstack([P, sp.csr_matrix((len(probes), heat.n - heat.n_solid))]))
-    for name, index in heat.lumped.items():
-        keys.append(("fluid", name))
-        rows.append(sp.csr_matrix(([1.0], ([0], [index])), shape=(1, heat.n)))
-    for name, boundary in p.means:
-        keys.append(("mean", name))
-        w = boundary_mean(model.mesh, heat.basis, boundary, model.fields["thickness"])
-        rows.append(sp.csr_matrix(np.r_[w, np.zeros(heat.n - heat.n_solid)][None, :]))
-    L = sp.vstack(rows).tocsr() if rows else sp.csr_matrix((0, heat.n))
-    R = np.array(mech.G) @ model.unit if mech.G and model.terms is not None else None
-    return Readout(tuple(keys + mech.keys), L, weights, len(keys), R, model.terms)
 
 
 def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float = 0.0) -> Model:
@@ -370,24 +205,25 @@ def build(problem: Problem, fmesh: FrameMesh, config=None, mesh_seconds: float =
             s.pattern.n, s.pattern.nnz, 1, problem.dim, ORDER_BESIDE["steps"], warm=True).path == "direct":
         s.find_order_beside()
     axi = problem.axisymmetric
-    el, terms, unit, mech, weights = None, None, None, _Rows([], [], []), None
+    el, terms, unit, mech, weights = None, None, None, Rows([], [], []), None
     if problem.elastic:
         T_basis = dof_basis(mesh, element(problem.dim, problem.order))  # the heat basis's DOFs
         el = assemble_elastic(mesh, problem.order, T_basis, f["E"], f["nu"], f["alpha"], f["thickness"],
                               problem.supports, problem.plane, simplices=s, lines=fmesh.lines,
                               contacts=problem.contacts)
         if problem.heat:  # the read-out's solver set up now, in a helper where it can be
-            mech = _mechanical_rows(problem, mesh, f, el, s)
+            mech = mechanical_rows(problem, mesh, f, el, s)
             el.solve.start(max(1, len(mech.G)))
         terms = mechanical_terms(problem, mesh, el.basis, f, fmesh.sensors, lambda sup, c: support_dofs(
             el.basis, mesh, sup.boundary, (c,), fmesh.lines))
         unit = unit_responses(el, terms) if terms is not None else None
-        weights = _weights(el, mech, T_basis.N) if problem.heat else None
+        weights = adjoint_weights(el, mech, T_basis.N) if problem.heat else None
     lap("elastic_setup")
     heat = assemble_heat(mesh, problem, f, 2 * problem.order + 1 if axi else None, s) if problem.heat else None
     lap("heat_assembly")
     model = Model(problem, fmesh, mesh, f, heat, el, None, config, timings, s, terms, unit)
     if heat is not None:
-        model = dataclasses.replace(model, readout=_readout(model, mech, weights or _weights(el, mech, heat.n_solid)))
+        weights = weights or adjoint_weights(el, mech, heat.n_solid)
+        model = dataclasses.replace(model, readout=build_readout(model, mech, weights))
     lap("adjoint_solves")
     return model

@@ -5,205 +5,26 @@ thermoelasticity with body force, prescribed temperature and a traction face)
 give spatial errors on refined meshes; patch cases are exact; an exact modal
 solution of the semi-discrete heat system, a 1-D slab's Fourier series and the
 frame's energy accounts check the time stepping (:mod:`validation.verification_time`).
-Nothing here plots or writes files.
+Nothing here plots or writes files. The manufactured solutions are
+:mod:`gatetherm.validation.verification_mms`, the shared pieces
+:mod:`gatetherm.validation.verification_common` (their names importable from here too); the
+exact elastic cases are here.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.sparse.linalg import spsolve
-from skfem import (CellBasis, ElementVector, FacetBasis, Functional, LinearForm, Mesh, MeshTet,
-                   MeshTri, asm, condense)
-from skfem.helpers import dot
+from skfem import CellBasis, ElementVector, FacetBasis, Mesh, MeshTet, MeshTri, asm
 
 from gatetherm.solvers.elasticity import assemble_elastic, moduli, stiffness, thermal_load
 from gatetherm.solvers.problem import Support
-from gatetherm.solvers.fem import Field, element
-from gatetherm.solvers.heat import capacity, conduction, film, film_load
-
-_EDGE = 1e-9
-"""Relative coordinate tolerance for picking mesh sides, 1."""
-
-
-# --- shared helpers ---------------------------------------------------------------------------
-
-def observed_order(h, err) -> float:
-    """Least-squares slope of log(err) against log(h) (or log(dt))."""
-    return float(np.polyfit(np.log(np.asarray(h, float)), np.log(np.asarray(err, float)), 1)[0])
-
-
-def uniform_fields(mesh: Mesh, *values: float) -> list[Field]:
-    """Uniform element-wise coefficient fields."""
-    return [Field(np.full(mesh.nelements, float(v))) for v in values]
-
-
-def rectangle(xs, ys, sides: dict[str, str]) -> MeshTri:
-    """Tensor triangle mesh on ``xs × ys`` (m) whose sides ``left``/``right``/
-    ``bottom``/``top`` become the boundaries named in ``sides`` (side → name)."""
-    m = MeshTri.init_tensor(np.asarray(xs, float), np.asarray(ys, float))
-    (x0, x1), (y0, y1) = (xs[0], xs[-1]), (ys[0], ys[-1])
-    tol = _EDGE * max(x1 - x0, y1 - y0)
-    test = {"left": lambda p: abs(p[0] - x0) < tol, "right": lambda p: abs(p[0] - x1) < tol,
-            "bottom": lambda p: abs(p[1] - y0) < tol, "top": lambda p: abs(p[1] - y1) < tol}
-    out: dict[str, np.ndarray] = {}
-    for side, name in sides.items():
-        f = m.facets_satisfying(test[side], boundaries_only=True)
-        out[name] = np.union1d(out.get(name, np.zeros(0, dtype=np.int64)), f)
-    return m.with_boundaries(out)
-
-
-def _l2(basis: CellBasis, U: np.ndarray, exact: Callable) -> float:
-    """L2 norm of (the FE field of U) − exact, scalar or vector."""
-    def sq(w):
-        d = (w.uh - exact(w.x)) ** 2
-        return d if d.ndim == 2 else d.sum(axis=0)
-    return float(np.sqrt(Functional(sq).assemble(basis, uh=basis.interpolate(U))))
-
-
-def _solve_fixed(K, rhs, D: np.ndarray, U: np.ndarray | None = None) -> np.ndarray:
-    """Solve ``K U = rhs`` with the DOFs ``D`` held at ``U[D]`` (zero without ``U``).
-    Sparse LU with SciPy's default COLAMD ordering: on these regular meshes SuperLU's
-    MMD_AT_PLUS_A ordering is ~40 times slower."""
-    A, b, U, free = condense(K, rhs, x=np.zeros(len(rhs)) if U is None else U, D=D)
-    U[free] = spsolve(A.tocsc(), b)
-    return U
-
-
-def dofs_where(basis: CellBasis, where: Callable, components) -> np.ndarray:
-    """Vector-basis DOFs of the ``components`` whose locations satisfy ``where(x)``."""
-    idx = basis.split_indices()
-    return np.concatenate([idx[c][where(basis.doflocs[:, idx[c]])] for c in components])
-
-
-# --- manufactured solutions -------------------------------------------------------------------
-
-@dataclass(frozen=True)
-class CosProduct:
-    """Manufactured field ``amp · Π_j cos(k_j x_j + p_j)``; ``x`` is (dim, ...)."""
-
-    amp: float
-    k: tuple[float, ...]
-    p: tuple[float, ...]
-
-    def _d(self, x, diff: tuple[int, ...]):
-        """The derivative ∂^diff of the field (``diff`` lists the axes)."""
-        out = self.amp
-        for j, (kj, pj) in enumerate(zip(self.k, self.p)):
-            a = kj * x[j] + pj
-            out = out * (np.cos(a), -kj * np.sin(a), -kj ** 2 * np.cos(a))[diff.count(j)]
-        return out
-
-    def value(self, x):
-        return self._d(x, ())
-
-    def grad(self, x):
-        return np.array([self._d(x, (m,)) for m in range(len(self.k))])
-
-    def laplacian(self, x):
-        return sum(self._d(x, (m, m)) for m in range(len(self.k)))
-
-    def hessian(self, x):
-        n = len(self.k)
-        return np.array([[self._d(x, (a, b)) for b in range(n)] for a in range(n)])
-
-
-# One field per dimension: no symmetry, in no FE space; displacements in m, temperatures in K.
-HEAT_U = {2: CosProduct(1.0, (1.3 * np.pi, 0.9 * np.pi), (0.2, -0.4)),
-          3: CosProduct(1.0, (1.1 * np.pi, 0.8 * np.pi, 0.7 * np.pi), (0.2, -0.4, 0.3))}
-ELASTIC_U = {2: (CosProduct(1e-4, (1.2 * np.pi, 0.7 * np.pi), (0.3, 0.1)),
-                 CosProduct(-6e-5, (0.8 * np.pi, 1.1 * np.pi), (-0.2, 0.5))),
-             3: (CosProduct(1e-4, (1.2 * np.pi, 0.7 * np.pi, 0.6 * np.pi), (0.3, 0.1, -0.2)),
-                 CosProduct(-6e-5, (0.8 * np.pi, 1.1 * np.pi, 0.5 * np.pi), (-0.2, 0.5, 0.1)),
-                 CosProduct(8e-5, (0.6 * np.pi, 0.9 * np.pi, 1.2 * np.pi), (0.4, -0.3, 0.2)))}
-ELASTIC_T = {2: CosProduct(12.0, (0.9 * np.pi, 1.3 * np.pi), (0.1, 0.6)),
-             3: CosProduct(12.0, (0.9 * np.pi, 1.3 * np.pi, 0.8 * np.pi), (0.1, 0.6, -0.3))}
-
-
-def heat_mms_error(mesh: Mesh, order: int, rc: float = 2.0, h: float = 3.0) -> float:
-    """L2 error of the steady problem ``rc u − ∇·(k ∇u) = q`` on ``mesh`` (all
-    boundaries ``k ∂u/∂n + h (u − g) = 0``), ``k = 1 + x/2``, exact ``HEAT_U``,
-    assembled from the module forms of :mod:`solvers.heat`.
-
-    The reaction term ``rc u`` is what a backward-Euler step adds; ``q`` and
-    ``g`` follow from the exact field by hand:
-    ``q = rc u − k Δu − (∂k/∂x) ∂u/∂x`` and ``g = u + k ∇u·n / h``.
-    """
-    u = HEAT_U[mesh.dim()]
-    e, q = element(mesh.dim(), order), 2 * order + 2
-    cb, fb = CellBasis(mesh, e, intorder=q), FacetBasis(mesh, e, intorder=q)
-    x, xf, n = (np.asarray(v) for v in (cb.global_coordinates(), fb.global_coordinates(), fb.normals))
-    k, kf = 1.0 + 0.5 * x[0], 1.0 + 0.5 * xf[0]
-    src = rc * u.value(x) - k * u.laplacian(x) - 0.5 * u.grad(x)[0]
-    g = u.value(xf) + kf * np.sum(u.grad(xf) * n, axis=0) / h
-    A = asm(conduction, cb, k=k, t=1.0) + asm(capacity, cb, rc=rc, t=1.0) + asm(film, fb, h=h, t=1.0)
-    b = asm(film_load, cb, h=src, t=1.0) + asm(film_load, fb, h=h * g, t=1.0)
-    return _l2(cb, spsolve(A.tocsc(), b), u.value)
-
-
-@LinearForm
-def vector_load(v, w):
-    """Body force or traction ``w.f`` (a vector at the quadrature points)."""
-    return dot(w.f, v)
-
-
-def _sigma(G: np.ndarray, T: np.ndarray, lam, mu, b) -> np.ndarray:
-    """σ = λ tr(ε) I + 2μ ε − b T I from the displacement gradient ``G`` (dim, dim, ...)."""
-    I = np.eye(len(G)).reshape(len(G), len(G), *([1] * (G.ndim - 2)))
-    return (lam * np.trace(G) - b * T) * I + mu * (G + np.swapaxes(G, 0, 1))
-
-
-def elastic_mms_error(mesh: Mesh, order: int, E=1.2e11, nu=0.26, alpha=1.05e-5) -> float:
-    """L2 displacement error (m) of thermoelasticity on the unit square/cube with the
-    exact ``ELASTIC_U`` and temperature rise ``ELASTIC_T`` (on the P``order``
-    temperature space), held at the exact values except on the traction face x = 1;
-    module forms ``stiffness`` and ``thermal_load``, plane stress in 2-D.
-
-    By hand, with ``b`` the thermal stress modulus,
-    ``f = −(λ + μ) ∇(∇·u) − μ Δu + b ∇T`` and on x = 1 the traction ``σ n`` with
-    ``σ = λ (∇·u) I + 2μ ε(u) − b T I``.
-    """
-    dim = mesh.dim()
-    lam, mu, b = moduli(E, nu, alpha, dim)
-    us, T = ELASTIC_U[dim], ELASTIC_T[dim]
-    q = 2 * order + 2
-    vb = CellBasis(mesh, ElementVector(element(dim, order)), intorder=q)
-    tb = CellBasis(mesh, element(dim, order), quadrature=vb.quadrature)
-    x = np.asarray(vb.global_coordinates())
-    H = np.array([c.hessian(x) for c in us])                       # H[i, l, m] = ∂l ∂m u_i
-    f = -(lam + mu) * np.einsum("mim...->i...", H) - mu * np.einsum("imm...->i...", H) \
-        + b * T.grad(x)
-    face = mesh.facets_satisfying(lambda p: p[0] > 1 - _EDGE, boundaries_only=True)
-    fb = FacetBasis(mesh, vb.elem, facets=face, intorder=q)
-    xf = np.asarray(fb.global_coordinates())
-    sig = _sigma(np.array([c.grad(xf) for c in us]), T.value(xf), lam, mu, b)
-    traction = np.einsum("ij...,j...->i...", sig, np.asarray(fb.normals))
-    rhs = asm(vector_load, vb, f=f) + asm(vector_load, fb, f=traction) \
-        + asm(thermal_load, tb, vb, b=b, t=1.0) @ T.value(tb.doflocs)
-    U = np.zeros(vb.N)
-    for c, idx in enumerate(vb.split_indices()):      # nodal interpolant: boundary values
-        U[idx] = us[c].value(vb.doflocs[:, idx])
-    clamp = vb.get_dofs(np.setdiff1d(mesh.boundary_facets(), face)).all()
-    U = _solve_fixed(asm(stiffness, vb, lam=lam, mu=mu, t=1.0), rhs, clamp, U)
-    return _l2(vb, U, lambda p: np.array([c.value(p) for c in us]))
-
-
-def unit_mesh(dim: int, n: int) -> Mesh:
-    """Unit square ``MeshTri().refined(n)`` (h = 2⁻ⁿ) or unit cube of n³ cubes of six
-    tetrahedra (h = 1/n)."""
-    if dim == 2:
-        return MeshTri().refined(n)
-    s = np.linspace(0.0, 1.0, n + 1)
-    return MeshTet.init_tensor(s, s, s)
-
-
-def spatial_study(error: Callable[[Mesh, int], float], dim: int, order: int, levels):
-    """(h, L2 errors, observed order) of ``error(mesh, order)`` over ``unit_mesh(dim, n)``
-    for n in ``levels``; ``error`` is :func:`heat_mms_error` or :func:`elastic_mms_error`."""
-    h = np.array([2.0 ** -n if dim == 2 else 1.0 / n for n in levels])
-    err = np.array([error(unit_mesh(dim, n), order) for n in levels])
-    return h, err, observed_order(h, err)
+from gatetherm.solvers.fem import element
+from gatetherm.validation.verification_common import (  # noqa: F401 (re-exported)
+    _l2, _sigma, _solve_fixed, dofs_where, observed_order, rectangle, uniform_fields, vector_load)
+from gatetherm.validation.verification_mms import (  # noqa: F401 (re-exported)
+    ELASTIC_T, ELASTIC_U, HEAT_U, SPATIAL_ELASTIC, SPATIAL_HEAT, CosProduct, elastic_mms_error, heat_mms_error,
+    spatial_study, unit_mesh)
 
 
 # --- exact elastic cases ----------------------------------------------------------------------
@@ -234,12 +55,6 @@ def thermoelastic_solve(mesh: Mesh, order: int, T_order: int, T_fun: Callable,
 
 BLOCK = (0.3, 0.1, 0.05)
 """Length, height and depth of the test block of the exact cases, m."""
-SPATIAL_HEAT = {"2-D P1": (2, 1, (3, 4, 5, 6, 7)), "2-D P2": (2, 2, (2, 3, 4, 5, 6)),
-                "3-D P1": (3, 1, (6, 8, 12, 16, 24)), "3-D P2": (3, 2, (3, 4, 6, 8, 12))}
-"""Heat MMS: label -> (dimension, element order, refinement levels of :func:`unit_mesh`)."""
-SPATIAL_ELASTIC = {"2-D P1": (2, 1, (3, 4, 5, 6, 7)), "2-D P2": (2, 2, (2, 3, 4, 5, 6)),
-                   "3-D P1": (3, 1, (6, 8, 12, 16, 20)), "3-D P2": (3, 2, (2, 3, 4, 6, 8))}
-"""Thermoelastic MMS (plane stress in 2-D): label -> (dimension, order, levels)."""
 
 
 def block(dim: int, n: int = 6) -> Mesh:

@@ -33,105 +33,21 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
 
 from gatetherm import InputError
 from gatetherm.studies.errormodel import select
+from gatetherm.studies.errormodel.fitparams import (  # noqa: F401 (re-exported)
+    CV_KINDS, FIT_FORMS, SPAN_RESOLUTIONS, FitParams)
 from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, check_leakage, residual_stats
 from gatetherm.studies.errormodel.paper import fit_paper_form
 from gatetherm.studies.errormodel.runs import Runs
-from gatetherm.studies.errormodel.terms import Term, noise_sd
+from gatetherm.studies.errormodel.terms import Term
 from gatetherm.studies.errormodel.trust import calibrate, term_ranges
+from gatetherm.studies.errormodel.tune import held_out, refine, variances
 
 log = logging.getLogger(__name__)
-
-FIT_FORMS = ("auto", "static", "dynamic", "paper")
-CV_KINDS = ("blocked", "chain")
-SQRT2 = float(np.sqrt(2.0))
-#: A temperature term spanning fewer resolutions than this in the fitting span is not offered.
-SPAN_RESOLUTIONS = 10
-
-
-@dataclass(frozen=True)
-class FitParams:
-    """Settings of :func:`fit_error_model`."""
-
-    max_sensors: int = 4
-    """Most temperature columns one target's model may read."""
-    max_inputs: int = 2
-    """Most operating-input terms in one target's model."""
-    exponents: tuple[float, ...] = (1.0, 2.0)
-    """Exponents p of the input terms (|u|/u_max)^p tried, dimensionless."""
-    input_taus_s: tuple[float, ...] = (60.0, 120.0, 240.0, 480.0, 960.0, 1920.0, 3840.0)
-    """Time constants of the input lags tried, s (the fast part; slow heating is what the temperatures see)."""
-    sensor_taus_s: tuple[float, ...] = ()
-    """Time constants of lagged temperature rises tried, s; empty = none."""
-    differences: bool = False
-    """Also offer every difference theta_a - theta_b as one regressor (two sensors, one coefficient)."""
-    folds: tuple[int, ...] = (4, 5, 6, 7, 8)
-    """Block counts of the blocked cross-validation; its error is averaged over them."""
-    min_gain: float = 0.03
-    """Relative drop of the held-out error a further term must bring, dimensionless."""
-    form: str = "auto"
-    """``auto``, ``static``, ``dynamic`` or ``paper`` (module docstring)."""
-    refine: bool = True
-    """Refine the selected time constants continuously and drop terms that do not earn ``min_gain``."""
-    resolution_K: float = 0.05
-    """Resolution of the temperature sensors, K, also taken as the standard deviation of their noise
-    (a thermocouple's 0.05 K): a term spanning less than :data:`SPAN_RESOLUTIONS` times this in the
-    fitting span is not offered, and the coefficients are fitted for readings with this noise
-    (module docstring); 0 = exact, noise-free readings."""
-    max_gap_s: float = 300.0
-    """Longest gap in a used column that is bridged by linear interpolation, s; rows in longer gaps
-    are left out of the fit and not predicted."""
-    cv: str = "blocked"
-    """Held-out error within a run: ``blocked`` (every block predicted by the fit on the others) or
-    ``chain`` (forward chaining: the latest blocks, each predicted by the fit on the rows before it).
-    Three or more runs are always held out one run at a time."""
-    noisy_cv: bool = False
-    """Score every candidate by its expected held-out error on readings carrying the sensors' noise
-    (``resolution_K``): a term whose noise costs more than it explains is not chosen."""
-    smooth_s: float = 0.0
-    """Time constant of a first-order lag every temperature reading passes before it enters a term,
-    in the fit as in ``predict``, s: white noise of the readings reduced to ``sqrt((1 - a) / (1 + a))``
-    of it (``a = exp(-h / smooth_s)``, h the sample step), which the coefficients' noise rule then
-    counts; 0 = the readings as they are."""
-    smooth_grid_s: tuple[float, ...] = ()
-    """Further values of ``smooth_s`` to try, s: the model is fitted with each (and ``smooth_s``) and
-    the one of the lowest held-out error, summed over the targets, is kept (``settings``:
-    ``smooth_held_out_um``, the sum for each value); empty = ``smooth_s`` only."""
-    anchor_s: float = 0.0
-    """Each run's (and each predicted file's) first reading of a temperature column is replaced by the
-    value there of the straight line through its readings of the first ``anchor_s`` seconds, s: with
-    several runs every term is taken from that reading, and one noisy sample would offset the whole
-    run; the noise rule then counts the reference's noise too. 0 = the first reading as it is."""
-    drift: bool = False
-    """With several runs, also offer a slow drift, the hours since each run's start (kept only where
-    it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with
-    the heating it should explain, and is not offered."""
-
-    def __post_init__(self):
-        if self.form not in FIT_FORMS:
-            raise InputError("form", f"{self.form!r} is not one of {', '.join(FIT_FORMS)}", "e.g. form auto")
-        if self.max_sensors < 1 or self.max_inputs < 0:
-            raise InputError("max_sensors", "must be >= 1 (and max_inputs >= 0)", "e.g. 4")
-        if not self.folds or min(self.folds) < 2:
-            raise InputError("folds", "need block counts >= 2", "e.g. (4, 5, 6, 7, 8)")
-        bad = [v for v in (*self.exponents, *self.input_taus_s, *self.sensor_taus_s, self.max_gap_s)
-               if not (np.isfinite(v) and v > 0)]
-        if bad:
-            raise InputError("exponents, time constants, max_gap_s", f"{bad[0]} is not > 0", "use positive values")
-        if not (np.isfinite(self.resolution_K) and self.resolution_K >= 0):
-            raise InputError("resolution_K", f"{self.resolution_K} is not >= 0", "e.g. 0.05 (K, a thermocouple)")
-        if self.cv not in CV_KINDS:
-            raise InputError("cv", f"{self.cv!r} is not one of {', '.join(CV_KINDS)}", "e.g. cv chain")
-        if not all(np.isfinite(v) and v >= 0 for v in (self.smooth_s, self.anchor_s, *self.smooth_grid_s)):
-            raise InputError("smooth_s, anchor_s", "must be >= 0", "e.g. 300 (s), 0 = off")
-        if not 0 <= self.min_gain < 1:
-            raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
 
 
 def fraction_span(t_s: np.ndarray, lo: float, hi: float) -> tuple[float, float]:
@@ -246,19 +162,6 @@ def _base_terms(candidates, inputs, data: Runs, params: FitParams) -> list[Term]
     return base
 
 
-def _variances(terms, data: Runs, params: FitParams) -> np.ndarray:
-    """Noise variance of the intercept (0) and of each term's values (K^2; 0 for inputs); with
-    ``anchor_s`` and several runs also the noise of each run's reference (``2 (2m - 1) / (m (m + 1))``
-    of a reading's, m the samples of the first ``anchor_s``)."""
-    step = data.step_s
-    var = [noise_sd(term, params.resolution_K, step, params.smooth_s) ** 2 for term in terms]
-    if params.anchor_s > 0 and data.anchored:
-        m = int(params.anchor_s // step) + 1
-        share = 2 * (2 * m - 1) / (m * (m + 1))  # 1 for m = 1, 2
-        var = [v + share * noise_sd(dataclasses.replace(term, tau_s=None), params.resolution_K, step) ** 2
-               for v, term in zip(var, terms)]
-    return np.array([0.0] + var)
-
 
 def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[list, list[select.Candidate]]:
     """Terms offered to the forward selection and their combination vectors (column 0 = ones);
@@ -284,12 +187,6 @@ def _candidates(base: list[Term], B, params: FitParams, dynamic: bool) -> tuple[
     return terms, cands
 
 
-def _cv(X, y, data: Runs, rows, params: FitParams, penalty) -> select.CrossValidation:
-    """Leave one run out with three or more runs, else ``params.cv`` within the rows."""
-    blocks = data.blocks(rows)
-    return select.CrossValidation(X, y, params.folds, blocks=blocks, penalty=penalty,
-                                  chain=blocks is None and params.cv == "chain", noisy=params.noisy_cv)
-
 
 def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetModel:
     y_all = np.asarray(y_all, float)
@@ -297,7 +194,7 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
     if rows.sum() < 4 * max(params.folds):
         raise InputError(f"target {name}", f"only {rows.sum()} valid samples in the fitting span",
                          f"give at least {4 * max(params.folds)}")
-    cv = _cv(B[rows], y_all[rows], data, rows, params, _variances(base, data, params))
+    cv = held_out(B[rows], y_all[rows], data, rows, params, variances(base, data, params))
     if params.form == "paper":
         return fit_paper_form(cv, name, base, B, y_all, rows, SPAN_RESOLUTIONS * params.resolution_K)
     forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
@@ -310,7 +207,7 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
         terms, cands = _candidates(base, B[rows], params, form == "dynamic")
         path = select.forward(cv, cands, intercept, params.max_sensors, params.max_inputs)
         pick = select.choose(path, params.min_gain)
-        fits[form] = _refine([terms[k] for k in pick.chosen], pick.cv_mae, data, y_all, rows, params) \
+        fits[form] = refine([terms[k] for k in pick.chosen], pick.cv_mae, data, y_all, rows, params) \
             if params.refine else ([terms[k] for k in pick.chosen], pick.cv_mae)
         selection += [{"form": form, "terms": [terms[k].label for k in s.chosen], "sensors": s.sensors,
                        "cv_mae_um": s.cv_mae} for s in path]
@@ -319,72 +216,11 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
         else "static"
     terms, cv_mae = fits[form]
     X = np.column_stack([np.ones(data.time.size)] + [data.column(term) for term in terms])
-    var = _variances(terms, data, params)
+    var = variances(terms, data, params)
     c = select.noisy_least_squares(X[rows], y_all[rows], var)
-    final = _cv(X[rows], y_all[rows], data, rows, params, var)
+    final = held_out(X[rows], y_all[rows], data, rows, params, var)
     interval = calibrate(final.residuals(np.eye(X.shape[1])), final.blocks,
                          chain=params.cv == "chain" and data.blocks(rows) is None)
     return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
                        residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection),
                        float(np.sqrt(var @ c**2)), interval, term_ranges(X[rows, 1:]))
-
-
-def _tuned(terms, data: Runs, y_all, rows, params: FitParams):
-    """The terms with their lag time constants refined by least squares on the span (each within the
-    grid's range widened by sqrt(2)) and their held-out error; inf if two lags of one signal end up
-    within a factor sqrt(2) of each other (one of them is redundant)."""
-    lagged = [j for j, term in enumerate(terms) if term.tau_s is not None]
-    fixed = [data.column(term)[rows] for term in terms]
-    y = y_all[rows]
-
-    def design(log_tau):
-        cs = list(fixed)
-        for j, lt in zip(lagged, log_tau):
-            cs[j] = data.column(dataclasses.replace(terms[j], tau_s=float(np.exp(lt))))[rows]
-        return np.column_stack([np.ones(y.size)] + cs)
-
-    def sse(log_tau):
-        X = design(log_tau)
-        now = list(terms)
-        for j, lt in zip(lagged, log_tau):
-            now[j] = dataclasses.replace(terms[j], tau_s=float(np.exp(lt)))
-        v = _variances(now, data, params)
-        c = select.noisy_least_squares(X, y, v)
-        r = X @ c - y
-        return float(r @ r + y.size * (v @ c**2))
-
-    out = list(terms)
-    if lagged:
-        grid = {j: params.input_taus_s if terms[j].kind == "input" else params.sensor_taus_s for j in lagged}
-        bounds = [(np.log(min(grid[j]) / SQRT2), np.log(max(grid[j]) * SQRT2)) for j in lagged]
-        res = minimize(sse, np.log([terms[j].tau_s for j in lagged]), method="L-BFGS-B", bounds=bounds)
-        for j, lt in zip(lagged, res.x):
-            out[j] = dataclasses.replace(terms[j], tau_s=float(np.exp(lt)))
-        if any(a.columns == b.columns and a.kind == b.kind and a.exponent == b.exponent
-               and max(a.tau_s, b.tau_s) < SQRT2 * min(a.tau_s, b.tau_s)
-               for i, a in enumerate(out) for b in out[i + 1:] if a.tau_s and b.tau_s):
-            return out, np.inf
-    X = np.column_stack([np.ones(y.size)] + [data.column(term)[rows] for term in out])
-    cv = _cv(X, y, data, rows, params, _variances(out, data, params))
-    return out, cv.error(np.eye(X.shape[1]))
-
-
-def _refine(terms, cv_mae, data: Runs, y_all, rows, params: FitParams):
-    """Refine the selected terms' time constants (:func:`_tuned`), then drop, one at a time, any
-    term whose removal (time constants refined again) raises the held-out error by less than
-    ``min_gain``: two grid lags that bracket one true time constant become one. Returns the terms
-    and their held-out error; the grid's (``terms``, ``cv_mae``) if refining does not lower it."""
-    best, best_cv = terms, cv_mae
-    tuned, tuned_cv = _tuned(terms, data, y_all, rows, params)
-    if tuned_cv <= best_cv:
-        best, best_cv = tuned, tuned_cv
-    dropped = True
-    while dropped and len(best) > 1:
-        dropped = False
-        for j in reversed(range(len(best))):
-            fewer, fewer_cv = _tuned(best[:j] + best[j + 1:], data, y_all, rows, params)
-            if fewer_cv < best_cv * (1 + params.min_gain):
-                log.info("%s dropped: held-out error %.4g without it, %.4g with", best[j].label, fewer_cv, best_cv)
-                best, best_cv, dropped = fewer, min(fewer_cv, best_cv), True
-                break
-    return best, best_cv

@@ -1,211 +1,27 @@
-"""A fitted thermal-error model, its ``model.json`` and its evaluation.
+"""A fitted thermal-error model's file, ``model.json`` (:func:`save_model`, :func:`load_model`).
 
-Per target (a displacement column, um)::
-
-    delta(t) = c0 + sum_j b_j x_j(t)
-
-with ``x_j`` the :class:`~gatetherm.studies.errormodel.terms.Term` values (temperature rises
-from the model's reference temperatures, K; operating inputs through first-order lags) and
-``b_j`` in um/K or um. The file (``format: gatetherm-errormodel/1``) holds, per target, the form,
-the terms with their coefficients and units, the chosen sensors, the residuals on the fitting span,
-the held-out error and the selection curve; once: the reference temperatures, the input scales,
-the fitting span. :func:`predict` evaluates it with numpy only.
+The file (``format: gatetherm-errormodel/1``) holds, per target, the form, the terms with their
+coefficients and units, the chosen sensors, the residuals on the fitting span, the held-out error
+and the selection curve; once: the reference temperatures, the input scales, the fitting span.
+The model itself (:class:`ErrorModel`, :class:`TargetModel`) is
+:mod:`gatetherm.studies.errormodel.fitted`; :func:`predict`, which evaluates it with numpy only,
+:mod:`gatetherm.studies.errormodel.prediction` (both importable from here too).
 """
 from __future__ import annotations
 
 import dataclasses
-import logging
-from dataclasses import dataclass, field
 from pathlib import Path
-
-import numpy as np
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.checks import FINITE, first_nonfinite, json_text, parse_json
 from gatetherm.files import read_text
-from gatetherm.studies.errormodel.terms import GapReport, Term, evaluate, fill_gaps, readings
-
-log = logging.getLogger(__name__)
+from gatetherm.studies.errormodel.fitted import (  # noqa: F401 (re-exported)
+    FORMS, ErrorModel, TargetModel, residual_stats)
+from gatetherm.studies.errormodel.prediction import (  # noqa: F401 (re-exported)
+    _term_values, check_columns, input_gaps, predict, score)
+from gatetherm.studies.errormodel.terms import Term
 
 FORMAT = "gatetherm-errormodel/1"
-FORMS = ("static", "dynamic", "paper")
-"""static: sensors (and differences) only; dynamic: also lags (inputs, temperatures);
-paper: ``K_i (theta_a - theta_b) - K_C theta_c`` without intercept (eq 21)."""
-
-
-@dataclass(frozen=True)
-class TargetModel:
-    """The model of one target column."""
-
-    target: str
-    """The predicted column, um."""
-    form: str
-    """One of :data:`FORMS`."""
-    terms: tuple[Term, ...]
-    """The regressors."""
-    coefficients: tuple[float, ...]
-    """One per term, um/K (sensor, difference) or um (input)."""
-    intercept_um: float = 0.0
-    """Constant c0, um (0 in the paper's form)."""
-    residual: dict = field(default_factory=dict)
-    """On the fitting span: ``mae_um``, ``rms_um``, ``max_abs_um``, ``samples``."""
-    held_out_mae_um: float | None = None
-    """Mean absolute error of the blocked cross-validation inside the fitting span, um."""
-    selection: tuple[dict, ...] = ()
-    """The forward-selection path: per step ``terms`` (labels), ``sensors`` (count), ``cv_mae_um``."""
-    noise_um: float | None = None
-    """Standard deviation the temperature sensors' noise adds to the prediction, um:
-    ``sqrt(sum_k (c_k sigma_k)^2)`` at the fit's sensor resolution (None: not recorded)."""
-    interval: dict = field(default_factory=dict)
-    """The 90 % interval from held-out residuals (:func:`~gatetherm.studies.errormodel.trust.calibrate`):
-    ``half_width_um`` (um), ``coverage`` (fraction of held-out samples inside, out of sample),
-    ``samples``, ``level``; empty: not calibrated."""
-    ranges: tuple = ()
-    """Per term its (smallest, largest) value on the fitting rows (the drift detector's reference)."""
-
-    @property
-    def sensors(self) -> tuple[str, ...]:
-        """The temperature columns the model reads, in term order."""
-        cols = [c for t in self.terms if t.kind not in ("input", "drift") for c in t.columns]
-        return tuple(dict.fromkeys(cols))
-
-    @property
-    def columns(self) -> tuple[str, ...]:
-        """Every column the model reads."""
-        return tuple(dict.fromkeys(c for t in self.terms for c in t.columns))
-
-
-@dataclass(frozen=True)
-class ErrorModel:
-    """Thermal-error models of one or more targets fitted on one series."""
-
-    targets: tuple[TargetModel, ...]
-    """One model per target."""
-    reference_degC: dict[str, float]
-    """Temperature of each used sensor that the rises are taken from, degC (default: its first
-    valid sample in the fitting span)."""
-    fit_span: dict
-    """``start_s``, ``end_s`` (s) and ``samples`` of the fitting span; ``source``: the data file."""
-    max_gap_s: float = 300.0
-    """Longest gap (s) in a used column that predictions bridge (linear fill); longer gaps are NaN."""
-    settings: dict = field(default_factory=dict)
-    """The fit settings (:class:`~gatetherm.studies.errormodel.fit.FitParams`) as a dict."""
-    run_reference: bool = False
-    """True (fitted on several runs): every predicted file is its own run, its rises taken from its
-    first sample and the prediction zero there (:mod:`~gatetherm.studies.errormodel.runs`)."""
-
-    @property
-    def columns(self) -> tuple[str, ...]:
-        """Every column any target model reads."""
-        return tuple(dict.fromkeys(c for m in self.targets for c in m.columns))
-
-    def target(self, name: str) -> TargetModel:
-        """The model of target ``name``."""
-        for m in self.targets:
-            if m.target == name:
-                return m
-        raise InputError(f"target {name}", "not in the model", f"use one of {', '.join(self.names)}")
-
-    @property
-    def names(self) -> tuple[str, ...]:
-        """The target columns."""
-        return tuple(m.target for m in self.targets)
-
-
-def residual_stats(r: np.ndarray) -> dict:
-    """MAE, RMS and largest absolute value (um) and count of residuals ``r`` (um)."""
-    return {"mae_um": float(np.mean(np.abs(r))), "rms_um": float(np.sqrt(np.mean(r**2))),
-            "max_abs_um": float(np.max(np.abs(r))), "samples": int(r.size)}
-
-
-def check_columns(model: ErrorModel, columns, where: str = "data") -> None:
-    """Raise InputError if ``columns`` (a mapping or TimeSeries) lacks ``time_s`` or a column the model reads."""
-    for name in ("time_s", *model.columns):
-        if name not in columns:
-            raise InputError(f"{getattr(columns, 'source', '') or where}: column {name}", "missing; the model reads it",
-                             f"give a file with the columns {', '.join(('time_s',) + model.columns)}")
-
-
-def _filled(model: ErrorModel, columns) -> tuple[dict, np.ndarray, dict[str, GapReport]]:
-    check_columns(model, columns)
-    t = np.asarray(columns["time_s"], float)
-    cols, bad, reports = {}, np.zeros(t.size, bool), {}
-    for name in model.columns:
-        try:
-            cols[name], long, reports[name] = fill_gaps(t, columns[name], model.max_gap_s)
-        except ValueError:
-            raise InputError(f"column {name}", "has no valid sample", "give measured values") from None
-        smooth, anchor = (float(model.settings.get(k, 0.0)) for k in ("smooth_s", "anchor_s"))
-        if name not in model.settings.get("inputs", ()) and (smooth > 0 or anchor > 0):
-            cols[name] = readings(t, cols[name], smooth, anchor)  # as the fit read them
-        bad |= long
-    return cols, bad, reports
-
-
-def input_gaps(model: ErrorModel, columns) -> dict[str, GapReport]:
-    """Per column the model reads, what :func:`predict` fills (only columns with gaps)."""
-    return {k: r for k, r in _filled(model, columns)[2].items() if r.filled}
-
-
-def _references(model: ErrorModel, cols, t: np.ndarray) -> dict:
-    if not model.run_reference:
-        return {**model.reference_degC, "time_s": float(model.fit_span.get("start_s", t[0]))}
-    return {**{c: float(v[0]) for c, v in cols.items()}, "time_s": float(t[0])}
-
-
-def _term_values(model: ErrorModel, columns):
-    cols, bad, _ = _filled(model, columns)
-    t = np.asarray(columns["time_s"], float)
-    ref = _references(model, cols, t)
-    values = {}
-    for m in model.targets:
-        vs = [evaluate(term, t, cols, ref) for term in m.terms]
-        values[m.target] = [v - v[0] for v in vs] if model.run_reference else vs
-    return values, bad, t
-
-
-def predict(model: ErrorModel, columns) -> dict[str, np.ndarray]:
-    """Evaluate the model at the samples of ``columns``.
-
-    Parameters
-    ----------
-    model : ErrorModel
-        From :func:`~gatetherm.studies.errormodel.fit.fit_error_model` or :func:`load_model`.
-    columns : mapping or TimeSeries
-        ``time_s`` (s, increasing) and every column the model reads (degC, the inputs' units).
-        Missing samples (NaN) are filled linearly (held at the ends); in gaps longer than
-        ``model.max_gap_s`` the prediction is NaN. Lags start in steady state at the first sample.
-        A model fitted on several runs takes the file as a run of its own: rises from its first
-        sample, the prediction 0 there.
-
-    Returns
-    -------
-    dict
-        Target name -> predicted displacement at each sample, um.
-    """
-    values, bad, t = _term_values(model, columns)
-    out = {}
-    for m in model.targets:
-        y = np.full(t.size, 0.0 if model.run_reference else m.intercept_um)
-        for v, b in zip(values[m.target], m.coefficients):
-            y += b * v
-        y[bad] = np.nan
-        out[m.target] = y
-    return out
-
-
-def score(predicted: dict[str, np.ndarray], columns) -> dict[str, dict]:
-    """Per predicted target: ``predicted_samples``, and where ``columns`` has the target measured,
-    :func:`residual_stats` of measured - predicted over the samples where both exist (um)."""
-    out = {}
-    for name, p in predicted.items():
-        entry = {"predicted_samples": int(np.isfinite(p).sum())}
-        if name in columns:
-            r = np.asarray(columns[name], float) - p
-            r = r[np.isfinite(r)]
-            entry.update(residual_stats(r) if r.size else {"samples": 0})
-        out[name] = entry
-    return out
 
 
 def to_dict(model: ErrorModel) -> dict:
