@@ -22,8 +22,9 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement", "check_rom",
-       "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit", "errormodel_predict",
+API = ("Case", "CompensationRun", "DiagnosisRun", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients",
+       "check_placement", "check_rom", "check_schedules", "compensate", "compensate_run", "condition", "configure",
+       "diagnose", "diagnose_run", "diagnosis_hypotheses", "diagnosis_model", "errormodel_fit", "errormodel_predict",
        "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule", "place_sensors", "reduce",
        "run", "schedule_file", "twin", "validate_zoo", "write_placement", "write_reduction")
 """Names of :mod:`gatetherm.api` offered here (imported on first use)."""

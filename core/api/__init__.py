@@ -43,7 +43,11 @@ in one line (``str(err)``) which argument is wrong and how to fix it:
 Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
+from gatetherm.api.compensation import OUTPUTS as COMPENSATE_OUTPUTS  # noqa: F401 - for the command line
+from gatetherm.api.compensation import WRITTEN, CompensationRun, compensate_run  # noqa: F401 - WRITTEN: cli
 from gatetherm.api.control import compensate, diagnose
+from gatetherm.api.diagnosis import OUTPUTS as DIAGNOSE_OUTPUTS  # noqa: F401 - for the command line
+from gatetherm.api.diagnosis import DiagnosisRun, diagnose_run, diagnosis_hypotheses, diagnosis_model
 from gatetherm.api.errormodel import Prediction, errormodel_fit, errormodel_predict, errormodel_refit
 from gatetherm.api.export import export_ccx
 from gatetherm.api.live import live, twin
@@ -53,9 +57,16 @@ from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficie
 from gatetherm.api.sensors import check_placement, place_sensors, write_placement
 from gatetherm.api.zoo import validate_zoo
 from gatetherm.checks import POSITIVE, Range  # noqa: F401
+from gatetherm.studies.control.methods import K_SOURCES, METHODS  # noqa: F401 - the command line's choices
+from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - the command line's default
 
-__all__ = ["Case", "Prediction", "Run", "Schedule", "SolverOptions", "beam_coefficients", "check_placement",
-           "check_rom", "check_schedules", "compensate", "condition", "configure", "diagnose", "errormodel_fit",
+COMPENSATION_METHODS = METHODS[:3]
+"""The methods ``gatetherm compensate --method`` offers (the fourth, errormodel, is its --model)."""
+
+__all__ = ["Case", "CompensationRun", "DiagnosisRun", "Prediction", "Run", "Schedule", "SolverOptions",
+           "beam_coefficients", "check_placement", "check_rom", "check_schedules", "compensate", "compensate_run",
+           "condition", "configure", "diagnose", "diagnose_run", "diagnosis_hypotheses", "diagnosis_model",
+           "errormodel_fit",
            "errormodel_predict", "errormodel_refit", "export_ccx", "gate_frame", "live", "load_case", "nc_schedule",
            "place_sensors", "reduce", "run", "schedule_file", "twin", "validate_zoo", "write_placement",
            "write_reduction"]
