@@ -30,25 +30,48 @@ def headstock(tmp_path_factory) -> Path:
     return d / "case.toml"
 
 
-def test_compensate_run_is_what_the_command_writes_and_prints(headstock, tmp_path, capsys):
+@pytest.fixture(scope="module")
+def machine(tmp_path_factory) -> Path:
+    """A machine's record (d_um = 2 theta_1 + noise) and the error model fitted on it."""
+    d = tmp_path_factory.mktemp("machine")
+    rng = np.random.default_rng(0)
+    t = 60.0 * np.arange(400)
+    s1, s2 = 22 + np.cumsum(rng.normal(0, 0.05, t.size)), 22 + np.cumsum(rng.normal(0, 0.05, t.size))
+    d_um = 2.0 * (s1 - s1[0]) + rng.normal(0, 0.05, t.size)
+    write_timeseries(d / "data.csv", TimeSeries({"time_s": t, "s1_degC": s1, "s2_degC": s2, "d_um": d_um},
+                                                 {"format": FORMAT}))
+    assert main(["errormodel", "fit", "--data", str(d / "data.csv"), "--targets", "d_um", "--out", str(d)]) == 0
+    return d
+
+
+def test_compensate_run_is_what_the_command_writes_and_prints(machine, tmp_path, capsys):
     calls = []
-    result = gt.compensate_run(case=str(headstock), method="mlr", ideal=True, force=True,
+    result = gt.compensate_run(str(machine / "data.csv"), model=str(machine / "model.json"), ideal=True,
                                on_progress=lambda i, n: calls.append((i, n)))
-    steps = len(gt.load_case(headstock).schedule.times) + 1  # the run's samples, then the compensation
-    assert calls[-1] == (steps, steps) and {n for _, n in calls} == {steps}
-    assert [i for i, _ in calls] == sorted(i for i, _ in calls) and len(calls) >= steps - 1
+    assert calls == [(1, 1)]  # a record: nothing to run, the compensation is the one step
     assert result.wrote(tmp_path / "lib") == f"wrote {tmp_path / 'lib'}/compensated.csv, compensation.png, summary.json"
     assert result.write(tmp_path / "lib") == result.wrote(tmp_path / "lib")
-    assert main(["compensate", "--case", str(headstock), "--method", "mlr", "--no-actuator", "--force",
-                 "--out", str(tmp_path / "cli")]) == 0
+    capsys.readouterr()
+    assert main(["compensate", "--model", str(machine / "model.json"), "--data", str(machine / "data.csv"),
+                 "--no-actuator", "--out", str(tmp_path / "cli")]) == 0
     printed = capsys.readouterr().out.splitlines()
     assert printed == [result.wrote(tmp_path / "cli"), *result.summary().splitlines()]
     lib, cli = files(tmp_path / "lib"), files(tmp_path / "cli")
     assert sorted(lib) == sorted(cli) == ["compensated.csv", "compensation.png", "summary.json"]
     assert lib["compensated.csv"] == cli["compensated.csv"] and lib["summary.json"] == cli["summary.json"]
     summary = json.loads(cli["summary.json"])
-    assert summary["benefit"] == result.record["benefit"] and summary["case"] == str(headstock)
-    assert result.summary().splitlines()[0].startswith(f"{headstock}: ")
+    assert summary["benefit"] == result.record["benefit"] and summary["model"] == str(machine / "model.json")
+    assert result.summary().splitlines()[0].startswith(f"{machine / 'data.csv'}: ")
+
+
+def test_compensate_run_of_a_case_reports_the_runs_samples(headstock):
+    calls = []
+    result = gt.compensate_run(case=str(headstock), method="mlr", ideal=True, force=True,
+                               on_progress=lambda i, n: calls.append((i, n)))
+    steps = len(gt.load_case(headstock).schedule.times) + 1  # the run's samples, then the compensation
+    assert calls[-1] == (steps, steps) and {n for _, n in calls} == {steps}
+    assert [i for i, _ in calls] == sorted(i for i, _ in calls) and len(calls) >= steps - 1
+    assert result.record["case"] == str(headstock) and result.what == str(headstock)
 
 
 def test_compensate_run_checks_its_arguments():
