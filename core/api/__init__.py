@@ -16,8 +16,9 @@ The paper's frame is a case like any other: ``gt.gate_frame(dim=2)``.
 
 The functions live by task in this package's modules: :mod:`gatetherm.api.run` (cases,
 schedules, runs), :mod:`gatetherm.api.reduction`, :mod:`gatetherm.api.control` (compensation,
-diagnosis), :mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`,
-:mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and :mod:`gatetherm.api.zoo`; every public name is offered here.
+diagnosis), :mod:`gatetherm.api.compensation` and :mod:`gatetherm.api.diagnosis` (the commands
+``compensate`` and ``diagnose``: one call each, a result that writes and summarises),
+:mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`, :mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and :mod:`gatetherm.api.zoo`; every public name is offered here.
 
 ### Errors
 

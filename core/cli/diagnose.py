@@ -89,10 +89,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")
     if not args.data or not args.out:
         raise InputError("--data/--out", "both are required", "e.g. gatetherm diagnose --data run.csv --out diag")
-    settings = settings_from(args)
-    result = diagnose_run(load_model(args), args.data, out=args.out, config=args.config,
-                          on_progress=Progress("diagnose"), record={"case": args.case, "mesh_size": args.mesh_size, "mesh_factor": args.mesh_factor},
-                          **settings)
+    record = {"case": args.case, "mesh_size": args.mesh_size, "mesh_factor": args.mesh_factor}
+    result = diagnose_run(load_model(args), args.data, out=args.out, config=args.config, record=record,
+                          on_progress=Progress("diagnose"), **settings_from(args))
     print(result.summary())  # written into --out by diagnose_run, the directory locked before the diagnosis
     print(result.wrote(args.out))
     return 0
