@@ -22,10 +22,11 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("BeamCoefficients", "Case", "DriftReport", "ErrorModelFit", "Export", "FrameFiles", "Prediction",
-       "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule", "SensorStudy", "SolverOptions",
-       "SweepResult", "Validation", "beam_coefficients", "beam_normalised", "check_placement", "check_rom",
-       "check_schedules", "compensate", "condition", "configure", "diagnose", "drift_report", "errormodel_fit",
+API = ("BeamCoefficients", "Case", "CompensationRun", "DiagnosisRun", "DriftReport", "ErrorModelFit", "Export",
+       "FrameFiles", "Prediction", "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule", "SensorStudy",
+       "SolverOptions", "SweepResult", "Validation", "beam_coefficients", "beam_normalised", "check_placement",
+       "check_rom", "check_schedules", "compensate", "compensate_run", "condition", "configure", "diagnose",
+       "diagnose_run", "diagnosis_hypotheses", "diagnosis_model", "drift_report", "errormodel_fit",
        "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live", "load_case",
        "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
        "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",

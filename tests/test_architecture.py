@@ -146,7 +146,6 @@ import sys  # noqa: E402
 #: Command-line modules that still import more than gatetherm.api, gatetherm.cli and the standard library,
 #: whose commands are being moved onto the API by others (issue 52): empty this as they merge.
 CLI_OFFENDERS = {
-    "gatetherm.cli.compensate": "front-a", "gatetherm.cli.diagnose": "front-a",
 }
 
 

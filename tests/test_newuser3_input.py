@@ -130,7 +130,7 @@ def test_a_thickness_beyond_ten_times_the_body_is_read_with_a_warning(tmp_path: 
 def test_the_p2_replay_warning_points_to_keep_order_for_a_gatetherm_run():
     import types
 
-    from gatetherm.cli.diagnose import order_warning
+    from gatetherm.api.diagnosis import order_warning
 
     p2 = types.SimpleNamespace(too_coarse=["delta_um"], order=2)
     made = order_warning(p2, {"source": "gatetherm"})

@@ -17,9 +17,11 @@ The paper's frame is a case like any other: ``gt.gate_frame(dim=2)``.
 The functions live by task in this package's modules: :mod:`gatetherm.api.case` (cases,
 schedules), :mod:`gatetherm.api.run` (runs), :mod:`gatetherm.api.jobs` (runs written: ``gatetherm
 run``, ``simulate``), :mod:`gatetherm.api.frame` (``mesh``, ``beam``), :mod:`gatetherm.api.reduction`,
-:mod:`gatetherm.api.control` (compensation, diagnosis), :mod:`gatetherm.api.errormodel`, :mod:`gatetherm.api.sensors`,
-:mod:`gatetherm.api.study` (sweeps), :mod:`gatetherm.api.reports`, :mod:`gatetherm.api.validate_study`,
-:mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and :mod:`gatetherm.api.zoo`; every public name is offered here.
+:mod:`gatetherm.api.control` (compensation, diagnosis), :mod:`gatetherm.api.compensation` and
+:mod:`gatetherm.api.diagnosis` (the commands ``compensate`` and ``diagnose``), :mod:`gatetherm.api.errormodel`,
+:mod:`gatetherm.api.sensors`, :mod:`gatetherm.api.study` (sweeps), :mod:`gatetherm.api.reports`,
+:mod:`gatetherm.api.validate_study`, :mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and
+:mod:`gatetherm.api.zoo`; every public name is offered here.
 
 ### Errors
 
@@ -45,7 +47,11 @@ in one line (``str(err)``) which argument is wrong and how to fix it:
 Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
+from gatetherm.api.compensation import OUTPUTS as COMPENSATE_OUTPUTS  # noqa: F401 - for the command line
+from gatetherm.api.compensation import WRITTEN, CompensationRun, compensate_run  # noqa: F401 - WRITTEN: cli
 from gatetherm.api.control import compensate, diagnose
+from gatetherm.api.diagnosis import OUTPUTS as DIAGNOSE_OUTPUTS  # noqa: F401 - for the command line
+from gatetherm.api.diagnosis import DiagnosisRun, diagnose_run, diagnosis_hypotheses, diagnosis_model
 from gatetherm.api.errormodel import ErrorModelFit, Prediction, Refit, errormodel_fit, errormodel_predict, \
     errormodel_refit
 from gatetherm.api.export import Export, export_case, export_ccx
@@ -64,12 +70,19 @@ from gatetherm.checks import POSITIVE, Range  # noqa: F401
 from gatetherm.solvers.errors import SolverError  # noqa: F401 - with these below, for the command line's dispatcher
 from gatetherm.studies.sweeps.runner import PointsFailed  # noqa: F401
 
+from gatetherm.studies.control.methods import K_SOURCES, METHODS  # noqa: F401 - the command line's choices
+from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - the command line's default
+
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
 
-__all__ = ["BeamCoefficients", "Case", "DriftReport", "ErrorModelFit", "Export", "FrameFiles", "Prediction",
-           "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule", "SensorStudy", "SolverOptions",
-           "SweepResult", "Validation", "beam_coefficients", "beam_normalised", "check_placement", "check_rom",
-           "check_schedules", "compensate", "condition", "configure", "diagnose", "drift_report", "errormodel_fit",
+COMPENSATION_METHODS = METHODS[:3]
+"""The methods ``gatetherm compensate --method`` offers (the fourth, errormodel, is its --model)."""
+
+__all__ = ["BeamCoefficients", "Case", "CompensationRun", "DiagnosisRun", "DriftReport", "ErrorModelFit", "Export",
+           "FrameFiles", "Prediction", "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule",
+           "SensorStudy", "SolverOptions", "SweepResult", "Validation", "beam_coefficients", "beam_normalised",
+           "check_placement", "check_rom", "check_schedules", "compensate", "compensate_run", "condition", "configure",
+           "diagnose", "diagnose_run", "diagnosis_hypotheses", "diagnosis_model", "drift_report", "errormodel_fit",
            "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live", "load_case",
            "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
            "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",

@@ -49,29 +49,14 @@ ends (with the time), are each printed as one ``warning:`` line and listed in su
 from __future__ import annotations
 
 import argparse
-import dataclasses
-import logging
 import math
-from pathlib import Path
 
-from gatetherm import InputError, write_text_atomic
-from gatetherm.checks import json_text
-from gatetherm.cli.options import add_model_options, refuse_model_options
-
-log = logging.getLogger(__name__)
-
-WRITTEN = ("u_piezo_um", "delta_pred_um", "delta_comp_um")
-"""Columns compensate adds to its input. Those of an earlier compensation (a file with its
-``compensation`` metadata) and ``u_piezo_um`` are replaced with a warning; in any other
-file a column of these names is refused, since it would be lost."""
-#: What a run writes into --out; a rerun replaces all of it.
-OUTPUTS = ("compensated.csv", "compensation.png", "piezo_loops.png", "summary.json")
+from gatetherm.api import COMPENSATE_OUTPUTS as OUTPUTS  # noqa: F401 - what a run writes into --out
+from gatetherm.api import COMPENSATION_METHODS, K_SOURCES, THERMOCOUPLES, InputError, compensate_run
+from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
 
 
 def register(subparsers) -> None:
-    from gatetherm.studies.control.methods import K_SOURCES, METHODS
-    from gatetherm.studies.control.predictive import THERMOCOUPLES
-
     p = subparsers.add_parser(
         "compensate",
         help="predict and compensate the thermal displacement of a run (paper section 3.2)",
@@ -96,7 +81,7 @@ def register(subparsers) -> None:
                    help="actuator update interval in minutes (default 5, as in the paper)")
     p.add_argument("--no-actuator", action="store_true",
                    help="ideal actuator: the stroke equals the command")
-    p.add_argument("--method", choices=METHODS[:3], default="paper",
+    p.add_argument("--method", choices=COMPENSATION_METHODS, default="paper",
                    help="paper (default): the paper's procedure; mlr: regression baseline; rom: Kalman filter "
                    "and predictive control on the reduced model")
     p.add_argument("--rom", metavar="ROM.npz", help="rom: reduced model from 'gatetherm reduce' (default: build "
@@ -119,39 +104,15 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-def _settings(args):
-    from gatetherm.studies.control.compensator import CompensatorParams
-    from gatetherm.studies.control.methods import Settings
-    from gatetherm.studies.control.predictive import PredictiveParams
-
+def _check(args) -> None:
+    """The options' own checks, before anything is read."""
     if not (math.isfinite(args.interval_min) and args.interval_min > 0):
         raise InputError("--interval-min", f"must be > 0, got {args.interval_min}", "e.g. --interval-min 5")
-    params = CompensatorParams(update_interval_s=args.interval_min * 60.0)
-    control = PredictiveParams(mode=args.updates, max_updates=args.max_updates, interval_s=params.update_interval_s)
-    sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
-    model = None
     if args.model is not None and args.method != "paper":
         raise InputError("--model/--method", f"--model replays a fitted error model: --method {args.method} would "
                          "be ignored", "drop --method, or drop --model")
-    if args.model is not None:  # a bad model file or --target fails before --out is touched
-        from gatetherm.studies.errormodel.model import load_model
-        from gatetherm.studies.errormodel.replay import loop_target
-
-        model = load_model(args.model)
-        loop_target(model, args.target)
     if not (math.isfinite(args.held_out) and 0 < args.held_out < 1):
         raise InputError("--held-out", f"{args.held_out:g} is not a fraction in (0, 1)", "e.g. --held-out 0.3")
-    return Settings("errormodel" if model else args.method, params, args.Ki, args.Kc, args.k_source, args.states,
-                    control, sensors=sensors, model=model, target=args.target, correction=args.correction,
-                    force=args.force, held_out=args.held_out)
-
-
-def run(args: argparse.Namespace) -> int:
-    import gatetherm as gt
-    from gatetherm.outdir import output_dir
-    from gatetherm.studies.run.timeseries import FORMAT, read_timeseries
-
-    settings = _settings(args)
     if args.model is not None and args.data is None:
         raise InputError("--model", "replays a fitted model on recorded data", "give --data FILE.csv")
     if args.data is None and args.condition is None and args.case is None:
@@ -162,83 +123,17 @@ def run(args: argparse.Namespace) -> int:
                          "compensate a case's own run (--case alone) or a recorded file (--data)")
     if args.case is not None:
         refuse_model_options(args)
-    if args.condition is not None:
-        from gatetherm.studies.run.conditions import condition as check_condition
-
-        check_condition(args.condition)  # a bad number fails (naming --condition) before the model is built
-        case = gt.gate_frame(args.dim, args.config)
-    else:
-        case = gt.load_case(args.case) if args.case else gt.gate_frame(args.dim, args.config)
-    if args.data is not None:
-        ts, what = read_timeseries(args.data, required=("time_s",)), str(args.data)
-        clash = [name for name in WRITTEN[1:] if name in ts]
-        if clash and "compensation" not in ts.metadata:
-            raise InputError(f"{args.data}, column {clash[0]}", "compensate writes a column of this name "
-                             "and the file is not from an earlier compensate", "rename the column so that it is kept")
-    with output_dir(args.out, OUTPUTS, keep=(args.config, args.data, *case.files)) as out_dir:
-        if args.data is None:
-            if not case.problem.signals.complete or case.time is None:
-                raise InputError(f"{case.source}: signals", "a compensated case needs [time] and [signals] with "
-                                 "theta_A, theta_B, theta_C and delta", "map them to its probes and a relative "
-                                 "displacement")
-            schedule = gt.condition(args.condition, case) if args.condition is not None else case.schedule
-            res = gt.run(case, schedule, keep=())
-            meta = {"format": FORMAT, "source": "gatetherm compensate", "schedule": schedule.label,
-                    "dim": str(case.dim), "config": case.source}
-            ts = res.scenario.series({**meta, **({"condition": str(args.condition)} if args.condition else {})})
-            what = f"condition {args.condition}" if args.condition is not None else str(args.case)
-        return _compensate(args, case, ts, what, settings, out_dir)
 
 
-def _um(value) -> str:
-    return "n/a" if value is None else f"{value:.2f} um"
-
-
-def _compensate(args, case, ts, what, settings, out_dir: Path) -> int:
-    from gatetherm.studies.control.methods import compensate
-    from gatetherm.studies.run.reduce import load_rom
-    from gatetherm.studies.run.timeseries import write_timeseries
-
-    actuator = None if args.no_actuator else case.actuator
-    replaced = [name for name in WRITTEN if name in ts]
-    if replaced:
-        log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
-    comp = compensate(ts, case, settings, actuator, rom=load_rom(args.rom) if args.rom else None, rom_dir=Path(args.out),
-                      source=what, rom_source=args.rom)
-    summary = {**comp.summary, "data": args.data, "case": args.case, "condition": args.condition,
-               "config": case.source, "dim": case.dim, **({"model": args.model} if args.model else {})}
-    text = json_text(summary, "summary.json", indent=2)
-    loop = comp.loop
-    out = ts.with_columns(u_piezo_um=loop.stroke_um, delta_pred_um=loop.delta_pred_um,
-                          delta_comp_um=loop.delta_comp_um)
-    out = dataclasses.replace(out, metadata={
-        **out.metadata, "compensation": f"{'' if settings.method == 'paper' else settings.method + ': '}{comp.label}, "
-        f"{'actuator model' if actuator else 'ideal actuator'}"})
-
-    from gatetherm.validation.plots import save
-    from gatetherm.validation.plots.compensation import plot_compensation, plot_piezo_loops  # outer layer
-    write_timeseries(out_dir / "compensated.csv", out)
-    from gatetherm.validation.plots.labels import signal_labels
-
-    save(plot_compensation(loop, title=f"{what}: {settings.method}, {comp.label}",
-                           delta=signal_labels(case.problem).get("delta_um", "δ")), out_dir / "compensation.png")
-    if actuator:
-        save(plot_piezo_loops(actuator), out_dir / "piezo_loops.png")
-    write_text_atomic(out_dir / "summary.json", text)
-    print(f"wrote {args.out}/compensated.csv, compensation.png, "
-          f"{'piezo_loops.png, ' if actuator else ''}summary.json")
-    settle = settings.params.settle_s / 60
-    print(f"{what}: {comp.head}; swing {summary['swing_um']:.2f} um, "
-          f"prediction error band {_um(summary['prediction_error_band_um'])}, "
-          f"residual band {_um(summary['residual_band_um'])} over the whole run after {settle:g} min, as applied "
-          f"({_um(summary['residual_at_updates_um'])} at the update instants), {summary['updates']} updates")
-    b = summary["benefit"]
-    what_checked = "the correction as applied" if b["basis"].startswith("as applied") else \
-        "a separate check, not the correction applied above"
-    print(f"held-out last {b['fraction'] * 100:.0f} % ({what_checked}): {_um(b['held_out_um'])} compensated, "
-          f"{_um(b['uncompensated_um'])} uncompensated ({b['verdict']}; {b['basis']})")
-    for line in summary.get("warnings", []):
-        print(f"warning: {line}")
-    if "warning" in summary:
-        print(f"warning: {summary['warning']}")
+def run(args: argparse.Namespace) -> int:
+    _check(args)
+    sensors = tuple(s.strip() for s in args.sensors.split(",") if s.strip())
+    result = compensate_run(args.data, args.case, condition=args.condition, dim=args.dim, config=args.config,
+                            method=args.method, interval_min=args.interval_min, updates=args.updates,
+                            max_updates=args.max_updates, ideal=args.no_actuator, rom=args.rom, model=args.model,
+                            out=args.out, on_progress=Progress("compensate"), Ki=args.Ki, Kc=args.Kc,
+                            k_source=args.k_source, states=args.states, sensors=sensors, target=args.target,
+                            correction=args.correction, force=args.force, held_out=args.held_out)
+    print(result.wrote(args.out))  # written into --out by compensate_run, the directory locked before the run
+    print(result.summary())
     return 0
