@@ -194,7 +194,7 @@ BAD = {
     "validate_zoo(timeout_s=nan)": (lambda c: gt.validate_zoo("o", timeout_s=NAN), InputError,
                                     "timeout_s: got nan, must be a finite number > 0"),
     "validate_zoo(on_cell=3)": (lambda c: gt.validate_zoo("o", on_cell=3), TypeError, "on_cell: got int, expected"),
-    "with_overrides('k=1')": (lambda c: c.with_overrides("k=1"), TypeError, "overrides: got str, expected a dict"),
+    "with_overrides('k=1')": (lambda c: c.with_overrides("k=1"), TypeError, "overrides: got str 'k=1', expected a dict"),
     "plot.series(None)": (lambda c: gt.plot.series(None, "delta_um"), TypeError, "run: got NoneType None"),
     "plot.series(unknown column)": (lambda c: gt.plot.series({"time_s": [0.0]}, "delta_um"), InputError,
                                     "columns: 'delta_um' not among the run's columns"),

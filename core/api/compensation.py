@@ -149,7 +149,7 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
     CompensationRun
         ``.record`` (summary.json's figures), ``.compensation``, ``.write(out)``, ``.summary()``.
     """
-    import gatetherm.api as gt
+    from gatetherm.api.case import gate_frame, load_case
     from gatetherm.studies.control.compensator import CompensatorParams
     from gatetherm.studies.control.methods import Settings, compensate as run_methods
     from gatetherm.studies.control.predictive import PredictiveParams
@@ -177,7 +177,7 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
     if isinstance(case, Case):
         model_case = case
     else:
-        model_case = gt.load_case(case) if case is not None and condition is None else gt.gate_frame(dim, config)
+        model_case = load_case(case) if case is not None and condition is None else gate_frame(dim, config)
     keep = (config, None if data is None else str(data), *model_case.files)
     ts, what = None, None
     if data is not None:
@@ -224,15 +224,16 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
 def _own_run(case: Case, condition: int | None, on_progress) -> tuple:
     """The time series of ``case``'s own run (or of the paper's ``condition`` on the frame), and the
     progress steps (the run's samples and the compensation)."""
-    import gatetherm.api as gt
+    from gatetherm.api.case import condition as paper_condition
+    from gatetherm.api.run import run
     from gatetherm.studies.run.timeseries import FORMAT
 
     if not case.problem.signals.complete or case.time is None:
         raise InputError(f"{case.source}: signals", "a compensated case needs [time] and [signals] with "
                          "theta_A, theta_B, theta_C and delta", "map them to its probes and a relative "
                          "displacement")
-    schedule = gt.condition(condition, case) if condition is not None else case.schedule
-    res = gt.run(case, schedule, keep=(), on_step=on_progress and (lambda i, n: on_progress(i, n + 1)))
+    schedule = paper_condition(condition, case) if condition is not None else case.schedule
+    res = run(case, schedule, keep=(), on_step=on_progress and (lambda i, n: on_progress(i, n + 1)))
     meta = {"format": FORMAT, "source": "gatetherm compensate", "schedule": schedule.label,
             "dim": str(case.dim), "config": case.source}
     return res.scenario.series({**meta, **({"condition": str(condition)} if condition else {})}), \

@@ -36,19 +36,19 @@ def diagnosis_model(case: str | os.PathLike | None = None, *, dim: int = 2, conf
     Case
         Raises InputError for a combination that does not go (naming the command's options).
     """
-    import gatetherm.api as gt
+    from gatetherm.api.case import gate_frame, load_case
 
     argument("case", case, (*PATH, type(None)), "a case file's path or None")
     if case is None:
         if mesh_factor is not None:
             raise InputError("--mesh-factor", "goes with --case only", "give --mesh-size for the paper model")
-        model = gt.gate_frame(dim, config)
+        model = gate_frame(dim, config)
         if mesh_size is not None:
             model = model.with_overrides({"mesh.size" if dim == 2 else "mesh.size_3d": mesh_size})
         return model
     if mesh_size is not None:
         raise InputError("--case/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
-    model = gt.load_case(case, mesh_factor or 1.0)
+    model = load_case(case, mesh_factor or 1.0)
     if model.time is None:
         raise InputError(f"{case}: time", "a diagnosed case needs [time] (a transient run)",
                          "add [time] with end and step; the run's times come from --data")

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.checks import CELSIUS, Range, ranges
+from gatetherm.checks import CELSIUS, Range, argument, ranges
 from gatetherm.files import read_text
 from gatetherm.geometry.mesh import FrameMesh, facet_keys
 from gatetherm.solvers.effects import Targets
@@ -127,9 +127,7 @@ class Case:
         """The case made again with ``overrides`` ({dotted key: value} of its file: ``materials.column.k``,
         ``thermal.free.film``, ``mesh.parameters.h``, ``geometry.l4`` …); effects and sensor faults kept.
         The mesh is reused when nothing it depends on changed."""
-        if not isinstance(overrides, (dict, type(None))):
-            raise TypeError(f"overrides: got {type(overrides).__name__}, expected a dict {{dotted key: value}}; "
-                            'e.g. {"thermal.free.film": 8.0}')
+        argument("overrides", overrides, (dict, type(None)), "a dict {dotted key: value}", 'e.g. {"thermal.free.film": 8.0}')
         if not overrides:
             return self
         made = self.origin.remake(overrides, self)
