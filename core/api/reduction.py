@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from pathlib import Path
 from typing import Callable
@@ -172,8 +173,9 @@ class ReductionRun:
                  f"unknowns in {self.seconds:.1f} s; BT bound "
                  + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items())]
         for c in self.checks:
-            lines.append(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm, "
-                         f"θ {c.max_theta_error_K:.3f} K; reduced run {c.rom_ms:.2f} ms (FE {c.fe_seconds:.1f} s)")
+            theta = "" if math.isnan(c.max_theta_error_K) else f", θ {c.max_theta_error_K:.3f} K"  # a case without θ
+            lines.append(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm{theta}; "
+                         f"reduced run {c.rom_ms:.2f} ms (FE {c.fe_seconds:.1f} s)")
             lines.append("  largest error per output: " + ", ".join(f"{k} {v:.3g}" for k, v in c.errors.items()))
         return "\n".join(lines)
 
