@@ -99,11 +99,28 @@ def test_insulated_block_heats_at_the_bearing_loss(tmp_path):
     assert err == pytest.approx(0.0, abs=1e-9)  # band: < 0.005
 
 
+def test_a_factor_on_an_element_loss_is_the_diagnosis_parameter_of_its_source(tmp_path):
+    """``factor`` scales the element's loss; the diagnosis offers it as ``source_REGION`` (a factor
+    on the loss), whose value 1.4 is the loss × 1.4 (a new user's machine: issue 51)."""
+    from gatetherm.studies.run.parameters import case_parameters
+
+    shutil.copy(DATA / "two_names.geo", tmp_path)
+    (tmp_path / "c.toml").write_text(BLOCK.replace("[sources.plate]\n", "[sources.plate]\nfactor = 1.25\n"))
+    (tmp_path / "speed.csv").write_text("time_s,n_spindle\n0,6000\n600,6000\n")
+    case = gt.load_case(tmp_path / "c.toml")
+    P = el.bearing_loss(6000.0, 22.0, 0.0825, 2.0, 0.0004, 2000.0)
+    np.testing.assert_allclose(gt.run(case)["P_plate_W"], 1.25 * P, rtol=1e-12)
+    (param,) = [q for q in case_parameters(case) if q.name == "source_plate"]
+    np.testing.assert_allclose(gt.run(case.with_overrides(param.overrides(1.4)))["P_plate_W"], 1.4 * 1.25 * P,
+                               rtol=1e-12)
+
+
 @pytest.mark.parametrize("body, where", [
     ('kind = "bearing"\npower = 10.0\ndm = 0.05\nspeed = 100.0\nviscosity = 10.0', "sources.plate.power"),
     ('kind = "guide"\nspeed = 0.1\ndm = 0.05', "sources.plate.dm"),
     ('kind = "gear"\nspeed = 0.1', "sources.plate.kind"),
     ('speed = 0.1\npower = 3.0', "sources.plate.speed"),
+    ('factor = 2.0\npower = 3.0', "sources.plate.factor"),
     ('kind = "motor"\nspeed = 3000.0\ntorque = 2.0\nefficiency = 1.5', "sources.plate.efficiency"),
     ('kind = "motor"\nspeed = 3000.0\ntorque = 2.0\nefficiency = "3/2"', "sources.plate.kind"),
 ])

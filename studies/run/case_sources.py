@@ -30,7 +30,7 @@ ELEMENT_KEYS = {
 """The keys of each element ``kind``."""
 MOVING = ("position", "direction", "length")
 """The keys of a source that moves (with power or kind)."""
-KEYS = {"sources.REGION": ("density", "power", "kind",
+KEYS = {"sources.REGION": ("density", "power", "kind", "factor",
                            *dict.fromkeys(k for keys in ELEMENT_KEYS.values() for k in keys), *MOVING)}
 """The keys of ``[sources.REGION]`` (as :data:`gatetherm.studies.run.case.KEYS`)."""
 POSITIVE_M = Range(0.0, lo_open=True, unit="m")
@@ -82,12 +82,13 @@ def element_loss(t: Table, names) -> Value:
     for k in ("density", "power"):
         if k in t.data:
             t.fail(k, f"goes without kind (the {kind}'s loss is the power)", "remove it or kind")
-    other = next((k for k in t.data if k != "kind" and k not in ELEMENT_KEYS[kind] + MOVING), None)
+    other = next((k for k in t.data if k not in ("kind", "factor") and k not in ELEMENT_KEYS[kind] + MOVING), None)
     if other:
         t.fail(other, f"is not a key of kind = \"{kind}\"", f"its keys: {', '.join(ELEMENT_KEYS[kind])}")
     if kind == "motor" and t.data.get("efficiency") is not None and not isinstance(t.data["efficiency"], str):
         Range(0.0, 1.0, lo_open=True, unit="1").check(t.key("efficiency"), t.data["efficiency"])
-    return Value.of(READERS[kind](t, names), t.key("kind"), LOSS)
+    text, factor = READERS[kind](t, names), t.number("factor", FACTOR, 1.0)
+    return Value.of(text if factor == 1.0 else f"{factor!r}*({text})", t.key("kind"), LOSS)
 
 
 SIZES = ("dm", "diameter", "lead", "length")

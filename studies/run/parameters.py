@@ -120,7 +120,10 @@ def case_parameters(case) -> tuple[Parameter, ...]:
                                   lambda v, n=fl.name, p=p: {f"fluids.{n}.{p}": v}, fl.name))
     for src in pr.sources:
         table = doc.get("sources", {}).get(src.region, {})
-        if "kind" in table:  # a machine element's loss: its operating point, not a factor
+        if "kind" in table:  # a machine element's loss: a factor on it (its operating point unchanged)
+            out.append(factor(f"source_{src.region}", "factor", "1", 1.0, SOURCE, f"factor on the {table['kind']} "
+                              f"loss of '{src.region}'", lambda v, r=src.region, f=table.get("factor", 1.0):
+                              {f"sources.{r}.factor": v * f}, src.region))
             continue
         key = "density" if "density" in table else "power"
         out.append(factor(f"source_{src.region}", "factor", "1", 1.0, SOURCE, f"factor on the heat source of "
