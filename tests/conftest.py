@@ -65,3 +65,17 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         for nodeid, label, observed, expected in orders:
             terminalreporter.write_line(f"{label:<46} {observed:6.3f}  (expected {expected:g})"
                                         f"   {nodeid.split('::')[0]}")
+
+
+def synthetic_record(path) -> None:
+    """A machine's record at ``path``: d_um = 2 (theta_1 - theta_1(0)) + noise of 0.05 um over 400
+    one-minute samples; theta_2 unrelated (a random walk each)."""
+    import numpy as np
+
+    from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
+
+    rng = np.random.default_rng(0)
+    t = 60.0 * np.arange(400)
+    s1, s2 = 22 + np.cumsum(rng.normal(0, 0.05, t.size)), 22 + np.cumsum(rng.normal(0, 0.05, t.size))
+    d_um = 2.0 * (s1 - s1[0]) + rng.normal(0, 0.05, t.size)
+    write_timeseries(path, TimeSeries({"time_s": t, "s1_degC": s1, "s2_degC": s2, "d_um": d_um}, {"format": FORMAT}))

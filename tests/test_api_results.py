@@ -7,12 +7,11 @@ import json
 import shutil
 from pathlib import Path
 
-import numpy as np
 import pytest
+from conftest import synthetic_record
 
 import gatetherm as gt
 from gatetherm import InputError
-from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
 
 
 def increasing_to_the_end(calls: list) -> bool:
@@ -25,12 +24,7 @@ def increasing_to_the_end(calls: list) -> bool:
 def record(tmp_path_factory) -> Path:
     """A machine's record: d_um = 2 (theta_1 - theta_1(0)) + noise of 0.05 um; theta_2 unrelated."""
     d = tmp_path_factory.mktemp("record")
-    rng = np.random.default_rng(0)
-    t = 60.0 * np.arange(400)
-    s1, s2 = 22 + np.cumsum(rng.normal(0, 0.05, t.size)), 22 + np.cumsum(rng.normal(0, 0.05, t.size))
-    d_um = 2.0 * (s1 - s1[0]) + rng.normal(0, 0.05, t.size)
-    write_timeseries(d / "data.csv", TimeSeries({"time_s": t, "s1_degC": s1, "s2_degC": s2, "d_um": d_um},
-                                                 {"format": FORMAT}))
+    synthetic_record(d / "data.csv")
     return d / "data.csv"
 
 

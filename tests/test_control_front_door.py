@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import synthetic_record
 
 import gatetherm as gt
 from gatetherm.cli import main
@@ -34,12 +35,7 @@ def headstock(tmp_path_factory) -> Path:
 def machine(tmp_path_factory) -> Path:
     """A machine's record (d_um = 2 theta_1 + noise) and the error model fitted on it."""
     d = tmp_path_factory.mktemp("machine")
-    rng = np.random.default_rng(0)
-    t = 60.0 * np.arange(400)
-    s1, s2 = 22 + np.cumsum(rng.normal(0, 0.05, t.size)), 22 + np.cumsum(rng.normal(0, 0.05, t.size))
-    d_um = 2.0 * (s1 - s1[0]) + rng.normal(0, 0.05, t.size)
-    write_timeseries(d / "data.csv", TimeSeries({"time_s": t, "s1_degC": s1, "s2_degC": s2, "d_um": d_um},
-                                                 {"format": FORMAT}))
+    synthetic_record(d / "data.csv")
     assert main(["errormodel", "fit", "--data", str(d / "data.csv"), "--targets", "d_um", "--out", str(d)]) == 0
     return d
 
