@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.geometry.build import _extract
+from gatetherm.geometry.extract import extract_mesh
 from gatetherm.geometry.geoscan import scan
 from gatetherm.geometry.groups import GroupRule, fragment, interfaces, physical, regions
 from gatetherm.geometry.isolate import READ_LIMIT_S, quiet, run_isolated
@@ -194,7 +194,7 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
         _, xyz, _ = gmsh.model.mesh.getNodes()
         if abs(xyz[2::3]).max(initial=0.0) > 1e-12:
             raise InputError(str(spec.path), "a 2-D geometry must lie in the x-y plane", "draw it in z = 0")
-    fm, notes = _extract(gmsh, dim, groups[dim], groups[dim - 1], points, groups[1] if dim == 3 else None)
+    fm, notes = extract_mesh(gmsh, dim, groups[dim], groups[dim - 1], points, groups[1] if dim == 3 else None)
     return to_arrays(fm, notes)
 
 

@@ -10,10 +10,11 @@ import pytest
 
 from gatetherm import InputError
 from gatetherm.geometry.frame import MeshParams
+from gatetherm.geometry.measure import region_volume
 from gatetherm.solvers.effects import (KINDS, ActiveEffects, apply_effects, catalogue_json, effects_from_table,
                                        effects_table, first_order_lag, parse_effect, resolve)
 from gatetherm.solvers.fem import to_skfem
-from gatetherm.solvers.frame import EFFECTS, TARGETS, frame_problem, region_volume
+from gatetherm.solvers.frame import EFFECTS, TARGETS, frame_problem
 from gatetherm.solvers.model import region_fields
 from gatetherm.studies.run.config import Config, load_config, parse_config
 from gatetherm.studies.run.frame_case import frame_case

@@ -132,7 +132,7 @@ def test_gmsh_finalised_when_build_raises(monkeypatch):
     def fail(*args, **kwargs):
         assert gmsh.isInitialized()
         raise RuntimeError("extraction failed")
-    monkeypatch.setattr(gatetherm.geometry.build, "_extract", fail)
+    monkeypatch.setattr(gatetherm.geometry.build, "extract_mesh", fail)
     with pytest.raises(RuntimeError, match="extraction failed"):
         build_mesh(P, 2, COARSE)
     assert not gmsh.isInitialized()
@@ -375,7 +375,7 @@ def test_enclosed_volume_of_the_tank_is_its_box(dim, frame_2d, frame_3d):
     """The oil volume from the tank wall's facets (divergence theorem) is the tank's box, to
     round-off: the box's faces are flat and meshed exactly."""
     from gatetherm.geometry.frame import tank_box
-    from gatetherm.solvers.frame import enclosed_volume
+    from gatetherm.geometry.measure import enclosed_volume
 
     fm = frame_2d if dim == 2 else frame_3d
     p = fm.meta["frame"]

@@ -50,7 +50,7 @@ def check_schedules(case: Case) -> list[Schedule]:
         Its own schedule and, where the case reads only the inputs they drive (the oil supply,
         the pump, the room), the paper's conditions 1-3.
     """
-    from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
+    from gatetherm.studies.run.timeseries import AMBIENT, PUMP, SUPPLY
 
     _case(case)
     out = [case.schedule] if len(case.schedule.times) > 1 else []

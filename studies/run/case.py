@@ -25,12 +25,14 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, argument, ranges
 from gatetherm.files import read_text
+from gatetherm.geometry.measure import region_volume
 from gatetherm.geometry.mesh import FrameMesh, facet_keys
 from gatetherm.solvers.effects import Targets
-from gatetherm.solvers.frame import region_volume
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.problem import FaceFilm, Problem, inputs, values
+from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.run import case_mech, case_mesh, case_sources, case_tables
+from gatetherm.studies.run.origin import ModelParameters, Origin
 from gatetherm.studies.run.parameters import UNCERTAIN_FIX, mesh_parameter
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
 from gatetherm.studies.run.tables import Inputs, Table
@@ -91,18 +93,16 @@ class Case:
     """None: steady state (or a prescribed temperature)."""
     schedule: Schedule = STEADY
     """What drives a run by default (a case file's ``[time]`` and schedule file; a paper condition)."""
-    origin: object = None
-    """How the case was made (:class:`CaseFile` or the frame generator's origin): ``remake``
-    with some of its keys changed (:meth:`with_overrides`), and its ``parameters`` (the
-    hypotheses a diagnosis may move)."""
+    origin: Origin | None = None
+    """How the case was made (:class:`CaseFile` or the frame generator's origin): ``remake`` with some of its
+    keys changed (:meth:`with_overrides`), and its ``parameters`` (the hypotheses a diagnosis may move)."""
     targets: Targets = Targets()
     """The names the effects act on (joints, supports, regions; declared effects)."""
     defaults: dict = field(default_factory=dict)
     """Inputs that a recorded series may leave out, with the value they then keep."""
-    actuator: object = None
-    """The compensation actuator (``[actuator]``: an ActuatorParams), None: ideal (a correction sent
-    to the control as an offset)."""
-    parameters: object = None
+    actuator: ActuatorParams | None = None
+    """The compensation actuator (``[actuator]``), None: ideal (a correction sent to the control as an offset)."""
+    parameters: ModelParameters | None = None
     """What a generator made the case from (the frame's ModelConfig), for analyses that only such a
     model has (beam theory); None for a case file."""
     effects: dict = field(default_factory=dict)

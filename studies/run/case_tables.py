@@ -12,9 +12,9 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.checks import Range, ranges
+from gatetherm.geometry.measure import enclosed_volume
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.geometry.nearest import nearest_on_body
-from gatetherm.solvers.frame import enclosed_volume
 from gatetherm.solvers.material import Material
 from gatetherm.solvers.problem import AXES, FixedTemperature, Fluid, Flux, Probe, Relative, Signals, Support
 from gatetherm.studies.run import case_films, case_mech

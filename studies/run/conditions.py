@@ -15,8 +15,8 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, POSITIVE, admissible
-from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
 from gatetherm.solvers.heat import Drive
+from gatetherm.studies.run.timeseries import AMBIENT, PUMP, SUPPLY
 
 HOUR = 3600.0
 

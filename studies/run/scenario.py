@@ -18,8 +18,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from gatetherm.geometry.measure import region_volume
 from gatetherm.solvers.effects import ActiveEffects, apply_effects
-from gatetherm.solvers.frame import region_volume
 from gatetherm.solvers.heat import HeatSolver, environment
 from gatetherm.solvers.model import Model, build
 from gatetherm.solvers.sensors import apply_faults

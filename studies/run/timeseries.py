@@ -28,10 +28,12 @@ from gatetherm.files import read_text
 log = logging.getLogger(__name__)
 
 FORMAT = "gatetherm-timeseries/1"
-INPUT_COLUMNS = ("time_s", "oil_degC", "pump")
+SUPPLY, PUMP, AMBIENT = "oil_degC", "pump", "ambient_degC"
+"""The inputs of an oil supply unit and the room: the format's input columns (the paper frame's inputs)."""
+INPUT_COLUMNS = ("time_s", SUPPLY, PUMP)
 OUTPUT_COLUMNS = ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")
 #: Optional columns of the format; anything else is kept but reported as unknown.
-OPTIONAL_COLUMNS = ("ambient_degC", "u_piezo_um")
+OPTIONAL_COLUMNS = (AMBIENT, "u_piezo_um")
 _SENSOR_COLUMN = re.compile(r"^T_\w+_degC$")
 #: Admissible values of the columns whose name matches a pattern (the first that does);
 #: any other column holds finite numbers.

@@ -26,12 +26,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY
 from gatetherm.studies.errormodel.fit import FitParams
 from gatetherm.studies.run.reduce import build_rom
 from gatetherm.studies.run.scenario import ScenarioCache, prepare
 from gatetherm.studies.run.schedules import condition_schedule
 from gatetherm.studies.run.simulate import column
+from gatetherm.studies.run.timeseries import AMBIENT, PUMP, SUPPLY
 from gatetherm.studies.sensors import greedy
 from gatetherm.studies.sensors.candidates import Box, candidates as find_candidates
 from gatetherm.studies.sensors.loads import duty_cycles, input_ranges
