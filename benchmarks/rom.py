@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 from gatetherm.solvers.rom_time import discretise, march_rom
-from gatetherm.studies.run.config import load_config
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.config import load_config
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.reduce import build_rom, check_run, series_inputs
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 

@@ -48,7 +48,7 @@ f^0.93 of the factor f: 0.78 million at 20)."""
 def mesh_file(dim: int, factor: float, folder) -> tuple[Path, float]:
     """A configuration file in ``folder`` meshing the ``dim``-D frame with about ``factor`` × the
     default nodes (the element size divided by factor^(1/dim)), and that element size (m)."""
-    from gatetherm.geometry.frame import MeshParams
+    from gatetherm.frame.geometry import MeshParams
 
     key = DEFAULT_SIZE[dim]
     size = getattr(MeshParams(), key) / factor ** (1.0 / dim)
@@ -60,9 +60,9 @@ def mesh_file(dim: int, factor: float, folder) -> tuple[Path, float]:
 def job(dim: int, factor: float) -> dict:
     """Condition 1 on the refined mesh; part times (s) and node counts."""
     from gatetherm.process import configure
-    from gatetherm.studies.run.config import load_config
+    from gatetherm.frame.config import load_config
     from gatetherm.studies.run.output import displacements
-    from gatetherm.studies.run.frame_case import frame_case
+    from gatetherm.frame.case import frame_case
     from gatetherm.studies.run.scenario import prepare
     from gatetherm.studies.run.simulate import delta_figures, run_model
 

@@ -39,7 +39,7 @@ class FrameMesh:
     sensors: dict[str, int]
     meta: dict = field(default_factory=dict, compare=False)
     """What the mesh was made from, when known: ``{"frame": FrameParams}`` for a mesh built
-    by :func:`gatetherm.geometry.build.build_mesh` (not kept in files)."""
+    by :func:`gatetherm.frame.build.build_mesh` (not kept in files)."""
     lines: dict[str, np.ndarray] = field(default_factory=dict)
     """3-D: named curves as (L, 2) node pairs (a support on a line)."""
 

@@ -1,6 +1,7 @@
 """How big a mesh will be, estimated before gmsh meshes, so that a mesh that cannot fit in
-memory is refused at once instead of exhausting the machine: the frame's from its
-parameters, a user's geometry from the gmsh model (in gmsh's process)."""
+memory is refused at once instead of exhausting the machine: a user's geometry from the gmsh
+model (in gmsh's process); the paper frame's from its parameters
+(:func:`gatetherm.frame.build.check_mesh_size`, with these budgets)."""
 from __future__ import annotations
 
 import math
@@ -9,12 +10,11 @@ import os
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.geometry.frame import Box, FrameParams, MeshParams, part_boxes, tank_box
 
 REFERENCE_NODES = 52_812
 """Nodes of the default 3-D frame mesh, at which the constants below were measured."""
 NODES_PER_ELEMENT = {2: 0.6, 3: 0.12}
-"""Nodes per *estimated* element (:func:`element_estimate`, :func:`model_estimate`): the frame's
+"""Nodes per *estimated* element (:func:`gatetherm.frame.build.element_estimate`, :func:`model_estimate`): the frame's
 2-D meshes 0.60-0.53 (7 509 to 53 592 nodes), 3-D 0.116-0.086 (52 812 to 779 457 nodes); the
 larger, so that memory is not underestimated."""
 NONZEROS_PER_NODE = {2: 7.0, 3: 13.6}
@@ -52,23 +52,10 @@ MAX_ELEMENTS = 50e6
 about 6 times the 3-D frame's at 20 times its default nodes (``benchmarks/scaling.py``)."""
 
 
-def _count(measure: float, h: float, dim: int) -> float:
+def count_elements(measure: float, h: float, dim: int) -> float:
     """Elements of size ``h`` in ``measure`` (area, volume); inf where ``h ** dim`` underflows."""
     cell = CELL[dim] * h ** dim
     return measure / cell if cell > 0 else math.inf
-
-
-def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
-    """Elements of the mesh of ``p`` at ``m``'s size: the frame's area (volume) over that of
-    an equilateral triangle (regular tetrahedron) of the element size. Against gmsh's counts
-    from 3k to 200k elements: up to 25 % low in 2-D (the refinement near the tank and the
-    joints), 1.5 to 2.1 times high in 3-D."""
-    def measure(b: Box) -> float:
-        return math.prod(b[2 * i + 1] - b[2 * i] for i in range(dim))
-
-    total = sum(map(measure, part_boxes(p, dim).values())) - measure(tank_box(p, dim))
-    s = m.size if dim == 2 else m.size_3d
-    return _count(total, s, dim)
 
 
 def _measure(gmsh, d: int, t: int) -> float:
@@ -88,7 +75,7 @@ def model_estimate(gmsh, dim: int) -> list[tuple[float, int | None, float]]:
     of their points' sizes, the size factor, the size fields' far size) and each Threshold
     field (its tag: the elements within its distance of the entities it measures from, the
     size growing linearly from SizeMin to SizeMax; a solid in it all at SizeMin). The area
-    (volume) per element of :func:`element_estimate`. Transfinite counts are not seen.
+    (volume) per element of :func:`gatetherm.frame.build.element_estimate`. Transfinite counts are not seen.
     Against gmsh: 1.26 (T4), 2.03 (T1), 1.54 (the C-frame example) times its count."""
     opt, f = gmsh.option.getNumber, gmsh.model.mesh.field
     box = np.reshape(gmsh.model.getBoundingBox(-1, -1), (2, 3))
@@ -102,7 +89,7 @@ def model_estimate(gmsh, dim: int) -> list[tuple[float, int | None, float]]:
         pts = [p for p in gmsh.model.getBoundary([(dim, t)], recursive=True) if p[0] == 0]
         lc = [s for s in gmsh.model.mesh.getSizes(pts) if s > 0] if pts and opt("Mesh.MeshSizeFromPoints") else []
         h = min(clip(math.exp(np.mean(np.log(lc))) if lc else float(np.linalg.norm(box[1] - box[0]))), far)
-        base += _count(_measure(gmsh, dim, t), h, dim)
+        base += count_elements(_measure(gmsh, dim, t), h, dim)
         h_base = min(h_base, h)
     out = [(base, None, h_base)]
     total = sum(_measure(gmsh, dim, t) for t in solids)
@@ -117,13 +104,13 @@ def model_estimate(gmsh, dim: int) -> list[tuple[float, int | None, float]]:
         n = 0.0
         for d, e in near:
             if d == dim:  # inside a solid: all at SizeMin, then the ramp outside its boundary
-                n += _count(_measure(gmsh, d, e), smin, dim)
+                n += count_elements(_measure(gmsh, d, e), smin, dim)
                 near += [(b, abs(t)) for b, t in gmsh.model.getBoundary([(d, e)], oriented=False)]
                 continue
             shell = {1: 2.0 * np.ones_like(r), 2: 2 * np.pi * r, 3: 4 * np.pi * r ** 2}[dim - d]
             with np.errstate(divide="ignore", over="ignore"):  # inf where h ** dim underflows
                 n += float(np.sum(_measure(gmsh, d, e) * shell / (CELL[dim] * h ** dim)) * (r[1] - r[0]))
-        out.append((min(n, _count(total, smin, dim)), int(tag), float(f.getNumber(tag, "SizeMin"))))
+        out.append((min(n, count_elements(total, smin, dim)), int(tag), float(f.getNumber(tag, "SizeMin"))))
     return out
 
 
@@ -202,9 +189,3 @@ def check_count(elements: float, dim: int, key: str, size: float, unit: str = " 
     about = "" if counted or not math.isfinite(elements) else "about "
     raise InputError(key, f"{size:g}{unit} gives {about}{got}, more than the budget of "
                      f"{MAX_ELEMENTS:.3g} elements", fix)
-
-
-def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
-    """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
-    key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
-    check_estimate(element_estimate(p, m, dim), dim, key, s)

@@ -4,7 +4,7 @@ the mesh's regions, boundaries and points by name; values that vary in time are
 :class:`~gatetherm.solvers.expr.Value` expressions of the run's inputs.
 
 A case file (``gatetherm run``) is read into a :class:`Problem`; the paper's frame is
-one too (:func:`gatetherm.solvers.frame.frame_problem`).
+one too (:func:`gatetherm.frame.problem.frame_problem`).
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ import functools
 
 import pytest
 
-from gatetherm.geometry.build import build_mesh
+from gatetherm.frame.build import build_mesh
 # The verification frame (validation/verification_time.py, also run by `gatetherm report`):
 # FIXED, a fixed frame (not the calibrated defaults) so that hand values in tests stay valid,
 # COARSE its mesh density, FIXED_MODEL the model whose meshes frame_2d, frame_3d are.
@@ -18,8 +18,8 @@ _ORDERS = pytest.StashKey[list]()
 @functools.lru_cache(maxsize=1)
 def fixed_case(dim: int = 2):
     """The frame of :data:`FIXED_MODEL` as a case (meshed once per session)."""
-    from gatetherm.studies.run.config import Config
-    from gatetherm.studies.run.frame_case import frame_case
+    from gatetherm.frame.config import Config
+    from gatetherm.frame.case import frame_case
 
     return frame_case(Config(model=FIXED_MODEL), dim)
 

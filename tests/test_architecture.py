@@ -15,8 +15,8 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Source folder -> package it installs as (pyproject.toml's package-dir).
 FOLDERS = {"core": "gatetherm", "geometry": "gatetherm.geometry", "solvers": "gatetherm.solvers",
            "studies": "gatetherm.studies", "validation": "gatetherm.validation"}
-LAYERS = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.validation",
-          "gatetherm.api", "gatetherm.cli")
+LAYERS = ("gatetherm", "gatetherm.geometry", "gatetherm.solvers", "gatetherm.studies", "gatetherm.frame",
+          "gatetherm.validation", "gatetherm.api", "gatetherm.cli")
 PLOTTING = ("matplotlib", "pyvista", "vtk", "vtkmodules")
 
 
@@ -59,8 +59,65 @@ def test_every_package_folder_is_mapped():
 def test_no_back_edges(name):
     own = layer(name)
     later = sorted(m for m in imports(MODULES[name])
-                   if (m == "gatetherm" or m.startswith("gatetherm.")) and m in MODULES and layer(m) > own)
+                   if (m == "gatetherm" or m.startswith("gatetherm.")) and m in MODULES and layer(m) > own
+                   and not (name in WING_IMPORTERS and in_wing(m)))  # those: test_nothing_generic_imports_the_wing
     assert not later, f"{name} ({LAYERS[own]}) imports later layers: {later}"
+
+
+# ---- the paper's frame is one wing (issue 52 item 2) ----------------------------------------------------
+
+WING = "gatetherm.frame"
+"""The paper's gate frame (core/frame/): its geometry and gmsh builder, problem, beam theory, load
+cases, model file, case generator and design sweeps. It makes a plain Case; validation, the API and
+the CLI may import it, the root package, geometry, solvers and studies never do."""
+#: Generic modules that still import the wing, with the reason; they only shrink (a stale entry fails).
+WING_IMPORTERS = {
+    "gatetherm.studies.sweeps.sweep": "a study's base is a case file or the frame: plan() applies the frame's "
+                                      "keys (gatetherm.frame.sweeppoint) to its model file (Config)",
+    "gatetherm.studies.sweeps.evaluate": "evaluates a frame point (its case, beam theory, FE load cases) beside "
+                                         "a case point",
+    "gatetherm.studies.sweeps.studyfile": "reads a frame study's model file ([study] config) beside a case study's case",
+}
+
+
+def in_wing(module: str) -> bool:
+    return module == WING or module.startswith(WING + ".")
+
+
+def wing_imports(path: Path) -> list[str]:
+    """The modules of the wing that the module at ``path`` imports (top level or inside a function)."""
+    return sorted(m for m in imports(path) if in_wing(m))
+
+
+BELOW_THE_WING = sorted(m for m in MODULES if layer(m) < LAYERS.index(WING))
+
+
+@pytest.mark.parametrize("name", BELOW_THE_WING)
+def test_nothing_generic_imports_the_wing(name):
+    """The root package, geometry, solvers and studies never import gatetherm.frame: where generic code
+    needs a frame fact it is passed in from above (the frame's case origin offers its beam coefficients
+    and oil supply; the API passes the rest)."""
+    bad = wing_imports(MODULES[name])
+    if name in WING_IMPORTERS:
+        assert bad, f"{name} no longer imports the frame's wing: remove it from WING_IMPORTERS"
+    else:
+        assert not bad, f"{name} ({LAYERS[layer(name)]}) imports the frame's wing: {bad}; pass what it needs in " \
+                        "from above (the case's origin, an argument) or move the module into core/frame/"
+
+
+def test_the_wing_check_sees_an_import_of_the_wing(tmp_path):
+    """The checker itself: the wing imported in every form, at the top level and inside a function,
+    is caught; a name that only starts like it is not; the wing sits between studies and validation."""
+    path = tmp_path / "generic.py"
+    path.write_text("import gatetherm.frame.beam\nfrom gatetherm import frame\nfrom gatetherm.frameworks import x\n\n"
+                    "def f():\n    from gatetherm.frame.case import gate_frame\n    import gatetherm.solvers.heat\n")
+    assert wing_imports(path) == ["gatetherm.frame", "gatetherm.frame.beam", "gatetherm.frame.case",
+                                  "gatetherm.frame.case.gate_frame"]
+    assert layer("gatetherm.studies.run.case") < layer("gatetherm.frame.case") < layer("gatetherm.validation.truth")
+    assert "gatetherm.frame.case" in MODULES and "gatetherm.frame.case" not in BELOW_THE_WING
+    assert {"gatetherm", "gatetherm.geometry.mesh", "gatetherm.solvers.heat", "gatetherm.studies.run.case"} \
+        <= set(BELOW_THE_WING)
+    assert set(WING_IMPORTERS) <= set(BELOW_THE_WING)
 
 
 @pytest.mark.parametrize("name", sorted(m for m in MODULES if layer(m) <= LAYERS.index("gatetherm.solvers")))

@@ -20,7 +20,7 @@ from gatetherm import InputError
 from gatetherm.checks import ranges
 from gatetherm.outdir import LOCK, output_dir
 from gatetherm.cli import main
-from gatetherm.studies.run.config import SCHEMA, parse_config
+from gatetherm.frame.config import SCHEMA, parse_config
 from gatetherm.studies.run.timeseries import read_timeseries
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate
 from test_compensator import HAND
@@ -109,7 +109,7 @@ def test_model_file_paths(tmp_path, capsys, make, needle):
 def test_model_file_with_bom_and_crlf_is_read(tmp_path):
     """As a Windows editor writes it."""
     cfg = _write(tmp_path / "m.toml", b"\xef\xbb\xbf# model\r\n[geometry]\r\nl4 = 0.3\r\n")
-    from gatetherm.studies.run.config import load_config
+    from gatetherm.frame.config import load_config
 
     assert load_config(cfg).model.frame.l4 == 0.3
 

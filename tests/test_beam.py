@@ -9,8 +9,8 @@ import pytest
 from scipy.optimize import brentq, minimize_scalar
 
 from gatetherm import InputError
-from gatetherm.solvers import beam
-from gatetherm.solvers.beam import BeamModel, coefficients, delta, normalised, tie_force
+from gatetherm.frame import beam
+from gatetherm.frame.beam import BeamModel, coefficients, delta, normalised, tie_force
 
 BETAS = (0.01, 0.03, 0.1, 0.3, 1.0)
 

@@ -8,11 +8,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from gatetherm.solvers import beam
-from gatetherm.solvers.frame import build_model
-from gatetherm.solvers.reduced import fe_coefficients
-from gatetherm.solvers.beam import theory_coefficients
-from gatetherm.studies.run.config import parse_config
+from gatetherm.frame import beam
+from gatetherm.frame.problem import build_model
+from gatetherm.frame.loadcases import fe_coefficients
+from gatetherm.frame.beam import theory_coefficients
+from gatetherm.frame.config import parse_config
 from gatetherm.studies.sweeps.sweep import configure, plan
 from gatetherm.validation import beam_vs_fe as bv
 

@@ -56,7 +56,7 @@ def test_groups_of_different_dimension_keep_their_names(tmp_path, fmt):
     else:
         import gmsh
 
-        from gatetherm.geometry.build import gmsh_session
+        from gatetherm.frame.build import gmsh_session
 
         path = tmp_path / "m.msh"
         with gmsh_session():

@@ -12,19 +12,19 @@ import json
 import numpy as np
 import pytest
 
-from gatetherm.solvers import beam
-from gatetherm.solvers.frame import build_model
-from gatetherm.solvers.reduced import fe_coefficients
+from gatetherm.frame import beam
+from gatetherm.frame.problem import build_model
+from gatetherm.frame.loadcases import fe_coefficients
 from gatetherm import cli
 from gatetherm.studies.control.actuator import ActuatorParams, dead_band_um
 from gatetherm.studies.control.methods import Settings, coefficients
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import FORMAT
-from gatetherm.solvers.beam import theory_coefficients
-from gatetherm.solvers.reduced import tip_coefficients_um
+from gatetherm.frame.beam import theory_coefficients
+from gatetherm.frame.loadcases import tip_coefficients_um
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
-from gatetherm.studies.run.config import load_config
+from gatetherm.frame.config import load_config
 from gatetherm.studies.run.simulate import run_model, sample_times
 from gatetherm.studies.run.timeseries import read_timeseries, write_timeseries
 from gatetherm.validation import compensation_study

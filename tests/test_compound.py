@@ -14,14 +14,14 @@ import json
 import numpy as np
 import pytest
 
-from gatetherm.geometry.frame import MeshParams
+from gatetherm.frame.geometry import MeshParams
 from gatetherm.cli import main
 from gatetherm.studies.diagnosis.calibrate import Objective, group_weights
 from gatetherm.studies.diagnosis.discrepancy import Settings, adopted_case, candidates, diagnose
 from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels
-from gatetherm.studies.run.config import config_toml, load_config
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.config import config_toml, load_config
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.scenario import measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries, write_timeseries
 from gatetherm.validation.compound_study import draw_value, kinds_markdown, pairs, pieces_by_key, visible

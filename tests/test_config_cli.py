@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gatetherm.cli import main
-from gatetherm.studies.run.config import Config, load_config, parse_config
+from gatetherm.frame.config import Config, load_config, parse_config
 from gatetherm import InputError
 from gatetherm.studies.run.timeseries import read_timeseries
 

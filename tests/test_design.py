@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gatetherm.studies.sweeps import design as ds
-from gatetherm.studies.run.config import parse_config
+from gatetherm.frame import design as ds
+from gatetherm.frame.config import parse_config
 from gatetherm.studies.sweeps.sweep import plan
 from gatetherm.studies.sweeps.evaluate import evaluate
 

@@ -13,21 +13,21 @@ import json
 import numpy as np
 import pytest
 
-from gatetherm.geometry.frame import MeshParams
+from gatetherm.frame.geometry import MeshParams
 from gatetherm.studies.diagnosis.calibrate import Scored
 from gatetherm.cli import main
-from gatetherm.solvers.frame import build_model
+from gatetherm.frame.problem import build_model
 from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
-from gatetherm.studies.run.config import load_config
+from gatetherm.frame.config import load_config
 from gatetherm.studies.diagnosis.discrepancy import Settings, _verdict, adopted_case, diagnose
-from gatetherm.solvers.frame import TARGETS
+from gatetherm.frame.problem import TARGETS
 from gatetherm.studies.diagnosis.hypotheses import effect_pieces
 from gatetherm.studies.diagnosis.select import Selection
 from gatetherm.studies.diagnosis.locate import Phase, locate, noise_sd, phases, significant, smooth, threshold
-from gatetherm.studies.run.config import config_toml
+from gatetherm.frame.config import config_toml
 from gatetherm.studies.run.simulate import run_model
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels, residuals
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.scenario import condition_schedule, measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.truth import Case, measured, truth

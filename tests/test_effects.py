@@ -9,15 +9,15 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.geometry.frame import MeshParams
+from gatetherm.frame.geometry import MeshParams
 from gatetherm.geometry.measure import region_volume
 from gatetherm.solvers.effects import (KINDS, ActiveEffects, apply_effects, catalogue_json, effects_from_table,
                                        effects_table, first_order_lag, parse_effect, resolve)
 from gatetherm.solvers.fem import to_skfem
-from gatetherm.solvers.frame import EFFECTS, TARGETS, frame_problem
+from gatetherm.frame.problem import EFFECTS, TARGETS, frame_problem
 from gatetherm.solvers.model import region_fields
-from gatetherm.studies.run.config import Config, load_config, parse_config
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.config import Config, load_config, parse_config
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.scenario import run_scenario
 from conftest import FIXED_MODEL, fixed_condition
 
@@ -88,7 +88,7 @@ def test_observation_effects_and_the_drifting_room(frame_2d):
 def test_model_effects_edit_the_named_parts(frame_2d):
     eff = ActiveEffects({"joint_resistance": 500.0, "joint_compliance": 2e11, "compliant_base": 1e10,
                          "base_conduction": 100.0, "piezo_heat": 2.0}, TARGETS)
-    from gatetherm.solvers.frame import frame_targets
+    from gatetherm.frame.problem import frame_targets
 
     eff = dataclasses.replace(eff, targets=frame_targets(FIXED_MODEL, frame_2d.regions))
     problem = apply_effects(frame_problem(FIXED_MODEL, frame_2d), eff, lambda r: region_volume(frame_2d, r, 0.12))

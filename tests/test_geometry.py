@@ -8,10 +8,10 @@ import gmsh
 import numpy as np
 import pytest
 
-import gatetherm.geometry.build
-from gatetherm.geometry.build import build_mesh
+import gatetherm.frame.build
+from gatetherm.frame.build import build_mesh
 from gatetherm import InputError
-from gatetherm.geometry.frame import FrameParams, MeshParams, sensor_points, tie_depth, validate, width
+from gatetherm.frame.geometry import FrameParams, MeshParams, sensor_points, tie_depth, validate, width
 from gatetherm.geometry.mesh import load_mesh, save_mesh
 
 from conftest import COARSE, FIXED as P
@@ -132,7 +132,7 @@ def test_gmsh_finalised_when_build_raises(monkeypatch):
     def fail(*args, **kwargs):
         assert gmsh.isInitialized()
         raise RuntimeError("extraction failed")
-    monkeypatch.setattr(gatetherm.geometry.build, "extract_mesh", fail)
+    monkeypatch.setattr(gatetherm.frame.build, "extract_mesh", fail)
     with pytest.raises(RuntimeError, match="extraction failed"):
         build_mesh(P, 2, COARSE)
     assert not gmsh.isInitialized()
@@ -374,7 +374,7 @@ def test_a_point_group_off_the_nodes_is_snapped_or_refused(tmp_path, caplog):
 def test_enclosed_volume_of_the_tank_is_its_box(dim, frame_2d, frame_3d):
     """The oil volume from the tank wall's facets (divergence theorem) is the tank's box, to
     round-off: the box's faces are flat and meshed exactly."""
-    from gatetherm.geometry.frame import tank_box
+    from gatetherm.frame.geometry import tank_box
     from gatetherm.geometry.measure import enclosed_volume
 
     fm = frame_2d if dim == 2 else frame_3d

@@ -17,7 +17,7 @@ import scipy.sparse as sp
 
 from gatetherm import process
 from gatetherm.solvers import iterative, p1, plan
-from gatetherm.solvers.frame import build_model
+from gatetherm.frame.problem import build_model
 from gatetherm.solvers import model as model_module
 from gatetherm.solvers.helper import Pending, SolveHelper, forked
 from gatetherm.solvers.iterative import PCG, SolverError

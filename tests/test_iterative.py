@@ -9,7 +9,7 @@ import pytest
 
 from gatetherm import InputError
 from gatetherm.solvers import iterative, krylov, plan
-from gatetherm.solvers.frame import build_model
+from gatetherm.frame.problem import build_model
 from gatetherm.solvers.linsolve import planned_solver, spd_factor
 from gatetherm.solvers.rom import _weights, linear_heat_model, project, reduce
 from gatetherm.solvers.rom_time import simulate_rom

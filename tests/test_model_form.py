@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.geometry.frame import MeshParams
+from gatetherm.frame.geometry import MeshParams
 from gatetherm.studies.diagnosis.calibrate import Objective, fit_one
 from gatetherm.studies.diagnosis.checks import explained_channels, folds, implausible, model_form
 from gatetherm.studies.diagnosis.discrepancy import case_phases
@@ -21,8 +21,8 @@ from gatetherm.studies.diagnosis.identify import ANGLE_DEG, groups, physical_fir
 from gatetherm.studies.diagnosis.locate import Phase, locate
 from gatetherm.studies.diagnosis.pattern import kind_of_cause
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels
-from gatetherm.studies.run.config import load_config
-from gatetherm.studies.run.frame_case import frame_case, frame_geometry
+from gatetherm.frame.config import load_config
+from gatetherm.frame.case import frame_case, frame_geometry
 from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.validation.compound_study import pieces_by_key
 from gatetherm.validation.scoring import score

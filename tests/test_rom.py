@@ -6,7 +6,7 @@ import scipy.sparse as sp
 
 from gatetherm import InputError
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
-from gatetherm.solvers.frame import build_model
+from gatetherm.frame.problem import build_model
 from gatetherm.solvers.rom import Input, ReducedModel, linear_heat_model, reduce
 from gatetherm.studies.run.reduce import load_rom, series_inputs, write_rom
 from gatetherm.solvers.rom_time import discretise, march_rom, simulate_rom

@@ -268,8 +268,8 @@ def test_after_gmsh_ran_here_its_processes_start_afresh(tmp_path):
     """A 3-D mesh made in this process leaves gmsh's threads behind: a forked child would wait
     for them for ever, so the next mesh is made by a new interpreter (in a subprocess here,
     not to leave the threads in the test session)."""
-    code = ("from gatetherm.geometry.build import _build, build_mesh, gmsh_session\n"
-            "from gatetherm.geometry.frame import FrameParams, MeshParams\n"
+    code = ("from gatetherm.frame.build import _build, build_mesh, gmsh_session\n"
+            "from gatetherm.frame.geometry import FrameParams, MeshParams\n"
             "from gatetherm.geometry.isolate import THREADS_STARTED\n"
             "m = MeshParams(size=0.04, size_3d=0.08)\n"
             "with gmsh_session() as g:\n    _build(FrameParams(), 3, m, g)\n"
@@ -280,7 +280,7 @@ def test_after_gmsh_ran_here_its_processes_start_afresh(tmp_path):
 
 
 def test_a_spawned_child_makes_the_same_mesh(monkeypatch):
-    from gatetherm.geometry.build import build_mesh
+    from gatetherm.frame.build import build_mesh
 
     from conftest import COARSE, FIXED
 

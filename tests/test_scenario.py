@@ -10,10 +10,10 @@ import pytest
 
 from conftest import COARSE, FIXED, FIXED_MODEL, fixed_condition
 from gatetherm import InputError
-from gatetherm.solvers.frame import build_model
+from gatetherm.frame.problem import build_model
 from gatetherm.cli import main
-from gatetherm.studies.run.config import config_toml, load_config
-from gatetherm.studies.run.frame_case import gate_frame
+from gatetherm.frame.config import config_toml, load_config
+from gatetherm.frame.case import gate_frame
 from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 
 EFFECT = {"compliant_base": 3e10}

@@ -11,7 +11,7 @@ from conftest import fixed_condition
 from gatetherm import InputError
 from gatetherm.solvers.effects import first_order_lag
 from gatetherm.solvers.sensors import apply_fault, apply_faults, compose, faults_from_table, faults_of
-from gatetherm.studies.run.config import config_toml, load_config, parse_config
+from gatetherm.frame.config import config_toml, load_config, parse_config
 from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 
 T = np.arange(0.0, 7200.0 + 1, 60.0)

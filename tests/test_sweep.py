@@ -16,12 +16,12 @@ import pytest
 import gatetherm
 
 from gatetherm import InputError
-from gatetherm.solvers import beam
+from gatetherm.frame import beam
 from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
 from gatetherm.cli import main
 from gatetherm.studies.sweeps import runner as sweep_runner
 from gatetherm.studies.sweeps.studyfile import parse_study
-from gatetherm.studies.run.config import parse_config
+from gatetherm.frame.config import parse_config
 
 #: A fully specified frame (independent of the shipped paper model, which is recalibrated).
 MODEL = {

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gatetherm.solvers.heat import TimeScheme
-from gatetherm.solvers.frame import PUMP, build_model
+from gatetherm.frame.problem import PUMP, build_model
 from conftest import FIXED_MODEL
 from gatetherm.validation.verification import SPATIAL_HEAT, heat_mms_error, spatial_study
 from gatetherm.validation.verification_time import (TIME_CASES, FRAME_TIMES, frame_drive, frame_energy, imbalances,

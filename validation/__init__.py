@@ -6,7 +6,7 @@ def paper_model(**mesh):
     model's own) replaced."""
     import dataclasses
 
-    from gatetherm.studies.run.config import load_config
+    from gatetherm.frame.config import load_config
 
     cfg = load_config()
     mesh = {k: v for k, v in mesh.items() if v}

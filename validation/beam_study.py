@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import write_text_atomic
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
 from gatetherm.studies.sweeps.runner import run_points, write_table
 
 
@@ -43,7 +43,7 @@ def write_beam_study(out: Path, base: Config, dim: int, workers: int = 1, schedu
     ``series``: a subset, see :func:`beam_vs_fe.studies`), write the tables, figures and
     ``report.md``; returns the summary (also ``summary.json``) with ``lines``, the key figures
     as sentences, ``by_beta`` (the error summary per coefficient and beta) and ``effective``."""
-    from gatetherm.solvers.beam import normalised
+    from gatetherm.frame.beam import normalised
     from gatetherm.validation import beam_vs_fe as bv
     from gatetherm.validation import beam_vs_fe_report as bv_report
     from gatetherm.validation.plots import save

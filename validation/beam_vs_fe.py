@@ -5,7 +5,7 @@ paper model with ``l1 = l/2`` and the columns slenderised to ``l/h = SLENDERNESS
 (``h = l/SLENDERNESS``; the tank's x-extent scaled with ``h``), ``beta`` set through
 ``A_C`` and ``l4 = l/a``; the column is raised for tie bars above the arms and, in 3-D,
 ``t_C`` is raised until the tie bar fits behind the arms. FE values are the
-element-exact load cases of solvers/reduced.py read at E (and at F).
+element-exact load cases of core/frame/loadcases.py read at E (and at F).
 
 Controlled series explain the gaps: the same sweep without the tank cavity, a
 slenderness series ``l/h``, a tie-bar height series ``t_C`` and a mesh series; and
@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from gatetherm.geometry.frame import MeshParams
-from gatetherm.solvers.beam import column_I
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.geometry import MeshParams
+from gatetherm.frame.beam import column_I
+from gatetherm.frame.config import Config
 from gatetherm.studies.sweeps.sweep import Study
 
 SLENDERNESS = 8.0

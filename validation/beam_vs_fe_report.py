@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
 from gatetherm.validation.beam_vs_fe import (A_VALUES, ABS_TOL_UM, ELEMENTS_ACROSS, GAP_REL, PARTS, REL_TOL, SLENDERNESS,
                                    agreement, cavity_stiffness_ratio)
 

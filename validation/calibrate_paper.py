@@ -15,7 +15,7 @@ import logging
 import numpy as np
 from scipy.optimize import minimize
 
-from gatetherm.studies.run.frame_case import condition_runs
+from gatetherm.frame.case import condition_runs
 from gatetherm.studies.run.scenario import ScenarioCache
 from gatetherm.studies.run.simulate import delta_figures
 from gatetherm.validation import paper_model

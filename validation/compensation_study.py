@@ -39,8 +39,8 @@ import numpy as np
 
 from gatetherm import write_text_atomic
 from gatetherm.studies.control import actuator as piezo
-from gatetherm.solvers.beam import theory_coefficients
-from gatetherm.solvers.reduced import tip_coefficients_um
+from gatetherm.frame.beam import theory_coefficients
+from gatetherm.frame.loadcases import tip_coefficients_um
 from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction,
                                                    predict, summarize)
 from gatetherm.studies.run.conditions import condition
@@ -140,7 +140,7 @@ def _row(number: int, label: str, ts, predictor, params, actuator) -> tuple[Row,
 def study(cfg, dim: int = 2, conditions=(1, 2, 3), params: CompensatorParams = CompensatorParams(),
           actuator: piezo.ActuatorParams = piezo.ActuatorParams()) -> Study:
     """Simulate ``conditions`` on ``cfg``'s model and compensate each with every predictor."""
-    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.frame.case import condition_runs
     from gatetherm.studies.run.scenario import ScenarioCache
     from gatetherm.studies.run.timeseries import FORMAT
 

@@ -34,8 +34,8 @@ from gatetherm.studies.diagnosis.calibrate import coordinate
 from gatetherm.studies.diagnosis.discrepancy import diagnose
 from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece, catalogue, configure
 from gatetherm.studies.diagnosis.replay import DELTA
-from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.config import Config
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 from gatetherm.studies.sweeps.pool import run_pool

@@ -1,13 +1,13 @@
 """``gatetherm validate design``: the tie-bar position that minimises the 5-h swing of
 delta over conditions 1-3, and a second tie bar above the cutting area (the numbers are
-studies/sweeps/design.py; this writes the tables, figures and report)."""
+core/frame/design.py; this writes the tables, figures and report)."""
 from __future__ import annotations
 
 import time
 from pathlib import Path
 
 from gatetherm import write_text_atomic
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
 from gatetherm.studies.sweeps.runner import run_points, write_table
 from gatetherm.validation.beam_study import columns_of, cpu_seconds
 
@@ -17,9 +17,9 @@ def write_design_study(out: Path, base: Config, dim: int, workers: int = 1, sche
                        second_above=None) -> list[str]:
     """Run the design studies (resumable), write the tables, figures and ``report.md``;
     returns the key figures as sentences. ``positions``, ``refine``, ``second_above``: a
-    coarser grid than studies/sweeps/design.py's (first grid, refined points, second-bar
+    coarser grid than core/frame/design.py's (first grid, refined points, second-bar
     heights as fractions of l)."""
-    from gatetherm.studies.sweeps import design as ds
+    from gatetherm.frame import design as ds
     from gatetherm.studies.sweeps.sweep import table
     from gatetherm.validation.plots import save
     from gatetherm.validation.plots.sweep import plot_histories, plot_positions, plot_second

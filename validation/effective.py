@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
 
 log = logging.getLogger(__name__)
 
@@ -54,7 +54,7 @@ def score(name: str, ki: float, kc: float, runs: dict[int, dict]) -> Source:
 
 def condition_runs(cfg: Config, dim: int) -> tuple[object, dict[int, dict]]:
     """The model and its run columns for conditions 1-3."""
-    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.frame.case import condition_runs
     from gatetherm.studies.run.scenario import ScenarioCache
 
     runs = condition_runs(cfg, dim, CONDITIONS, ScenarioCache())
@@ -64,8 +64,8 @@ def condition_runs(cfg: Config, dim: int) -> tuple[object, dict[int, dict]]:
 def effective_coefficients(cfg: Config, dim: int = 2) -> list[Source]:
     """Theory, FE load cases (at F) and least-squares fits (per run and pooled),
     each scored on all three runs."""
-    from gatetherm.solvers.reduced import fe_coefficients
-    from gatetherm.solvers.beam import theory_coefficients
+    from gatetherm.frame.loadcases import fe_coefficients
+    from gatetherm.frame.beam import theory_coefficients
     from gatetherm.studies.control.regression import fit_coefficients
 
     model, runs = condition_runs(cfg, dim)

@@ -35,9 +35,9 @@ import numpy as np
 
 from gatetherm import write_text_atomic
 from gatetherm.solvers.effects import resolve
-from gatetherm.solvers.frame import EFFECTS, TARGETS
-from gatetherm.studies.run.config import Config, load_config
-from gatetherm.studies.run.frame_case import FRAME_GEOMETRY, frame_case
+from gatetherm.frame.problem import EFFECTS, TARGETS
+from gatetherm.frame.config import Config, load_config
+from gatetherm.frame.case import FRAME_GEOMETRY, frame_case
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
 from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.sweeps.pool import run_pool

@@ -12,7 +12,7 @@ import json
 from pathlib import Path
 
 from gatetherm import write_text_atomic
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
 
 #: (condition, summary key, paper value, label); cond. 3's peak is its second positive one.
 PAPER = [(1, "first_peak_um", 44.0, "first peak [µm]"), (1, "first_peak_min", 15.0, "time of peak [min]"),
@@ -33,7 +33,7 @@ def within(key: str, got: float | None, want: float, dim: int) -> bool:
 
 def run_condition(cfg: Config, dim: int, c: int, cache=None, keep_times=()):
     """(the run, its summary: the figures of :data:`PAPER`, wall time, nodes) of condition ``c``."""
-    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.frame.case import condition_runs
     from gatetherm.studies.run.simulate import delta_figures
 
     run = condition_runs(cfg, dim, (c,), cache, keep_times=keep_times)[c]

@@ -34,14 +34,14 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import write_text_atomic
-from gatetherm.solvers.beam import theory_coefficients
+from gatetherm.frame.beam import theory_coefficients
 from gatetherm.solvers.effects import resolve
-from gatetherm.solvers.frame import EFFECTS, TARGETS
+from gatetherm.frame.problem import EFFECTS, TARGETS
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.control.compensator import CompensatorParams, close_loop, external_prediction, summarize
 from gatetherm.studies.control.predictive import PredictiveParams
 from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
-from gatetherm.studies.run.frame_case import frame_case
+from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.reduce import cached_rom, check_run, rom_outputs
 from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
 from gatetherm.validation.truth import Case, measured, truth

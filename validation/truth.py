@@ -15,11 +15,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gatetherm.solvers.frame import EFFECTS
+from gatetherm.frame.problem import EFFECTS
 from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.diagnosis.replay import resolution
-from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.frame_case import FRAME_GEOMETRY, frame_case
+from gatetherm.frame.config import Config
+from gatetherm.frame.case import FRAME_GEOMETRY, frame_case
 from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, OUTPUT_COLUMNS, TimeSeries
@@ -50,7 +50,7 @@ MISMATCH = {"mismatch:h_oil_on": (1.5,), "mismatch:h_air": (0.6,)}
 #: The parameter piece that names each mismatch.
 MISMATCH_PIECE = {"mismatch:h_oil_on": "oil_film_on", "mismatch:h_air": "air_film"}
 GEOMETRY_OFF = (0.05, 0.10)
-"""A dimension the diagnosis tries (:data:`~gatetherm.studies.run.frame_case.FRAME_GEOMETRY`) is off by
+"""A dimension the diagnosis tries (:data:`~gatetherm.frame.case.FRAME_GEOMETRY`) is off by
 this fraction of its value (drawn uniformly, either sign)."""
 
 
@@ -105,7 +105,7 @@ def truth(config: Config, case: Case, dim: int = 2, mesh_factor: float = TRUTH_M
             return {**drive(t), "ambient_degC": room + case.strength * np.sin(2 * np.pi * t / SINE_PERIOD_S)}
         return run(cfg, dataclasses.replace(sched, drive=swinging)).columns
     elif case.effect == "tie_heat_leak":
-        from gatetherm.geometry.frame import part_boxes
+        from gatetherm.frame.geometry import part_boxes
 
         x0, x1, y0, y1, z0, z1 = part_boxes(cfg.frame, dim)["tie_bar"]
         cfg = dataclasses.replace(cfg, source={"tie_bar": -case.strength / ((x1 - x0) * (y1 - y0) * (z1 - z0))})

@@ -12,9 +12,9 @@ import numpy as np
 import scipy.linalg
 from scipy.optimize import brentq
 
-from gatetherm.geometry.frame import FrameParams, MeshParams
+from gatetherm.frame.geometry import FrameParams, MeshParams
 from gatetherm.solvers.expr import Value
-from gatetherm.solvers.frame import AMBIENT, PUMP, SUPPLY, ModelConfig, ThermalParams, build_model, paper_heat
+from gatetherm.frame.problem import AMBIENT, PUMP, SUPPLY, ModelConfig, ThermalParams, build_model, paper_heat
 from gatetherm.solvers.heat import HeatSolver, HeatSystem, TimeScheme, assemble_heat, environment, march
 from gatetherm.solvers.problem import Film, Problem
 from gatetherm.validation.verification import observed_order, rectangle, uniform_fields

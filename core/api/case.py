@@ -13,8 +13,8 @@ from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.case import load_case as _load_case
 from gatetherm.studies.run.conditions import CONDITIONS
 from gatetherm.studies.run.conditions import condition as _condition
-from gatetherm.studies.run.config import Config
-from gatetherm.studies.run.frame_case import gate_frame as _gate_frame
+from gatetherm.frame.config import Config
+from gatetherm.frame.case import gate_frame as _gate_frame
 from gatetherm.studies.run.schedules import Schedule, condition_schedule, file_schedule
 
 __all__ = ["Case", "Schedule", "beam_coefficients", "condition", "gate_frame", "load_case", "nc_schedule",

@@ -50,7 +50,7 @@ class FrameFiles:
 
     def _write(self, stage: Path) -> None:
         from gatetherm.geometry.mesh import save_mesh
-        from gatetherm.studies.run.frame_case import write_frame_case
+        from gatetherm.frame.case import write_frame_case
 
         for name in MESH_FILES:
             save_mesh(self.case.mesh, stage / name)
@@ -140,7 +140,7 @@ def beam_normalised(l_over_l4: float, beta: float) -> BeamCoefficients:
     -------
     BeamCoefficients
     """
-    from gatetherm.solvers.beam import normalised
+    from gatetherm.frame.beam import normalised
 
     a = float(argument("l_over_l4", l_over_l4, numbers.Real, "a number", "pass l/l4, e.g. 1.5"))
     b = float(argument("beta", beta, numbers.Real, "a number", "pass e.g. 0.1"))

@@ -30,7 +30,7 @@ class Validation:
 
 
 def _config(o):
-    from gatetherm.studies.run.config import load_config
+    from gatetherm.frame.config import load_config
 
     return load_config(o.get("config"))
 

@@ -30,8 +30,8 @@ the start) and the hold is logged. No prediction exists for the first two sample
 The piezo command ``u = -delta_et`` is refreshed every ``update_interval_s`` from the
 first sample and held in between (0 before the first prediction).
 
-Coefficient sources (um/K): ``gatetherm.solvers.beam.theory_coefficients`` (beam theory of a
-model's frame), ``gatetherm.solvers.reduced.tip_coefficients_um`` (FE load cases at the tips F), and
+Coefficient sources (um/K): ``gatetherm.frame.beam.theory_coefficients`` (beam theory of a
+model's frame), ``gatetherm.frame.loadcases.tip_coefficients_um`` (FE load cases at the tips F), and
 ``studies.regression.fit_coefficients`` (least squares on a run). Any other predictor
 (e.g. the static regression baseline) can drive the same loop via :func:`external_prediction`.
 """

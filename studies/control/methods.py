@@ -112,7 +112,8 @@ def _coefficients(case, ts, s: Settings, cache) -> tuple[float, float, str, str]
         if not (math.isfinite(s.Ki) and math.isfinite(s.Kc)):
             raise InputError("--Ki/--Kc", "must be finite numbers", "e.g. --Ki 2.1 --Kc 0.8")
         return s.Ki, s.Kc, "explicit", ""
-    beam = case is not None and case.parameters is not None
+    # the paper frame's origin offers its beam theory and FE load cases (gatetherm.frame.case.FrameOrigin)
+    beam = getattr(case.origin, "coefficients", None) if case is not None and case.parameters is not None else None
     source = s.k_source or ("theory" if beam else "fit")
     if source == "fit":
         ki, kc, note = fit_coefficients_noted(ts, s.resolution_K)
@@ -120,13 +121,7 @@ def _coefficients(case, ts, s: Settings, cache) -> tuple[float, float, str, str]
     if not beam:
         raise InputError("--k-source", f"'{source}' needs the paper frame's beam model; this case has none",
                          "use --k-source fit or --Ki/--Kc")
-    if source == "theory":
-        from gatetherm.solvers.beam import theory_coefficients
-
-        return (*theory_coefficients(case.parameters), source, "")
-    from gatetherm.solvers.reduced import tip_coefficients_um
-
-    return (*tip_coefficients_um(prepare(case, cache=cache).model), source, "")
+    return (*beam(case, source, lambda: prepare(case, cache=cache).model), source, "")
 
 
 def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Settings(),

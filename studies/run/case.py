@@ -83,7 +83,7 @@ class Case:
     """A model ready to run: a problem on its named mesh, what drives it, and how it was made.
 
     A case file is read into one (:func:`load_case`); so is the paper's frame
-    (:func:`gatetherm.studies.run.frame_case.gate_frame`). Every command, study and API
+    (:func:`gatetherm.frame.case.gate_frame`). Every command, study and API
     function runs a Case; nothing downstream asks which of the two it came from."""
 
     name: str

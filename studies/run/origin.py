@@ -5,6 +5,9 @@ frame's model configuration). Generic code uses these members only and imports n
 ``case``: the :class:`~gatetherm.studies.run.case.Case` (not imported here: it imports this module)."""
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
 from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
 
 if TYPE_CHECKING:
@@ -42,3 +45,14 @@ class ModelParameters(Protocol):
     """Polynomial degree of temperature and displacement."""
     scheme: TimeScheme
     """Time stepping of the heat equation."""
+
+
+def scheme_digest(cfg: ModelParameters) -> str:
+    """Eight hex digits naming the numerical scheme of ``cfg`` (a model's parameters or a
+    :class:`~gatetherm.solvers.problem.Problem`): element order, time stepping and the linear
+    solvers' settings (not the physics)."""
+    from gatetherm.solvers import linsolve
+
+    blob = json.dumps({"order": cfg.order, "time": dataclasses.asdict(cfg.scheme), "linear": linsolve.SETTINGS},
+                      sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:8]

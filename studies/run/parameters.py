@@ -4,7 +4,7 @@ A :class:`Parameter` knows the case's value, a plausible range and the keys of t
 new value writes (:attr:`Parameter.overrides`), so a diagnosis or a study moves it by making
 the case again (:meth:`~gatetherm.studies.run.case.Case.with_overrides`). A case file's are
 found from its document (:func:`case_parameters`); the paper frame's generator declares its
-own (:func:`gatetherm.studies.run.frame_case.frame_parameters`).
+own (:func:`gatetherm.frame.case.frame_parameters`).
 
 *Geometry* parameters (:func:`geometry`) are dimensions the user marks as uncertain: a new value
 makes the mesh again (``remesh``), so every model run of one costs a remeshing too.

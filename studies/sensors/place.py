@@ -98,8 +98,8 @@ def paper_conditions(case) -> list:
     the frame's inputs (oil supply, pump, room), else none."""
     if not case.inputs() or not case.inputs() <= {SUPPLY, PUMP, AMBIENT} or PUMP not in case.inputs():
         return []
-    cfg = getattr(case.origin, "config", None)
-    return [condition_schedule(n, *(() if cfg is None else (cfg.supply,))) for n in (1, 2, 3)]
+    supply = getattr(case.origin, "supply", None)  # the paper frame's oil supply unit (its model file's)
+    return [condition_schedule(n, *(() if supply is None else (supply,))) for n in (1, 2, 3)]
 
 
 def _loads(case, s: PlacementSettings, schedules, held_out):

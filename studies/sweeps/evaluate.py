@@ -1,7 +1,7 @@
 """Evaluating sweep points: the FE and beam-theory coefficients or a heating run of one
 :class:`~studies.sweep.Task`, and running many tasks in this process or on an executor.
 
-studies/sweep.py turns a study into tasks and the records into a table.
+studies/sweeps/sweep.py turns a study into tasks and the records into a table.
 """
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ from typing import Any, Callable
 import numpy as np
 
 import gatetherm
-from gatetherm.solvers.frame import scheme_digest
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
+from gatetherm.studies.run.origin import scheme_digest
 from gatetherm.studies.sweeps.sweep import Task
 
 log = logging.getLogger(__name__)
@@ -26,8 +26,8 @@ _GMSH = threading.Lock()
 
 def _coefficients(model, cfg: Config) -> dict[str, float]:
     """FE (element-exact load cases, at E and at F) and beam-theory K_i, K_C in um/K, and normalised."""
-    from gatetherm.solvers import beam
-    from gatetherm.solvers.reduced import fe_coefficients
+    from gatetherm.frame import beam
+    from gatetherm.frame.loadcases import fe_coefficients
 
     p, m = cfg.model.frame, cfg.model
     tie = m.tie_material or m.material
@@ -93,7 +93,7 @@ def evaluate(task: Task) -> dict[str, Any]:
         res = {**case_results(case, run.columns), "nodes": int(len(case.mesh.points))}
         return {**record, "status": "ok", "results": res, "seconds": round(time.perf_counter() - t0, 3),
                 "scheme": scheme_digest(case.problem)}
-    from gatetherm.studies.run.frame_case import frame_case
+    from gatetherm.frame.case import frame_case
 
     cfg, dim = task.config, task.dim
     with _GMSH:

@@ -13,7 +13,7 @@ from gatetherm import InputError
 from gatetherm.files import read_text
 
 if TYPE_CHECKING:
-    from gatetherm.studies.run.config import Config
+    from gatetherm.frame.config import Config
     from gatetherm.studies.sweeps.sweep import Study
 
 
@@ -60,7 +60,7 @@ def case_columns(case) -> tuple[str, ...]:
 def parse_study(data: dict, source: str = "<study>", base: Config | None = None, case: str | None = None) -> Study:
     """Build a :class:`Study` from a parsed STUDY.toml (``base``: the frame's model it overrides;
     ``case``: a case file it overrides instead)."""
-    from gatetherm.studies.run.config import load_config
+    from gatetherm.frame.config import load_config
     from gatetherm.studies.sweeps.sweep import COMPUTE, Study
 
     known = {t: list if t == "plot" else dict for t in TABLES}
@@ -156,7 +156,7 @@ def load_study(path) -> Study:
         data = tomllib.loads(read_text(p, "STUDY.toml", "give a study file"))
     except tomllib.TOMLDecodeError as err:
         raise InputError(str(p), f"not valid TOML ({err})") from None
-    from gatetherm.studies.run.config import load_config
+    from gatetherm.frame.config import load_config
 
     try:
         head = data.setdefault("study", {})

@@ -12,7 +12,7 @@ value of every relative displacement and the final temperature of every probe. O
 frame, keys are
 
 * ``<section>.<field>`` for the model-file sections ``geometry``, ``mesh``, ``material``,
-  ``material.tie_bar``, ``thermal``, ``supply`` and ``model`` (see studies/config.py);
+  ``material.tie_bar``, ``thermal``, ``supply`` and ``model`` (see core/frame/config.py);
 * ``condition``: the paper's condition 1-3 (for the ``run`` computation);
 * ``effect.<name>``: a catalogue effect (solvers/effects.py) in its unit;
 * ``derived.<name>``: the parameters of :data:`DERIVED`, applied after the direct
@@ -26,8 +26,8 @@ depth ``A_C/t_C`` fits behind the arms. A point whose frame still cannot be buil
 Every point has a key, a hash of everything its result depends on, so results
 can be stored per point and a stopped sweep resumes without recomputing
 anything finished (studies/sweeps/runner.py does the files and the processes).
-Evaluating the points is in studies/sweep_evaluate.py; the frame's keys applied to its model are
-:mod:`gatetherm.studies.sweeps.framepoint` (its names importable from here too).
+Evaluating the points is in studies/sweeps/evaluate.py; the frame's keys applied to its model are
+:mod:`gatetherm.frame.sweeppoint` (its names importable from here too).
 """
 from __future__ import annotations
 
@@ -40,9 +40,9 @@ from typing import Any
 
 from gatetherm import InputError
 import gatetherm
-from gatetherm.solvers.frame import scheme_digest
-from gatetherm.studies.run.config import Config
-from gatetherm.studies.sweeps.framepoint import (  # noqa: F401 (re-exported)
+from gatetherm.frame.config import Config
+from gatetherm.studies.run.origin import scheme_digest
+from gatetherm.frame.sweeppoint import (  # noqa: F401 (re-exported)
     DERIVED, PINHOLE, SECTIONS, _number, configure, fit_frame)
 
 #: What a point can compute, with the result columns each adds (besides "nodes").
@@ -55,7 +55,7 @@ COMPUTE = {
 }
 MADE_BY = ("version", "scheme")
 """Table columns naming what computed a point: gatetherm version and scheme digest
-(:func:`~gatetherm.solvers.frame.scheme_digest`), both part of the point key."""
+(:func:`~gatetherm.studies.run.origin.scheme_digest`), both part of the point key."""
 
 
 @dataclass(frozen=True)

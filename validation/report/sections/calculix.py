@@ -19,7 +19,7 @@ TOLERANCE = 5e-3
 def compute(ctx) -> Result:
     from gatetherm import write_text_atomic
     from gatetherm.studies.run.ccx import export_state, relative_from_dat
-    from gatetherm.studies.run.frame_case import frame_case
+    from gatetherm.frame.case import frame_case
 
     s = ctx.scope
     cfg = paper_model(size_3d=s["size_3d"])

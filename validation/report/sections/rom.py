@@ -7,7 +7,7 @@ from gatetherm.validation import paper_model
 
 
 def compute(ctx) -> Result:
-    from gatetherm.solvers.frame import EFFECTS
+    from gatetherm.frame.problem import EFFECTS
     from gatetherm.validation import rom_study as rs
     from gatetherm.validation.plots import save
     from gatetherm.validation.plots.rom import plot_rom_bands, plot_rom_error

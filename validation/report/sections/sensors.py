@@ -38,7 +38,7 @@ def _errors(label, form, held, cv, targets) -> list[str]:
 def compute(ctx) -> Result:
     import gatetherm.validation
     from gatetherm.studies.run.case import load_case
-    from gatetherm.studies.run.frame_case import gate_frame
+    from gatetherm.frame.case import gate_frame
     from gatetherm.studies.sensors.check import fe_check
     from gatetherm.studies.sensors.place import PlacementSettings, place_sensors
     from gatetherm.validation.plots import save

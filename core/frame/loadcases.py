@@ -20,9 +20,9 @@ from typing import Callable
 import numpy as np
 from skfem import CellBasis, asm
 
+from gatetherm.frame.problem import is_tie
 from gatetherm.solvers.elasticity import moduli, thermal_load_at
 from gatetherm.solvers.fem import Field
-from gatetherm.solvers.frame import is_tie
 from gatetherm.solvers.model import Model
 
 

@@ -1,7 +1,7 @@
 """The paper's design conclusion tested by FE: where to put the tie bar, and what a
 second tie bar above the cutting area does (paper section 3.1 and conclusion 3).
 
-Both parts are sweep studies (studies/sweep.py) on a model (the paper model by
+Both parts are sweep studies (studies/sweeps/sweep.py) on a model (the paper model by
 default) that run the 5-h conditions 1-3 and read the swing of delta (tips F):
 
 1. *Position*: one tie bar at ``l4`` from just above the mounting face to just below
@@ -21,7 +21,7 @@ import dataclasses
 
 import numpy as np
 
-from gatetherm.studies.run.config import Config
+from gatetherm.frame.config import Config
 from gatetherm.studies.sweeps.sweep import Study
 
 CONDITIONS = (1, 2, 3)
@@ -126,7 +126,7 @@ def with_frame(cfg: Config, **changes) -> Config:
 
 def histories(designs: dict[str, Config], dim: int) -> dict[str, dict[int, tuple]]:
     """delta(t) (s, um) of each design (label -> model) for conditions 1-3."""
-    from gatetherm.studies.run.frame_case import condition_runs
+    from gatetherm.frame.case import condition_runs
     from gatetherm.studies.run.scenario import ScenarioCache
 
     out = {}

@@ -10,8 +10,6 @@ mounting face, the sensors as probes and δ, δ_E as relative displacements.
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
 import logging
 import time
 from dataclasses import dataclass, field
@@ -20,22 +18,20 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, NONNEGATIVE, POSITIVE, Range, admissible
-from gatetherm.geometry.build import build_mesh
-from gatetherm.geometry.frame import FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth, width
+from gatetherm.frame.build import build_mesh
+from gatetherm.frame.geometry import FrameParams, MeshParams, TIE_SENSORS, part_boxes, tank_box, tie_depth, width
 from gatetherm.geometry.measure import enclosed_volume, region_volume
 from gatetherm.geometry.mesh import FrameMesh
-from gatetherm.solvers import linsolve
 from gatetherm.solvers.effects import JointLayer, Named, Targets
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import FC300, Material
 from gatetherm.solvers.model import Model, build
 from gatetherm.solvers.problem import FaceFilm, Film, Fluid, Problem, Probe, Relative, Signals, Source, Support
+from gatetherm.studies.run.timeseries import AMBIENT, PUMP, SUPPLY  # noqa: F401 (the frame's inputs; re-exported)
 
 log = logging.getLogger(__name__)
 
-SUPPLY, PUMP, AMBIENT = "oil_degC", "pump", "ambient_degC"
-"""The inputs of the frame: the data format's input columns (:data:`gatetherm.studies.run.timeseries.SUPPLY` …)."""
 GEOMETRY_FREE = ("l1",)
 """FrameParams fields the mesh does not depend on (the beam theory's heated height)."""
 RELATIVE = {"delta": ("F_L", "F_R"), "delta_E": ("E_L", "E_R")}
@@ -108,14 +104,6 @@ class ModelConfig:
     """Heat released uniformly in a region, by region name, W."""
     scheme: TimeScheme = TimeScheme()
     """Time stepping of the heat equation."""
-
-
-def scheme_digest(cfg) -> str:
-    """Eight hex digits naming the numerical scheme: element order, time stepping and the
-    linear solvers' settings (not the physics)."""
-    blob = json.dumps({"order": cfg.order, "time": dataclasses.asdict(cfg.scheme), "linear": linsolve.SETTINGS},
-                      sort_keys=True)
-    return hashlib.sha256(blob.encode()).hexdigest()[:8]
 
 
 def is_tie(region: str) -> bool:

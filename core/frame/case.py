@@ -16,15 +16,17 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.geometry.build import build_mesh
-from gatetherm.geometry.frame import FrameParams
+from gatetherm.frame.beam import theory_coefficients
+from gatetherm.frame.build import build_mesh
+from gatetherm.frame.config import Config, config_toml, load_config, parse_config
+from gatetherm.frame.geometry import FrameParams
+from gatetherm.frame.loadcases import tip_coefficients_um
+from gatetherm.frame.problem import AMBIENT, GEOMETRY_FREE, check_mesh, frame_problem, frame_targets
 from gatetherm.geometry.mesh import FrameMesh
-from gatetherm.solvers.frame import AMBIENT, GEOMETRY_FREE, check_mesh, frame_problem, frame_targets
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.run.case import Case, TimeSettings, nested
 from gatetherm.studies.run.casefile import case_toml
 from gatetherm.studies.run.conditions import condition
-from gatetherm.studies.run.config import Config, config_toml, load_config, parse_config
 from gatetherm.studies.run.parameters import GEOMETRY, SHIFT, Parameter, geometry
 from gatetherm.studies.run.schedules import condition_schedule
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
@@ -50,7 +52,7 @@ def gate_frame(dim: int = 2, config: Config | str | os.PathLike | None = None, c
     dim : int
         2 (plane-stress section) or 3 (solid).
     config : Config, path or None
-        Its parameters: a model file (path), a :class:`~gatetherm.studies.run.config.Config`,
+        Its parameters: a model file (path), a :class:`~gatetherm.frame.config.Config`,
         or None for the shipped paper model.
     condition : int
         The paper's condition (1, 2 or 3) that drives it by default.
@@ -109,6 +111,18 @@ class FrameOrigin:
     def model_file(self, case: Case, header: str = "") -> str:
         """The model file of ``case`` (made by this origin): its parameters, effects and sensor faults."""
         return config_toml(dataclasses.replace(self.config, effects=case.effects, sensors=case.sensors), header)
+
+    @property
+    def supply(self):
+        """The oil supply unit of the model file (:class:`~gatetherm.studies.run.conditions.SupplyParams`)."""
+        return self.config.supply
+
+    def coefficients(self, case: Case, source: str, model) -> tuple[float, float]:
+        """The compensator's (K_i, K_C), um/K, of the frame ``case``: ``source`` ``"theory"`` the beam
+        theory of its parameters, else the FE load cases at the tips F on ``model()`` (its assembled model)."""
+        if source == "theory":
+            return theory_coefficients(case.parameters)
+        return tip_coefficients_um(model())
 
 
 def frame_parameters(cfg: Config) -> tuple[Parameter, ...]:

@@ -22,9 +22,9 @@ from importlib import resources
 from gatetherm import InputError
 from gatetherm.checks import check_fields
 from gatetherm.files import read_text
-from gatetherm.geometry.frame import FrameParams, MeshParams, check_tie_depth, validate
+from gatetherm.frame.geometry import FrameParams, MeshParams, check_tie_depth, validate
+from gatetherm.frame.problem import TARGETS, ModelConfig, ThermalParams
 from gatetherm.solvers.effects import effects_from_table, effects_table
-from gatetherm.solvers.frame import TARGETS, ModelConfig, ThermalParams
 from gatetherm.solvers.heat import TimeScheme
 from gatetherm.solvers.material import Material
 from gatetherm.solvers.sensors import faults_from_table, faults_table_lines

@@ -22,8 +22,8 @@ from numpy.typing import ArrayLike
 from gatetherm import InputError
 
 if TYPE_CHECKING:
-    from gatetherm.geometry.frame import FrameParams
-    from gatetherm.solvers.frame import ModelConfig
+    from gatetherm.frame.geometry import FrameParams
+    from gatetherm.frame.problem import ModelConfig
 
 
 @dataclass(frozen=True)

@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import functools
 import logging
+import math
 
+from gatetherm.frame.geometry import (Box, FrameParams, MeshParams, part_boxes, sensor_points, tank_box, validate,
+                                      validate_mesh)
 from gatetherm.geometry.extract import extract_mesh
-from gatetherm.geometry.frame import (FrameParams, MeshParams, part_boxes, sensor_points,
-                            tank_box, validate, validate_mesh)
 from gatetherm.geometry.isolate import gmsh_session, run_isolated  # noqa: F401 (gmsh_session: the API's)
 from gatetherm.geometry.mesh import FrameMesh, from_arrays, to_arrays
-from gatetherm.geometry.sizing import check_mesh_size
+from gatetherm.geometry.sizing import check_estimate, count_elements
 
 log = logging.getLogger(__name__)
 _TOL = 1e-7
@@ -115,3 +116,22 @@ def _build(p: FrameParams, dim: int, mesh: MeshParams, gmsh) -> tuple[dict, dict
     gmsh.model.mesh.generate(dim)
     fm, notes = extract_mesh(gmsh, dim, region_ents, facet_ents, point_of)
     return to_arrays(fm, notes)
+
+
+def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
+    """Elements of the mesh of ``p`` at ``m``'s size: the frame's area (volume) over that of
+    an equilateral triangle (regular tetrahedron) of the element size. Against gmsh's counts
+    from 3k to 200k elements: up to 25 % low in 2-D (the refinement near the tank and the
+    joints), 1.5 to 2.1 times high in 3-D."""
+    def measure(b: Box) -> float:
+        return math.prod(b[2 * i + 1] - b[2 * i] for i in range(dim))
+
+    total = sum(map(measure, part_boxes(p, dim).values())) - measure(tank_box(p, dim))
+    s = m.size if dim == 2 else m.size_3d
+    return count_elements(total, s, dim)
+
+
+def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
+    """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
+    key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
+    check_estimate(element_estimate(p, m, dim), dim, key, s)

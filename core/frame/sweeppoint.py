@@ -9,10 +9,10 @@ from typing import Any, Callable
 
 from gatetherm import InputError
 from gatetherm.checks import FINITE
-from gatetherm.geometry.frame import FrameParams, tie_depth, tie_heights, validate
-from gatetherm.geometry.sizing import check_mesh_size
-from gatetherm.solvers.beam import beta_area
-from gatetherm.studies.run.config import Config, parse_config
+from gatetherm.frame.beam import beta_area
+from gatetherm.frame.build import check_mesh_size
+from gatetherm.frame.config import Config, parse_config
+from gatetherm.frame.geometry import FrameParams, tie_depth, tie_heights, validate
 
 SECTIONS = ("geometry", "mesh", "material", "material.tie_bar", "thermal", "supply", "model")
 PINHOLE = 0.003
@@ -88,8 +88,8 @@ def _nest(flat: dict[str, Any]) -> dict:
 
 def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = True):
     """``(config, condition, effects, skip)`` of one point; bad keys raise InputError."""
+    from gatetherm.frame.problem import TARGETS
     from gatetherm.solvers.effects import resolve
-    from gatetherm.solvers.frame import TARGETS
     from gatetherm.studies.run.conditions import CONDITIONS
 
     sections, geometry, derived, effects, condition = {}, {}, {}, {}, None

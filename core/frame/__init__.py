@@ -1,0 +1,18 @@
+"""The paper's gate frame, one wing of gatetherm: everything that knows this one machine.
+
+It makes a plain :class:`~gatetherm.studies.run.case.Case` (:func:`gatetherm.frame.case.gate_frame`)
+that every command, study and API function runs like a case file's, and owns what only this frame has:
+
+- :mod:`~gatetherm.frame.geometry`: its parameters (:class:`FrameParams`, :class:`MeshParams`), boxes,
+  sensor points and checks; :mod:`~gatetherm.frame.build`: its gmsh builder and mesh-size estimate;
+- :mod:`~gatetherm.frame.problem`: its problem (:class:`ModelConfig`, :func:`frame_problem`), effect
+  targets and the mesh check; :mod:`~gatetherm.frame.config`: its model file (``--config``);
+- :mod:`~gatetherm.frame.beam`: the beam theory; :mod:`~gatetherm.frame.loadcases`: FE load cases at the tips;
+- :mod:`~gatetherm.frame.case`: the case generator, its origin (which offers the compensator its beam
+  coefficients) and the paper's conditions run on it; :mod:`~gatetherm.frame.sweeppoint` and
+  :mod:`~gatetherm.frame.design`: its parametric and design studies.
+
+Layer: after ``gatetherm.studies``, before ``gatetherm.validation``. The root package, geometry,
+solvers and studies never import it (``tests/test_architecture.py``); validation, the API and the
+CLI do.
+"""
