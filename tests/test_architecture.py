@@ -71,12 +71,7 @@ WING = "gatetherm.frame"
 cases, model file, case generator and design sweeps. It makes a plain Case; validation, the API and
 the CLI may import it, the root package, geometry, solvers and studies never do."""
 #: Generic modules that still import the wing, with the reason; they only shrink (a stale entry fails).
-WING_IMPORTERS = {
-    "gatetherm.studies.sweeps.sweep": "a study's base is a case file or the frame: plan() applies the frame's "
-                                      "keys (gatetherm.frame.sweeppoint) to its model file (Config)",
-    "gatetherm.studies.sweeps.evaluate": "evaluates a frame point (its case, beam theory, FE load cases) beside "
-                                         "a case point",
-    "gatetherm.studies.sweeps.studyfile": "reads a frame study's model file ([study] config) beside a case study's case",
+WING_IMPORTERS: dict[str, str] = {
 }
 
 

@@ -13,7 +13,8 @@ from gatetherm.frame.problem import build_model
 from gatetherm.frame.loadcases import fe_coefficients
 from gatetherm.frame.beam import theory_coefficients
 from gatetherm.frame.config import parse_config
-from gatetherm.studies.sweeps.sweep import configure, plan
+from gatetherm.frame.sweeppoint import configure
+from gatetherm.studies.sweeps.sweep import plan
 from gatetherm.validation import beam_vs_fe as bv
 
 GEOMETRY = dict(h=0.1, depth=0.12, column_height=0.63, l=0.6, l1=0.3, l4=0.3, l_C=0.4, A_C=1e-3, t_C=0.04,

@@ -21,6 +21,7 @@ from gatetherm.studies.sweeps import evaluate as sweep_evaluate, sweep
 from gatetherm.cli import main
 from gatetherm.studies.sweeps import runner as sweep_runner
 from gatetherm.studies.sweeps.studyfile import parse_study
+from gatetherm.frame import sweeppoint
 from gatetherm.frame.config import parse_config
 
 #: A fully specified frame (independent of the shipped paper model, which is recalibrated).
@@ -85,7 +86,7 @@ def _table(path: Path) -> list[dict]:
 ])
 def test_bad_study_files_raise_one_line_naming_the_key(data, key):
     with pytest.raises(InputError) as err:
-        parse_study(data, "s.toml", BASE)
+        parse_study(data, "s.toml", BASE, frame=sweeppoint.FRAME)
     assert str(err.value).startswith(f"{key}:") and "\n" not in str(err.value)
 
 
@@ -101,53 +102,53 @@ def test_bad_study_files_raise_one_line_naming_the_key(data, key):
     ({"condition": [7]}, "condition"),
 ])
 def test_bad_parameters_are_caught_before_any_point_runs(grid, key):
-    study = parse_study({"grid": grid}, "s.toml", BASE)
+    study = parse_study({"grid": grid}, "s.toml", BASE, frame=sweeppoint.FRAME)
     with pytest.raises(InputError) as err:
         sweep.plan(study)
     assert str(err.value).startswith(f"{key}:") and "\n" not in str(err.value)
 
 
 def test_run_needs_a_condition():
-    study = parse_study({"study": {"compute": ["run"]}, "grid": {"geometry.l4": [0.2]}}, "s.toml", BASE)
+    study = parse_study({"study": {"compute": ["run"]}, "grid": {"geometry.l4": [0.2]}}, "s.toml", BASE, frame=sweeppoint.FRAME)
     with pytest.raises(InputError, match="^condition:"):
         sweep.plan(study)
 
 
 def test_derived_parameters_follow_their_definitions():
-    cfg, _, _, skip = sweep.configure(BASE, {"derived.l_over_h": 8.0, "derived.l1_over_l": 0.5,
+    cfg, _, _, skip = sweeppoint.configure(BASE, {"derived.l_over_h": 8.0, "derived.l1_over_l": 0.5,
                                              "derived.l_over_l4": 2.5, "derived.beta": 0.03}, 2)
     p = cfg.model.frame
     assert skip == ""
     assert p.h == pytest.approx(0.6 / 8.0, rel=1e-15) and p.l1 == 0.3 and p.l4 == pytest.approx(0.24, rel=1e-15)
     assert p.tank_wall / p.h == pytest.approx(0.1, rel=1e-14) and p.tank_width / p.h == pytest.approx(0.3, rel=1e-14)
     assert float(beam.beta(p.depth * p.h ** 3 / 12, p.l_C, p.A_C, p.l)) == pytest.approx(0.03, rel=1e-14)
-    cfg, *_ = sweep.configure(BASE, {"derived.tank_cavity": False}, 2)
-    assert cfg.model.frame.tank_width == cfg.model.frame.tank_height == sweep.PINHOLE
-    assert cfg.model.frame.tank_wall + sweep.PINHOLE / 2 == pytest.approx(cfg.model.frame.h / 2)
+    cfg, *_ = sweeppoint.configure(BASE, {"derived.tank_cavity": False}, 2)
+    assert cfg.model.frame.tank_width == cfg.model.frame.tank_height == sweeppoint.PINHOLE
+    assert cfg.model.frame.tank_wall + sweeppoint.PINHOLE / 2 == pytest.approx(cfg.model.frame.h / 2)
 
 
 def test_frame_is_fitted_to_the_tie_bars():
-    cfg, _, _, skip = sweep.configure(BASE, {"geometry.l4": 0.9}, 2)
+    cfg, _, _, skip = sweeppoint.configure(BASE, {"geometry.l4": 0.9}, 2)
     assert skip == "" and cfg.model.frame.column_height == pytest.approx(0.92)
-    _, _, _, skip = sweep.configure(BASE, {"geometry.l4": 0.9}, 2, fit=False)
+    _, _, _, skip = sweeppoint.configure(BASE, {"geometry.l4": 0.9}, 2, fit=False)
     assert skip.startswith("l4:")
-    _, _, _, skip = sweep.configure(BASE, {"geometry.l4": 0.6}, 2)
+    _, _, _, skip = sweeppoint.configure(BASE, {"geometry.l4": 0.6}, 2)
     assert "overlaps the arms" in skip
-    cfg, _, _, skip = sweep.configure(BASE, {"geometry.l4": 0.6, "geometry.A_C": 6e-3}, 3)
+    cfg, _, _, skip = sweeppoint.configure(BASE, {"geometry.l4": 0.6, "geometry.A_C": 6e-3}, 3)
     assert skip == "" and cfg.model.frame.A_C / cfg.model.frame.t_C <= 0.06 < 6e-3 / 0.04
 
 
 def test_point_key_is_the_final_model():
-    same = sweep.configure(BASE, {"derived.l_over_l4": 2.0}, 2)[0]
-    direct = sweep.configure(BASE, {"geometry.l4": BASE.model.frame.l / 2.0}, 2)[0]
-    assert sweep.point_key(same, 2, ("coefficients",), None, ()) == \
-        sweep.point_key(direct, 2, ("coefficients",), None, ())
+    same = sweeppoint.configure(BASE, {"derived.l_over_l4": 2.0}, 2)[0]
+    direct = sweeppoint.configure(BASE, {"geometry.l4": BASE.model.frame.l / 2.0}, 2)[0]
+    assert sweeppoint.point_key(same, 2, ("coefficients",), None, ()) == \
+        sweeppoint.point_key(direct, 2, ("coefficients",), None, ())
     warmer = dataclasses.replace(direct, model=dataclasses.replace(
         direct.model, thermal=dataclasses.replace(direct.model.thermal, h_air=20.0)))
     for compute, differs in ((("coefficients",), False), (("run",), True)):
-        keys = {sweep.point_key(c, 2, compute, 1, ()) for c in (direct, warmer)}
+        keys = {sweeppoint.point_key(c, 2, compute, 1, ()) for c in (direct, warmer)}
         assert (len(keys) == 2) is differs
-    assert sweep.point_key(direct, 3, ("coefficients",), None, ()) != sweep.point_key(direct, 2, ("coefficients",), None, ())
+    assert sweeppoint.point_key(direct, 3, ("coefficients",), None, ()) != sweeppoint.point_key(direct, 2, ("coefficients",), None, ())
 
 
 def test_sweep_writes_one_row_per_point_and_resumes(study_dir, monkeypatch, capsys):

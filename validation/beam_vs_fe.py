@@ -20,6 +20,7 @@ import numpy as np
 from gatetherm.frame.geometry import MeshParams
 from gatetherm.frame.beam import column_I
 from gatetherm.frame.config import Config
+from gatetherm.frame.sweeppoint import FRAME
 from gatetherm.studies.sweeps.sweep import Study
 
 SLENDERNESS = 8.0
@@ -64,7 +65,7 @@ def _fixed(base: Config, dim: int, l_over_h: float, across: int, tank: bool = Tr
 
 def _study(name, base, dim, fixed, grid) -> Study:
     return Study(name, dim, base, tuple(fixed.items()), tuple((k, tuple(v)) for k, v in grid.items()),
-                 ("coefficients",))
+                 ("coefficients",), frame=FRAME)
 
 
 def studies(base: Config, dim: int, a_every: int = 1, series: bool = True) -> dict[str, list[Study]]:

@@ -123,11 +123,12 @@ def sweep(study: str | os.PathLike, out: str | os.PathLike, *, workers: int = 1,
     from gatetherm.checks import whole_argument
     from gatetherm.outdir import output_dir
     from gatetherm.studies.sweeps.runner import PointStore, run_studies
+    from gatetherm.frame.sweeppoint import FRAME
     from gatetherm.studies.sweeps.studyfile import load_study
     from gatetherm.studies.sweeps.sweep import plan, table
 
     whole_argument("workers", workers, _WORKERS, "e.g. 1 (in this process) or the CPU count")
-    s = load_study(study)
+    s = load_study(study, FRAME)  # the frame's side of a study of the frame
     try:
         tasks = plan(s)
     except InputError as err:

@@ -10,7 +10,7 @@ that every command, study and API function runs like a case file's, and owns wha
 - :mod:`~gatetherm.frame.beam`: the beam theory; :mod:`~gatetherm.frame.loadcases`: FE load cases at the tips;
 - :mod:`~gatetherm.frame.case`: the case generator, its origin (which offers the compensator its beam
   coefficients) and the paper's conditions run on it; :mod:`~gatetherm.frame.sweeppoint` and
-  :mod:`~gatetherm.frame.design`: its parametric and design studies.
+  :mod:`~gatetherm.frame.design`: its side of a parametric study (``sweeppoint.FRAME``) and its design study.
 
 Layer: after ``gatetherm.studies``, before ``gatetherm.validation``. The root package, geometry,
 solvers and studies never import it (``tests/test_architecture.py``); validation, the API and the

@@ -22,6 +22,7 @@ import dataclasses
 import numpy as np
 
 from gatetherm.frame.config import Config
+from gatetherm.frame.sweeppoint import FRAME
 from gatetherm.studies.sweeps.sweep import Study
 
 CONDITIONS = (1, 2, 3)
@@ -45,7 +46,7 @@ def position_range(cfg: Config, dim: int) -> tuple[float, float]:
 def _study(name: str, cfg: Config, dim: int, fixed: dict, grid: dict) -> Study:
     return Study(name, dim, cfg, tuple(fixed.items()),
                  tuple((k, tuple(v)) for k, v in grid.items()) + (("condition", CONDITIONS),),
-                 ("run", "coefficients"))
+                 ("run", "coefficients"), frame=FRAME)
 
 
 def position_study(cfg: Config, dim: int, l4_values) -> Study:

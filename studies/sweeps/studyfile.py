@@ -13,8 +13,7 @@ from gatetherm import InputError
 from gatetherm.files import read_text
 
 if TYPE_CHECKING:
-    from gatetherm.frame.config import Config
-    from gatetherm.studies.sweeps.sweep import Study
+    from gatetherm.studies.sweeps.sweep import FramePoints, Study
 
 
 KEYS = {"study": ("name", "case", "dim", "config", "compute", "fit_frame"), "plot": ("x", "y", "hue")}
@@ -57,10 +56,12 @@ def case_columns(case) -> tuple[str, ...]:
     return tuple(out)
 
 
-def parse_study(data: dict, source: str = "<study>", base: Config | None = None, case: str | None = None) -> Study:
-    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the frame's model it overrides;
-    ``case``: a case file it overrides instead)."""
-    from gatetherm.frame.config import load_config
+def parse_study(data: dict, source: str = "<study>", base=None, case: str | None = None,
+                frame: FramePoints | None = None) -> Study:
+    """Build a :class:`Study` from a parsed STUDY.toml (``base``: the frame's model it overrides, None:
+    its ``[study] config`` or the paper model; ``case``: a case file it overrides instead). ``frame``: the
+    frame's side of a study (:data:`gatetherm.frame.sweeppoint.FRAME`, passed in by the API); without
+    it only a case study is read."""
     from gatetherm.studies.sweeps.sweep import COMPUTE, Study
 
     known = {t: list if t == "plot" else dict for t in TABLES}
@@ -88,13 +89,16 @@ def parse_study(data: dict, source: str = "<study>", base: Config | None = None,
     fit = head.get("fit_frame", True)
     if not isinstance(fit, bool):
         raise InputError("study.fit_frame", f"expected true/false, got {fit!r}")
+    if frame is None:
+        raise InputError("study.case", "a study of the paper's frame needs gatetherm.frame",
+                         "run it with gatetherm.api.sweep (gatetherm sweep), or give a case")
     if base is None:
-        base = load_config(head.get("config"))
+        base = frame.model(head.get("config"), "--config")
     fixed, grid = _set_and_grid(data, '"geometry.l4" = [0.2, 0.3]')
     columns = {k for k, _ in grid} | {"nodes"} | {c for k in compute for c in COMPUTE[k]}
     plots = _plots(data, columns)
     return Study(str(head.get("name", source)), dim, base, tuple(fixed.items()), tuple(grid),
-                 tuple(compute), tuple(plots), fit)
+                 tuple(compute), tuple(plots), fit, frame=frame)
 
 
 def _case_study(data: dict, head: dict, source: str, path: str) -> Study:
@@ -149,15 +153,15 @@ def _plots(data: dict, columns: set) -> list:
     return plots
 
 
-def load_study(path) -> Study:
-    """Read a STUDY.toml; a relative ``study.config`` or ``study.case`` is taken from the study file's folder."""
+def load_study(path, frame: FramePoints | None = None) -> Study:
+    """Read a STUDY.toml; a relative ``study.config`` or ``study.case`` is taken from the study file's folder.
+    ``frame``: the frame's side of a study (:data:`gatetherm.frame.sweeppoint.FRAME`, passed in by the
+    API); without it only a case study is read."""
     p = Path(path)
     try:
         data = tomllib.loads(read_text(p, "STUDY.toml", "give a study file"))
     except tomllib.TOMLDecodeError as err:
         raise InputError(str(p), f"not valid TOML ({err})") from None
-    from gatetherm.frame.config import load_config
-
     try:
         head = data.setdefault("study", {})
         if not isinstance(head, dict):
@@ -171,7 +175,10 @@ def load_study(path) -> Study:
         config = head.pop("config", None)
         if config is not None and not isinstance(config, str):
             raise InputError("study.config", f"expected a file name, got {config!r}")
-        base = load_config(None if config is None else p.parent / config, "study.config")
-        return parse_study(data, str(p), base)
+        if frame is None:
+            raise InputError("study.case", "a study of the paper's frame needs gatetherm.frame",
+                             "run it with gatetherm.api.sweep (gatetherm sweep), or give a case")
+        base = frame.model(None if config is None else p.parent / config, "study.config")
+        return parse_study(data, str(p), base, frame=frame)
     except InputError as err:
         raise err.at(str(p)) from None

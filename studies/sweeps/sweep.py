@@ -26,8 +26,9 @@ depth ``A_C/t_C`` fits behind the arms. A point whose frame still cannot be buil
 Every point has a key, a hash of everything its result depends on, so results
 can be stored per point and a stopped sweep resumes without recomputing
 anything finished (studies/sweeps/runner.py does the files and the processes).
-Evaluating the points is in studies/sweeps/evaluate.py; the frame's keys applied to its model are
-:mod:`gatetherm.frame.sweeppoint` (its names importable from here too).
+Evaluating the points is in studies/sweeps/evaluate.py. A study of the frame has its points made
+and evaluated by the frame (:class:`FramePoints`: :data:`gatetherm.frame.sweeppoint.FRAME`, passed
+in by the API); nothing here imports the frame.
 """
 from __future__ import annotations
 
@@ -36,14 +37,12 @@ import hashlib
 import itertools
 import json
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from gatetherm import InputError
 import gatetherm
-from gatetherm.frame.config import Config
+from gatetherm.checks import FINITE
 from gatetherm.studies.run.origin import scheme_digest
-from gatetherm.frame.sweeppoint import (  # noqa: F401 (re-exported)
-    DERIVED, PINHOLE, SECTIONS, _number, configure, fit_frame)
 
 #: What a point can compute, with the result columns each adds (besides "nodes").
 COMPUTE = {
@@ -56,6 +55,33 @@ COMPUTE = {
 MADE_BY = ("version", "scheme")
 """Table columns naming what computed a point: gatetherm version and scheme digest
 (:func:`~gatetherm.studies.run.origin.scheme_digest`), both part of the point key."""
+
+
+def number(key: str, value, typ: type):
+    """``value`` of the study key ``key`` as ``typ`` (bool, int or float), else InputError."""
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise InputError(key, f"expected true/false, got {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not FINITE.admits(value):
+        raise InputError(key, f"expected a finite number, got {value!r}")
+    if typ is int and not float(value).is_integer():
+        raise InputError(key, f"expected a whole number, got {value!r}")
+    return typ(value)
+
+
+class FramePoints(Protocol):
+    """The paper frame's side of a study (:data:`gatetherm.frame.sweeppoint.FRAME`): its model
+    file, its keys applied to it, its points evaluated."""
+
+    def model(self, path, key: str):
+        """The frame's model file at ``path`` (None: the shipped paper model); ``key`` names it in errors."""
+
+    def point(self, study: "Study", params: tuple, overrides: dict) -> "Task":
+        """The point of ``study`` at ``overrides`` (``params``: its grid values), its keys checked."""
+
+    def evaluate(self, task: "Task", record: dict) -> dict:
+        """``record`` (key, params, status …) completed with the point's results."""
 
 
 @dataclass(frozen=True)
@@ -73,8 +99,8 @@ class Study:
 
     name: str
     dim: int
-    base: Config | None
-    """The paper frame's model (None: a study of :attr:`case`)."""
+    base: Any
+    """The paper frame's model file (:class:`gatetherm.frame.config.Config`; None: a study of :attr:`case`)."""
     fixed: tuple[tuple[str, Any], ...]
     """Overrides applied at every point, (key, value)."""
     grid: tuple[tuple[str, tuple], ...]
@@ -87,6 +113,8 @@ class Study:
     """A case file whose keys the grid sets (instead of the frame's :attr:`base`)."""
     columns: tuple[str, ...] = ()
     """The result columns of a case study's ``run`` (its relative displacements and probes)."""
+    frame: FramePoints | None = None
+    """A study of the frame: who makes and evaluates its points (:data:`gatetherm.frame.sweeppoint.FRAME`)."""
 
 
 @dataclass(frozen=True)
@@ -96,7 +124,8 @@ class Task:
     key: str
     params: tuple[tuple[str, Any], ...]
     """The grid values of this point (its table columns)."""
-    config: Config | None
+    config: Any
+    """A frame point's model file (None: a case point)."""
     dim: int
     compute: tuple[str, ...]
     condition: int | None
@@ -107,24 +136,9 @@ class Task:
     """A case study's case file."""
     overrides: tuple[tuple[str, Any], ...] = ()
     """A case study's keys of the case file at this point."""
+    frame: FramePoints | None = None
+    """A frame point: who evaluates it (the study's :attr:`Study.frame`)."""
 
-
-
-def point_key(cfg: Config, dim: int, compute, condition, effects) -> str:
-    """Hash of everything a point's result depends on: the gatetherm version, the numerical
-    scheme, the final model (without the thermal and supply data when nothing is run),
-    dimension, computations, condition, effects."""
-    model = dataclasses.asdict(cfg.model)
-    data = {"model": model, "supply": dataclasses.asdict(cfg.supply), "effects": cfg.effects,
-            "version": gatetherm.__version__, "scheme": scheme_digest(cfg.model)}
-    if "run" not in compute:
-        for name in ("thermal", "source", "joint_conductance", "scheme"):
-            model.pop(name, None)
-        data.pop("supply")
-        condition = None
-    blob = json.dumps({**data, "dim": dim, "compute": sorted(compute), "condition": condition,
-                       "effect_values": effects}, sort_keys=True, default=repr)
-    return hashlib.sha256(blob.encode()).hexdigest()[:20]
 
 
 def case_point(study: Study, base, overrides: dict[str, Any]) -> Task:
@@ -136,7 +150,7 @@ def case_point(study: Study, base, overrides: dict[str, Any]) -> Task:
     effects, keys = {}, {}
     for key, value in overrides.items():
         if key.startswith("effect."):
-            effects[key[len("effect."):]] = _number(key, value, float)
+            effects[key[len("effect."):]] = number(key, value, float)
         else:
             keys[key] = value
     case = base.with_overrides(keys)
@@ -178,12 +192,10 @@ def plan(study: Study) -> list[Task]:
             task = case_point(study, base, overrides)
             tasks.append(dataclasses.replace(task, params=params))
             continue
-        cfg, cond, eff, skip = configure(study.base, overrides, study.dim, study.fit_frame)
-        if "run" in study.compute and cond is None:
-            raise InputError("condition", "the 'run' computation needs a heating condition",
-                             "add condition = [1, 2, 3] to [grid] or condition = 1 to [set]")
-        key = point_key(cfg, study.dim, study.compute, cond, eff)
-        tasks.append(Task(key, params, cfg, study.dim, study.compute, cond, eff, skip))
+        if study.frame is None:
+            raise InputError(study.name, "a study of the paper's frame needs the frame's points",
+                             "give Study(frame=gatetherm.frame.sweeppoint.FRAME), or run it with gatetherm.api.sweep")
+        tasks.append(study.frame.point(study, params, overrides))
     if tasks and all(t.skip for t in tasks):
         raise InputError(study.name, f"no point of the study can be built ({tasks[0].skip})",
                          "change the grid")
