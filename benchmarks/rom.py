@@ -21,8 +21,9 @@ import numpy as np
 from gatetherm.solvers.rom_time import discretise, march_rom
 from gatetherm.frame.config import load_config
 from gatetherm.frame.case import frame_case
+from gatetherm.frame.conditions import condition_schedule
 from gatetherm.studies.run.reduce import build_rom, check_run, series_inputs
-from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 
 TARGET_MS = 10.0
 

@@ -29,7 +29,7 @@ def fixed_condition(steps: int, condition: int = 1):
     condition's schedule."""
     import dataclasses
 
-    from gatetherm.studies.run.schedules import condition_schedule
+    from gatetherm.frame.conditions import condition_schedule
 
     sched = condition_schedule(condition)
     return fixed_case(), dataclasses.replace(sched, times=sched.times[:steps + 1])

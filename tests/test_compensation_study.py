@@ -22,9 +22,10 @@ from gatetherm.frame.case import frame_case
 from gatetherm.studies.run.scenario import run_scenario
 from gatetherm.studies.run.timeseries import FORMAT
 from gatetherm.frame.beam import theory_coefficients
+from gatetherm.frame.conditions import CONDITIONS
 from gatetherm.frame.loadcases import tip_coefficients_um
-from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.frame.config import load_config
+from gatetherm.studies.run.conditions import condition_drive
 from gatetherm.studies.run.simulate import run_model, sample_times
 from gatetherm.studies.run.timeseries import read_timeseries, write_timeseries
 from gatetherm.validation import compensation_study

@@ -17,7 +17,6 @@ from gatetherm.frame.geometry import MeshParams
 from gatetherm.studies.diagnosis.calibrate import Scored
 from gatetherm.cli import main
 from gatetherm.frame.problem import build_model
-from gatetherm.studies.run.conditions import CONDITIONS, condition_drive
 from gatetherm.frame.config import load_config
 from gatetherm.studies.diagnosis.discrepancy import Settings, _verdict, adopted_case, diagnose
 from gatetherm.frame.problem import TARGETS
@@ -28,7 +27,9 @@ from gatetherm.frame.config import config_toml
 from gatetherm.studies.run.simulate import run_model
 from gatetherm.studies.diagnosis.replay import Replayer, compared_channels, residuals
 from gatetherm.frame.case import frame_case
-from gatetherm.studies.run.scenario import condition_schedule, measured_schedule, run_scenario
+from gatetherm.frame.conditions import CONDITIONS, condition_schedule
+from gatetherm.studies.run.conditions import condition_drive
+from gatetherm.studies.run.scenario import measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import TimeSeries, write_timeseries
 from gatetherm.validation.truth import Case, measured, truth
 

@@ -129,7 +129,7 @@ def _ends(name):
 
 def _detectability(conditions):
     """Max |change| of θ_A/θ_B/θ_C (K) and held-out RMS change of δ (µm) per effect and range end."""
-    from gatetherm.studies.run.schedules import condition_schedule
+    from gatetherm.frame.conditions import condition_schedule
 
     cfg = load_config()
     case = frame_case(dataclasses.replace(cfg, model=dataclasses.replace(cfg.model, mesh=COARSE)), 2)

@@ -16,13 +16,14 @@ import pytest
 import scipy.sparse as sp
 
 from gatetherm import process
+from gatetherm.frame.conditions import CONDITIONS
 from gatetherm.solvers import iterative, p1, plan
 from gatetherm.frame.problem import build_model
 from gatetherm.solvers import model as model_module
 from gatetherm.solvers.helper import Pending, SolveHelper, forked
 from gatetherm.solvers.iterative import PCG, SolverError
 from gatetherm.solvers.linsolve import nd_order, spd_factor
-from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+from gatetherm.studies.run.conditions import SupplyParams, condition_drive
 from gatetherm.studies.run.output import displacements
 from gatetherm.studies.run.simulate import delta_figures, run_model, sample_times
 
@@ -276,7 +277,7 @@ def test_a_written_run_with_the_helper_has_the_fields_and_pictures_of_one_withou
 
     import gatetherm as gt
     from conftest import fixed_case
-    from gatetherm.studies.run.schedules import condition_schedule
+    from gatetherm.frame.conditions import condition_schedule
 
     monkeypatch.setenv(plan.PATH_ENV, "iterative")
     case = fixed_case(3)

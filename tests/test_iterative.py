@@ -8,12 +8,13 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
+from gatetherm.frame.conditions import CONDITIONS
 from gatetherm.solvers import iterative, krylov, plan
 from gatetherm.frame.problem import build_model
 from gatetherm.solvers.linsolve import planned_solver, spd_factor
 from gatetherm.solvers.rom import _weights, linear_heat_model, project, reduce
 from gatetherm.solvers.rom_time import simulate_rom
-from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+from gatetherm.studies.run.conditions import SupplyParams, condition_drive
 from gatetherm.studies.run.reduce import series_inputs
 from gatetherm.studies.run.simulate import column, run_model, sample_times
 

@@ -143,7 +143,7 @@ def test_a_3d_deformed_picture_from_the_surface_is_the_one_from_the_volume(tmp_p
 
     from conftest import fixed_case
     from gatetherm.studies.run.output import nearest_state, nodal_fields
-    from gatetherm.studies.run.schedules import condition_schedule
+    from gatetherm.frame.conditions import condition_schedule
     from gatetherm.validation.plots.field import deformed, render_deformed
 
     sched = condition_schedule(1)

@@ -5,6 +5,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from gatetherm import InputError
+from gatetherm.frame.conditions import CONDITIONS
 from gatetherm.solvers.gramians import ShiftedSolves, gramian_factor
 from gatetherm.frame.problem import build_model
 from gatetherm.solvers.rom import Input, ReducedModel, linear_heat_model, reduce
@@ -12,7 +13,7 @@ from gatetherm.studies.run.reduce import load_rom, series_inputs, write_rom
 from gatetherm.solvers.rom_time import discretise, march_rom, simulate_rom
 from gatetherm.studies.control.observer import ObserverParams, kalman, uniform_state
 from gatetherm.studies.control.predictive import PredictiveParams, event_updates, minimax, plan_threshold
-from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+from gatetherm.studies.run.conditions import SupplyParams, condition_drive
 from gatetherm.studies.run.simulate import column, run_model, sample_times
 
 from conftest import FIXED_MODEL

@@ -101,7 +101,8 @@ def test_supply_hose_hand_values(frame_2d):
     """The hose is fed by the supply only (one-way), so condition 1 gives it hand values:
     after an hour with the pump on it holds (G·40 + UA·20)/(G + UA) °C (G = ρc·Q), and an
     hour after the pump stops it has relaxed towards the room as exp(−UA t / C_hose)."""
-    from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+    from gatetherm.frame.conditions import CONDITIONS
+    from gatetherm.studies.run.conditions import SupplyParams, condition_drive
     from gatetherm.studies.run.simulate import run_model, sample_times
 
     model = build_model(FIXED_MODEL, 2, fmesh=frame_2d)

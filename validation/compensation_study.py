@@ -40,10 +40,10 @@ import numpy as np
 from gatetherm import write_text_atomic
 from gatetherm.studies.control import actuator as piezo
 from gatetherm.frame.beam import theory_coefficients
+from gatetherm.frame.conditions import condition
 from gatetherm.frame.loadcases import tip_coefficients_um
 from gatetherm.studies.control.compensator import (ClosedLoop, CompensatorParams, close_loop, external_prediction,
                                                    predict, summarize)
-from gatetherm.studies.run.conditions import condition
 from gatetherm.studies.control.regression import (THETAS, LinearModel, apply_regression, fit_coefficients,
                                                   fit_regression, regression_forecast)
 from gatetherm.studies.run.simulate import delta_figures

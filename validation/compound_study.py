@@ -36,7 +36,8 @@ from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece, catalogu
 from gatetherm.studies.diagnosis.replay import DELTA
 from gatetherm.frame.config import Config
 from gatetherm.frame.case import frame_case
-from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.frame.conditions import condition_schedule
+from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 from gatetherm.studies.sweeps.pool import run_pool
 from gatetherm.validation import hidden_effects as single, paper_model

@@ -42,8 +42,9 @@ from gatetherm.studies.control.compensator import CompensatorParams, close_loop,
 from gatetherm.studies.control.predictive import PredictiveParams
 from gatetherm.studies.control.regression import THETAS, fit_regression, regression_forecast
 from gatetherm.frame.case import frame_case
+from gatetherm.frame.conditions import condition_schedule
 from gatetherm.studies.run.reduce import cached_rom, check_run, rom_outputs
-from gatetherm.studies.run.scenario import ScenarioCache, condition_schedule, run_scenario
+from gatetherm.studies.run.scenario import ScenarioCache, run_scenario
 from gatetherm.validation.truth import Case, measured, truth
 
 log = logging.getLogger(__name__)

@@ -20,7 +20,8 @@ from gatetherm.studies.diagnosis.hypotheses import configure
 from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.frame.config import Config
 from gatetherm.frame.case import FRAME_GEOMETRY, frame_case
-from gatetherm.studies.run.scenario import Schedule, condition_schedule, run_scenario
+from gatetherm.frame.conditions import condition_schedule
+from gatetherm.studies.run.scenario import Schedule, run_scenario
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import FORMAT, OUTPUT_COLUMNS, TimeSeries
 

@@ -267,7 +267,8 @@ def imbalances(e: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 def pump_switch_errors(fmesh=None) -> dict[str, float]:
     """Condition 2 on the verification frame sampled every minute: the largest |δ − δ_ref| (µm)
     of the default scheme and of backward Euler at 60 s, δ_ref by CN at 3.75 s."""
-    from gatetherm.studies.run.conditions import CONDITIONS, SupplyParams, condition_drive
+    from gatetherm.frame.conditions import CONDITIONS
+    from gatetherm.studies.run.conditions import SupplyParams, condition_drive
     from gatetherm.studies.run.simulate import run_model, sample_times
 
     model = build_model(FIXED_MODEL, 2, fmesh=fmesh)

@@ -11,11 +11,11 @@ from gatetherm.checks import POSITIVE, Range, argument, number_argument, whole_a
 from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.case import load_case as _load_case
-from gatetherm.studies.run.conditions import CONDITIONS
-from gatetherm.studies.run.conditions import condition as _condition
 from gatetherm.frame.config import Config
 from gatetherm.frame.case import gate_frame as _gate_frame
-from gatetherm.studies.run.schedules import Schedule, condition_schedule, file_schedule
+from gatetherm.frame.conditions import CONDITIONS, condition_schedule
+from gatetherm.frame.conditions import condition as _condition
+from gatetherm.studies.run.schedules import Schedule, file_schedule
 
 __all__ = ["Case", "Schedule", "beam_coefficients", "condition", "gate_frame", "load_case", "nc_schedule",
            "schedule_file"]

@@ -171,7 +171,7 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
         loop_target(fitted, settings.get("target"))
     s = Settings("errormodel" if fitted else method, params, control=control, model=fitted, **settings)
     if condition is not None:
-        from gatetherm.studies.run.conditions import condition as check_condition
+        from gatetherm.frame.conditions import condition as check_condition
 
         check_condition(condition)  # a bad number fails before the model is built
     if isinstance(case, Case):

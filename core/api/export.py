@@ -168,7 +168,7 @@ def export_case(case: Case | str | os.PathLike | None = None, *, condition: int 
     from gatetherm.checks import argument
     from gatetherm.outdir import output_dir
     from gatetherm.studies.run.ccx import check_time, export_state
-    from gatetherm.studies.run.conditions import condition as check_condition
+    from gatetherm.frame.conditions import condition as check_condition
 
     argument("case", case, (Case, *PATH, type(None)), "a Case, a case file's path or None")
     argument("out", out, (*PATH, type(None)), "a folder's path or None")

@@ -91,7 +91,7 @@ def mesh_frame(dim: int = 2, config: str | os.PathLike | None = None, condition:
     FrameFiles
     """
     from gatetherm.outdir import output_dir
-    from gatetherm.studies.run.conditions import condition as check_condition
+    from gatetherm.frame.conditions import condition as check_condition
 
     argument("config", config, (*PATH, type(None)), "a model file's path or None")
     argument("out", out, (*PATH, type(None)), "a folder's path or None")

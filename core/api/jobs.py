@@ -171,7 +171,7 @@ def simulate(condition: int | None = None, schedule: str | os.PathLike | None = 
     """
     from gatetherm import InputError
     from gatetherm.solvers.effects import parse_effect
-    from gatetherm.studies.run.conditions import condition as check_condition
+    from gatetherm.frame.conditions import condition as check_condition
 
     if (condition is None) == (schedule is None):
         raise InputError("condition/schedule", "give one of the two", "e.g. condition=1")

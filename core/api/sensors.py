@@ -65,6 +65,7 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
         A setting out of range, an unknown boundary or input, no candidate left, a case without
         relative displacements.
     """
+    from gatetherm.frame.conditions import paper_conditions
     from gatetherm.studies.errormodel.fit import FitParams
     from gatetherm.studies.sensors.candidates import Box
     from gatetherm.studies.sensors.place import PlacementSettings, place_sensors as place
@@ -96,6 +97,7 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
         settings["boundaries"] = (b,) if isinstance(b, str) else tuple(b)
     if on_progress is not None and not callable(on_progress):
         raise TypeError(f"on_progress: got {type(on_progress).__name__}, expected a callable on_progress(i, n) or None")
+    held_out = held_out or paper_conditions(case) or None  # the paper's conditions 1-3 for the frame's inputs
     return place(case, PlacementSettings(count=count, fit=FitParams(**fit), **settings), schedules, held_out,
                  on_progress=on_progress)
 

@@ -18,6 +18,7 @@ import numpy as np
 from gatetherm import InputError, write_text_atomic
 from gatetherm.frame.beam import theory_coefficients
 from gatetherm.frame.build import build_mesh
+from gatetherm.frame.conditions import condition, condition_schedule
 from gatetherm.frame.config import Config, config_toml, load_config, parse_config
 from gatetherm.frame.geometry import FrameParams
 from gatetherm.frame.loadcases import tip_coefficients_um
@@ -26,9 +27,7 @@ from gatetherm.geometry.mesh import FrameMesh
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.run.case import Case, TimeSettings, nested
 from gatetherm.studies.run.casefile import case_toml
-from gatetherm.studies.run.conditions import condition
 from gatetherm.studies.run.parameters import GEOMETRY, SHIFT, Parameter, geometry
-from gatetherm.studies.run.schedules import condition_schedule
 from gatetherm.studies.run.timeseries import FORMAT, TimeSeries, write_timeseries
 
 SCHEDULE_STEP_S = 15.0

@@ -89,9 +89,9 @@ def _nest(flat: dict[str, Any]) -> dict:
 
 def configure(base: Config, overrides: dict[str, Any], dim: int, fit: bool = True):
     """``(config, condition, effects, skip)`` of one point; bad keys raise InputError."""
+    from gatetherm.frame.conditions import CONDITIONS
     from gatetherm.frame.problem import TARGETS
     from gatetherm.solvers.effects import resolve
-    from gatetherm.studies.run.conditions import CONDITIONS
 
     sections, geometry, derived, effects, condition = {}, {}, {}, {}, None
     fields = {f.name for f in dataclasses.fields(FrameParams)}

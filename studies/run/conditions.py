@@ -1,10 +1,11 @@
-"""The oil-supply schedules of the paper's experiments, and schedules from files.
+"""An oil supply unit's schedules, and schedules from files.
 
 A condition is data: the supply unit's initial oil temperature and a list of
 segments, each with a start time, the pump state and the controller set point.
 The supply oil approaches the set point with a first-order lag (its heater or
-the forced cooling of condition 3), which is what makes condition 2 start from
-20 °C oil. The tank itself (oil mass, wall film) is part of the FE model.
+forced cooling), which is what makes the paper's condition 2 start from 20 °C oil.
+The tank itself (oil mass, wall film) is part of the FE model. The paper's
+experiments are conditions of this kind: :mod:`gatetherm.frame.conditions`.
 """
 from __future__ import annotations
 
@@ -56,26 +57,6 @@ class Condition:
     """Supply oil temperature at t = 0, °C (None: the room temperature)."""
     duration: float = 5 * HOUR
     """Length of the run, s."""
-
-
-def _alternating(T0: float | None, name: str) -> Condition:
-    return Condition(name, tuple(Segment(k * HOUR, k % 2 == 0, 40.0) for k in range(5)), T0)
-
-
-CONDITIONS: dict[int, Condition] = {
-    1: _alternating(40.0, "oil pre-heated to 40 °C; pump on at 0, then OFF/ON/OFF/ON hourly"),
-    2: _alternating(None, "heater and pump start at 0 from 20 °C oil; then pump OFF/ON/OFF/ON hourly"),
-    3: Condition("as 2; oil forced to 20 °C at 1 h, 40 °C again at 2 h; pump off 3–4 h",
-                 (Segment(0, True, 40.0), Segment(HOUR, True, 20.0), Segment(2 * HOUR, True, 40.0),
-                  Segment(3 * HOUR, False, 40.0), Segment(4 * HOUR, True, 40.0)), None),
-}
-
-
-def condition(number: int) -> Condition:
-    if number not in CONDITIONS:
-        raise InputError("--condition", f"no condition {number}",
-                         f"choose one of {', '.join(map(str, CONDITIONS))} or give a schedule file")
-    return CONDITIONS[number]
 
 
 def supply_temperature(cond: Condition, sp: SupplyParams, t: np.ndarray) -> np.ndarray:

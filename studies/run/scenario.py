@@ -24,8 +24,7 @@ from gatetherm.solvers.heat import HeatSolver, environment
 from gatetherm.solvers.model import Model, build
 from gatetherm.solvers.sensors import apply_faults
 from gatetherm.studies.run.case import Case
-from gatetherm.studies.run.schedules import (STEADY, Schedule, condition_schedule, file_schedule,  # noqa: F401
-                                             series_schedule)
+from gatetherm.studies.run.schedules import STEADY, Schedule, file_schedule, series_schedule  # noqa: F401
 from gatetherm.studies.run.simulate import RunResult, check_temperatures, loss_columns, output_columns, run_model
 from gatetherm.studies.run.timeseries import TimeSeries
 
@@ -189,5 +188,5 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
     return ScenarioRun(cols, result, model, eff, schedule, time.perf_counter() - t0)
 
 
-__all__ = ["STEADY", "Prepared", "ScenarioCache", "ScenarioRun", "Schedule", "active", "condition_schedule",
-           "effective", "file_schedule", "measured_schedule", "prepare", "run_scenario"]
+__all__ = ["STEADY", "Prepared", "ScenarioCache", "ScenarioRun", "Schedule", "active", "effective",
+           "file_schedule", "measured_schedule", "prepare", "run_scenario"]

@@ -2,8 +2,8 @@
 
 A schedule is a drive (the inputs a case's values read, by name, as a function of time) and
 the sample times. It comes from a case's ``[time]`` settings and schedule file, from one of
-the paper's conditions (the oil supply unit's set points), or from the inputs recorded in a
-time series (a measured run replayed at its own sample times).
+the paper's conditions (the oil supply unit's set points: :mod:`gatetherm.frame.conditions`),
+or from the inputs recorded in a time series (a measured run replayed at its own sample times).
 """
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.solvers.heat import Drive
-from gatetherm.studies.run.conditions import SupplyParams, TableDrive, condition, condition_drive, filled
+from gatetherm.studies.run.conditions import TableDrive, filled
 from gatetherm.studies.run.simulate import sample_times
 from gatetherm.studies.run.timeseries import TimeSeries, check_steps, read_timeseries
 
@@ -37,13 +37,6 @@ class Schedule:
 
 STEADY = Schedule(lambda _: {}, np.zeros(1), "steady state")
 """One state at t = 0, in equilibrium with the inputs."""
-
-
-def condition_schedule(number: int, supply: SupplyParams = SupplyParams(), step_s: float = 60.0) -> Schedule:
-    """The paper's condition ``number`` (its oil supply unit ``supply``), sampled every ``step_s``."""
-    cond = condition(number)
-    return Schedule(condition_drive(cond, supply), sample_times(cond.duration, step_s),
-                    f"condition {number}: {cond.name}", number)
 
 
 def series_drive(ts: TimeSeries, needed, held=(), defaults: Mapping[str, float] | None = None,

@@ -3,9 +3,9 @@
 1. Candidates (:mod:`.candidates`): outer-surface (or named-boundary) nodes, thinned, minus boxes
    and the parts the case says cannot carry a sensor (``[sensors] exclude``).
 2. Loads (:mod:`.loads`): training = the case's schedule (unless it is held out) and a generated
-   family of duty cycles (or given schedules); held out = given schedules, or for a case driven
-   by the paper frame's inputs (oil supply, pump, room) the paper's conditions 1-3, else a
-   generated family of its own seed.
+   family of duty cycles (or given schedules); held out = given schedules (the API gives the
+   paper's conditions 1-3 for a case driven by the paper frame's inputs: oil supply, pump, room:
+   :func:`gatetherm.frame.conditions.paper_conditions`), else a generated family of its own seed.
 3. The reduced model (:func:`gatetherm.studies.run.reduce.build_rom`) marches every load once;
    each candidate's temperature is its basis row times the states (:mod:`.reduced`); the targets
    are every relative displacement of the case; every sensor reading gets its noise
@@ -29,9 +29,7 @@ from gatetherm import InputError
 from gatetherm.studies.errormodel.fit import FitParams
 from gatetherm.studies.run.reduce import build_rom
 from gatetherm.studies.run.scenario import ScenarioCache, prepare
-from gatetherm.studies.run.schedules import condition_schedule
 from gatetherm.studies.run.simulate import column
-from gatetherm.studies.run.timeseries import AMBIENT, PUMP, SUPPLY
 from gatetherm.studies.sensors import greedy
 from gatetherm.studies.sensors.candidates import Box, candidates as find_candidates
 from gatetherm.studies.sensors.loads import duty_cycles, input_ranges
@@ -93,17 +91,8 @@ class PlacementSettings:
                 raise InputError(name, f"{getattr(self, name, self.fit.form)!r} is not admissible", fix)
 
 
-def paper_conditions(case) -> list:
-    """The paper's conditions 1-3 (driven by the case's oil supply unit) if the case reads only
-    the frame's inputs (oil supply, pump, room), else none."""
-    if not case.inputs() or not case.inputs() <= {SUPPLY, PUMP, AMBIENT} or PUMP not in case.inputs():
-        return []
-    supply = getattr(case.origin, "supply", None)  # the paper frame's oil supply unit (its model file's)
-    return [condition_schedule(n, *(() if supply is None else (supply,))) for n in (1, 2, 3)]
-
-
 def _loads(case, s: PlacementSettings, schedules, held_out):
-    known = list(held_out) if held_out else paper_conditions(case)
+    known = list(held_out) if held_out else []
     own = [case.schedule] if len(case.schedule.times) > 1 else []
     ranges = input_ranges(case, own + known, dict((n, (lo, hi)) for n, lo, hi in s.ranges))
     ref = own[0].times if own else None
@@ -157,7 +146,8 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
     schedules : sequence of Schedule, optional
         Training duty cycles instead of the generated family (the case's own schedule is added).
     held_out : sequence of Schedule, optional
-        Loads to judge on (default: the paper's conditions 1-3 for the frame's inputs, else generated).
+        Loads to judge on (default: generated; :func:`gatetherm.api.place_sensors` gives the paper's
+        conditions 1-3 for a case driven by the frame's inputs).
     cache : ScenarioCache, optional
         Reuses the assembled model.
     on_progress : callable, optional

@@ -39,6 +39,7 @@ def compute(ctx) -> Result:
     import gatetherm.validation
     from gatetherm.studies.run.case import load_case
     from gatetherm.frame.case import gate_frame
+    from gatetherm.frame.conditions import paper_conditions
     from gatetherm.studies.sensors.check import fe_check
     from gatetherm.studies.sensors.place import PlacementSettings, place_sensors
     from gatetherm.validation.plots import save
@@ -46,15 +47,15 @@ def compute(ctx) -> Result:
 
     sc = ctx.scope
     frame = gate_frame(2)
-    by_seed = {seed: place_sensors(frame, PlacementSettings(count=sc["frame_count"], loads=sc["loads"], seed=seed))
-               for seed in sc["seeds"]}
+    by_seed = {seed: place_sensors(frame, PlacementSettings(count=sc["frame_count"], loads=sc["loads"], seed=seed),
+                                   held_out=paper_conditions(frame)) for seed in sc["seeds"]}
     pf = by_seed[sc["seeds"][0]]
     paper = {p.name: p.xyz for p in frame.problem.probes if p.name in ("A", "B") or p.name.startswith("C")}
     marks = {**paper, **{p.name: p.xyz for p in frame.problem.probes if p.name in TIPS}}
     save(plot_machine(frame.mesh, pf, probes=paper).figure, ctx.work / "frame_sensors.png")
     check = fe_check(frame, pf)
     case = load_case(Path(gatetherm.validation.__path__[0]) / sc["case"])
-    pc = place_sensors(case, PlacementSettings(count=sc["case_count"], loads=sc["loads"]))
+    pc = place_sensors(case, PlacementSettings(count=sc["case_count"], loads=sc["loads"]), held_out=paper_conditions(case))
     named = {n for names in pc.signals["sensors"].values() for n in names}
     own = {p.name: p.xyz for p in case.problem.probes if p.name in named}
     save(plot_machine(case.mesh, pc, probes=own).figure, ctx.work / "cframe_sensors.png")
