@@ -64,6 +64,8 @@ BAD = {
     "condition(step_s=0)": (lambda c: gt.condition(1, step_s=0), InputError, "step_s: got 0, must be a finite number"),
     "condition(True)": (lambda c: gt.condition(True), TypeError, "number: got bool True, expected a whole number"),
     "condition(4)": (lambda c: gt.condition(4), InputError, "number: got 4, must be a whole number in [1, 3]"),
+    "condition(case=file)": (lambda c: gt.condition(1, case=c["frame"]), InputError,
+                             "case: 'C-frame machining centre' has no oil supply unit of the paper's model"),
     "condition(1, step_s=7)": (lambda c: gt.condition(1, step_s=7), InputError,
                                "step_s: 7 s does not divide the condition's 18000 s"),
     "reduce(states=0)": (lambda c: gt.reduce(c["frame"], 0), InputError,

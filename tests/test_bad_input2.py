@@ -84,6 +84,16 @@ def test_a_temperature_in_kelvins_is_read_with_a_warning(tmp_path, caplog):
     assert "thermal.jacket.ambient: 293.15 °C reads like a temperature in kelvins (20 °C)" in caplog.text
 
 
+def test_a_negative_constant_load_is_read_with_a_word(tmp_path, caplog):
+    """A signed column's load or speed is read as its magnitude (a loss does not change sign);
+    a negative number written by hand is read the same way, and said."""
+    with caplog.at_level(logging.WARNING):
+        case = gt.load_case(spindle(tmp_path, "load = 2000.0", "load = -2000.0"))
+    assert "sources.front_bearing.load = -2000 N: its sign is ignored (a loss depends on the magnitude); " \
+           "give 2000" in caplog.text
+    assert case.name
+
+
 def test_a_guide_friction_above_one_is_refused():
     from gatetherm.studies.run.case_sources import FRICTION
     assert FRICTION.admits(0.003) and not FRICTION.admits(3.0) and not FRICTION.admits(-0.001)
@@ -102,6 +112,36 @@ def test_a_mesh_parameter_the_script_never_reads_is_refused(tmp_path, caplog):
     with caplog.at_level(logging.WARNING):
         gt.load_case(tmp_path / "case.toml")  # a refinement coarser than the mesh: read, with a word
     assert "mesh.refine[1].size 0.02 m is not finer than [mesh] size 0.01 m" in caplog.text
+
+
+BOX_FIELD = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 1, 1};
+Field[1] = Box; Field[1].VIn = 0.01; Field[1].VOut = 0.2;
+Field[1].XMin = 0; Field[1].XMax = 0.2; Field[1].YMin = 0; Field[1].YMax = 1;
+Background Field = 1;
+Physical Surface("body") = {1};
+Physical Curve("left") = {4};
+"""
+
+
+def test_a_refinement_keeps_the_scripts_own_background_field(tmp_path, caplog):
+    """A case's ``[[mesh.refine]]`` used to replace the script's ``Background Field``: the
+    0.01-m strip of the script became 0.17-m elements (4 563 elements → 50), without a word."""
+    from gatetherm.geometry.gmshfile import MeshSpec, Refinement, mesh_geometry
+    (tmp_path / "box.geo").write_text(BOX_FIELD)
+
+    def strip(fm):  # mean first-edge length of the elements in the script's fine strip x < 0.2
+        p, c = fm.points, fm.cells
+        inside = p[c].mean(axis=1)[:, 0] < 0.2
+        return len(c), float(np.linalg.norm(p[c[inside, 0]] - p[c[inside, 1]], axis=1).mean())
+
+    n0, h0 = strip(mesh_geometry(MeshSpec(tmp_path / "box.geo")))
+    with caplog.at_level(logging.WARNING):
+        n1, h1 = strip(mesh_geometry(MeshSpec(tmp_path / "box.geo", refine=(Refinement("left", 0.05, 0.1),))))
+    assert h0 == pytest.approx(0.0102, abs=5e-4) and h1 == pytest.approx(0.0104, abs=5e-4)  # band: < 0.02
+    assert n1 == pytest.approx(n0, rel=0.2)  # 4163 against 4563 (the rest of the body: gmsh's own extension)
+    assert ("mesh.refine[1] (near left): size = 0.05 m, but the file's own sizes give 0.01 m there already, "
+            "so it changes nothing") in caplog.text
 
 
 @pytest.mark.parametrize("program, kwargs, needle", [

@@ -55,7 +55,8 @@ def check_schedules(case: Case) -> list[Schedule]:
     _case(case)
     out = [case.schedule] if len(case.schedule.times) > 1 else []
     if case.inputs() and case.inputs() <= {SUPPLY, PUMP, AMBIENT}:
-        out += [condition(n, case) for n in (1, 2, 3) if condition(n, case).label != case.schedule.label]
+        frame = case if getattr(case.origin, "config", None) is not None else None  # else: the paper's supply unit
+        out += [condition(n, frame) for n in (1, 2, 3) if condition(n, frame).label != case.schedule.label]
     return sorted(out, key=lambda s: (s.condition is None, s.condition or 0))
 
 
