@@ -70,9 +70,11 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
     ``columns(problem, key) -> (name, scale)`` names each read-out key as a data-format column."""
     h, prob, r = model.heat, model.problem, model.readout
     if h.varying:
+        at = ", ".join(f"{v.boundary} {v.h_ref:.3g}" for v in h.varying)
         raise InputError(f"film of '{h.varying[0].boundary}'", "follows the temperature (a correlation or radiation): "
                          "the reduced model is linear and would hold it at its reference",
-                         "give the film as a number to reduce the case")
+                         f"give each such film as a number to reduce the case (at the law's reference: {at} "
+                         "W/(m² K); the law at a run's mean wall temperature and speed is closer: docs/case-file.md)")
     T0, n = float(prob.T0), h.n
     fixed = h.fixed_dofs
     free = complement(n, fixed)
