@@ -251,7 +251,8 @@ def mesh_geometry(spec: MeshSpec) -> FrameMesh:
         read = scan(script, root, spec.include)  # every file it reads inside the case's folder or named
         background = any(a == "Background" and b == "Field" for f in read if f.suffix.lower() == SCRIPT
                          for (a, _), (b, _) in pairwise(tokens(f.read_text(encoding="utf-8", errors="replace"))))
-    meta, arrays = run_isolated(functools.partial(_mesh_in_gmsh, spec, own_background=background), str(spec.path), script,
+    meta, arrays = run_isolated(functools.partial(_mesh_in_gmsh, spec, own_background=background), str(spec.path),
+                                script,
                                 functools.partial(scan, root=root, allowed=spec.include, commands=True))
     for note in meta.pop("notes", []):
         log.warning(note)
