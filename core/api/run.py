@@ -7,7 +7,7 @@ import logging
 import os
 import time as _time
 from pathlib import Path
-from typing import Callable, Iterable, Mapping
+from typing import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -240,7 +240,8 @@ def _fields_every(case: Case) -> float:
 
 
 def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
-        keep=None, on_step: Callable[[int, int], None] | None = None, check_order: bool = False,
+        keep: Sequence[float] | None = None, on_step: Callable[[int, int], None] | None = None,
+        check_order: bool = False,
         fields_every: float | None = None) -> Run:
     """Run ``case``.
 
