@@ -328,3 +328,37 @@ def test_a_correlation_film_refused_by_the_reduction_names_its_equivalent(tmp_pa
     assert str(info.value).startswith("film of 'nose': follows the temperature (a correlation or radiation)")
     assert "give each such film as a number to reduce the case (at the law's reference: nose 40 W/(m² K)" \
         in str(info.value)
+
+
+@pytest.mark.parametrize("old, new, needle", [
+    ("[probes.mount_point]", '[probes."mount,point"]',
+     "probes.mount,point: cannot name a probe's columns (it holds a comma"),
+    ("point = [0.07, 0.05]", "point = [1e300, 0.05]", "probes.mount_point.point: [1e+300, 0.05] lies outside the mesh"),
+    ('quantities = ["u"]', 'quantities = ["u", "u"]', "probes.mount_point.quantities: ['u', 'u'] is not admissible; "
+                                                      "choose each once from"),
+    ('name = "spindle_unit"', 'name = "x\\u001b]0;pwned\\u0007"',
+     "case.name: is not one printable line of at most 200 characters (11 characters)"),
+    ('file = "spindle.geo"', f'file = "{"s" * 300}.geo"', "mesh.file: is not one printable line of at most 200"),
+], ids=["comma in a probe", "a point 1e300 away", "a quantity twice", "escapes in the name", "a 300-character path"])
+def test_a_name_or_point_that_would_fail_later_is_refused_at_reading(tmp_path, old, new, needle):
+    """Each of these passed the reader (the third audit): a probe name with a comma failed only
+    after the whole run, writing its column; a point 1e300 away raised an IndexError inside
+    scikit-fem; terminal escapes in the name went raw into timeseries.csv."""
+    with pytest.raises(InputError) as info:
+        gt.load_case(spindle(tmp_path, old, new))
+    assert needle in str(info.value) and "\x1b" not in str(info.value)
+
+
+def test_a_material_value_outside_what_machines_have_is_read_with_a_word(tmp_path, caplog):
+    with caplog.at_level(logging.WARNING):
+        gt.load_case(spindle(tmp_path, "c = 460.0", "c = 0.46"))  # kJ/(kg K) meant
+    assert "materials.shaft.c = 0.46 J/(kg K) is outside what the solids of machines have (50 to 5000): check its " \
+           "unit (SI: J/(kg K))" in caplog.text
+
+
+def test_an_error_line_is_bounded_and_escapes_control_characters():
+    from gatetherm import one_line
+
+    err = InputError("--targets", f"'{'x' * 100_000}' is not a column", "name a column")
+    assert len(str(err)) < 1000 and "(100018 characters)" in str(err)
+    assert one_line("a\x1b[2Jb\nc") == "a\\x1b[2Jb\\nc"
