@@ -83,6 +83,13 @@ class InputError(ValueError):
         return type(self)(f"{where}{sep}{self.field}", self.problem, self.fix)
 
 
+class UnknownName(InputError, KeyError):
+    """A name that is not among those offered (a run's column, a field): an InputError naming
+    them, and a KeyError for the code that looks names up."""
+
+    __str__ = Exception.__str__
+
+
 def _new_temporary(path: Path) -> Path:
     """Create an empty file beside ``path`` with a fresh name; the umask sets its mode."""
     while True:

@@ -45,6 +45,8 @@ before any work); ranges and names from each function:
   files), naming the file, the key or line and the fix; a number that would be written to a
   file as NaN or infinity is :class:`gatetherm.checks.NonFiniteError`, a kind of InputError
   naming the quantity.
+- :class:`gatetherm.UnknownName` (an InputError and a ``KeyError``) for a name not among those
+  offered: ``run["nosuch_um"]``, ``run.field("Tx")``, naming the ones there are.
 - ``OSError`` for a file that cannot be written (a full disk), naming the file.
 
 Anything else is a defect of gatetherm: please report it.
