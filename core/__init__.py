@@ -54,14 +54,23 @@ def __getattr__(name: str):
     raise AttributeError(f"module 'gatetherm' has no attribute {name!r}")
 
 
+def one_line(text: str, limit: int = 300) -> str:
+    """``text`` as a terminal shows it safely: control characters escaped (a user's text may
+    carry a terminal's escape sequences or a line break), and cut in the middle beyond ``limit``
+    characters."""
+    text = "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+    return text if len(text) <= limit else f"{text[:limit // 2]} … ({len(text)} characters) … {text[-limit // 4:]}"
+
+
 class InputError(ValueError):
-    """Bad user input. ``str(err)`` is one line naming the field and the fix."""
+    """Bad user input. ``str(err)`` is one line naming the field and the fix (each part at most
+    a few hundred characters, control characters escaped: :func:`one_line`)."""
 
     def __init__(self, field: str, problem: str, fix: str = ""):
         self.field, self.problem, self.fix = field, problem, fix
-        msg = f"{field}: {problem}"
+        msg = f"{one_line(field)}: {one_line(problem, 600)}"
         if fix:
-            msg += f"; {fix}"
+            msg += f"; {one_line(fix, 600)}"
         super().__init__(msg)
 
     def __reduce__(self):  # picklable, so that a worker process can report it
@@ -72,6 +81,13 @@ class InputError(ValueError):
         if not where or self.field.startswith(f"{where}{sep}"):
             return self
         return type(self)(f"{where}{sep}{self.field}", self.problem, self.fix)
+
+
+class UnknownName(InputError, KeyError):
+    """A name that is not among those offered (a run's column, a field): an InputError naming
+    them, and a KeyError for the code that looks names up."""
+
+    __str__ = Exception.__str__
 
 
 def _new_temporary(path: Path) -> Path:

@@ -282,13 +282,3 @@ def whole_argument(name: str, value, rng: Range, fix: str = "") -> int:
 def _short(value) -> str:
     text = repr(value)
     return text if len(text) <= 40 else text[:37] + "..."
-
-
-def settings_argument(cls, settings, function: str) -> dict:
-    """``settings`` (a function's ``**settings``) if each is a field of the dataclass ``cls``,
-    else a one-line :class:`TypeError` naming the unknown one and listing the known ones."""
-    known = [f.name for f in dataclasses.fields(cls)]
-    unknown = [k for k in settings if k not in known]
-    if unknown:
-        raise TypeError(f"{unknown[0]}: is not a setting of {function}; settings: {', '.join(known)}")
-    return settings

@@ -31,6 +31,7 @@ import pickle
 import struct
 
 from gatetherm import InputError
+from gatetherm.options import SolverOptions
 
 log = logging.getLogger(__name__)
 
@@ -202,7 +203,7 @@ def virtual_machine() -> bool:
         return False
 
 
-def configure(options=None):
+def configure(options: SolverOptions | None = None):
     """Set up the running process for gatetherm's numerics, as every command does first.
 
     Each setting adapts to the machine it runs on (docs/performance.md has the measurement
@@ -231,7 +232,7 @@ def configure(options=None):
     gatetherm.SolverOptions
         The options in force.
     """
-    from gatetherm.options import SolverOptions, set_current
+    from gatetherm.options import set_current
 
     if options is None:
         options = SolverOptions.from_environment()

@@ -11,11 +11,14 @@ import functools
 import logging
 import signal
 from dataclasses import dataclass, field
+from itertools import pairwise
 from pathlib import Path
+
+import numpy as np
 
 from gatetherm import InputError
 from gatetherm.geometry.extract import extract_mesh
-from gatetherm.geometry.geoscan import scan
+from gatetherm.geometry.geoscan import scan, tokens
 from gatetherm.geometry.groups import GroupRule, fragment, interfaces, physical, regions
 from gatetherm.geometry.isolate import READ_LIMIT_S, quiet, run_isolated
 from gatetherm.geometry.mesh import FrameMesh, check_mesh, from_arrays, to_arrays
@@ -58,10 +61,26 @@ class MeshSpec:
     """The factor ``size`` and the refinements' sizes were multiplied by; it scales the file's own sizes too."""
 
 
-def _refine(gmsh, spec: MeshSpec, names: dict) -> dict[int, int]:
-    """Size fields of the refinements; their field tags and numbers (from 1)."""
+def _own_background(gmsh) -> list[int]:
+    """The file's own size fields that may be its ``Background Field``: those no other field
+    reads (a Distance gives lengths, not sizes)."""
+    f = gmsh.model.mesh.field
+    read = set()
+    for tag in f.list():
+        for key, many in (("InField", False), ("IField", False), ("FieldsList", True)):
+            try:
+                read |= {int(t) for t in f.getNumbers(tag, key)} if many else {int(f.getNumber(tag, key))}
+            except Exception:  # noqa: BLE001 - gmsh: the field has no such option
+                pass
+    return [t for t in f.list() if t not in read and f.getType(t) not in ("Distance", "Attractor")]
+
+
+def _refine(gmsh, spec: MeshSpec, names: dict, own_background: bool = False) -> dict[int, int]:
+    """Size fields of the refinements; their field tags and numbers (from 1). A script's own
+    background field stays in force (the smallest size wins)."""
     f = gmsh.model.mesh.field
     big = spec.size or 1e22
+    own = _own_background(gmsh) if own_background and spec.refine else []
     fields = []
     for r in spec.refine:
         groups = [k for k, n in names.items() if n == r.near]
@@ -81,7 +100,7 @@ def _refine(gmsh, spec: MeshSpec, names: dict) -> dict[int, int]:
         fields.append(thr)
     if fields:
         low = f.add("Min")
-        f.setNumbers(low, "FieldsList", fields)
+        f.setNumbers(low, "FieldsList", fields + own)
         f.setAsBackgroundMesh(low)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     return {tag: i for i, tag in enumerate(fields, start=1)}
@@ -146,7 +165,32 @@ def _read(gmsh, spec: MeshSpec) -> int:
     return dim
 
 
-def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
+def _mean_edge(gmsh, d: int, entities) -> float | None:
+    """Mean length of the first edge of the mesh's elements on ``entities`` of dimension ``d``."""
+    lengths = []
+    for e in entities:
+        tags, xyz, _ = gmsh.model.mesh.getNodes(d, int(e), includeBoundary=True)
+        at = dict(zip(tags.tolist(), xyz.reshape(-1, 3)))
+        for kind, _, nodes in zip(*gmsh.model.mesh.getElements(d, int(e))):
+            n = gmsh.model.mesh.getElementProperties(kind)[3]
+            lengths += [float(np.linalg.norm(at[a] - at[b])) for a, b in nodes.reshape(-1, n)[:, :2].tolist()]
+    return sum(lengths) / len(lengths) if lengths else None
+
+
+def _coarser(gmsh, spec: MeshSpec, names: dict) -> list[str]:
+    """Notes for refinements coarser than the mesh the file's own sizes made at their group
+    (they change nothing there)."""
+    notes = []
+    for i, r in enumerate(spec.refine, start=1):
+        d, tag = next(k for k, n in names.items() if n == r.near)
+        h = _mean_edge(gmsh, d, gmsh.model.getEntitiesForPhysicalGroup(d, tag)) if d else None
+        if h is not None and h < 0.5 * r.size:
+            notes.append(f"mesh.refine[{i}] (near {r.near}): size = {r.size:g} m, but the file's own sizes give "
+                         f"{h:.3g} m there already, so it changes nothing; give a smaller size, or remove it")
+    return notes
+
+
+def _mesh_in_gmsh(spec: MeshSpec, gmsh, own_background: bool = False) -> tuple[dict, dict]:
     """Read, name, check the size of and mesh the geometry (in the sandboxed child)."""
     dim = _read(gmsh, spec)
     parts = len(gmsh.model.getEntities(dim))
@@ -166,7 +210,7 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
     if spec.size:
         gmsh.option.setNumber("Mesh.MeshSizeMax", spec.size)
     names = physical(gmsh)
-    mine = _refine(gmsh, spec, names)
+    mine = _refine(gmsh, spec, names, own_background)
     parts = model_estimate(gmsh, dim)
     _, tag, size = max(parts, key=lambda p: p[0])
     check_estimate(sum(p[0] for p in parts), dim, *_size_key(spec, tag, size, mine))
@@ -195,16 +239,20 @@ def _mesh_in_gmsh(spec: MeshSpec, gmsh) -> tuple[dict, dict]:
         if abs(xyz[2::3]).max(initial=0.0) > 1e-12:
             raise InputError(str(spec.path), "a 2-D geometry must lie in the x-y plane", "draw it in z = 0")
     fm, notes = extract_mesh(gmsh, dim, groups[dim], groups[dim - 1], points, groups[1] if dim == 3 else None)
-    return to_arrays(fm, notes)
+    return to_arrays(fm, [*_coarser(gmsh, spec, names), *notes])
 
 
 def mesh_geometry(spec: MeshSpec) -> FrameMesh:
     """Mesh ``spec.path`` and return the named mesh (2-D if the geometry is planar)."""
     root = spec.root or spec.path.parent
     script = spec.path if spec.path.suffix.lower() == SCRIPT else None
+    background = False
     if script is not None:
-        scan(script, root, spec.include)  # every file it reads inside the case's folder or named
-    meta, arrays = run_isolated(functools.partial(_mesh_in_gmsh, spec), str(spec.path), script,
+        read = scan(script, root, spec.include)  # every file it reads inside the case's folder or named
+        background = any(a == "Background" and b == "Field" for f in read if f.suffix.lower() == SCRIPT
+                         for (a, _), (b, _) in pairwise(tokens(f.read_text(encoding="utf-8", errors="replace"))))
+    meta, arrays = run_isolated(functools.partial(_mesh_in_gmsh, spec, own_background=background), str(spec.path),
+                                script,
                                 functools.partial(scan, root=root, allowed=spec.include, commands=True))
     for note in meta.pop("notes", []):
         log.warning(note)

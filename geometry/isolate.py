@@ -43,6 +43,9 @@ log = logging.getLogger(__name__)
 FORBIDDEN = "the geometry script tried to run a program / write a file; gatetherm does not allow it"
 PROGRESS_S = 3.0
 """Interval of the progress lines of gmsh's log (``-v``), s."""
+STILL_S = 30.0
+"""Without ``-v``: a line saying gmsh is still at work after this long, and every twice as long
+since (a mesh of millions of elements takes minutes; nothing on the terminal looked like a hang)."""
 READ_LIMIT_S = 30
 """Longest a geometry script may take to run, before meshing, s: a script that runs longer (an
 endless loop) is refused (the child ends on SIGALRM). Meshing itself has no time limit."""
@@ -162,9 +165,13 @@ def run_isolated(work, label: str, script: Path | None = None, scan=None) -> tup
     listener, data, lines, tried = None, bytearray(), deque(maxlen=20), None
     open_fds = {out_r, log_r, mine.fileno()}
     try:
-        last, partial = -PROGRESS_S, b""
+        last, partial, start, still = -PROGRESS_S, b"", time.monotonic(), STILL_S
         while out_r in open_fds or log_r in open_fds:
             ready, _, _ = select.select(list(open_fds), [], [], 1.0)
+            if not verbose and time.monotonic() - start >= still:
+                log.warning("%s: gmsh is still at work after %.0f s (a large mesh; Ctrl-C stops it, a larger "
+                            "[mesh] size or --mesh-factor makes it quicker)", label, time.monotonic() - start)
+                still *= 2
             for fd in ready:
                 if fd == mine.fileno():
                     mode, fds, _, _ = socket.recv_fds(mine, 256, 1)

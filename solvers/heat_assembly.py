@@ -90,46 +90,12 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         cb = cells()
         K = K + asm(film, cb, h=problem.faces.h, t=2.0)
         loads.append((asm(film_load, cb, h=problem.faces.h, t=2.0), problem.faces.ambient, "faces"))
-    moving = []
-    for src in problem.sources:
-        if src.on_boundary:  # a power on a surface: ∫ t v over the boundary, normalised to it
-            vec = boundary_terms(mesh, src.region, e, q, th)[1]
-        else:
-            cb = cells()
-            on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
-            vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
-        if src.position is not None:
-            moving.append(moving_load(mesh, basis, src, vec, order))
-            continue
-        if src.on_boundary:
-            loads.append((vec / vec.sum(), src.density, "source"))
-            continue
-        loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
+    source_loads, moving = _sources(mesh, basis, problem, e, q, th, cells)
+    loads += source_loads
     n_solid = basis.N
-    caps, losses, lumped, couplings = [], [], {}, []
-    for fluid in problem.fluids:
-        lumped[fluid.name] = n_solid + len(caps)
-        caps.append(fluid.capacity)
-        losses.append((0.0, None))
-        couplings.append(boundary_terms(mesh, fluid.boundary, e, q, th))
-        if fluid.hose_capacity > 0:
-            lumped[fluid.hose_name or f"{fluid.name}_hose"] = n_solid + len(caps)
-            caps.append(fluid.hose_capacity)
-            losses.append((fluid.hose_loss, fluid.ambient))
+    caps, losses, lumped, couplings = _lumped(mesh, problem, e, q, th, n_solid)
     n = n_solid + len(caps)
-
-    pumped = []
-    for fluid, (A_ww, c) in zip(problem.fluids, couplings):
-        o = lumped[fluid.name]
-        i = lumped.get(fluid.hose_name or f"{fluid.name}_hose", o) if fluid.hose_capacity > 0 else o
-        A, idx = A_ww.tocoo(), np.flatnonzero(c)
-        oo = np.full(len(idx), o)
-        wall = sp.csr_matrix((np.r_[A.data, -c[idx], -c[idx], c.sum()],
-                              (np.r_[A.row, idx, oo, o], np.r_[A.col, oo, idx, o])), shape=(n, n))
-        flow = sp.csr_matrix(([1.0, -1.0, 1.0], ([o, o, i], [o, i, i])), shape=(n, n))
-        pumped.append(Pumped(wall, fluid.film_on, fluid.film_off, flow, fluid.conductance, i,
-                             fluid.pump, fluid.supply))
-        log.info("heat system: fluid %s on %s, wall area %.4g m²", fluid.name, fluid.boundary, c.sum())
+    pumped = _pumped(problem, couplings, lumped, n)
     M, K0 = bordered(M, caps), bordered(K, [ua for ua, _ in losses])  # K0: the hoses' losses on its border
     loads = [Load(np.r_[v, np.zeros(len(caps))], value, kind) for v, value, kind in loads]
     for k, (ua, ambient) in enumerate(losses):
@@ -142,3 +108,56 @@ def assemble_heat(mesh, problem, fields: dict[str, Field], intorder: int | None 
         [d for d, _ in fixed]))) if fixed else 0)
     return HeatSystem(basis, M, K0, tuple(pumped), tuple(loads), fixed, n_solid, lumped, problem.T0, s,
                       tuple(varying), tuple(moving))
+
+
+def _sources(mesh, basis, problem, e, q, th, cells) -> tuple[list, list]:
+    """The sources' load vectors (with their power densities) and the moving ones' loads;
+    ``cells()`` is a basis with quadrature for the volume integrals."""
+    loads, moving = [], []
+    for src in problem.sources:
+        if src.on_boundary:  # a power on a surface: ∫ t v over the boundary, normalised to it
+            vec = boundary_terms(mesh, src.region, e, q, th)[1]
+        else:
+            cb = cells()
+            on = Field.by_region(mesh, {src.region: 1.0}, 0.0)
+            vec = asm(film_load, cb, h=on.at(cb), t=th.at(cb))
+        if src.position is not None:
+            moving.append(moving_load(mesh, basis, src, vec, problem.order))
+        elif src.on_boundary:
+            loads.append((vec / vec.sum(), src.density, "source"))
+        else:
+            loads.append((vec * src.per if src.per != 1.0 else vec, src.density, "source"))
+    return loads, moving
+
+
+def _lumped(mesh, problem, e, q, th, n_solid: int) -> tuple[list, list, dict, list]:
+    """The fluids' lumped unknowns after the solid's (a tank, and its hose where it has one):
+    their capacities, losses ``(UA, ambient)``, numbers by name, and each tank's wall terms."""
+    caps, losses, lumped, couplings = [], [], {}, []
+    for fluid in problem.fluids:
+        lumped[fluid.name] = n_solid + len(caps)
+        caps.append(fluid.capacity)
+        losses.append((0.0, None))
+        couplings.append(boundary_terms(mesh, fluid.boundary, e, q, th))
+        if fluid.hose_capacity > 0:
+            lumped[fluid.hose_name or f"{fluid.name}_hose"] = n_solid + len(caps)
+            caps.append(fluid.hose_capacity)
+            losses.append((fluid.hose_loss, fluid.ambient))
+    return caps, losses, lumped, couplings
+
+
+def _pumped(problem, couplings, lumped: dict, n: int) -> list[Pumped]:
+    """Each fluid's wall exchange and pumped flow, on all ``n`` unknowns."""
+    pumped = []
+    for fluid, (A_ww, c) in zip(problem.fluids, couplings):
+        o = lumped[fluid.name]
+        i = lumped.get(fluid.hose_name or f"{fluid.name}_hose", o) if fluid.hose_capacity > 0 else o
+        A, idx = A_ww.tocoo(), np.flatnonzero(c)
+        oo = np.full(len(idx), o)
+        wall = sp.csr_matrix((np.r_[A.data, -c[idx], -c[idx], c.sum()],
+                              (np.r_[A.row, idx, oo, o], np.r_[A.col, oo, idx, o])), shape=(n, n))
+        flow = sp.csr_matrix(([1.0, -1.0, 1.0], ([o, o, i], [o, i, i])), shape=(n, n))
+        pumped.append(Pumped(wall, fluid.film_on, fluid.film_off, flow, fluid.conductance, i,
+                             fluid.pump, fluid.supply))
+        log.info("heat system: fluid %s on %s, wall area %.4g m²", fluid.name, fluid.boundary, c.sum())
+    return pumped

@@ -65,18 +65,11 @@ def mode_name(states) -> str:
     return "_".join("on" if s else "off" for s in states)
 
 
-def linear_heat_model(model, columns) -> LinearHeatModel:
-    """The seam: read the switched linear system off an assembled model (heat solve with a read-out).
-    ``columns(problem, key) -> (name, scale)`` names each read-out key as a data-format column."""
-    h, prob, r = model.heat, model.problem, model.readout
-    if h.varying:
-        raise InputError(f"film of '{h.varying[0].boundary}'", "follows the temperature (a correlation or radiation): "
-                         "the reduced model is linear and would hold it at its reference",
-                         "give the film as a number to reduce the case")
-    T0, n = float(prob.T0), h.n
-    fixed = h.fixed_dofs
-    free = complement(n, fixed)
-    groups: dict = {}  # (value, temperature?) -> [(kind, vector over n or callable of mode)]
+def _heat_inputs(h, T0: float):
+    """The heat system's inputs and, per pump mode, its stiffness and input columns (over all
+    unknowns): every source, flux and film ambient by its value, each fixed temperature."""
+    n = h.n
+    groups: dict = {}  # (value, temperature?) -> [vector over n]
     for p in h.pumped:
         groups.setdefault((p.supply, True), [])
     for load in h.loads:
@@ -110,6 +103,56 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
         held[dofs] = 1.0
         for m in modes:
             cols[m].append(-(K[m] @ held))
+    return modes, K, inputs, cols
+
+
+def _outputs(model, columns, terms):
+    """The read-out rows (data-format scale) over all unknowns, their names, their parts from
+    the mechanical load terms, and which act on the rise above ``T_ref`` (W rows)."""
+    h, prob, r = model.heat, model.problem, model.readout
+    L, W = r.L.toarray(), np.hstack([r.W, np.zeros((len(r.W), h.n - h.n_solid))])
+    rows, names, mech, is_W = [], [], [], []
+    for i, key in enumerate(r.keys):
+        if key[0] == "sigma" and key[2] == "von_mises":
+            continue
+        name, scale = columns(prob, key)
+        rows.append((L[i] if i < r.n_L else W[i - r.n_L]) * scale)
+        mech.append(r.R[i - r.n_L] * scale if i >= r.n_L and terms else np.zeros(len(terms)))
+        names.append(name)
+        is_W.append(i >= r.n_L)
+    if prob.signals.theta_C:
+        rows.append(np.mean([rows[names.index(columns(prob, ("T", c))[0])] for c in prob.signals.theta_C], axis=0))
+        mech.append(np.zeros(len(terms)))
+        names.append("theta_C_degC")
+        is_W.append(False)
+    return np.array(rows), names, np.array(mech).reshape(len(names), len(terms)), np.array(is_W)
+
+
+def _key_outputs(model, columns, names) -> tuple:
+    """The outputs a reduction is judged on: relative displacements, θ, tank walls and fluids."""
+    prob, r = model.problem, model.readout
+    walls = {f"T_{m}_degC" for m, b in prob.means if b in {f.boundary for f in prob.fluids}}
+    key = [nm for nm in names if nm.endswith("_um") and any(k[0] == "relative" and columns(prob, k)[0] == nm
+                                                            for k in r.keys)]
+    key += [c for c in ("theta_A_degC", "theta_B_degC", "theta_C_degC") if c in names]
+    key += [nm for nm in names if nm in walls] + [f"T_{f.name}_degC" for f in prob.fluids if f"T_{f.name}_degC" in names]
+    return tuple(key) or tuple(names)
+
+
+def linear_heat_model(model, columns) -> LinearHeatModel:
+    """The seam: read the switched linear system off an assembled model (heat solve with a read-out).
+    ``columns(problem, key) -> (name, scale)`` names each read-out key as a data-format column."""
+    h, prob, r = model.heat, model.problem, model.readout
+    if h.varying:
+        at = ", ".join(f"{v.boundary} {v.h_ref:.3g}" for v in h.varying)
+        raise InputError(f"film of '{h.varying[0].boundary}'", "follows the temperature (a correlation or radiation): "
+                         "the reduced model is linear and would hold it at its reference",
+                         f"give each such film as a number to reduce the case (at the law's reference: {at} "
+                         "W/(m² K); the law at a run's mean wall temperature and speed is closer: docs/case-file.md)")
+    T0, n = float(prob.T0), h.n
+    fixed = h.fixed_dofs
+    free = complement(n, fixed)
+    modes, K, inputs, cols = _heat_inputs(h, T0)
     n_heat = len(inputs)
     terms = r.terms.values if r.terms is not None and r.R is not None else ()
     varying = [j for j, v in enumerate(terms) if not v.is_constant]
@@ -118,40 +161,17 @@ def linear_heat_model(model, columns) -> LinearHeatModel:
         for m in modes:
             cols[m].append(np.zeros(n))
     B = {m: np.column_stack(c)[free] if c else np.zeros((len(free), 0)) for m, c in cols.items()}
-    L, W = r.L.toarray(), np.hstack([r.W, np.zeros((len(r.W), n - h.n_solid))])
-    rows, names, mech = [], [], []
-    for i, key in enumerate(r.keys):
-        if key[0] == "sigma" and key[2] == "von_mises":
-            continue
-        name, scale = columns(prob, key)
-        rows.append((L[i] if i < r.n_L else W[i - r.n_L]) * scale)
-        mech.append(r.R[i - r.n_L] * scale if i >= r.n_L and terms else np.zeros(len(terms)))
-        names.append(name)
-    s = prob.signals
-    if s.theta_C:
-        rows.append(np.mean([rows[names.index(columns(prob, ("T", c))[0])] for c in s.theta_C], axis=0))
-        mech.append(np.zeros(len(terms)))
-        names.append("theta_C_degC")
-    R = np.array(rows)
-    mech = np.array(mech).reshape(len(names), len(terms))
+    R, names, mech, is_W = _outputs(model, columns, terms)
     constant = np.array([v.constant if v.is_constant else 0.0 for v in terms])
-    is_W = np.array([i >= r.n_L for i, k in enumerate(r.keys) if not (k[0] == "sigma" and k[2] == "von_mises")]
-                    + ([False] if s.theta_C else []))
     ref = np.where(is_W, R.sum(axis=1) * prob.T_ref, 0.0)  # W acts on the rise above T_ref
     D = np.zeros((len(names), len(inputs)))
     for j, (dofs, _) in enumerate(h.fixed):
         D[:, n_heat - len(h.fixed) + j] = R[:, dofs].sum(axis=1)
     for k, j in enumerate(varying):
         D[:, n_heat + k] = mech[:, j]
-    walls = {f"T_{m}_degC" for m, b in prob.means if b in {f.boundary for f in prob.fluids}}
-    key = [nm for nm in names if nm.endswith("_um") and any(k[0] == "relative" and columns(prob, k)[0] == nm
-                                                            for k in r.keys)]
-    key += [c for c in ("theta_A_degC", "theta_B_degC", "theta_C_degC") if c in names]
-    key += [nm for nm in names if nm in walls] + [f"T_{f.name}_degC" for f in prob.fluids if f"T_{f.name}_degC" in names]
     M = h.M.tocsr()
     if fixed.size:
         M, K = M[free][:, free].tocsr(), {m: k[free][:, free].tocsr() for m, k in K.items()}
     y0 = R.sum(axis=1) * T0 - ref + (mech @ constant if len(terms) else 0.0)  # constant loads: gravity's sag
-    return LinearHeatModel(M, K, B, R[:, free], D, y0, tuple(inputs), tuple(names),
-                           tuple(key) or tuple(names), tuple(p.pump.text or repr(p.pump.constant) for p in h.pumped),
-                           T0)
+    return LinearHeatModel(M, K, B, R[:, free], D, y0, tuple(inputs), tuple(names), _key_outputs(model, columns, names),
+                           tuple(p.pump.text or repr(p.pump.constant) for p in h.pumped), T0)

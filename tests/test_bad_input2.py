@@ -84,6 +84,16 @@ def test_a_temperature_in_kelvins_is_read_with_a_warning(tmp_path, caplog):
     assert "thermal.jacket.ambient: 293.15 °C reads like a temperature in kelvins (20 °C)" in caplog.text
 
 
+def test_a_negative_constant_load_is_read_with_a_word(tmp_path, caplog):
+    """A signed column's load or speed is read as its magnitude (a loss does not change sign);
+    a negative number written by hand is read the same way, and said."""
+    with caplog.at_level(logging.WARNING):
+        case = gt.load_case(spindle(tmp_path, "load = 2000.0", "load = -2000.0"))
+    assert "sources.front_bearing.load = -2000 N: its sign is ignored (a loss depends on the magnitude); " \
+           "give 2000" in caplog.text
+    assert case.name
+
+
 def test_a_guide_friction_above_one_is_refused():
     from gatetherm.studies.run.case_sources import FRICTION
     assert FRICTION.admits(0.003) and not FRICTION.admits(3.0) and not FRICTION.admits(-0.001)
@@ -102,6 +112,36 @@ def test_a_mesh_parameter_the_script_never_reads_is_refused(tmp_path, caplog):
     with caplog.at_level(logging.WARNING):
         gt.load_case(tmp_path / "case.toml")  # a refinement coarser than the mesh: read, with a word
     assert "mesh.refine[1].size 0.02 m is not finer than [mesh] size 0.01 m" in caplog.text
+
+
+BOX_FIELD = """SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 1, 1};
+Field[1] = Box; Field[1].VIn = 0.01; Field[1].VOut = 0.2;
+Field[1].XMin = 0; Field[1].XMax = 0.2; Field[1].YMin = 0; Field[1].YMax = 1;
+Background Field = 1;
+Physical Surface("body") = {1};
+Physical Curve("left") = {4};
+"""
+
+
+def test_a_refinement_keeps_the_scripts_own_background_field(tmp_path, caplog):
+    """A case's ``[[mesh.refine]]`` used to replace the script's ``Background Field``: the
+    0.01-m strip of the script became 0.17-m elements (4 563 elements → 50), without a word."""
+    from gatetherm.geometry.gmshfile import MeshSpec, Refinement, mesh_geometry
+    (tmp_path / "box.geo").write_text(BOX_FIELD)
+
+    def strip(fm):  # mean first-edge length of the elements in the script's fine strip x < 0.2
+        p, c = fm.points, fm.cells
+        inside = p[c].mean(axis=1)[:, 0] < 0.2
+        return len(c), float(np.linalg.norm(p[c[inside, 0]] - p[c[inside, 1]], axis=1).mean())
+
+    n0, h0 = strip(mesh_geometry(MeshSpec(tmp_path / "box.geo")))
+    with caplog.at_level(logging.WARNING):
+        n1, h1 = strip(mesh_geometry(MeshSpec(tmp_path / "box.geo", refine=(Refinement("left", 0.05, 0.1),))))
+    assert h0 == pytest.approx(0.0102, abs=5e-4) and h1 == pytest.approx(0.0104, abs=5e-4)  # band: < 0.02
+    assert n1 == pytest.approx(n0, rel=0.2)  # 4163 against 4563 (the rest of the body: gmsh's own extension)
+    assert ("mesh.refine[1] (near left): size = 0.05 m, but the file's own sizes give 0.01 m there already, "
+            "so it changes nothing") in caplog.text
 
 
 @pytest.mark.parametrize("program, kwargs, needle", [
@@ -177,7 +217,7 @@ BAD = {
                                 "nosuch: is not a setting of place_sensors; settings: "),
     "diagnose(nosuch=1)": (lambda c: gt.diagnose(c, "x.csv", nosuch=1), TypeError,
                            "nosuch: is not a setting of diagnose"),
-    "compensate(None)": (lambda c: gt.compensate(None, c), TypeError, "series: got NoneType None, expected a Run"),
+    "compensate(None)": (lambda c: gt.compensate(None, c), TypeError, "series: got NoneType None, expected a TimeSeries or a Run"),
     "errormodel_fit(None)": (lambda c: gt.errormodel_fit(None, ["x_um"]), TypeError, "data: got NoneType None"),
     "errormodel_fit(targets='x_um')": (lambda c: gt.errormodel_fit("d.csv", "x_um"), TypeError,
                                        "targets: got str 'x_um', expected a list of column names"),
@@ -189,11 +229,11 @@ BAD = {
                                     "applied: got int 5, expected a dict"),
     "twin(5)": (lambda c: gt.twin(5, "opc.tcp://127.0.0.1:4840"), TypeError, "case: got int 5, expected a Case"),
     "validate_zoo(machines='c_frame')": (lambda c: gt.validate_zoo("o", machines="c_frame"), TypeError,
-                                         "machines: got str 'c_frame', expected a list of names"),
+                                         "machines: got str 'c_frame', expected a list of str or None"),
     "validate_zoo(machines=[])": (lambda c: gt.validate_zoo("o", machines=[]), InputError, "machines: is empty"),
     "validate_zoo(timeout_s=nan)": (lambda c: gt.validate_zoo("o", timeout_s=NAN), InputError,
-                                    "timeout_s: got nan, must be a finite number > 0"),
-    "validate_zoo(on_cell=3)": (lambda c: gt.validate_zoo("o", on_cell=3), TypeError, "on_cell: got int, expected"),
+                                    "timeout_s: got nan, must be a finite number"),
+    "validate_zoo(on_cell=3)": (lambda c: gt.validate_zoo("o", on_cell=3), TypeError, "on_cell: got int 3, expected a function or None"),
     "with_overrides('k=1')": (lambda c: c.with_overrides("k=1"), TypeError, "overrides: got str 'k=1', expected a dict"),
     "plot.series(None)": (lambda c: gt.plot.series(None, "delta_um"), TypeError, "run: got NoneType None"),
     "plot.series(unknown column)": (lambda c: gt.plot.series({"time_s": [0.0]}, "delta_um"), InputError,
@@ -201,12 +241,12 @@ BAD = {
     "export_ccx(title with a line break)": (lambda c: gt.export_ccx(c, "o", title="a\n*STEP"), InputError,
                                             "title: 'a\\n*STEP' is not one line of text"),
     "export_ccx(run='yes')": (lambda c: gt.export_ccx(c, "o", run="yes"), TypeError, "run: got str 'yes', expected"),
-    "export_ccx(out=5)": (lambda c: gt.export_ccx(c, 5), TypeError, "out: got int 5, expected a folder's path"),
+    "export_ccx(out=5)": (lambda c: gt.export_ccx(c, 5), TypeError, "out: got int 5, expected a str or path"),
     "export_ccx(schedule='s.csv')": (lambda c: gt.export_ccx(c, "o", schedule="s.csv"), TypeError,
                                      "schedule: got str 's.csv', expected a Schedule or None"),
     "export_ccx(None)": (lambda c: gt.export_ccx(None, "o"), TypeError, "case: got NoneType None, expected a Case"),
     "place_sensors(held_out='x.csv')": (lambda c: gt.place_sensors(c, held_out="x.csv"), TypeError,
-                                        "held_out: got str, expected a list of Schedule or None"),
+                                        "held_out: got str 'x.csv', expected a list of Schedule or None"),
     "live(out=None)": (lambda c: gt.live(c, method="paper", endpoint="opc.tcp://127.0.0.1:4840", out=None), TypeError,
                        "out: got NoneType None, expected a folder's path"),
     "plot.sweep(no file)": (lambda c: gt.plot.sweep("nosuch.csv", "x", "y"), InputError,
@@ -277,3 +317,48 @@ def test_a_zoo_cell_ends_quietly_on_the_commands_signal():
         for s, h in saved.items():
             signal.signal(s, h)
     assert cell["text"] == f"{signal.SIG_DFL} {signal.SIG_DFL}"
+
+
+def test_a_correlation_film_refused_by_the_reduction_names_its_equivalent(tmp_path):
+    """A reduced model is linear: a film that follows the temperature is refused, and the
+    message names a number to give instead (the law's reference coefficient)."""
+    case = gt.load_case(spindle(tmp_path, "reference = 40.0", "reference = 40.0"))
+    with pytest.raises(InputError) as info:
+        gt.reduce(case)
+    assert str(info.value).startswith("film of 'nose': follows the temperature (a correlation or radiation)")
+    assert "give each such film as a number to reduce the case (at the law's reference: nose 40 W/(m² K)" \
+        in str(info.value)
+
+
+@pytest.mark.parametrize("old, new, needle", [
+    ("[probes.mount_point]", '[probes."mount,point"]',
+     "probes.mount,point: cannot name a probe's columns (it holds a comma"),
+    ("point = [0.07, 0.05]", "point = [1e300, 0.05]", "probes.mount_point.point: [1e+300, 0.05] lies outside the mesh"),
+    ('quantities = ["u"]', 'quantities = ["u", "u"]', "probes.mount_point.quantities: ['u', 'u'] is not admissible; "
+                                                      "choose each once from"),
+    ('name = "spindle_unit"', 'name = "x\\u001b]0;pwned\\u0007"',
+     "case.name: is not one printable line of at most 200 characters (11 characters)"),
+    ('file = "spindle.geo"', f'file = "{"s" * 300}.geo"', "mesh.file: is not one printable line of at most 200"),
+], ids=["comma in a probe", "a point 1e300 away", "a quantity twice", "escapes in the name", "a 300-character path"])
+def test_a_name_or_point_that_would_fail_later_is_refused_at_reading(tmp_path, old, new, needle):
+    """Each of these passed the reader (the third audit): a probe name with a comma failed only
+    after the whole run, writing its column; a point 1e300 away raised an IndexError inside
+    scikit-fem; terminal escapes in the name went raw into timeseries.csv."""
+    with pytest.raises(InputError) as info:
+        gt.load_case(spindle(tmp_path, old, new))
+    assert needle in str(info.value) and "\x1b" not in str(info.value)
+
+
+def test_a_material_value_outside_what_machines_have_is_read_with_a_word(tmp_path, caplog):
+    with caplog.at_level(logging.WARNING):
+        gt.load_case(spindle(tmp_path, "c = 460.0", "c = 0.46"))  # kJ/(kg K) meant
+    assert "materials.shaft.c = 0.46 J/(kg K) is outside what the solids of machines have (50 to 5000): check its " \
+           "unit (SI: J/(kg K))" in caplog.text
+
+
+def test_an_error_line_is_bounded_and_escapes_control_characters():
+    from gatetherm import one_line
+
+    err = InputError("--targets", f"'{'x' * 100_000}' is not a column", "name a column")
+    assert len(str(err)) < 1000 and "(100018 characters)" in str(err)
+    assert one_line("a\x1b[2Jb\nc") == "a\\x1b[2Jb\\nc"

@@ -73,7 +73,7 @@ def test_compensate_run_of_a_case_reports_the_runs_samples(headstock):
 def test_compensate_run_checks_its_arguments():
     with pytest.raises(TypeError, match="^on_progress: got int 3, expected a function"):
         gt.compensate_run("x.csv", on_progress=3)
-    with pytest.raises(TypeError, match="^case: got int 7, expected a case file's path, a Case or None"):
+    with pytest.raises(TypeError, match="^case: got int 7, expected a str or path, a Case or None; make one with gt.load_case"):
         gt.compensate_run("x.csv", 7)
 
 

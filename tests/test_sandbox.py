@@ -9,7 +9,9 @@ once; a mesh too big for memory is refused before gmsh meshes.
 """
 from __future__ import annotations
 
+import logging
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -303,3 +305,23 @@ def test_an_endless_loop_in_a_script_is_refused_after_the_read_limit(tmp_path, m
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "gmsh was still reading it after 2 s (an endless loop in the script?)" in err
     assert not (tmp_path / "o").exists()
+
+
+def _slow(gmsh):
+    import time
+
+    time.sleep(1.5)
+    return {"n": 1}, {}
+
+
+def test_a_long_meshing_says_gmsh_is_still_at_work(monkeypatch, caplog):
+    """Without -v, gmsh prints nothing: a mesh of millions of elements looked like a hang (the
+    third audit: a STEP of 150 boxes at 0.5 mm, nothing in 180 s)."""
+    from gatetherm.geometry import isolate
+
+    monkeypatch.setattr(isolate, "STILL_S", 0.5)
+    with caplog.at_level(logging.WARNING, logger="gatetherm.geometry.isolate"):
+        meta, _ = isolate.run_isolated(_slow, "big.step")
+    assert meta["n"] == 1
+    assert re.search(r"big\.step: gmsh is still at work after \d+ s \(a large mesh; Ctrl-C stops it", caplog.text)
+    assert caplog.text.count("gmsh is still at work") <= 1 + 5  # then at 1, 2, 4 … s: a handful, not a flood

@@ -26,7 +26,10 @@ run``, ``simulate``), :mod:`gatetherm.api.frame` (``mesh``, ``beam``), :mod:`gat
 ### Errors
 
 Every public function checks its arguments where it is called, before any numerics, and says
-in one line (``str(err)``) which argument is wrong and how to fix it:
+in one line (``str(err)``) which argument is wrong and how to fix it. Types come from the
+function's annotations (:mod:`gatetherm.api.boundary`: a string where a list belongs, a number
+for a path, a callback that is not a function, a NaN, a fraction for a count are refused
+before any work); ranges and names from each function:
 
 - :class:`TypeError` for an argument of the wrong type: ``gt.run("case.toml")`` gives
   ``case: got str 'case.toml', expected a Case; make one with gt.load_case(path) or
@@ -42,6 +45,8 @@ in one line (``str(err)``) which argument is wrong and how to fix it:
   files), naming the file, the key or line and the fix; a number that would be written to a
   file as NaN or infinity is :class:`gatetherm.checks.NonFiniteError`, a kind of InputError
   naming the quantity.
+- :class:`gatetherm.UnknownName` (an InputError and a ``KeyError``) for a name not among those
+  offered: ``run["nosuch_um"]``, ``run.field("Tx")``, naming the ones there are.
 - ``OSError`` for a file that cannot be written (a full disk), naming the file.
 
 Anything else is a defect of gatetherm: please report it.
@@ -87,6 +92,21 @@ __all__ = ["BeamCoefficients", "Case", "CompensationRun", "DiagnosisRun", "Drift
            "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
            "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",
            "write_reduction"]
+
+
+def _check_arguments() -> None:
+    """Every public function checks its arguments' types where it is called
+    (:func:`gatetherm.api.boundary.checked`)."""
+    import inspect
+
+    from gatetherm.api.boundary import checked
+
+    for name in __all__:
+        if inspect.isfunction(globals()[name]) and not hasattr(globals()[name], "__checked__"):
+            globals()[name] = checked(globals()[name])
+
+
+_check_arguments()
 
 
 def __getattr__(name: str):

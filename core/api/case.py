@@ -63,7 +63,8 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
     number : int
         1, 2 or 3 (``docs/paper.md``).
     case : Case, optional
-        A frame case whose supply unit drives it (default: the shipped paper model's).
+        A frame case whose supply unit drives it (default: the shipped paper model's); a case
+        read from a case file has none and is refused.
     step_s : float
         Sample interval, s.
 
@@ -81,6 +82,10 @@ def condition(number: int, case: Case | None = None, step_s: float = 60.0) -> Sc
         raise InputError("step_s", f"{step_s:g} s does not divide the condition's {duration:g} s",
                          "give a divisor of it, e.g. 60")
     supply = getattr(getattr(case, "origin", None), "config", None)
+    if case is not None and supply is None:
+        raise InputError("case", f"{case.name!r} has no oil supply unit of the paper's model (a case file's "
+                         "sources are its own)", "give a frame case (gt.gate_frame), or drive the case by its own "
+                         "schedule ([time] schedule)")
     return condition_schedule(number, *(() if supply is None else (supply.supply,)), step_s=step_s)
 
 

@@ -103,9 +103,11 @@ class CompensationRun:
 
 
 def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLike | Case | None = None, *,
-                   condition: int | None = None, dim: int = 2, config: str | None = None, method: str = "paper",
+                   condition: int | None = None, dim: int = 2, config: str | os.PathLike | None = None,
+                   method: str = "paper",
                    interval_min: float = 5.0, updates: str = "event", max_updates: int = 60,
-                   ideal: bool = False, rom: str | None = None, model: str | None = None, out=None,
+                   ideal: bool = False, rom: str | os.PathLike | None = None, model: str | os.PathLike | None = None,
+                   out: str | os.PathLike | None = None,
                    on_progress: Callable[[int, int], None] | None = None, **settings) -> CompensationRun:
     """Compensate a record as ``gatetherm compensate`` does: a time-series file, one of the paper's
     conditions simulated on the frame, or a case's own run; never silently worse (:func:`compensate`).

@@ -1,11 +1,17 @@
 """Compensation and diagnosis of a run or a measurement (:mod:`gatetherm.api`)."""
 from __future__ import annotations
 
+import os
+
 from gatetherm.api.run import PATH, Case, Run, _case
-from gatetherm.checks import argument, settings_argument
+from gatetherm.api.boundary import settings_argument
+from gatetherm.checks import argument
+from gatetherm.studies.control.actuator import ActuatorParams
+from gatetherm.studies.run.timeseries import TimeSeries
 
 
-def compensate(series, case: Case | None = None, method: str = "paper", *, actuator="case", **settings):
+def compensate(series: TimeSeries | Run, case: Case | None = None, method: str = "paper", *,
+               actuator: ActuatorParams | str | None = "case", **settings):
     """Compensate a run: predict δ and drive the actuator with the command, never silently worse.
 
     Before the correction is returned, its benefit is measured on the record's held-out last 30 %
@@ -58,7 +64,7 @@ def compensate(series, case: Case | None = None, method: str = "paper", *, actua
     return methods_compensate(series, case, Settings(method=method, **settings), chosen, rom=rom)
 
 
-def diagnose(case: Case, measured, **settings):
+def diagnose(case: Case, measured: TimeSeries | str | os.PathLike, **settings):
     """Where ``case`` and a measured run disagree, and the missing pieces that explain it.
 
     Parameters

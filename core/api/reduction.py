@@ -5,10 +5,11 @@ import dataclasses
 import math
 import os
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Sequence
 
 from gatetherm.api.run import Case, Schedule, _case, condition
 from gatetherm.checks import Range, argument, whole_argument
+from gatetherm.solvers.rom import ReducedModel, Reduction
 
 STATES = Range(2, 200, whole=True)
 """States a reduced model may have (``gatetherm reduce --states``)."""
@@ -55,11 +56,12 @@ def check_schedules(case: Case) -> list[Schedule]:
     _case(case)
     out = [case.schedule] if len(case.schedule.times) > 1 else []
     if case.inputs() and case.inputs() <= {SUPPLY, PUMP, AMBIENT}:
-        out += [condition(n, case) for n in (1, 2, 3) if condition(n, case).label != case.schedule.label]
+        frame = case if getattr(case.origin, "config", None) is not None else None  # else: the paper's supply unit
+        out += [condition(n, frame) for n in (1, 2, 3) if condition(n, frame).label != case.schedule.label]
     return sorted(out, key=lambda s: (s.condition is None, s.condition or 0))
 
 
-def check_rom(case: Case, rom, schedules=None) -> list:
+def check_rom(case: Case, rom: ReducedModel, schedules: Sequence[Schedule] | None = None) -> list:
     """The reduced model ``rom`` of ``case`` against full FE runs.
 
     Parameters
@@ -85,7 +87,8 @@ def check_rom(case: Case, rom, schedules=None) -> list:
     return check(case, rom, check_schedules(case) if schedules is None else schedules, ScenarioCache())
 
 
-def write_reduction(out: str | os.PathLike, red, checks, case: Case, states: int, seconds: float) -> dict:
+def write_reduction(out: str | os.PathLike, red: Reduction, checks: Sequence, case: Case, states: int,
+                    seconds: float) -> dict:
     """Write a reduction: ``out/rom.npz``, ``out/rom.key`` and, last, ``out/summary.json``.
 
     Parameters
@@ -181,7 +184,8 @@ class ReductionRun:
 
 
 def reduce_case(case: Case | str | os.PathLike | None = None, *, dim: int = 2, config: str | os.PathLike | None = None,
-                states: int = 30, check=(), check_fe: bool = True, out: str | os.PathLike | None = None,
+                states: int = 30, check: Sequence[str | os.PathLike] = (), check_fe: bool = True,
+                out: str | os.PathLike | None = None,
                 on_progress=None) -> ReductionRun:
     """A reduced heat model of a case (or the paper's frame), checked against full FE runs:
     what ``gatetherm reduce`` does.

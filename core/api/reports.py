@@ -6,6 +6,7 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Sequence
 
 from gatetherm.validation.report.registry import SECTIONS
 
@@ -57,7 +58,7 @@ class DriftReport:
         return "\n".join([f"wrote {self.out}/index.html and drift.png", *self.notes[:-1]])
 
 
-def report(out: str | os.PathLike, *, full: bool = False, sections=None, workers: int = 1,
+def report(out: str | os.PathLike, *, full: bool = False, sections: Sequence[str] | None = None, workers: int = 1,
            docs: str | os.PathLike | None = None, on_section=None, on_progress=None) -> Report:
     """Compute (or reuse from ``out``) every section of the validation report and write
     ``out/index.html`` with its figures and ``out/validation.md`` (docs/validation.md says what

@@ -7,11 +7,11 @@ import logging
 import os
 import time as _time
 from pathlib import Path
-from typing import Callable, Iterable, Mapping
+from typing import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
-from gatetherm import InputError
+from gatetherm import InputError, UnknownName
 from gatetherm.api.case import PATH, Case, Schedule, _case  # noqa: F401 - PATH, _case: for the API's modules
 from gatetherm.api.case import beam_coefficients, condition, gate_frame, load_case, nc_schedule, schedule_file
 from gatetherm.checks import POSITIVE, Range, argument, number_argument
@@ -59,7 +59,7 @@ class Run:
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self.columns:
-            raise KeyError(f"{name!r}: columns are {', '.join(self.columns)}")
+            raise UnknownName("name", f"{name!r} is not a column of the run", f"columns: {', '.join(self.columns)}")
         return self.columns[name]
 
     @property
@@ -101,7 +101,7 @@ class Run:
         _, U = self.state(t)
         fields = nodal_fields(self.scenario.model, U, stress=name not in ("T", "u"))
         if name not in fields:
-            raise KeyError(f"{name!r}: fields are {', '.join(fields)}")
+            raise UnknownName("name", f"{name!r} is not a field of the run", f"fields: {', '.join(fields)}")
         return fields[name]
 
     def summary(self) -> dict:
@@ -240,7 +240,8 @@ def _fields_every(case: Case) -> float:
 
 
 def run(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
-        keep=None, on_step: Callable[[int, int], None] | None = None, check_order: bool = False,
+        keep: Sequence[float] | None = None, on_step: Callable[[int, int], None] | None = None,
+        check_order: bool = False,
         fields_every: float | None = None) -> Run:
     """Run ``case``.
 

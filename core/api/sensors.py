@@ -5,16 +5,20 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
+from typing import Mapping, Sequence
 
 from gatetherm.api.run import Case, Schedule, _case
-from gatetherm.checks import Range, argument, number_argument, settings_argument, whole_argument
+from gatetherm.api.boundary import settings_argument
+from gatetherm.checks import Range, argument, number_argument, whole_argument
+from gatetherm.studies.sensors.check import FECheck
+from gatetherm.studies.sensors.result import Placement
 
 SPAN = Range(-1e9, 1e9)
 """What a bound of ``ranges`` may be, in the input's unit (°C, W, 1/min …)."""
 
 
-def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, on_progress=None, **settings):
+def place_sensors(case: Case, count: int = 3, *, schedules: Sequence[Schedule] | None = None,
+                  held_out: Sequence[Schedule] | None = None, on_progress=None, **settings):
     """Where to put ``count`` thermocouples on ``case``: the surface points whose temperatures
     predict every relative displacement best on held-out duty cycles (docs/sensors.md).
 
@@ -102,7 +106,7 @@ def place_sensors(case: Case, count: int = 3, *, schedules=None, held_out=None, 
                  on_progress=on_progress)
 
 
-def check_placement(case: Case, placement):
+def check_placement(case: Case, placement: Placement):
     """The independent check of a :func:`place_sensors` result by full FE runs (no reduced model):
     the case made again with the chosen points as ``[probes]``, every training and held-out load
     run in full, the placement model's terms refitted by least squares on the training runs and
@@ -130,7 +134,8 @@ def check_placement(case: Case, placement):
     return fe_check(case, placement)
 
 
-def write_placement(out: str | os.PathLike, placement, case: Case, check=None, extra: Mapping | None = None) -> dict:
+def write_placement(out: str | os.PathLike, placement: Placement, case: Case, check: FECheck | None = None,
+                    extra: Mapping | None = None) -> dict:
     """Write what ``gatetherm sensors`` writes into ``out``: ``sensors.toml`` (the chosen points as
     ``[probes]``), ``model.json`` (the fitted error model, as ``gatetherm errormodel fit``
     writes it), ``curve.csv``, ``curve.png`` (held-out error against the number of sensors),
@@ -170,7 +175,8 @@ def write_placement(out: str | os.PathLike, placement, case: Case, check=None, e
     return placement.write(out, extra=more)
 
 
-def sensor_study(case, count: int = 3, *, schedules=(), held_out=(), check: bool = False, mesh_factor: float = 1.0,
+def sensor_study(case: Case | str | os.PathLike, count: int = 3, *, schedules: Sequence[Schedule | str | os.PathLike] = (),
+                 held_out: Sequence[Schedule | str | os.PathLike] = (), check: bool = False, mesh_factor: float = 1.0,
             on_progress=None, **settings) -> SensorStudy:
     """What ``gatetherm sensors`` does: :func:`place_sensors` on a case (or a case file), and
     optionally :func:`check_placement`; the result writes the command's files and its summary.

@@ -3,12 +3,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Sequence
 
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE, argument, number_argument
 
 
-def validate_zoo(out: str | os.PathLike, machines=None, *, capabilities=None, timeout_s: float | None = None,
+def validate_zoo(out: str | os.PathLike, machines: Sequence[str] | None = None, *,
+                 capabilities: Sequence[str] | None = None, timeout_s: float | None = None,
                  on_cell=None) -> dict:
     """Run every capability on every machine of the zoo and write the matrix.
 

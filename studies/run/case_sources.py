@@ -45,6 +45,9 @@ LOSS = Range(0.0, unit="W")
 
 def _text(t: Table, k: str, names, default=None, unit: str = "", rng: Range | None = None) -> str:
     v = t.value(k, names, default, unit, rng)
+    if k in ("speed", "load") and v.is_constant and float(v.constant) < 0:  # a signed column is read as |x|
+        log.warning("%s = %g %s: its sign is ignored (a loss depends on the magnitude); give %g", t.key(k),
+                    float(v.constant), unit, -float(v.constant))
     return v.text or repr(v.constant)
 
 

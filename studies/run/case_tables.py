@@ -39,6 +39,10 @@ MATERIAL_KEYS = {"k": "W/(m K)", "rho": "kg/m³", "c": "J/(kg K)", "E": "Pa", "n
                  "thickness": "m"}
 MATERIAL = ranges(Material)
 """Admissible values of the material keys (those of the model file's [material])."""
+PLAUSIBLE = {"k": (0.01, 2500.0), "rho": (10.0, 25000.0), "c": (50.0, 5000.0), "E": (1e5, 1.3e12)}
+"""What the solids of machines span (insulating foams to diamond's conduction, foams to tungsten's
+density, …, rubber to diamond's stiffness): a value outside is read with a warning (a unit slip:
+c = 0.46 meant kJ/(kg K))."""
 THICKNESS = Range(1e-6, 1e3, unit="m")
 """Thickness of a 2-D section, from a micrometre to a kilometre: far beyond, the solid's
 matrices lose every digit against the rest (PARDISO fails at 1e30 and 1e-30 m in the
@@ -64,6 +68,10 @@ def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
                    f"{'elasticity' if k in ('E', 'nu', 'alpha') else 'the heat solve'})")
         given = {k: t.number(k, MATERIAL[k], math.nan if k not in need else None) for k in MATERIAL}
         materials[region] = Material(**given)
+        for k, (lo, hi) in PLAUSIBLE.items():
+            if k in t.data and not lo <= given[k] <= hi:
+                log.warning("%s = %g %s is outside what the solids of machines have (%g to %g): check its unit "
+                            "(SI: %s)", t.key(k), given[k], MATERIAL_KEYS[k], lo, hi, MATERIAL_KEYS[k])
         if "thickness" in t.data:
             if fm.dim == 3:
                 t.fail("thickness", "applies to 2-D sections only", "remove it")
@@ -171,7 +179,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool =
     out = []
     finder = None
     for name in pr.data:
-        t = pr.sub(name, KEYS["probes.NAME"])
+        t = pr.sub(pr.column_name(name, "probe"), KEYS["probes.NAME"])
         point = t.data.get("point")
         if isinstance(point, str):
             if point not in fm.sensors:
@@ -186,15 +194,15 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool =
                 finder = to_skfem(fm).element_finder()
             try:
                 finder(*np.array(xyz)[:, None])
-            except ValueError:
+            except (ValueError, IndexError):  # outside (IndexError: far outside, in skfem's search)
                 xyz = _onto_body(t, fm, xyz, quiet)
                 finder(*np.array(xyz)[:, None])  # in its element now (a ValueError here is a defect)
         else:
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
                    'e.g. point = "A" or point = [0.1, 0.2]')
         q = t.data.get("quantities", list(quantities))
-        if not (isinstance(q, list) and q and all(x in quantities for x in q)):
-            t.fail("quantities", f"{q!r} is not admissible", f"choose from {', '.join(quantities)}")
+        if not (isinstance(q, list) and q and all(x in quantities for x in q) and len(set(q)) == len(q)):
+            t.fail("quantities", f"{q!r} is not admissible", f"choose each once from {', '.join(quantities)}")
         region = t.name("region", fm.regions, "region", default="") or None
         out.append(Probe(name, xyz, tuple(q), region))
     return tuple(out)
@@ -204,7 +212,8 @@ def _onto_body(t: Table, fm: FrameMesh, xyz: tuple, quiet: bool = False) -> tupl
     """Coordinates outside the elements: read at the nearest point of the body if within the
     tolerance of a point group (a warning gives the distance), else refused with the distance
     and the nearest point."""
-    near = nearest_on_body(fm.points, fm.cells, xyz)
+    with np.errstate(over="ignore"):  # a point 1e300 away: an infinite distance, refused below
+        near = nearest_on_body(fm.points, fm.cells, xyz)
     at = ", ".join(f"{v:.6g}" for v in near.point)
     if near.distance > near.tolerance:
         t.fail("point", f"{list(xyz)} lies outside the mesh, {near.distance:.3g} m from the body (more than the "
@@ -220,7 +229,7 @@ def relative(top: Table, probes, dim: int) -> tuple:
     names = [p.name for p in probes if "u" in p.quantities] + [p.name for p in probes if "u" not in p.quantities]
     out = []
     for name in rel.data:
-        t = rel.sub(name, KEYS["relative.NAME"])
+        t = rel.sub(rel.column_name(name, "relative displacement"), KEYS["relative.NAME"])
         a, b = t.name("a", names, "probe"), t.name("b", names, "probe")
         if a == b:  # its displacement is zero at every time: a δ that can never say anything
             t.fail("b", f"is {b!r}, the same probe as a: the relative displacement would be 0 at all times",

@@ -13,6 +13,10 @@ from gatetherm.studies.run.timeseries import alike
 
 log = logging.getLogger(__name__)
 
+MAX_TEXT = 200
+"""Longest string a case file's value may be (a name, a file's path, a choice)."""
+COLUMN_UNSAFE = ',"#'
+"""Characters a name that becomes a data-format column may not hold (docs/data-format.md)."""
 KELVIN_LIKE = (253.15, 373.15)
 """Temperatures in °C that are a machine's surroundings written in kelvins (-20 … 100 °C in K):
 read, with a warning."""
@@ -73,7 +77,18 @@ class Table:
         v = self.data[k]
         if not isinstance(v, str) or (choices and v not in choices):
             self.fail(k, f"{v!r} is not admissible", f"choose one of {', '.join(choices)}" if choices else "give a string")
+        if not v.isprintable() or len(v) > MAX_TEXT:
+            self.fail(k, f"is not one printable line of at most {MAX_TEXT} characters ({len(v)} characters)",
+                      "give a plain name or path, without control characters")
         return v
+
+    def column_name(self, name: str, what: str) -> str:
+        """``name`` (a key of this table: a probe, a relative displacement) if it can name a
+        data-format column; refused at reading, not after a run."""
+        if not name.isprintable() or len(name) > 64 or any(c in name for c in COLUMN_UNSAFE) or not name.strip():
+            self.fail(name, f"cannot name a {what}'s columns (it holds a comma, a quote, a '#' or a control "
+                      "character, or is empty or longer than 64 characters)", "use letters, digits, '_', '-' or '.'")
+        return name
 
     def name(self, k: str, valid, what: str, default=None) -> str:
         v = self.string(k, default=default)

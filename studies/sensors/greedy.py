@@ -133,3 +133,30 @@ def path(design: Design, count: int, form: str, params: FitParams, xyz: np.ndarr
             lags = design.choose_lags(chosen, params)
         out.append(Step(tuple(chosen), form, lags, tuple(map(float, design.errors(chosen, lags)))))
     return out
+
+
+def curve(paths, forms, count: int, min_distance_m: float, fit: FitParams, point) -> tuple[list, list, str]:
+    """The error curve along the greedy paths: one more sensor while it lowers the
+    leave-one-load-out error by ``fit.min_gain`` and a candidate is left ``min_distance_m`` from
+    the chosen; why it stopped. ``point(k, step)`` scores the ``k + 1``-th (a curve point)."""
+    points, chosen = [], []
+    for k in range(count):
+        if any(len(paths[f]) <= k for f in forms):
+            return points, chosen, (f"no candidate is left {min_distance_m:g} m or more from the {k} chosen: "
+                                   f"the curve stops at {k}")
+        step = best_form([paths[f][k] for f in forms], fit)
+        if chosen and step.error > chosen[-1].error * (1 - fit.min_gain):
+            return points, chosen, (f"a sensor {k + 1} lowers the leave-one-load-out error by less than "
+                                   f"{fit.min_gain:.0%} ({chosen[-1].error:.3g} -> {step.error:.3g} um): "
+                                   f"the curve stops at {k}")
+        chosen.append(step)
+        points.append(point(k, step))
+    return points, chosen, ""
+
+
+def rising(curve) -> list[str]:
+    """Notes where the held-out error rises along the curve."""
+    return [f"the held-out error rises from {a.count} to {b.count} sensors "
+            f"({a.held_out_mean_um:.3g} -> {b.held_out_mean_um:.3g} um) although the leave-one-load-out "
+            "error falls: within the scatter of the estimate, or the held-out loads differ from the training loads"
+            for a, b in zip(curve, curve[1:]) if b.held_out_mean_um > a.held_out_mean_um]

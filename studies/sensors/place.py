@@ -223,20 +223,11 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
                 for x, th in zip(ho, temps(ho, list(step.sensors)))]
         return sens, model, held_out_mae(model, cols, truth)
 
-    curve, chosen, stopped, notes = [], [], "", []
-    for k in range(s.count):
-        if any(len(paths[f]) <= k for f in forms):
-            stopped = (f"no candidate is left {s.min_distance_m:g} m or more from the {k} chosen: "
-                       f"the curve stops at {k}")
-            break
-        step = greedy.best_form([paths[f][k] for f in forms], fit)
-        if chosen and step.error > chosen[-1].error * (1 - fit.min_gain):
-            stopped = (f"a sensor {k + 1} lowers the leave-one-load-out error by less than {fit.min_gain:.0%} "
-                       f"({chosen[-1].error:.3g} -> {step.error:.3g} um): the curve stops at {k}")
-            break
+    def point(k, step):
         sens, _, err = scored(step)
-        chosen.append(step)
-        curve.append(CurvePoint(k + 1, step.form, sens, dict(zip(targets, step.cv_mae_um)), err))
+        return CurvePoint(k + 1, step.form, sens, dict(zip(targets, step.cv_mae_um)), err)
+
+    curve, chosen, stopped = greedy.curve(paths, forms, s.count, s.min_distance_m, fit, point)
     selection = [{"form": c.form, "terms": [x.column for x in c.sensors], "sensors": c.count,
                   "cv_mae_um": c.cv_mean_um} for c in curve]
     final = chosen[-1]
@@ -246,12 +237,7 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
         if len(final.sensors) > 1:
             rest = greedy.fixed_set(design, final.sensors[:i] + final.sensors[i + 1:], final.form, fit)
             failed[sensor.name] = scored(rest)[2]
-    for a, b in zip(curve, curve[1:]):
-        if b.held_out_mean_um > a.held_out_mean_um:
-            notes.append(f"the held-out error rises from {a.count} to {b.count} sensors "
-                         f"({a.held_out_mean_um:.3g} -> {b.held_out_mean_um:.3g} um) although the leave-one-load-out "
-                         "error falls: within the scatter of the estimate, or the held-out loads differ from the "
-                         "training loads")
+    notes = greedy.rising(curve)
     signals = _signals(case, rom, design, tr, ho, terms, targets, truth, fit, s, span, source)
     idx = [sl[i] for i in final.sensors]
     held_T = {x.label: p.T0 + x.states @ rows[idx].T for x in ho}
