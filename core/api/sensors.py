@@ -7,9 +7,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping, Sequence
 
-from gatetherm.api.run import Case, Schedule, _case
+from gatetherm import InputError
 from gatetherm.api.boundary import settings_argument
-from gatetherm.checks import Range, argument, number_argument, whole_argument
+from gatetherm.api.run import Case, Schedule, _case
+from gatetherm.checks import POSITIVE, Range, argument, number_argument, whole_argument
 from gatetherm.studies.sensors.check import FECheck
 from gatetherm.studies.sensors.result import Placement
 
@@ -207,6 +208,10 @@ def sensor_study(case: Case | str | os.PathLike, count: int = 3, *, schedules: S
     from gatetherm.api.run import load_case, schedule_file
 
     path = isinstance(case, (str, os.PathLike))
+    number_argument("mesh_factor", mesh_factor, POSITIVE, "e.g. 0.5 for elements half as large")
+    if not path and mesh_factor != 1.0:
+        raise InputError("mesh_factor", "goes with a case file's path only (a Case is meshed already)",
+                         "give the case file's path, or gt.load_case(path, mesh_factor)")
     case = load_case(case, mesh_factor) if path else case
     _case(case)
     names = [str(f) for f in (*schedules, *held_out) if isinstance(f, (str, os.PathLike))]
