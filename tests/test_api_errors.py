@@ -70,6 +70,8 @@ BAD = {
                                     "mesh_factor: got 0, must be a finite number > 0"),
     "sensor_study(Case, mesh_factor=2)": (lambda c: gt.sensor_study(c["frame"], mesh_factor=2), InputError,
                                           "mesh_factor: goes with a case file's path only"),
+    "place_sensors(duration_s=-3600)": (lambda c: gt.place_sensors(c["frame"], duration_s=-3600.0), InputError,
+                                        "duration_s: -3600 s is not two or more"),
     "condition(case=file)": (lambda c: gt.condition(1, case=c["frame"]), InputError,
                              "case: 'C-frame machining centre' has no oil supply unit of the paper's model"),
     "condition(1, step_s=7)": (lambda c: gt.condition(1, step_s=7), InputError,

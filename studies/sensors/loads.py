@@ -126,8 +126,8 @@ def duty_cycles(ranges, count: int, duration_s: float, step_s: float, seed: int 
                 label: str = "training") -> list[Schedule]:
     """``count`` generated loads (module docstring) of ``duration_s`` sampled every ``step_s`` (s)."""
     if not duration_s >= 2 * step_s > 0:
-        raise InputError("duty cycle", f"{duration_s:g} s is shorter than two {step_s:g}-s steps",
-                         "give a longer duration")
+        raise InputError("duration_s", f"{duration_s:g} s is not two or more {step_s:g}-s steps (step_s) of a "
+                         "generated duty cycle", "give a longer duration_s or a shorter step_s, both > 0")
     rng = np.random.default_rng(seed_of(seed, label))
     t = np.arange(int(round(duration_s / step_s)) + 1) * float(step_s)
     held = frozenset(r.name for r in ranges if r.held)
