@@ -130,3 +130,17 @@ def test_missing_values_and_blank_lines_read_as_nan(tmp_path):
     assert ts.metadata == {}
     np.testing.assert_array_equal(ts["oil_degC"], [40, math.nan])
     np.testing.assert_array_equal(ts["delta_um"], [0, 1.5])
+
+
+def test_a_celsius_column_in_kelvins_is_read_with_a_word(tmp_path, caplog):
+    """A room written in kelvins in a schedule or a record (the third audit: ``amb_degC = 293``
+    was read without a word, unlike the same number in a case file)."""
+    import logging
+
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    (tmp_path / "s.csv").write_text("time_s,amb_degC,t1_degC\n0,293.15,20\n60,293.65,21\n")
+    with caplog.at_level(logging.WARNING):
+        read_timeseries(tmp_path / "s.csv", required=("time_s",))
+    assert "column amb_degC: every value lies in 253-373, a machine's surroundings in kelvins" in caplog.text
+    assert "t1_degC" not in caplog.text

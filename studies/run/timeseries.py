@@ -238,6 +238,10 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS, named_by: dic
         bad = np.flatnonzero(~np.isnan(values) & ~rng.mask(values)) if rng else ()
         if len(bad):
             fail(int(bad[0]), name, f"got {show(values[bad[0]])}, must be {rng}", "check the value and its unit")
+        finite = values[np.isfinite(values)]
+        if name.endswith("_degC") and finite.size and 253.15 <= finite.min() and finite.max() <= 373.15:
+            log.warning("%s, column %s: every value lies in 253-373, a machine's surroundings in kelvins "
+                        "(%.6g K is %.6g °C); the column is in °C", path, name, finite[0], finite[0] - 273.15)
     return TimeSeries(cols, metadata, str(path))
 
 
