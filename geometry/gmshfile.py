@@ -258,6 +258,11 @@ def mesh_geometry(spec: MeshSpec) -> FrameMesh:
         log.warning(note)
     fm = from_arrays(meta, arrays)
     check_mesh(fm, str(spec.path))
+    extent = float(np.ptp(fm.points, axis=0).max())
+    if spec.size and spec.size > 2 * extent:
+        log.warning("mesh.size = %g m is larger than the body (%.3g m across): the elements are as coarse as its "
+                    "geometry allows (%d of them); give a size of a fraction of the body", spec.size, extent,
+                    len(fm.cells))
     log.info("meshed %s: %d nodes, %d elements, regions %s", spec.path.name, len(fm.points), len(fm.cells),
              ", ".join(fm.regions))
     return fm

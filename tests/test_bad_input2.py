@@ -362,3 +362,11 @@ def test_an_error_line_is_bounded_and_escapes_control_characters():
     err = InputError("--targets", f"'{'x' * 100_000}' is not a column", "name a column")
     assert len(str(err)) < 1000 and "(100018 characters)" in str(err)
     assert one_line("a\x1b[2Jb\nc") == "a\\x1b[2Jb\\nc"
+
+
+def test_a_mesh_size_larger_than_the_body_is_read_with_a_word(tmp_path, caplog):
+    from gatetherm.geometry.gmshfile import MeshSpec, mesh_geometry
+    (tmp_path / "box.geo").write_text(BOX_FIELD.replace("Background Field = 1;", ""))
+    with caplog.at_level(logging.WARNING):
+        mesh_geometry(MeshSpec(tmp_path / "box.geo", size=1e300))
+    assert "mesh.size = 1e+300 m is larger than the body (1 m across)" in caplog.text
