@@ -98,13 +98,13 @@ def report(dim: int, cfg: Config, source: str, errors, errors_no_tank, skipped, 
          f"beta is set through A_C (eq 26, I = depth h^3/12), l4 = l/(l/l4); the column top is raised to "
          f"l4 + t_C/2 where the tie bar is above the arms. FE: P{m.order} elements, size h/{ELEMENTS_ACROSS[dim]} "
          f"(x{m.mesh.refine:g} at joints and tank). K_i, K_C from the element-exact load cases "
-         "(solvers/reduced.py: fe_coefficients): (a) theta_A - theta_B = 1 K linear through column_L's width "
+         "(core/frame/loadcases.py: fe_coefficients): (a) theta_A - theta_B = 1 K linear through column_L's width "
          "up to l1 (the cavity carries no load), (b) +1 K on the tie-bar regions only; read at E_L/E_R "
          "(the tips F, in errors.csv, differ from E by at most "
          f"{max(abs(e['fe_F_um_per_K'] - e['fe_E_um_per_K']) for e in errors):.2g} um/K: the arms carry no "
          "temperature and follow the column top"
          + (", here with the small twist of a column whose front half carries them" if dim == 3 else "")
-         + "). The nodal load cases (solvers/reduced.py: fe_coefficients) also heat one element layer "
+         + "). The nodal load cases (core/frame/loadcases.py: fe_coefficients) also heat one element layer "
          "of column at the tie-bar joints, which inflates K_C by O(element size) for thin tie bars.", ""]
     if skipped:
         L += [f"Skipped in {dim}-D (the tie bar would overlap the arms, |l4 - l| < (t_C + arm_thickness)/2): "
