@@ -265,7 +265,11 @@ def test_cli_resolution_sets_the_noise_rule(tmp_path, capsys):
     assert err.count("\n") == 1 and "resolution_K: -1.0 is not >= 0" in err, err
     assert cli(*args, "--resolution-K", "0") == 0
     assert "sensor noise 0 um" in capsys.readouterr().out
-    assert cli(*args) == 0  # 0.05 K: the noise is 0.05 K x sqrt(K_1^2 + K_3^2)
-    m = load_model(tmp_path / "f" / "model.json").target("d_um")
-    assert m.noise_um == pytest.approx(0.05 * np.hypot(*m.coefficients[:2]), rel=1e-9) and len(m.terms) == 2
-    assert m.noise_um == pytest.approx(0.096, abs=0.005)  # achieved 0.0960
+    assert cli(*args) == 0  # 0.05 K, smoothed over 300 s: 0.05 K x sqrt((1 - a)/(1 + a)) x |K|
+    model = load_model(tmp_path / "f" / "model.json")
+    m = model.target("d_um")
+    a = np.exp(-60.0 / model.settings["smooth_s"]) if model.settings["smooth_s"] else 0.0
+    sd = 0.05 * np.sqrt((1 - a) / (1 + a))
+    assert m.noise_um == pytest.approx(sd * np.linalg.norm(m.coefficients), rel=1e-9)
+    assert {"s1_degC", "s3_degC"} <= set(m.sensors)  # the two in d_um (a static form adds s4 for the missing lag)
+    assert model.settings["smooth_s"] == 300.0 and m.noise_um == pytest.approx(0.0324, abs=0.003)  # achieved 0.0324
