@@ -116,7 +116,9 @@ def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams 
     model = fit_error_model(series, targets, candidates, inputs, params, spans, source=source)
     if on_progress is not None:
         on_progress(len(runs) + 1, len(runs) + 1)
-    return ErrorModelFit(model, len(runs), "leave one run out" if len(runs) >= 3 else params.cv,
+    how = "leave one run out" if len(runs) >= 3 else \
+        f"{params.cv}, chosen on the latest forward-chaining blocks" if params.choose_latest else params.cv
+    return ErrorModelFit(model, len(runs), how,
                          tuple(str(r) for r in runs if _is_path(r)))
 
 
