@@ -1,11 +1,12 @@
 """How far a thermal-error model's prediction can be trusted: its 90 % interval, calibrated on
 held-out data, and a drift detector.
 
-* :func:`calibrate`: the half-width of the 90 % interval is the 90 % quantile of the held-out
-  absolute residuals (those of the model's own cross-validation: forward chaining, leave one run
-  out, or blocked folds). Its coverage is checked out of sample: each held-out block's residuals
-  against the quantile of the blocks that do not overlap it (in forward chaining: that end before
-  it starts), the fraction inside over all checked samples.
+* :func:`calibrate_forward` (one or two runs): the half-width grows with the horizon h since the
+  fit, ``w (1 + h / L)``, w the 90 % quantile of the forward-chaining residuals inside the fitting
+  span scaled the same way by their own horizons; :func:`calibrate` (leave one run out): the 90 %
+  quantile of the held-out absolute residuals. Coverage is checked out of sample: each held-out
+  block's residuals against the quantile of the blocks that end before it starts (forward) or do
+  not overlap it, the fraction inside over all checked samples.
 * :func:`trust` widens the interval where the model extrapolates: by the part of the prediction
   that rests on terms beyond their fitted ranges (:func:`beyond`), which the held-out calibration
   cannot vouch for.
