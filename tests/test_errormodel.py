@@ -265,7 +265,51 @@ def test_cli_resolution_sets_the_noise_rule(tmp_path, capsys):
     assert err.count("\n") == 1 and "resolution_K: -1.0 is not >= 0" in err, err
     assert cli(*args, "--resolution-K", "0") == 0
     assert "sensor noise 0 um" in capsys.readouterr().out
-    assert cli(*args) == 0  # 0.05 K: the noise is 0.05 K x sqrt(K_1^2 + K_3^2)
-    m = load_model(tmp_path / "f" / "model.json").target("d_um")
-    assert m.noise_um == pytest.approx(0.05 * np.hypot(*m.coefficients[:2]), rel=1e-9) and len(m.terms) == 2
-    assert m.noise_um == pytest.approx(0.096, abs=0.005)  # achieved 0.0960
+    assert cli(*args) == 0  # 0.05 K, smoothed over 300 s: 0.05 K x sqrt((1 - a)/(1 + a)) x |K|
+    model = load_model(tmp_path / "f" / "model.json")
+    m = model.target("d_um")
+    a = np.exp(-60.0 / model.settings["smooth_s"]) if model.settings["smooth_s"] else 0.0
+    sd = 0.05 * np.sqrt((1 - a) / (1 + a))
+    assert m.noise_um == pytest.approx(sd * np.linalg.norm(m.coefficients), rel=1e-9)
+    assert {"s1_degC", "s3_degC"} <= set(m.sensors)  # the two in d_um (a static form adds s4 for the missing lag)
+    assert model.settings["smooth_s"] == 300.0 and m.noise_um == pytest.approx(0.0324, abs=0.003)  # achieved 0.0324
+
+
+def test_forward_interval_grows_with_the_horizon():
+    """Held-out residuals exactly 1 + h / L (h since the fold's last fitting row, L its length): the
+    scores are all 1, so the half-width is 1 um and every block is inside; the interval then grows as
+    1 + h / fit_length on a file that continues the fitting run, and from a later file's first sample."""
+    from gatetherm.studies.errormodel.trust import calibrate_forward, horizon_factor
+
+    t = np.arange(100.0)
+    blocks = [(50, 75), (75, 100)]
+    res = [(1.0 + (t[lo:hi] - t[lo - 1]) / (t[lo - 1] - t[0])) * np.where(np.arange(hi - lo) % 2, 1, -1)
+           for lo, hi in blocks]
+    iv = calibrate_forward(res, blocks, t)
+    assert iv["half_width_um"] == pytest.approx(1.0) and iv["coverage"] == 1.0 and iv["samples"] == 25
+    assert iv["fit_end_s"] == 99.0 and iv["fit_length_s"] == 99.0
+    assert horizon_factor(iv, np.arange(0.0, 199.0)) == pytest.approx(np.r_[np.ones(100), 1 + np.arange(1, 100) / 99])
+    assert horizon_factor(iv, np.arange(500.0, 599.0)) == pytest.approx(1 + np.arange(99) / 99)
+    assert horizon_factor({}, t) == pytest.approx(np.ones(100))  # a constant interval (leave one run out)
+
+
+def test_choose_latest_picks_on_forward_chaining():
+    """choose_latest: held_out_mae_um is the forward-chaining error of the model kept (the model's own
+    chain error, recomputed), the interval is calibrated forward and holds the later hours."""
+    from gatetherm.studies.errormodel.trust import trust
+
+    ts = synthetic(n=1200)
+    fit = ts.slice(slice(0, 900))
+    model = fit_error_model(fit, ["d_um"], SENSORS, ("spindle_rpm",),
+                            FitParams(resolution_K=0.0, choose_latest=True))
+    m = model.target("d_um")
+    assert {"s1_degC", "s3_degC"} <= set(m.sensors) and m.form == "dynamic"
+    assert m.interval["growth"] == "horizon" and m.interval["fit_length_s"] == pytest.approx(899 * 60.0)
+    p = predict(model, ts)["d_um"]
+    band = trust(model, ts, {"d_um": p})["d_um"]
+    y = np.asarray(ts["d_um"])[900:]
+    inside = np.mean((y >= band["lower"][900:]) & (y <= band["upper"][900:]))
+    assert inside == pytest.approx(1.0, abs=0.005)  # band: >= 0.85 (noise only: the model is exact; wider later)
+    assert m.held_out_mae_um == pytest.approx(0.0418, abs=0.003)  # white noise of 0.05 um: E|e| = 0.0399
+    assert m.interval["coverage"] == pytest.approx(0.910, abs=0.01)  # band: 0.85-0.95 (forward, in the fitting span)
+    assert m.interval["half_width_um"] == pytest.approx(0.0759, abs=0.004)  # 1.645 x 0.05 um = 0.082 for white noise

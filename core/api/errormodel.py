@@ -35,12 +35,13 @@ def _model(model) -> ErrorModel:
     return model if isinstance(model, ErrorModel) else load_model(model)
 
 
-ROBUST = FitParams(drift=True, noisy_cv=True, smooth_grid_s=(300.0,), anchor_s=600.0)
-"""The API's and the command's default fit: blocked cross-validation within a run (forward chaining,
-``cv="chain"``, measured no better on FL_THERMAL: docs/errormodel.md), leave one run out with three
-or more runs, a drift term offered with several runs, candidates scored by their expected held-out error
-on readings with the sensors' noise, the readings smoothed over 300 s where that lowers the held-out error,
-each run referenced on its first 600 s (docs/errormodel.md, "Sensor noise")."""
+ROBUST = FitParams(drift=True, noisy_cv=True, smooth_grid_s=(300.0,), anchor_s=600.0, choose_latest=True)
+"""The API's and the command's default fit: within a run, the model (terms, form, the readings'
+smoothing) chosen by its forward-chaining error on the fitting span's latest blocks among the models on
+the blocked-cross-validation selection path (``choose_latest``); leave one run out with three or more
+runs (readings not smoothed there); a drift term offered with several runs; candidates scored by their
+expected held-out error on readings with the sensors' noise; each run referenced on its first 600 s
+(docs/errormodel.md, "Sensor noise", "Data never seen")."""
 
 
 def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams = ROBUST,
@@ -115,7 +116,9 @@ def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams 
     model = fit_error_model(series, targets, candidates, inputs, params, spans, source=source)
     if on_progress is not None:
         on_progress(len(runs) + 1, len(runs) + 1)
-    return ErrorModelFit(model, len(runs), "leave one run out" if len(runs) >= 3 else params.cv,
+    how = "leave one run out" if len(runs) >= 3 else \
+        f"{params.cv}, chosen on the latest forward-chaining blocks" if params.choose_latest else params.cv
+    return ErrorModelFit(model, len(runs), how,
                          tuple(str(r) for r in runs if _is_path(r)))
 
 

@@ -58,8 +58,9 @@ def register(subparsers) -> None:
     f.add_argument("--fit-span", default="0:1", metavar="START:END",
                    help="fitting span as fractions of each run's duration (default 0:1, all)")
     f.add_argument("--cv", choices=CV_KINDS, default=ROBUST.cv,
-                   help="held-out error within a run: blocked (every block predicted by the fit on the others; "
-                   "default) or chain (the latest blocks, each by the fit on the rows before it)")
+                   help="held-out error within a run that orders the forward selection: blocked (every block "
+                   "predicted by the fit on the others; default) or chain (the latest blocks, each by the fit on the "
+                   "rows before it); the model on the path is then chosen by its forward-chaining error")
     f.add_argument("--no-drift", action="store_true",
                    help="do not offer the slow drift term (hours since the run's start; offered with several runs)")
     f.add_argument("--resolution-K", type=float, default=ROBUST.resolution_K, metavar="K",

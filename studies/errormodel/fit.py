@@ -44,7 +44,7 @@ from gatetherm.studies.errormodel.model import ErrorModel, TargetModel, check_le
 from gatetherm.studies.errormodel.paper import fit_paper_form
 from gatetherm.studies.errormodel.runs import Runs
 from gatetherm.studies.errormodel.terms import Term
-from gatetherm.studies.errormodel.trust import calibrate, term_ranges
+from gatetherm.studies.errormodel.trust import calibrate, calibrate_forward, term_ranges
 from gatetherm.studies.errormodel.tune import held_out, refine, variances
 
 log = logging.getLogger(__name__)
@@ -94,6 +94,10 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
         (first valid sample in the span, degC; none for several runs) and the span; see
         :mod:`gatetherm.studies.errormodel.model`.
     """
+    several = isinstance(series, (list, tuple)) and len(series) >= 3
+    if params.smooth_grid_s and several:  # left to the readings as they are: docs/errormodel.md, "Several runs"
+        log.info("three or more runs: the readings are not smoothed (smooth_grid_s is tried within one or two runs)")
+        params = dataclasses.replace(params, smooth_grid_s=())
     if params.smooth_grid_s:
         fits = {float(v): fit_error_model(series, targets, candidates, inputs,
                                           dataclasses.replace(params, smooth_s=float(v), smooth_grid_s=()), span, source)
@@ -199,7 +203,7 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
         return fit_paper_form(cv, name, base, B, y_all, rows, SPAN_RESOLUTIONS * params.resolution_K)
     forms = {"auto": ("static", "dynamic"), "static": ("static",), "dynamic": ("dynamic",)}[params.form]
     has_dynamic = any(b.tau_s is not None for b in base)
-    fits, selection = {}, []
+    fits, selection, pool = {}, [], {}
     intercept = np.eye(len(base) + 1)[:, :1]
     for form in forms:
         if form == "dynamic" and not has_dynamic:
@@ -211,16 +215,43 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
             if params.refine else ([terms[k] for k in pick.chosen], pick.cv_mae)
         selection += [{"form": form, "terms": [terms[k].label for k in s.chosen], "sensors": s.sensors,
                        "cv_mae_um": s.cv_mae} for s in path]
-    form = "dynamic" if "dynamic" in fits and ("static" not in fits or
-                                               fits["dynamic"][1] < fits["static"][1] * (1 - params.min_gain)) \
-        else "static"
-    terms, cv_mae = fits[form]
+        if params.choose_latest and data.blocks(rows) is None:
+            pool[form] = [[terms[k] for k in s.chosen] for s in path if s.chosen] + [fits[form][0]]
+    if pool:
+        terms, cv_mae, form = _latest(pool, data, y_all, rows, params)
+    else:
+        form = "dynamic" if "dynamic" in fits and ("static" not in fits or
+                                                   fits["dynamic"][1] < fits["static"][1] * (1 - params.min_gain)) \
+            else "static"
+        terms, cv_mae = fits[form]
     X = np.column_stack([np.ones(data.time.size)] + [data.column(term) for term in terms])
     var = variances(terms, data, params)
     c = select.noisy_least_squares(X[rows], y_all[rows], var)
-    final = held_out(X[rows], y_all[rows], data, rows, params, var)
-    interval = calibrate(final.residuals(np.eye(X.shape[1])), final.blocks,
-                         chain=params.cv == "chain" and data.blocks(rows) is None)
+    if data.blocks(rows) is None:  # one or two runs: calibrated as a control uses it, on the latest blocks
+        final = held_out(X[rows], y_all[rows], data, rows, dataclasses.replace(params, cv="chain"), var)
+        interval = calibrate_forward(final.residuals(np.eye(X.shape[1])), final.blocks, data.time[rows])
+    else:
+        final = held_out(X[rows], y_all[rows], data, rows, params, var)
+        interval = calibrate(final.residuals(np.eye(X.shape[1])), final.blocks, chain=False)
     return TargetModel(name, form, tuple(terms), tuple(float(v) for v in c[1:]), float(c[0]),
                        residual_stats(X[rows] @ c - y_all[rows]), float(cv_mae), tuple(selection),
                        float(np.sqrt(var @ c**2)), interval, term_ranges(X[rows, 1:]))
+
+
+def _latest(pool: dict, data: Runs, y_all, rows, params: FitParams):
+    """The candidate of ``pool`` (form -> lists of terms) chosen by the forward-chaining error on the
+    latest blocks of the fitting rows (``params.choose_latest``): the one of the fewest terms (ties: the
+    first listed) whose error is within ``min_gain`` of the lowest. Its terms, that error and its form."""
+    chain = dataclasses.replace(params, cv="chain")
+    scored = []
+    for form, models in pool.items():
+        for terms in models:
+            X = np.column_stack([np.ones(data.time.size)] + [data.column(term) for term in terms])
+            err = held_out(X[rows], y_all[rows], data, rows, chain, variances(terms, data, params)).error(
+                np.eye(X.shape[1]))
+            scored.append((len(terms), len(scored), err, terms, form))
+    lowest = min(s[2] for s in scored)
+    _, _, err, terms, form = min(s for s in scored if s[2] <= lowest * (1 + params.min_gain))
+    log.info("chosen on the latest blocks: %s, %s (forward-chaining error %.4g; lowest %.4g)", form,
+             ", ".join(t.label for t in terms), err, lowest)
+    return terms, err, form

@@ -62,12 +62,19 @@ class FitParams:
     smooth_grid_s: tuple[float, ...] = ()
     """Further values of ``smooth_s`` to try, s: the model is fitted with each (and ``smooth_s``) and
     the one of the lowest held-out error, summed over the targets, is kept (``settings``:
-    ``smooth_held_out_um``, the sum for each value); empty = ``smooth_s`` only."""
+    ``smooth_held_out_um``, the sum for each value); empty = ``smooth_s`` only. Tried within one or
+    two runs; three or more runs are fitted with ``smooth_s`` alone (docs/errormodel.md, "Several runs":
+    chosen by leave one run out, the smoothing lost on four of five held-out simulated runs)."""
     anchor_s: float = 0.0
     """Each run's (and each predicted file's) first reading of a temperature column is replaced by the
     value there of the straight line through its readings of the first ``anchor_s`` seconds, s: with
     several runs every term is taken from that reading, and one noisy sample would offset the whole
     run; the noise rule then counts the reference's noise too. 0 = the first reading as it is."""
+    choose_latest: bool = False
+    """Within one or two runs, choose the model by its forward-chaining error on the fitting span's
+    latest blocks (as a control uses it): the candidates are every model on each form's forward-selection
+    path (ordered by ``cv``) and the refined pick, and the one of the lowest forward-chaining error is
+    kept; ``held_out_mae_um`` is then that error, and so is what ``smooth_grid_s`` compares."""
     drift: bool = False
     """With several runs, also offer a slow drift, the hours since each run's start (kept only where
     it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with

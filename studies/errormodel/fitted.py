@@ -40,7 +40,9 @@ class TargetModel:
     residual: dict = field(default_factory=dict)
     """On the fitting span: ``mae_um``, ``rms_um``, ``max_abs_um``, ``samples``."""
     held_out_mae_um: float | None = None
-    """Mean absolute error of the blocked cross-validation inside the fitting span, um."""
+    """Held-out mean absolute error inside the fitting span, um: of the cross-validation (``cv``; leave
+    one run out with three or more runs), or with ``choose_latest`` the forward-chaining error on the
+    span's latest blocks that chose the model."""
     selection: tuple[dict, ...] = ()
     """The forward-selection path: per step ``terms`` (labels), ``sensors`` (count), ``cv_mae_um``."""
     noise_um: float | None = None
@@ -49,7 +51,9 @@ class TargetModel:
     interval: dict = field(default_factory=dict)
     """The 90 % interval from held-out residuals (:func:`~gatetherm.studies.errormodel.trust.calibrate`):
     ``half_width_um`` (um), ``coverage`` (fraction of held-out samples inside, out of sample),
-    ``samples``, ``level``; empty: not calibrated."""
+    ``samples``, ``level``; within one or two runs also ``growth`` ("horizon"), ``fit_end_s`` and
+    ``fit_length_s`` (s): the half-width grows as ``1 + h / fit_length_s``
+    (:func:`~gatetherm.studies.errormodel.trust.calibrate_forward`); empty: not calibrated."""
     ranges: tuple = ()
     """Per term its (smallest, largest) value on the fitting rows (the drift detector's reference)."""
 

@@ -1,11 +1,12 @@
 """How far a thermal-error model's prediction can be trusted: its 90 % interval, calibrated on
 held-out data, and a drift detector.
 
-* :func:`calibrate`: the half-width of the 90 % interval is the 90 % quantile of the held-out
-  absolute residuals (those of the model's own cross-validation: forward chaining, leave one run
-  out, or blocked folds). Its coverage is checked out of sample: each held-out block's residuals
-  against the quantile of the blocks that do not overlap it (in forward chaining: that end before
-  it starts), the fraction inside over all checked samples.
+* :func:`calibrate_forward` (one or two runs): the half-width grows with the horizon h since the
+  fit, ``w (1 + h / L)``, w the 90 % quantile of the forward-chaining residuals inside the fitting
+  span scaled the same way by their own horizons; :func:`calibrate` (leave one run out): the 90 %
+  quantile of the held-out absolute residuals. Coverage is checked out of sample: each held-out
+  block's residuals against the quantile of the blocks that end before it starts (forward) or do
+  not overlap it, the fraction inside over all checked samples.
 * :func:`trust` widens the interval where the model extrapolates: by the part of the prediction
   that rests on terms beyond their fitted ranges (:func:`beyond`), which the held-out calibration
   cannot vouch for.
@@ -34,7 +35,8 @@ MAX_MISSED = 0.25
 def calibrate(residuals: list[np.ndarray], blocks: list[tuple[int, int]], chain: bool) -> dict:
     """``half_width_um`` of the 90 % interval, ``coverage`` (out-of-sample check, module docstring;
     None if no block could be checked) and ``samples`` checked, from the held-out ``residuals`` per
-    block (um) of ``blocks`` (row ranges)."""
+    block (um) of ``blocks`` (row ranges). Used for leave one run out; a single run's interval is
+    :func:`calibrate_forward`."""
     if not residuals:
         return {}
     a = [np.abs(r) for r in residuals]
@@ -49,6 +51,47 @@ def calibrate(residuals: list[np.ndarray], blocks: list[tuple[int, int]], chain:
         inside += int((a[i] <= q).sum())
         n += a[i].size
     return {"half_width_um": half, "coverage": inside / n if n else None, "samples": n, "level": LEVEL}
+
+
+def calibrate_forward(residuals: list[np.ndarray], blocks: list[tuple[int, int]], t_s: np.ndarray) -> dict:
+    """The 90 % interval of a model fitted on one run, growing with the horizon since the fit:
+    ``half(h) = half_width_um * (1 + h / fit_length_s)``, h the time since the fitting span's end, s.
+
+    ``residuals`` are the forward-chaining held-out residuals (um) of ``blocks`` (row ranges, each
+    predicted by the fit on the rows before it; ``t_s`` the rows' times, s): each sample's score is
+    ``|r| / (1 + h / L)``, h its time since the end of its fold's fitting rows and L their length;
+    ``half_width_um`` is the scores' 90 % quantile. ``coverage`` checks it out of sample: each block
+    against the quantile of the scores of the blocks that end before it starts."""
+    if not residuals:
+        return {}
+    scores, ends = [], []
+    for r, (lo, hi) in zip(residuals, blocks):
+        length = max(float(t_s[lo - 1] - t_s[0]), 1e-9)
+        h = t_s[lo:hi] - t_s[lo - 1]
+        scores.append(np.abs(r) / (1.0 + h / length))
+    half = float(np.quantile(np.concatenate(scores), LEVEL))
+    inside, n = 0, 0
+    for i, (lo, _) in enumerate(blocks):
+        earlier = [scores[j] for j, (_, h2) in enumerate(blocks) if h2 <= lo]
+        if earlier:
+            inside += int((scores[i] <= np.quantile(np.concatenate(earlier), LEVEL)).sum())
+            n += scores[i].size
+    return {"half_width_um": half, "coverage": inside / n if n else None, "samples": n, "level": LEVEL,
+            "growth": "horizon", "fit_end_s": float(t_s[-1]), "fit_length_s": float(t_s[-1] - t_s[0])}
+
+
+def horizon_factor(interval: dict, t_s: np.ndarray) -> np.ndarray:
+    """Per sample the factor ``1 + h / fit_length_s`` of a horizon-growing interval
+    (:func:`calibrate_forward`); 1 for a constant one. h is the time since the fitting span's end on
+    the file's clock where the file's first sample lies within the fitting span (the fitting run
+    continued), else the time since the file's first sample (a later file, taken as starting right
+    after the fit)."""
+    t_s = np.asarray(t_s, float)
+    if interval.get("growth") != "horizon" or not t_s.size:
+        return np.ones(t_s.size)
+    end, length = interval["fit_end_s"], max(interval["fit_length_s"], 1e-9)
+    h = t_s - end if end - length <= t_s[0] < end else t_s - t_s[0]
+    return 1.0 + np.maximum(h, 0.0) / length
 
 
 def term_ranges(X: np.ndarray) -> tuple[tuple[float, float], ...]:
@@ -116,7 +159,8 @@ def trust(model: ErrorModel, columns, predicted: dict[str, np.ndarray] | None = 
     out = {}
     for m in model.targets:
         p = predicted[m.target]
-        half = m.interval.get("half_width_um", np.nan) + beyond(values[m.target], m.ranges, m.coefficients)
+        half = m.interval.get("half_width_um", np.nan) * horizon_factor(m.interval, columns["time_s"]) \
+            + beyond(values[m.target], m.ranges, m.coefficients)
         off = outside(values[m.target], m.ranges, [t.kind for t in m.terms]) if m.ranges \
             else np.zeros(p.size, bool)
         missed = None
