@@ -107,12 +107,17 @@ def describe(hint) -> str:
     if origin is abc.Callable or hint in (abc.Callable, typing.Callable):
         return "a function"
     if origin in (abc.Mapping, dict, abc.MutableMapping) or hint in (dict, abc.Mapping):
-        return "a mapping" + (f" of {describe(args[0])} to {describe(args[1])}" if args else "")
+        return "a mapping" + (f" of {_bare(describe(args[0]))} to {_bare(describe(args[1]))}" if args else "")
     if origin in (list, tuple, set, frozenset, abc.Sequence, abc.Iterable, abc.Collection, abc.Set):
         if origin is tuple and args and args[-1] is not Ellipsis:
             return "a (" + ", ".join(describe(a) for a in args) + ")"
-        return "a list" + (f" of {describe(args[0])}" if args else "").replace(" of a ", " of ")
+        return "a list" + (f" of {_bare(describe(args[0]))}" if args else "")
     return f"a {getattr(hint, '__name__', str(hint))}"
+
+
+def _bare(words: str) -> str:
+    """``words`` without a leading article (``a list of str``, not ``of a str``)."""
+    return words.removeprefix("a ").removeprefix("an ")
 
 
 def _number(value, hint, kind) -> bool:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from typing import Callable, Mapping, Sequence
 
 from gatetherm import InputError
 from gatetherm.api.errormodel_results import FIT_OUTPUTS, PREDICT_OUTPUTS, ErrorModelFit, Prediction, \
@@ -44,9 +45,11 @@ expected held-out error on readings with the sensors' noise; each run referenced
 (docs/errormodel.md, "Sensor noise", "Data never seen")."""
 
 
-def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams = ROBUST,
-                   span: tuple[float, float] = (0.0, 1.0), *, named_as=("targets", "candidates", "inputs"),
-                   on_progress=None, **settings) -> ErrorModelFit:
+def errormodel_fit(data: str | os.PathLike | TimeSeries | Sequence[str | os.PathLike | TimeSeries],
+                   targets: Sequence[str], candidates: Sequence[str] | None = None, inputs: Sequence[str] = (),
+                   params: FitParams = ROBUST, span: tuple[float, float] = (0.0, 1.0), *,
+                   named_as: tuple[str, str, str] = ("targets", "candidates", "inputs"),
+                   on_progress: Callable[[int, int], None] | None = None, **settings) -> ErrorModelFit:
     """Fit a thermal-error model per target on one measured run or several.
 
     Parameters
@@ -122,7 +125,8 @@ def errormodel_fit(data, targets, candidates=None, inputs=(), params: FitParams 
                          tuple(str(r) for r in runs if _is_path(r)))
 
 
-def errormodel_predict(model, data) -> Prediction:
+def errormodel_predict(model: ErrorModel | ErrorModelFit | str | os.PathLike,
+                       data: str | os.PathLike | TimeSeries) -> Prediction:
     """Apply a model with its 90 % interval and drift check.
 
     Parameters
@@ -153,7 +157,9 @@ def errormodel_predict(model, data) -> Prediction:
                       scores, gaps, tuple(c["warning"] for c in checks.values() if c["warning"]), model, ts, sources)
 
 
-def errormodel_refit(model, data, window_s: float, applied=None, *, named_as: str = "applied") -> Refit:
+def errormodel_refit(model: ErrorModel | ErrorModelFit | str | os.PathLike, data: str | os.PathLike | TimeSeries,
+                     window_s: float, applied: Mapping[str, str] | Sequence[str] | None = None, *,
+                     named_as: str = "applied") -> Refit:
     """Refit a model's coefficients on the last ``window_s`` of new data, guarded against fitting its
     own corrections and never silently worse (:mod:`gatetherm.studies.errormodel.refit`).
 
