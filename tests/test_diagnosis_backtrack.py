@@ -11,6 +11,7 @@ import pytest
 from gatetherm import InputError
 from gatetherm.studies.diagnosis.calibrate import Objective, Refused
 from gatetherm.studies.diagnosis.hypotheses import Piece, model_side
+from gatetherm.studies.diagnosis.progress import Budget
 from gatetherm.studies.diagnosis.select import select, select_confirmed
 
 HOUR = 3600.0
@@ -35,7 +36,7 @@ class Surrogate(Objective):
     """Columns linear in the values of the pieces; ``FREE`` is refused like a part left free to move."""
 
     def __init__(self, truth: dict):
-        rep = SimpleNamespace(times=T, runs=0, config=None)
+        rep = SimpleNamespace(times=T, runs=0, config=None, budget=Budget())
         y = self.columns(truth)
         super().__init__(rep, y, CHANNELS, {"delta_um": 0.1, "theta_A_degC": 0.05}, T <= 0.6 * T[-1])
         self.refused = 0

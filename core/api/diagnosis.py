@@ -207,7 +207,9 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out=None, record=None,
     config : path, optional
         The model file the frame was read from (never overwritten by :meth:`DiagnosisRun.write`).
     on_progress : callable, optional
-        ``on_progress(i, n)``: the replay, then the diagnosis, i increasing up to n (n = 2).
+        ``on_progress(i, n)`` after every model run: ``i`` runs done (one more each call) of about
+        ``n`` planned (estimated, and updated as the search goes: ``n`` may change, never below
+        ``i + 1`` before the end); the last call has ``i == n ==`` the result's ``diagnosis.runs``.
     **settings
         Fields of :class:`gatetherm.studies.diagnosis.discrepancy.Settings` (``train_fraction``,
         ``effects``, ``parameters``, ``sensors``, ``uncertain``, ``refine`` …).
@@ -230,11 +232,7 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out=None, record=None,
     measured_schedule(model, ts, str(data))  # every input the case reads is in the file
 
     def diagnosed() -> DiagnosisRun:
-        if on_progress is not None:
-            on_progress(1, 2)
-        diag = run_diagnosis(model, ts, choices)
-        if on_progress is not None:
-            on_progress(2, 2)
+        diag = run_diagnosis(model, ts, choices, on_progress)
         return DiagnosisRun(diag, model, str(data), dict(ts.metadata), dict(record or {}), keep)
 
     if out is None:

@@ -116,8 +116,8 @@ def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: d
             _drop(dropped, err, ctx)
             return None
 
-    if not ctx:
-        singles = [(p, tried(lambda p=p: obj.scored(fit_one(obj, {}, p)))) for p in pool]
+    if not ctx:  # the plan of the model runs updated after every fit (:meth:`~.progress.Budget.first_round`)
+        singles = obj.replayer.budget.first_round(pool, lambda p: tried(lambda: obj.scored(fit_one(obj, {}, p))))
         singles = [(p, s) for p, s in singles if s is not None]
         fits.update({frozenset([p]): s for p, s in singles})
     sur = Surrogate(obj, ctx)
@@ -145,8 +145,7 @@ def _real(obj: Objective, screened: Scored, fits: dict) -> Scored:
 
 def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: int = 4, top: int = 3,
            swaps: int = 2, dropped: dict | None = None) -> Selection:
-    """Forward selection from the baseline over ``candidates`` (the module docstring);
-    ``dropped``: pieces the model refused before (kept out, and listed)."""
+    """Forward selection from the baseline over ``candidates`` (module docstring); ``dropped``: refused before."""
     base = obj.scored({})
     sel = Selection(base, base, [], dropped=dict(dropped or {}))
     fits: dict[frozenset, Scored] = {}
@@ -233,6 +232,7 @@ def _forward(obj: Objective, sel: Selection, current: Scored, candidates, margin
         sel.rounds.append(dataclasses.replace(rnd, added=added))
         current = best  # fitted jointly already
         sel.order += list(added)
+        obj.replayer.budget.round_done(len(current.values))
     return current
 
 
