@@ -41,6 +41,7 @@ from gatetherm.studies.diagnosis.calibrate import Objective, Refused, Scored, fi
 from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece
 from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.diagnosis.surrogate import Surrogate, screen
+from gatetherm.studies.diagnosis.backtrack import select_confirmed  # noqa: F401 (its home before)
 
 log = logging.getLogger(__name__)
 
@@ -162,44 +163,6 @@ def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: i
     sel.final = current
     _alternatives(obj, sel, candidates, margin)
     return sel
-
-
-def select_confirmed(pick, judge, candidates: list[Piece], tries: int = 3):
-    """Forward selection that goes back when the model-form checks reject its pieces.
-
-    ``pick(pool, dropped)`` selects from ``pool`` (:func:`select`, ``dropped`` the pieces the
-    model refused so far); ``judge(selection)`` gives ``(named, stand_ins, checks)`` of the chosen
-    set (:func:`~gatetherm.studies.diagnosis.checks.confirm`: ``named`` {piece: value} that hold,
-    ``stand_ins`` {piece: (value, why)} that do not). While the judge rejects stand-ins, they
-    leave the candidates and the selection runs again on the rest (the model runs made so far
-    are kept), ``tries`` selections at most: a pair of stand-ins chosen first no longer hides the
-    piece that alone explains the data (issue 51). A later selection that names nothing does not
-    replace an earlier one that named pieces.
-
-    Returns
-    -------
-    (Selection, dict, checks)
-        The selection kept (every stand-in rejected on the way in its :attr:`Selection.stand_ins`,
-        every refused piece in :attr:`Selection.dropped`), its named pieces and their checks.
-    """
-    pool, rejected, dropped, best = list(candidates), {}, {}, None
-    for i in range(tries):
-        sel = pick(pool, dropped)
-        dropped = sel.dropped
-        named, stand, chk = judge(sel)
-        rejected.update(stand)
-        if best is None or named or not best[1]:
-            best = (sel, named, chk)
-        if not stand:
-            break
-        pool = [p for p in pool if p not in stand and p not in dropped]
-        if i + 1 < tries:
-            log.info("model-form checks rejected %s as stand-ins: selecting again from the %d other candidates",
-                     " + ".join(p.label for p in stand), len(pool))
-    sel, named, chk = best
-    sel.stand_ins = {p: v for p, v in rejected.items() if p not in named}
-    sel.dropped = dropped
-    return sel, named, chk
 
 
 def _forward(obj: Objective, sel: Selection, current: Scored, candidates, margin: float, max_pieces: int, top: int,
