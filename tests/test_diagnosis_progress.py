@@ -54,13 +54,20 @@ def test_a_budget_plans_from_the_runs_measured():
     later = 3 * ROUND_RUNS + CHECK_RUNS
     assert planned[0] == (2, 2 + 10 * FIRST_RUNS + later) and planned[2] == (14, 14 + 8 * 6 + later)
     assert seen[-1] == (62, 62 + later)
-    b.round_done(chosen=3)  # no round left: the checks
-    assert seen[-1] == (62, 62 + CHECK_RUNS)
-    for _ in range(CHECK_RUNS + 5):  # more runs than planned: n stays ahead of i
+    for _ in range(2 * ROUND_RUNS):  # a round twice the prior: the next one planned at that
         b.ran()
-    assert seen[-1] == (79, 80)
+    b.round_done(chosen=2)
+    assert seen[-1] == (62 + 2 * ROUND_RUNS, 62 + 2 * ROUND_RUNS + 2 * ROUND_RUNS + CHECK_RUNS)
+    b.round_done(chosen=3)  # no round left: the checks
+    done = 62 + 2 * ROUND_RUNS
+    assert seen[-1] == (done, done + CHECK_RUNS)
+    for _ in range(CHECK_RUNS + 5):  # more runs than planned: a tenth more planned, n stays ahead of i
+        b.ran()
+    reached, done = done + CHECK_RUNS, done + CHECK_RUNS + 5
+    assert seen[-1] == (done, reached + reached // 10)
     b.finish()
-    assert seen[-1] == (79, 79) and [i for i, _ in seen] == sorted(i for i, _ in seen)
+    assert seen[-1] == (done, done) and [i for i, _ in seen] == sorted(i for i, _ in seen)
+    assert all(n > i for i, n in seen[:-1])
 
 
 def test_the_plan_names_the_runs_the_time_and_what_makes_it_cheaper():

@@ -5,8 +5,9 @@ check, every hypothesis' value tried, every joint refit, the model-form checks) 
 is made (:meth:`Budget.ran`). How many the search will make is known only roughly beforehand:
 :meth:`Budget.expect` sets the runs still to come from what the search has left (the first
 round's fits of the hypotheses that need runs, the later rounds, the checks), with the runs
-per fit measured so far where there are some, else :data:`FIRST_RUNS`, :data:`ROUND_RUNS` and
-:data:`CHECK_RUNS` (the averages of the diagnoses in docs/diagnosis.md). ``on_progress(i, n)``
+per fit and per round measured so far where there are some, else :data:`FIRST_RUNS`, :data:`ROUND_RUNS`
+and :data:`CHECK_RUNS` (rough priors: a selection that goes back when the checks reject stand-ins can
+take twice the runs planned, and where the plan is reached before the end, a tenth more is planned). ``on_progress(i, n)``
 sees ``i`` (runs done) grow by one each run and ``n`` (planned) never below ``i + 1`` until the
 diagnosis ends, where ``i == n`` is the number of runs the result reports.
 """
@@ -19,10 +20,12 @@ log = logging.getLogger(__name__)
 
 FIRST_RUNS = 7
 """Model runs of one hypothesis' first fit: a 5-point scan of its range (its model value free) and secant steps."""
-ROUND_RUNS = 30
-"""Model runs of one later selection round: the best three additions and pairs refitted jointly."""
-CHECK_RUNS = 12
-"""Model runs after the selection: model-form checks, uncertainties, shares (about one per piece each)."""
+ROUND_RUNS = 40
+"""Model runs of one later selection round: the best three additions and pairs refitted jointly (36 in the
+C-frame's unmarked spindle-length scenario of ``gatetherm validate case-diagnosis``)."""
+CHECK_RUNS = 40
+"""Model runs after the selection: removal check, swaps, alternatives, model-form checks, uncertainties, shares,
+and a selection again without the stand-ins (whose first round is mostly runs made before)."""
 LONG_S = 600.0
 """A diagnosis planned to take longer than this (s, at the measured time per run) is announced
 with the options that make it cheaper."""
@@ -38,6 +41,8 @@ class Budget:
         """Runs done; runs planned (``first``: the baseline runs before the search is planned)."""
         self.rounds_left = max(max_pieces - 1, 0)
         """Selection rounds still to come after the first."""
+        self.since, self.costs, self.per_round = 0, [], float(ROUND_RUNS)
+        """Runs done when the last round ended; the runs each later round took; the runs planned a round."""
         self.shown = (0, 0)
 
     def _show(self) -> None:
@@ -46,9 +51,10 @@ class Budget:
             self.on_progress(self.done, self.planned)
 
     def ran(self) -> None:
-        """One model run made."""
+        """One model run made (where the plan is reached before the end, a tenth more is planned)."""
         self.done += 1
-        self.planned = max(self.planned, self.done + 1)
+        if self.done >= self.planned:
+            self.planned = self.done + max(self.done // 10, 1)
         self._show()
 
     def expect(self, more: float) -> None:
@@ -58,7 +64,7 @@ class Budget:
 
     def later(self) -> float:
         """Runs of what follows the first round: the later rounds and the checks."""
-        return self.rounds_left * ROUND_RUNS + CHECK_RUNS
+        return self.rounds_left * self.per_round + CHECK_RUNS
 
     def first_round(self, pool, fit: Callable) -> list:
         """[(piece, fit(piece))] of every hypothesis of ``pool`` (a selection's first round), the plan
@@ -71,10 +77,14 @@ class Budget:
             if p.rerun:
                 i += 1
                 self.expect((n - i) * (self.done - start) / i + self.later())
+        self.since = self.done
         return out
 
     def round_done(self, chosen: int) -> None:
-        """A selection round ended with ``chosen`` pieces chosen."""
+        """A later selection round ended with ``chosen`` pieces chosen: the rounds left planned at the
+        runs a round took so far (at least :data:`ROUND_RUNS`)."""
+        self.costs.append(self.done - self.since)
+        self.since, self.per_round = self.done, max(ROUND_RUNS, sum(self.costs) / len(self.costs))
         self.rounds_left = max(self.max_pieces - chosen - 1, 0)
         self.expect(self.later())
 
