@@ -120,4 +120,5 @@ def plan_line(rerun: int, pieces: int, runs: int, per_run: float, order: int, ma
     if order == 2 and p1_run is not None:
         cheaper += f"; --keep-order replays with P1 elements ({p1_run:.1f} s a run, but see the discretisation check)"
     return (f"diagnosis: about {planned} model runs planned ({pieces} hypotheses, {rerun} of them need model runs), "
-            f"{per_run:.1f} s a run (the baseline, P{order}): about {planned * per_run / 60:.0f} min; {cheaper}")
+            f"{per_run:.1f} s a run (the baseline, P{order}): about {planned * per_run / 60:.0f} min (up to twice that "
+            f"where the model-form checks send the selection back); {cheaper}")
