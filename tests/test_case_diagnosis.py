@@ -153,7 +153,8 @@ def test_case_diagnosis_study(tmp_path):
     catalogue and parameter scenarios are found, and so is the spindle housing 3 cm longer where
     its length is marked uncertain; noise only on the example's own mesh (discretisation check 1.23
     resolutions) is replayed with P2 elements and is no discrepancy. Unmarked, the longer spindle
-    is not `explained` but a conductivity is named for it: the one scenario missed."""
+    is not `explained` but a conductivity is named for it, the other sets that fit in part listed as
+    stand-ins: the one scenario missed."""
     line, rows = write_case_diagnosis(tmp_path)
     by = {r["scenario"]: r for r in rows}
     assert set(by) == set(SCENARIOS)
@@ -164,7 +165,16 @@ def test_case_diagnosis_study(tmp_path):
     fitted = by["spindle length, marked"]["fitted"][f"{SPINDLE}.spindle_length"]
     assert fitted == pytest.approx(0.3805, abs=0.001)  # hidden 0.38; achieved 0.38045
     unmarked = by["spindle length, not marked"]
-    assert unmarked["verdict"] != "explained" and unmarked["wrong_names"] == ["parameter:conductivity"]
+    # A cause outside every hypothesis. Since source_REGION joined the hypotheses (issue 53), the third
+    # selection (after ambient drift + θ_C gain, then δ gain + heat capacity, were rejected as stand-ins)
+    # named source ×0.90 + expansion ×1.10 + conductivity ×0.85, holding on every phase but leaving a
+    # significant residual: three wrong causes that look confirmed, where the geometry changed. A later
+    # selection now replaces the first named set only where it explains the run (diagnosis/backtrack.py):
+    # the first stays, conductivity ×0.885 failing all four phase checks (the verdict: something outside
+    # the hypotheses), and the third's source and expansion are listed as stand-ins (achieved, scenario
+    # alone: partly-explained, conductivity with film_free in its group, 6 stand-ins, 545 runs).
+    assert unmarked["verdict"] == "partly-explained" and unmarked["wrong_names"] == ["parameter:conductivity"]
+    assert {"parameter:source_spindle", "parameter:expansion"} <= set(unmarked["stand_ins"])
     assert by["noise-only, case mesh"]["p2_minus_p1_delta"] > 1.0 > by["noise-only"]["p2_minus_p1_delta"]
     assert line.startswith("8 of 9 scenarios found")
 

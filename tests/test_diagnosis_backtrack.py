@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 
 from gatetherm import InputError
-from gatetherm.studies.diagnosis.calibrate import Objective, Refused
+from gatetherm.studies.diagnosis.calibrate import Objective, Refused, Scored
 from gatetherm.studies.diagnosis.hypotheses import Piece, model_side
-from gatetherm.studies.diagnosis.select import select, select_confirmed
+from gatetherm.studies.diagnosis.progress import Budget
+from gatetherm.studies.diagnosis.backtrack import LATER
+from gatetherm.studies.diagnosis.select import Selection, select, select_confirmed
 
 HOUR = 3600.0
 T = np.arange(0.0, 6 * HOUR + 1, 300.0)
@@ -35,7 +37,7 @@ class Surrogate(Objective):
     """Columns linear in the values of the pieces; ``FREE`` is refused like a part left free to move."""
 
     def __init__(self, truth: dict):
-        rep = SimpleNamespace(times=T, runs=0, config=None)
+        rep = SimpleNamespace(times=T, runs=0, config=None, budget=Budget())
         y = self.columns(truth)
         super().__init__(rep, y, CHANNELS, {"delta_um": 0.1, "theta_A_degC": 0.05}, T <= 0.6 * T[-1])
         self.refused = 0
@@ -116,3 +118,27 @@ def test_back_tracking_stops_without_stand_ins_and_keeps_a_named_set():
 
     sel, named, _ = select_confirmed(pick, judge, [DRIFT, FILM])
     assert named == {DRIFT: 0.5} and list(sel.stand_ins) == [FILM]
+
+
+def test_a_later_set_that_does_not_hold_either_does_not_replace_the_named_one():
+    """A cause outside the hypotheses: the first selection names the film (its partner the joint a
+    stand-in), the retry names the film with the drift, and neither set holds on every phase: the
+    first stays named, the drift is listed as a stand-in (as the C-frame's unmarked spindle length:
+    conductivity, then conductivity + source + expansion). A retry whose set holds replaces it."""
+    def pick_with(explains_later: bool):
+        def pick(pool, dropped):
+            values = {FILM: 1.2, JOINT: 0.4} if JOINT in pool else {FILM: 1.1, DRIFT: 0.3}
+            s = Scored(values, 0.0, 0.0, {}, explains_later and JOINT not in pool)
+            return Selection(s, s, list(values))
+        return pick
+
+    def judge(sel):
+        stand = {p: (v, "implausible") for p, v in sel.final.values.items() if p == JOINT}
+        named = {p: v for p, v in sel.final.values.items() if p != JOINT}
+        return named, stand, SimpleNamespace(holds=not stand)  # the retry holds on every phase
+
+    sel, named, chk = select_confirmed(pick_with(False), judge, [FILM, JOINT, DRIFT])
+    assert named == {FILM: 1.2} and not chk.holds  # the retry holds, but leaves a significant residual
+    assert sel.stand_ins == {JOINT: (0.4, "implausible"), DRIFT: (0.3, LATER)}
+    sel, named, chk = select_confirmed(pick_with(True), judge, [FILM, JOINT, DRIFT])
+    assert named == {FILM: 1.1, DRIFT: 0.3} and chk.holds and set(sel.stand_ins) == {JOINT}

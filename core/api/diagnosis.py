@@ -74,6 +74,7 @@ def diagnosis_hypotheses(model: Case, uncertain=(), as_json: bool = False) -> st
         The table (kind, name, parameter, plausible range, unit, and what each means) or the JSON text.
     """
     from gatetherm.studies.diagnosis.hypotheses import catalogue
+    from gatetherm.studies.diagnosis.progress import FIRST_RUNS
     from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
 
     argument("model", model, Case, "a Case", "make one with gt.load_case(path) or gt.gate_frame()")
@@ -86,6 +87,10 @@ def diagnosis_hypotheses(model: Case, uncertain=(), as_json: bool = False) -> st
         if p.kind != "sensor":
             rows.append(f"{'':<11}{p.doc}")
     rows.append("Sensor faults are tried on every compared channel of the file (further T_<name>_degC too).")
+    rerun = sum(p.rerun for p in pieces if p.kind != "sensor")
+    rows.append(f"A diagnosis tries every hypothesis above (--effects, --parameters, --no-sensors restrict them); "
+                f"{rerun} need model runs (about {FIRST_RUNS} each in the first round, a few tens more per piece "
+                "chosen), the others act on a kept run.")
     return "\n".join(rows)
 
 
@@ -207,7 +212,10 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out=None, record=None,
     config : path, optional
         The model file the frame was read from (never overwritten by :meth:`DiagnosisRun.write`).
     on_progress : callable, optional
-        ``on_progress(i, n)``: the replay, then the diagnosis, i increasing up to n (n = 2).
+        ``on_progress(i, n)`` after every model run and where the plan changes: ``i`` model runs done
+        (never falling, one more at a time) of about ``n`` planned (estimated, and updated as the search
+        goes: ``n`` may change, never below ``i + 1`` before the end); the last call has ``i == n ==``
+        the result's ``diagnosis.runs``.
     **settings
         Fields of :class:`gatetherm.studies.diagnosis.discrepancy.Settings` (``train_fraction``,
         ``effects``, ``parameters``, ``sensors``, ``uncertain``, ``refine`` …).
@@ -230,11 +238,7 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out=None, record=None,
     measured_schedule(model, ts, str(data))  # every input the case reads is in the file
 
     def diagnosed() -> DiagnosisRun:
-        if on_progress is not None:
-            on_progress(1, 2)
-        diag = run_diagnosis(model, ts, choices)
-        if on_progress is not None:
-            on_progress(2, 2)
+        diag = run_diagnosis(model, ts, choices, on_progress)
         return DiagnosisRun(diag, model, str(data), dict(ts.metadata), dict(record or {}), keep)
 
     if out is None:

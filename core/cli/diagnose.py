@@ -91,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--data/--out", "both are required", "e.g. gatetherm diagnose --data run.csv --out diag")
     record = {"case": args.case, "mesh_size": args.mesh_size, "mesh_factor": args.mesh_factor}
     result = diagnose_run(load_model(args), args.data, out=args.out, config=args.config, record=record,
-                          on_progress=Progress("diagnose"), **settings_from(args))
+                          on_progress=Progress("diagnose: model runs"), **settings_from(args))
     print(result.summary())  # written into --out by diagnose_run, the directory locked before the diagnosis
     print(result.wrote(args.out))
     return 0

@@ -44,8 +44,9 @@ from gatetherm.studies.diagnosis.checks import Checks, confirm
 from gatetherm.studies.diagnosis.hypotheses import (Piece, configure, effect_keys, effect_pieces, parameter_pieces,
                                                     sensor_pieces)
 from gatetherm.studies.diagnosis.identify import Group, groups, physical_first
-from gatetherm.studies.diagnosis.locate import Finding, Phase, input_phases, locate, noise_sd, phases
+from gatetherm.studies.diagnosis.locate import Finding, Phase, case_phases, locate, noise_sd
 from gatetherm.studies.diagnosis.pattern import kind_of_cause, unexplained
+from gatetherm.studies.diagnosis.progress import Budget
 from gatetherm.studies.diagnosis.replay import DELTA, Replayer, compared_channels, resolution, residuals
 from gatetherm.studies.diagnosis.select import Round, Selection, physical_in_place, select, select_confirmed
 from gatetherm.studies.run.case import Case
@@ -259,7 +260,7 @@ def _verdict(discrepant: bool, sel, final: Scored | None = None, stand=(), check
     return "partly-explained", f"{names} lower the held-out score, but " + " and ".join(why)
 
 
-def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Diagnosis:
+def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings(), on_progress=None) -> Diagnosis:
     """Run the whole workflow on a measured series ``ts``, replayed through ``case``.
 
     Parameters
@@ -270,6 +271,8 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
         The measurement: every input the case reads, and the channels to compare.
     settings : Settings
         Training window, margin, candidate effects and parameters.
+    on_progress : callable, optional
+        ``on_progress(i, n)``: ``i`` model runs done of about ``n`` planned (:mod:`progress`).
 
     Returns
     -------
@@ -279,7 +282,8 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
         raise InputError("--train-fraction", f"must be between 0.2 and 0.9, got {settings.train_fraction}",
                          "e.g. 0.6: fit on the first 3 h of a 5-h run, score on the last 2 h")
     t0 = time.perf_counter()
-    rep = Replayer(case, ts)
+    budget = Budget(on_progress, settings.max_pieces, 2 if case.problem.order == 1 and settings.p2_check else 1)
+    rep = Replayer(case, ts, budget=budget)
     t = rep.times
     base_cols = rep.run()
     inputs = tuple(rep.drive.columns)
@@ -290,16 +294,16 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
         raise InputError("--data", f"{len(t)} samples are too few to train and hold out", "give a longer run")
     run_phases = case_phases(case, t, rep.drive.columns)
     res0, findings, discrepant = _located(ts, base_cols, channels, t, run_phases)
-    check, runs, refined = None, 0, ""
+    check, runs, refined, p1_run = None, 0, "", None
     if case.problem.order == 1 and settings.p2_check:
-        fine = Replayer(case.with_order(2), ts)
+        fine = Replayer(case.with_order(2), ts, budget=budget)
         fine_cols = fine.run()
         check = {c: float(np.max(np.abs(fine_cols[c] - base_cols[c]))) / resolution(c) for c in channels}
         coarse = [c for c, v in check.items() if v > 1.0]
         if discrepant and coarse and settings.refine:
             log.info("diagnosis: the P1 model's discretisation error exceeds the resolution on %s (%.2g "
                      "resolutions): replaying with P2 elements", ", ".join(coarse), max(check.values()))
-            runs, rep, base_cols = rep.runs, fine, fine_cols
+            runs, rep, base_cols, p1_run = rep.runs, fine, fine_cols, rep.seconds
             res0, findings, discrepant = _located(ts, base_cols, channels, t, run_phases)
             refined = "" if discrepant else ("with P2 elements the baseline residual is within the sensor "
                                              "resolution: the P1 model's was its own discretisation error")
@@ -309,6 +313,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     obj = Objective(rep, ts, channels, scale, train)
     chk, stand, grp = None, {}, []
     if discrepant:
+        budget.announce(pool, rep.seconds, rep.config.problem.order, p1_run)
         sel, named, chk = select_confirmed(
             lambda cands, dropped: select(obj, cands, settings.margin_min, settings.max_pieces, settings.screen_top,
                                           dropped=dropped),
@@ -332,6 +337,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings()) -> Dia
     remaining = tuple(locate(t, after, run_phases)) if after else ()
     cause = kind_of_cause(t, after or res0, base_cols, list(remaining or findings)) if verdict != "explained" else ""
     runs += rep.runs
+    budget.finish()
     log.info("diagnosis: %s (%s), %d model runs", verdict, reason, runs)
     return Diagnosis(verdict, reason, pieces, sel.best_rejected, sel.base, final, tuple(sel.rounds),
                      tuple(sel.removed), channels, scale, t, float(t[train][-1]), tuple(run_phases), tuple(findings),
@@ -353,14 +359,4 @@ def adopted_case(case: Case, diag: Diagnosis) -> Case | None:
     if not diag.pieces:
         return None
     return configure(case, {r.piece: r.value for r in diag.pieces})
-
-
-def case_phases(case: Case, t: np.ndarray, columns: dict) -> list[Phase]:
-    """Phases of a run: a pumped fluid's (pump off, heating, forced cooling, supply steady) where
-    the case has one whose supply and pump are columns, else where an input steps."""
-    fluid = next((f for f in case.problem.fluids if len(f.supply.names()) == 1 and len(f.pump.names()) == 1
-                  and f.supply.text in columns and f.pump.text in columns), None)
-    if fluid is None:
-        return input_phases(t, columns)
-    return phases(t, columns[fluid.supply.text], columns[fluid.pump.text])
 

@@ -192,3 +192,14 @@ def locate(t: np.ndarray, res: dict[str, np.ndarray], run_phases: list[Phase]) -
             out.append(Finding(c, ph, float(np.sqrt(np.mean(r[m] ** 2))), float(s[i]), float(t[i]),
                                float(np.mean(sig[m]))))
     return out
+
+
+def case_phases(case, t: np.ndarray, columns: dict) -> list[Phase]:
+    """Phases of a run: a pumped fluid's (pump off, heating, forced cooling, supply steady) where
+    the case has one whose supply and pump are columns, else where an input steps."""
+    fluid = next((f for f in case.problem.fluids if len(f.supply.names()) == 1 and len(f.pump.names()) == 1
+                  and f.supply.text in columns and f.pump.text in columns), None)
+    if fluid is None:
+        return input_phases(t, columns)
+    return phases(t, columns[fluid.supply.text], columns[fluid.pump.text])
+

@@ -14,10 +14,12 @@ thermocouples (the paper's sensors).
 from __future__ import annotations
 
 import logging
+import time
 
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.studies.diagnosis.progress import Budget
 from gatetherm.studies.run.case import Case
 from gatetherm.studies.run.scenario import ScenarioCache, measured_schedule, run_scenario
 from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, TimeSeries
@@ -66,8 +68,12 @@ class Replayer:
     """Runs a case through the inputs of the measured series ``ts`` at its sample times (the
     scenario path, one :class:`~gatetherm.studies.run.scenario.ScenarioCache` for all hypotheses)."""
 
-    def __init__(self, case: Case, ts: TimeSeries, cache: int = 4):
+    def __init__(self, case: Case, ts: TimeSeries, cache: int = 4, budget: Budget | None = None):
         self.config = case
+        self.budget = Budget() if budget is None else budget
+        """The model runs done and planned (:mod:`progress`; a budget may count the runs of several replayers)."""
+        self.seconds = 0.0
+        """Wall time of the last model run, s."""
         self.schedule = measured_schedule(case, ts)
         self.times = self.schedule.times
         self.drive = self.schedule.drive
@@ -86,7 +92,13 @@ class Replayer:
     def run(self, case: Case | None = None) -> dict[str, np.ndarray]:
         """Output columns (data-format names and units) of ``case`` (default: the replayer's,
         which must be a variant of it on the same mesh)."""
-        return run_scenario(case or self.config, self.schedule, cache=self.cache).columns
+        before, t0 = self.runs, time.perf_counter()
+        try:
+            return run_scenario(case or self.config, self.schedule, cache=self.cache).columns
+        finally:  # a run the model refuses counts too
+            if self.runs > before:
+                self.seconds = time.perf_counter() - t0
+                self.budget.ran()
 
 
 def room_inputs(case: Case) -> set[str]:

@@ -41,6 +41,7 @@ from gatetherm.studies.diagnosis.calibrate import Objective, Refused, Scored, fi
 from gatetherm.studies.diagnosis.hypotheses import PROPORTIONAL, Piece
 from gatetherm.studies.diagnosis.replay import resolution
 from gatetherm.studies.diagnosis.surrogate import Surrogate, screen
+from gatetherm.studies.diagnosis.backtrack import select_confirmed  # noqa: F401 (its home before)
 
 log = logging.getLogger(__name__)
 
@@ -116,8 +117,8 @@ def _round(obj: Objective, current: Scored, pool: list[Piece], top: int, fits: d
             _drop(dropped, err, ctx)
             return None
 
-    if not ctx:
-        singles = [(p, tried(lambda p=p: obj.scored(fit_one(obj, {}, p)))) for p in pool]
+    if not ctx:  # the plan of the model runs updated after every fit (:meth:`~.progress.Budget.first_round`)
+        singles = obj.replayer.budget.first_round(pool, lambda p: tried(lambda: obj.scored(fit_one(obj, {}, p))))
         singles = [(p, s) for p, s in singles if s is not None]
         fits.update({frozenset([p]): s for p, s in singles})
     sur = Surrogate(obj, ctx)
@@ -145,8 +146,7 @@ def _real(obj: Objective, screened: Scored, fits: dict) -> Scored:
 
 def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: int = 4, top: int = 3,
            swaps: int = 2, dropped: dict | None = None) -> Selection:
-    """Forward selection from the baseline over ``candidates`` (the module docstring);
-    ``dropped``: pieces the model refused before (kept out, and listed)."""
+    """Forward selection from the baseline over ``candidates`` (module docstring); ``dropped``: refused before."""
     base = obj.scored({})
     sel = Selection(base, base, [], dropped=dict(dropped or {}))
     fits: dict[frozenset, Scored] = {}
@@ -163,44 +163,6 @@ def select(obj: Objective, candidates: list[Piece], margin: float, max_pieces: i
     sel.final = current
     _alternatives(obj, sel, candidates, margin)
     return sel
-
-
-def select_confirmed(pick, judge, candidates: list[Piece], tries: int = 3):
-    """Forward selection that goes back when the model-form checks reject its pieces.
-
-    ``pick(pool, dropped)`` selects from ``pool`` (:func:`select`, ``dropped`` the pieces the
-    model refused so far); ``judge(selection)`` gives ``(named, stand_ins, checks)`` of the chosen
-    set (:func:`~gatetherm.studies.diagnosis.checks.confirm`: ``named`` {piece: value} that hold,
-    ``stand_ins`` {piece: (value, why)} that do not). While the judge rejects stand-ins, they
-    leave the candidates and the selection runs again on the rest (the model runs made so far
-    are kept), ``tries`` selections at most: a pair of stand-ins chosen first no longer hides the
-    piece that alone explains the data (issue 51). A later selection that names nothing does not
-    replace an earlier one that named pieces.
-
-    Returns
-    -------
-    (Selection, dict, checks)
-        The selection kept (every stand-in rejected on the way in its :attr:`Selection.stand_ins`,
-        every refused piece in :attr:`Selection.dropped`), its named pieces and their checks.
-    """
-    pool, rejected, dropped, best = list(candidates), {}, {}, None
-    for i in range(tries):
-        sel = pick(pool, dropped)
-        dropped = sel.dropped
-        named, stand, chk = judge(sel)
-        rejected.update(stand)
-        if best is None or named or not best[1]:
-            best = (sel, named, chk)
-        if not stand:
-            break
-        pool = [p for p in pool if p not in stand and p not in dropped]
-        if i + 1 < tries:
-            log.info("model-form checks rejected %s as stand-ins: selecting again from the %d other candidates",
-                     " + ".join(p.label for p in stand), len(pool))
-    sel, named, chk = best
-    sel.stand_ins = {p: v for p, v in rejected.items() if p not in named}
-    sel.dropped = dropped
-    return sel, named, chk
 
 
 def _forward(obj: Objective, sel: Selection, current: Scored, candidates, margin: float, max_pieces: int, top: int,
@@ -233,6 +195,7 @@ def _forward(obj: Objective, sel: Selection, current: Scored, candidates, margin
         sel.rounds.append(dataclasses.replace(rnd, added=added))
         current = best  # fitted jointly already
         sel.order += list(added)
+        obj.replayer.budget.round_done(len(current.values))
     return current
 
 
