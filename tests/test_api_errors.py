@@ -72,6 +72,8 @@ BAD = {
                                           "mesh_factor: goes with a case file's path only"),
     "place_sensors(duration_s=-3600)": (lambda c: gt.place_sensors(c["frame"], duration_s=-3600.0), InputError,
                                         "duration_s: -3600 s is not two or more"),
+    "diagnose_run(steady)": (lambda c: gt.diagnose_run(c["plate"], "m.csv"), InputError,
+                             "model: 'plate' is steady (no [time]): a diagnosis compares a transient run"),
     "condition(case=file)": (lambda c: gt.condition(1, case=c["frame"]), InputError,
                              "case: 'C-frame machining centre' has no oil supply unit of the paper's model"),
     "condition(1, step_s=7)": (lambda c: gt.condition(1, step_s=7), InputError,

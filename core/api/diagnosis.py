@@ -6,7 +6,7 @@ import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Mapping, Sequence
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.api.run import PATH, Case
@@ -16,7 +16,7 @@ from gatetherm.checks import argument
 OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "report.md", "diagnosis.json")
 
 
-def diagnosis_model(case: str | os.PathLike | None = None, *, dim: int = 2, config: str | None = None,
+def diagnosis_model(case: str | os.PathLike | None = None, *, dim: int = 2, config: str | os.PathLike | None = None,
                     mesh_size: float | None = None, mesh_factor: float | None = None) -> Case:
     """The model a diagnosis replays: a case file, or the paper's frame.
 
@@ -55,7 +55,7 @@ def diagnosis_model(case: str | os.PathLike | None = None, *, dim: int = 2, conf
     return model
 
 
-def diagnosis_hypotheses(model: Case, uncertain=(), as_json: bool = False) -> str:
+def diagnosis_hypotheses(model: Case, uncertain: Sequence[str] = (), as_json: bool = False) -> str:
     """The hypotheses a diagnosis of ``model`` tries: catalogue effects, existing parameters,
     dimensions and sensor faults (``gatetherm diagnose --list-effects``).
 
@@ -192,7 +192,8 @@ class DiagnosisRun:
         return "\n".join(lines)
 
 
-def diagnose_run(model: Case, data: str | os.PathLike, *, out=None, record=None, config: str | None = None,
+def diagnose_run(model: Case, data: str | os.PathLike, *, out: str | os.PathLike | None = None,
+                 record: Mapping[str, object] | None = None, config: str | os.PathLike | None = None,
                  on_progress: Callable[[int, int], None] | None = None, **settings) -> DiagnosisRun:
     """Diagnose the measured file ``data`` against ``model`` as ``gatetherm diagnose`` does
     (:func:`diagnose`; docs/diagnosis.md).
@@ -232,6 +233,9 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out=None, record=None,
     argument("model", model, Case, "a Case", "make one with gt.diagnosis_model() or gt.load_case(path)")
     argument("data", data, PATH, "a time-series file's path")
     argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
+    if model.time is None:
+        raise InputError("model", f"{model.name!r} is steady (no [time]): a diagnosis compares a transient run",
+                         "give the case [time] with end and step; the run's times come from the data")
     choices = Settings(**settings)
     keep = (config, str(data), *model.files)
     ts = read_timeseries(data, required=("time_s",))
