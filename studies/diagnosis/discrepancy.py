@@ -266,7 +266,7 @@ def diagnose(case: Case, ts: TimeSeries, settings: Settings = Settings(), on_pro
     Parameters
     ----------
     case : Case
-        The model (a case file's, or the paper frame's: :func:`~gatetherm.studies.run.frame_case.gate_frame`).
+        The model (a case file's, or the paper frame's: :func:`~gatetherm.frame.case.gate_frame`).
     ts : TimeSeries
         The measurement: every input the case reads, and the channels to compare.
     settings : Settings
