@@ -319,8 +319,8 @@ def test_the_api_call_check_sees_a_command_that_bypasses_the_api(tmp_path):
 #: fit of a piece) whose helpers are used nowhere else; control.methods is the table of the four
 #: compensation methods with their fit and replay.
 LONG_MODULES = {
-    "gatetherm.studies.control.methods": 325, "gatetherm.studies.diagnosis.calibrate": 303,
-    "gatetherm.studies.diagnosis.discrepancy": 366, "gatetherm.studies.diagnosis.select": 342,
+    "gatetherm.studies.control.methods": 320, "gatetherm.studies.diagnosis.calibrate": 303,
+    "gatetherm.studies.diagnosis.discrepancy": 362, "gatetherm.studies.diagnosis.select": 305,
     "gatetherm.studies.run.case": 427,
 }
 
