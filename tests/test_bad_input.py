@@ -541,17 +541,17 @@ def _coefficient(model: dict, text: str) -> str:
 
 
 @pytest.mark.parametrize("edit, needle", [
-    (lambda d: {**d, "targets": {}}, "model.json: targets: is empty: the model predicts nothing"),
+    (lambda d: {**d, "targets": {}}, "model.json: targets: must be a non-empty table of the targets' models"),
     (lambda d: _coefficient(d, "NaN"), "holds NaN, not a finite"),
     (lambda d: _coefficient(d, "1e999"), "holds 1e999, not a fin"),
     (lambda d: _coefficient(d, '"nan"'),
-     "model.json: targets.d_um.terms[0].coefficient: is nan, not a finite number"),
+     "model.json: targets.d_um.terms[0].coefficient: must be a number within ±1e+09"),
     (lambda d: _coefficient(d, "1" * 400),
      "holds the integer 111111111111... of 400 digits"),
     (lambda d: "[" * 100_000 + "]" * 100_000, "model.json: nested deeper than 32 levels"),
     (lambda d: {**d, "targets": {"d_um": {**d["targets"]["d_um"], "terms": [
         {"kind": "sensor", "column": "d_um", "coefficient": 1.0}]}}, "reference_degC": {"d_um": 0.0}},
-     "model.json: targets.d_um: reads its own target column"),
+     "model.json: targets.d_um.terms[0].column: reads the target d_um itself: a model cannot read the column"),
 ], ids=["no targets", "NaN", "1e999", "'nan'", "400 digits", "nested 100000 deep", "reads its target"])
 def test_error_model_files_are_refused_in_one_line(tmp_path, capsys, fitted, edit, needle):
     data, model = fitted

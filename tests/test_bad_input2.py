@@ -175,7 +175,7 @@ def test_a_model_file_number_that_is_a_string_is_refused_on_load(tmp_path):
     (tmp_path / "m.json").write_text(json.dumps(d))
     with pytest.raises(InputError) as info:
         load_model(tmp_path / "m.json")
-    assert "m.json: fit_span.start_s: got 'abc', must be a finite number" in str(info.value)
+    assert "m.json: fit_span: start_s and end_s must be numbers (s), start_s <= end_s" in str(info.value)
 
 
 def test_an_error_model_of_nothing_says_so(caplog):
@@ -370,3 +370,29 @@ def test_a_mesh_size_larger_than_the_body_is_read_with_a_word(tmp_path, caplog):
     with caplog.at_level(logging.WARNING):
         mesh_geometry(MeshSpec(tmp_path / "box.geo", size=1e300))
     assert "mesh.size = 1e+300 m is larger than the body (1 m across)" in caplog.text
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda d: d["targets"]["x_um"]["terms"][0].update(coefficient="2.9"), "terms[0].coefficient: must be a number"),
+    (lambda d: d["targets"]["x_um"]["terms"][0].update(coefficient=1e308), "terms[0].coefficient: must be a number"),
+    (lambda d: d["targets"]["x_um"].pop("intercept_um"), "targets.x_um.intercept_um: must be a number"),
+    (lambda d: d["targets"]["x_um"].update(terms=[]), "targets.x_um.terms: must be a non-empty list of terms"),
+    (lambda d: d["targets"]["x_um"]["terms"][0].update(unit="mm/K"), "terms[0].unit: is 'mm/K', but the coefficient"),
+    (lambda d: d["targets"]["x_um"]["interval"].update(half_width_um=-1.0), "targets.x_um.interval: its widths must"),
+    (lambda d: d.update(max_gap_s=-300), "max_gap_s: must be a number > 0 s"),
+    (lambda d: d.update(targets=["x_um"]), "targets: must be a non-empty table"),
+], ids=["coefficient a string", "coefficient 1e308", "no intercept", "no terms", "a unit of mm/K",
+        "a negative interval", "a negative gap", "targets a list"])
+def test_a_hand_edited_model_file_is_refused_by_its_entry(tmp_path, edit, needle):
+    """Each was read without a word, or failed inside predict (the third audit, class D)."""
+    t = np.arange(200) * 60.0
+    a, b = 20 + 5 * (1 - np.exp(-t / 3600)), 20 + 2 * (1 - np.exp(-t / 7000))
+    data = TimeSeries({"time_s": t, "t1_degC": a, "t2_degC": b,
+                       "x_um": 3 * (a - 20) - 1.5 * (b - 20) + 0.01 * np.sin(np.arange(200))}, {})
+    save_model(tmp_path / "m.json", gt.errormodel_fit(data, ["x_um"]).model)
+    d = json.loads((tmp_path / "m.json").read_text())
+    edit(d)
+    (tmp_path / "m.json").write_text(json.dumps(d))
+    with pytest.raises(InputError) as info:
+        load_model(tmp_path / "m.json")
+    assert needle in str(info.value)

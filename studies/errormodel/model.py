@@ -42,20 +42,69 @@ def to_dict(model: ErrorModel) -> dict:
             "targets": targets}
 
 
+FIX = "give a model.json from 'gatetherm errormodel fit'"
+COEFFICIENT = 1e9
+"""Largest coefficient or intercept a model file may hold (µm, µm/K …): beyond, an edit gone wrong."""
+
+
+def _number(value, lo: float = -COEFFICIENT, hi: float = COEFFICIENT) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and lo <= value <= hi
+
+
+def _check_document(data: dict, where: str) -> None:
+    """InputError naming the entry of a model file that is not what :func:`to_dict` writes: a
+    hand edit that would otherwise be read without a word (a string coefficient, a missing
+    intercept, a negative interval, an inverted range, a term reading its own target …)."""
+    def need(ok, key: str, what: str):
+        if not ok:
+            raise InputError(f"{where}: {key}", what, FIX)
+
+    targets = data.get("targets")
+    need(isinstance(targets, dict) and targets, "targets", "must be a non-empty table of the targets' models")
+    for name, d in targets.items():
+        k = f"targets.{name}"
+        need(isinstance(d, dict), k, "must be a table")
+        need(_number(d.get("intercept_um")), f"{k}.intercept_um", f"must be a number within ±{COEFFICIENT:g} µm")
+        need(isinstance(d.get("terms"), list) and d["terms"], f"{k}.terms", "must be a non-empty list of terms")
+        for i, t in enumerate(d["terms"]):
+            need(isinstance(t, dict), f"{k}.terms[{i}]", "must be a table")
+            need(_number(t.get("coefficient")), f"{k}.terms[{i}].coefficient", f"must be a number within ±{COEFFICIENT:g}")
+            need(name not in (t.get("column"), t.get("other")), f"{k}.terms[{i}].column",
+                 f"reads the target {name} itself: a model cannot read the column it predicts")
+        need(all(_number(v, 0.0) for key, v in d.get("interval", {}).items() if key.endswith("_um")),
+             f"{k}.interval", "its widths must be numbers >= 0 µm")
+        need(all(isinstance(r, list) and len(r) == 2 and all(_number(v, -1e300, 1e300) for v in r) and r[0] <= r[1]
+                 for r in d.get("ranges", [])), f"{k}.ranges", "each must be [low, high] with low <= high")
+    span = data.get("fit_span", {})
+    need(isinstance(span, dict) and span.get("start_s", 0) <= span.get("end_s", float("inf"))
+         if all(_number(span.get(x, 0), -1e300, 1e300) for x in ("start_s", "end_s")) else False,
+         "fit_span", "start_s and end_s must be numbers (s), start_s <= end_s")
+    need(_number(data.get("max_gap_s", 300.0), 0.0, 1e300) and data.get("max_gap_s", 300.0) > 0, "max_gap_s",
+         "must be a number > 0 s")
+    need(_number(data.get("settings", {}).get("smooth_s", 0.0), 0.0, 1e300), "settings.smooth_s",
+         "must be a number >= 0 s")
+
+
 def from_dict(data: dict, where: str = "model") -> ErrorModel:
     """Inverse of :func:`to_dict`; InputError naming the entry on a bad file."""
     if not isinstance(data, dict) or data.get("format") != FORMAT:
-        raise InputError(f"{where}: format", f"not a {FORMAT} file",
-                         "give a model.json from 'gatetherm errormodel fit'")
+        raise InputError(f"{where}: format", f"not a {FORMAT} file", FIX)
+    _check_document(data, where)
     try:
         targets = []
         for name, d in data["targets"].items():
             terms = tuple(Term(**{k: v for k, v in t.items() if k not in ("coefficient", "unit", "label")})
                           for t in d["terms"])
+            units = [(i, t["unit"], term.unit) for i, (t, term) in enumerate(zip(d["terms"], terms))
+                     if "unit" in t and t["unit"] != term.unit]
+            if units:
+                i, given, unit = units[0]
+                raise InputError(f"targets.{name}.terms[{i}].unit", f"is {given!r}, but the coefficient of such a "
+                                 f"term is in {unit}", "give the coefficient in that unit")
             if d["form"] not in FORMS:
                 raise InputError(f"{where}: targets.{name}.form", f"unknown {d['form']!r}", f"use {', '.join(FORMS)}")
             targets.append(TargetModel(name, d["form"], terms, tuple(float(t["coefficient"]) for t in d["terms"]),
-                                       float(d.get("intercept_um", 0.0)), d.get("residual", {}),
+                                       float(d["intercept_um"]), d.get("residual", {}),
                                        d.get("held_out_mae_um"), tuple(d.get("selection", ())),
                                        d.get("noise_um"), dict(d.get("interval", {})),
                                        tuple(tuple(float(v) for v in r) for r in d.get("ranges", ()))))
