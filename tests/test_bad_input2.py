@@ -396,3 +396,23 @@ def test_a_hand_edited_model_file_is_refused_by_its_entry(tmp_path, edit, needle
     with pytest.raises(InputError) as info:
         load_model(tmp_path / "m.json")
     assert needle in str(info.value)
+
+
+def _em_record() -> TimeSeries:
+    t = np.arange(200) * 60.0
+    a, b = 20 + 5 * (1 - np.exp(-t / 3600)), 20 + 2 * (1 - np.exp(-t / 7000))
+    return TimeSeries({"time_s": t, "t1_degC": a, "t2_degC": b,
+                       "x_um": 3 * (a - 20) - 1.5 * (b - 20) + 0.01 * np.sin(np.arange(200))}, {})
+
+
+@pytest.mark.parametrize("call, needle", [
+    (lambda d: gt.errormodel_fit([d, d, d], ["x_um"]), "data[1]: is the same record as data[0]"),
+    (lambda d: gt.errormodel_fit(d, ["x_um"], ["time_s", "t1_degC"]), "candidates time_s: is the time, not a sensor"),
+    (lambda d: gt.errormodel_fit(d, ["x_um"], ["t1_degC", "t1_degC"]), "candidates t1_degC: is named twice"),
+], ids=["a run three times", "time as a sensor", "a sensor twice"])
+def test_an_error_model_fit_that_would_mislead_is_refused(call, needle):
+    """The third audit (class C): a run given three times reported a leave-one-run-out error
+    that was in-sample (0.127 µm, the interval narrowed from ±0.244 to ±0.186 µm)."""
+    with pytest.raises(InputError) as info:
+        call(_em_record())
+    assert needle in str(info.value)

@@ -3,8 +3,11 @@ run or several, predict with a 90 % interval and a drift check, refit as data ar
 from __future__ import annotations
 
 import dataclasses
+import logging
 import os
 from typing import Callable, Mapping, Sequence
+
+import numpy as np
 
 from gatetherm import InputError
 from gatetherm.api.errormodel_results import FIT_OUTPUTS, PREDICT_OUTPUTS, ErrorModelFit, Prediction, \
@@ -16,6 +19,8 @@ from gatetherm.studies.errormodel.model import ErrorModel, check_columns, check_
 from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.refit import refit
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
+
+log = logging.getLogger(__name__)
 
 
 def _is_path(data) -> bool:
@@ -114,6 +119,14 @@ def errormodel_fit(data: str | os.PathLike | TimeSeries | Sequence[str | os.Path
         series.append(_read(r, required, named))
         if on_progress is not None:
             on_progress(len(series), len(runs) + 1)
+    for j, ts in enumerate(series):  # a run given twice: its held-out error would be in-sample
+        same = next((i for i in range(j) if _same_record(series[i], ts, ("time_s", *targets))), None)
+        if same is not None:
+            raise InputError(f"data[{j}]", f"is the same record as data[{same}] ({runs[same]}): a run left out "
+                             "would be fitted all the same", "give each run once")
+    for t in targets:
+        if t.endswith("_degC"):
+            log.warning("targets %s: a temperature column, predicted as a displacement in um", t)
     spans = [fraction_span(ts["time_s"], *span) for ts in series]
     source = ", ".join(str(r) for r in runs if not hasattr(r, "names"))
     model = fit_error_model(series, targets, candidates, inputs, params, spans, source=source)
@@ -198,3 +211,9 @@ def errormodel_refit(model: ErrorModel | ErrorModelFit | str | os.PathLike, data
         applied = dict(zip(model.names, applied))
     new, report = refit(model, _read(data), window_s, applied)
     return Refit(new, report, window_s, files)
+
+
+def _same_record(a: TimeSeries, b: TimeSeries, columns) -> bool:
+    """Whether ``a`` and ``b`` hold the same samples of ``columns``."""
+    return all(c in a.columns and c in b.columns and a[c].shape == b[c].shape
+               and np.array_equal(a[c], b[c], equal_nan=True) for c in columns)

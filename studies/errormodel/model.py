@@ -144,6 +144,12 @@ def check_leakage(targets, candidates=(), inputs=(), names=("targets", "candidat
     if "time_s" in targets:
         raise InputError(f"{names[0]} time_s", "is the time, not a displacement", "name displacement columns, um")
     for field, given in zip(names[1:], (candidates or (), inputs or ())):
+        if "time_s" in given:  # the clock is no sensor: a fit on it is a drift in disguise, fitted to the record
+            raise InputError(f"{field} time_s", "is the time, not a sensor or an input",
+                             f"drop time_s from {field} (a slow drift is a term of its own: docs/errormodel.md)")
+        twice = next((c for i, c in enumerate(given) if c in given[:i]), None)
+        if twice is not None:
+            raise InputError(f"{field} {twice}", "is named twice", f"name {twice} once")
         leak = [c for c in given if c in set(targets)]
         if leak:
             raise InputError(f"{field} {leak[0]}", f"is a target ({names[0]}): a model cannot read the column it "
