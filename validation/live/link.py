@@ -9,18 +9,29 @@ from gatetherm.validation.live.nodes import NodeMap
 
 
 async def _connect(url: str, nodes: NodeMap, timeout: float):
+    """A connected client and the map's nodes; a failed attempt closes what it opened (a control
+    has few sessions to spare, and an attempt that timed out half-way would keep one)."""
     from asyncua import Client, ua
 
     client = Client(url, timeout=timeout)
-    await client.connect()
-    resolved = {}
-    for table in (nodes.read, nodes.write):
-        for name, text in table.items():
-            nid = ua.NodeId.from_string(text)
-            uri = getattr(nid, "NamespaceUri", None)
-            if uri:
-                nid = ua.NodeId(nid.Identifier, await client.get_namespace_index(uri), nid.NodeIdType)
-            resolved[name] = client.get_node(nid)
+    try:
+        await client.connect()
+        resolved, index = {}, {}
+        for table in (nodes.read, nodes.write):
+            for name, text in table.items():
+                nid = ua.NodeId.from_string(text)
+                uri = getattr(nid, "NamespaceUri", None)
+                if uri:
+                    if uri not in index:
+                        index[uri] = await client.get_namespace_index(uri)
+                    nid = ua.NodeId(nid.Identifier, index[uri], nid.NodeIdType)
+                resolved[name] = client.get_node(nid)
+    except BaseException:
+        try:
+            client.disconnect_socket()
+        except Exception:  # noqa: BLE001 - nothing was opened
+            pass
+        raise
     return client, resolved
 
 
