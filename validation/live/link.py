@@ -13,7 +13,9 @@ async def _connect(url: str, nodes: NodeMap, timeout: float):
     has few sessions to spare, and an attempt that timed out half-way would keep one)."""
     from asyncua import Client, ua
 
-    client = Client(url, timeout=timeout)
+    # its watchdog reads the server's state every watchdog_intervall s with that as the timeout (default
+    # 1 s): a loaded control (one twin with 100 clients) would be declared lost; probe at the request timeout
+    client = Client(url, timeout=timeout, watchdog_intervall=timeout)
     try:
         await client.connect()
         resolved, index = {}, {}

@@ -69,7 +69,7 @@ class Guards:
     ramp_um_per_s: float = 0.1
     """Rate at which the correction falls to zero while the connection stays lost, µm per wall s."""
     timeout_s: float = 5.0
-    """Timeout of one OPC UA request, s."""
+    """Timeout of one OPC UA request, s (also the interval and timeout of the client's watchdog probe)."""
 
 
 @dataclass(frozen=True)
