@@ -30,7 +30,8 @@ from gatetherm.studies.control.stepwise_rom import RomStepper
 from gatetherm.studies.run.timeseries import TimeSeries
 from gatetherm.validation.live.journal import Journal
 from gatetherm.validation.live.nodes import default_map
-from gatetherm.validation.live.service import LiveParams, Service, _connect, _sample, _write
+from gatetherm.validation.live.link import _connect, _sample, _write
+from gatetherm.validation.live.service import LiveParams, Service
 from gatetherm.validation.live.twin import TwinParams, serve
 
 CASE = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame" / "case.toml"

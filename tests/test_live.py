@@ -256,3 +256,61 @@ def test_an_axis_model_writes_the_gradient_and_reference_to_the_twins_nodes(tmp_
     assert seen["gradient_um_per_m"] == ts["gradient_um_per_m"][-1] and seen["reference_m"] == 0.0
     print(f"gradient {ts['gradient_um_per_m'][-1]:.3f} um/m at offset {ts['offset_um'][-1]:.3f} um; "
           f"the twin's node {seen['gradient_um_per_m']:.3f}")
+
+
+@pytest.mark.slow
+def test_one_twin_serves_several_machines_each_in_its_namespace(tmp_path):
+    """``twin --machines 3``: one process, machine i in ``urn:gatetherm:machine:i``. A service on
+    machine 2 through a map file; the test writes offsets 0 and 5 µm to machines 1 and 3: read
+    at one machine time, their compensated δ differs by exactly 5 µm (one model, ideal offsets);
+    the twin serves 3 × 21 samples and the service logs 21 periods, none missed."""
+    import asyncio
+    import threading
+
+    from gatetherm.studies.errormodel.model import ErrorModel, TargetModel
+    from gatetherm.studies.errormodel.terms import Term
+
+    model = ErrorModel((TargetModel("delta_um", "static", (Term("sensor", "theta_A_degC"),), (1.5,), 0.5),),
+                       {"theta_A_degC": 20.0}, {"start_s": 0.0, "end_s": 1.0, "samples": 2})
+    port, out, diffs, done = free_port(), tmp_path / "out", [], threading.Event()
+    ns = [f"urn:gatetherm:machine:{i}" for i in (1, 2, 3)]
+    (tmp_path / "m2.toml").write_text("[read]\n" + "".join(f'{n} = "nsu={ns[1]};s={n}"\n' for n in (
+        "time_s", "theta_A_degC", "delta_um", "delta_residual_um")) + f'[write]\noffset_um = "nsu={ns[1]};s=offset_um"\n')
+
+    def others():  # machines 1 and 3: offsets 0 and 5 um written, their compensated delta read at one time
+        from asyncua import Client, ua
+
+        async def run():
+            end = time.monotonic() + LIMIT_S
+            while not done.is_set() and time.monotonic() < end:
+                try:
+                    async with Client(f"opc.tcp://127.0.0.1:{port}", timeout=5) as c:
+                        idx = [await c.get_namespace_index(u) for u in (ns[0], ns[2])]
+                        node = {(i, n): c.get_node(ua.NodeId(n, i)) for i in idx
+                                for n in ("time_s", "delta_residual_um", "offset_um")}
+                        for i, value in zip(idx, (0.0, 5.0)):
+                            await node[i, "offset_um"].write_value(ua.DataValue(ua.Variant(value, ua.VariantType.Double)))
+                        order = [node[idx[0], "time_s"], node[idx[1], "time_s"], node[idx[0], "delta_residual_um"],
+                                 node[idx[1], "delta_residual_um"], node[idx[0], "time_s"], node[idx[1], "time_s"]]
+                        while not done.is_set():
+                            t1, t3, r1, r3, u1, u3 = await c.read_values(order)
+                            if np.isfinite(t1) and t1 == t3 == u1 == u3:
+                                diffs.append(r3 - r1)
+                            await asyncio.sleep(0.01)
+                except (OSError, asyncio.TimeoutError, ConnectionError):
+                    await asyncio.sleep(0.2)
+        asyncio.run(run())
+
+    tw = twin(port, "--speed", 120, "--until", 1200, "--states", 10, "--machines", 3)
+    thread = threading.Thread(target=others, daemon=True)
+    thread.start()
+    try:
+        res = gt.live(None, endpoint=f"opc.tcp://127.0.0.1:{port}", out=out, model=model, map=tmp_path / "m2.toml",
+                      until=1200)
+    finally:
+        done.set()
+        thread.join(timeout=LIMIT_S)
+        code, stdout, _ = finish(tw)
+    assert code == 0 and "served 63 samples of 3 machines, t = 0 .. 1200 s" in stdout, stdout
+    assert res["periods"] == 21 and res["missed"] == 0 and res["rows"] == 21
+    assert len(diffs) >= 10 and np.max(np.abs(np.array(diffs) - 5.0)) < 1e-9, diffs[:5]

@@ -133,6 +133,34 @@ def test_the_gradient_along_an_axis_is_the_closed_form(tmp_path):
     assert set(state["stepper"]["probes"]) == set(positions)
 
 
+def test_the_gradient_change_is_limited_per_period(tmp_path):
+    """The closed form above with the gradient's change limited to 1 µm/m per period (the offset's
+    limit out of the way): from 0, the gradient written is max(−(2 + 0.4 (k + 1)), −k) µm/m, i.e.
+    −1, −2, −3 (limited), then −4.0 and −4.4 as wanted; the offset is the closed form's throughout."""
+    positions = {"delta_p0_um": 0.0, "delta_p1_um": 0.4, "delta_p2_um": 1.0}
+    axis = Axis(positions, reference_m=0.25)
+    stepper = AxisStepper({k: RegressionStepper(probe_model(s), PARAMS) for k, s in positions.items()}, axis)
+    logged = (*LOGGED[:-1], "worse", "gradient_um_per_m", "reference_m")
+    guards = Guards(max_change_um=100.0, max_gradient_change_um_per_m=1.0)
+    assert Guards().max_gradient_change_um_per_m == 5.0  # the documented default
+    svc = Service(stepper, Journal(tmp_path, logged, {"source": "test"}), LiveParams(guards=guards), ("theta_A_degC",))
+    rows = [svc.period(60.0 * k, k, {"theta_A_degC": 20.0 + 0.1 * k}) for k in range(6)]
+    k = np.arange(1, 6)
+    wanted = -(2.0 + 4.0 * 0.1 * (k + 1))
+    written = np.maximum(wanted, -1.0 * k)
+    got = np.array([r["gradient_um_per_m"] for r in rows[1:]])
+    assert np.max(np.abs(got - written)) < 1e-12 and list(got[:3]) == [-1.0, -2.0, -3.0]
+    assert [r["limited"] for r in rows] == [0, 1, 1, 1, 0, 0]
+    offset = -(0.5 + 2 * 0.25 + (1.5 + 4 * 0.25) * 0.1 * (k + 1))
+    assert np.max(np.abs(np.array([r["offset_um"] for r in rows[1:]]) - offset)) < 1e-12
+    events = (tmp_path / "events.log").read_text()
+    assert "gradient -2.800 -> -1.000 um/m" in events and events.count("gradient") == 3
+    with pytest.raises(InputError, match="must be > 0"):
+        from gatetherm.validation.live.service import check
+
+        check(LiveParams(guards=Guards(max_gradient_change_um_per_m=0.0)))
+
+
 def test_the_line_and_the_axis_checks():
     assert line([0.0, 2.0], [1.0, 5.0], 1.0) == pytest.approx((3.0, 2.0), abs=1e-12)
     assert all(math.isnan(v) for v in line([0.0, 1.0], [1.0, math.nan], 0.0))

@@ -72,13 +72,89 @@ def test_status_page_and_json_over_http(tmp_path):
     assert len(d["series"]["delta_um"]) == 361 and d["series"]["delta_um"][0][0] == 2340.0  # the last 6 h
 
 
-@pytest.mark.skipif(not (shutil.which("chromium") or shutil.which("chromium-browser")), reason="chromium not installed")
-def test_status_page_renders_in_a_headless_browser(tmp_path):
-    exe = shutil.which("chromium") or shutil.which("chromium-browser")
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync")
+"""Off line and as root (docs/live.md): without them chromium waits on the closed network."""
+
+
+class Ticking(Status):
+    """The service's status with one more period in at every request of the page, as if a
+    period passed between two looks."""
+
+    def __init__(self, directory, rows):
+        super().__init__(directory, SENSORS)
+        self.pending, self.served = list(rows), 0
+
+    def page(self) -> str:
+        if self.pending:
+            row = self.pending.pop(0)
+            self.add(row, {"periods": int(row["time_s"] // 60) + 1, "held": row["held"], "limited": 0})
+        self.served += 1
+        return super().page()
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (.ci/run installs Debian's chromium)")
+def test_status_page_in_a_headless_browser(tmp_path):
+    """What an operator sees: the DOM after the page's script ran in headless chromium. The page
+    is fetched again every 5 s (virtual time: ``--virtual-time-budget`` runs the timers without
+    waiting on the wall clock), and each look shows one more period: δ, the correction, each
+    sensor's health, the guards that fired, the events; then the service stops answering and the
+    page says it is stale instead of showing old values as live."""
+    (tmp_path / "events.log").write_text("23940 sample held: theta_A_degC missing; correction held at -39.800 um\n")
+    all_rows = list(rows())
+    status = Ticking(tmp_path, all_rows[-3:])
+    for row in all_rows[:-3]:
+        status.add(row, {"periods": int(row["time_s"] // 60) + 1, "held": 0, "limited": 0})
+    dom = look(tmp_path, status, 12000)
+    assert status.served == 3  # the first look and two refreshes, 5 s and 10 s of virtual time on
+    assert 'data-refreshed="2"' in dom and "updated every" not in dom  # the script swapped the content in
+    now = dom[dom.index('<p id="now">'):]
+    now = now[:now.index("</p>")]
+    # the third look: period 399 (the last row), δ 39.9 µm, compensated 0.5 µm, correction -39.9 µm
+    assert now == '<p id="now">machine time 23940 s; δ measured 39.90 µm; δ compensated 0.50 µm; correction -39.90 µm'
+    assert '<td>theta_A_degC</td><td></td><td class="missing">missing</td>' in dom
+    assert '<td>theta_B_degC</td><td>20.000</td><td class="held">held</td>' in dom
+    assert '<p id="fired">fired: held (1)</p>' in dom and "<li>periods: 400</li>" in dom
+    assert "theta_A_degC missing; correction held at -39.800 um" in dom
+    assert dom.count("<polyline") == 3 and '<svg id="chart"' in dom
+
+    # the service stops answering after the second look: the page keeps the second look's content
+    # and says since when it is not updated
+    status = Ticking(tmp_path, all_rows[-3:])
+    for row in all_rows[:-3]:
+        status.add(row, {"periods": int(row["time_s"] // 60) + 1, "held": 0, "limited": 0})
+    dom = look(tmp_path, status, 12000, close_after=2)
+    assert status.served == 2 and 'data-refreshed="1"' in dom
+    assert '<p id="link" class="stale">NOT UPDATED since' in dom and "the service does not answer" in dom
+    assert '<p id="now">machine time 23880 s; δ measured 39.80 µm' in dom
+
+
+def look(tmp_path, status, budget_ms, close_after=None) -> str:
+    """The DOM of the status page after ``budget_ms`` of the browser's virtual time; with
+    ``close_after``, the server stops listening once it has served the page that many times."""
+    port, profile = free_port(), tmp_path / f"profile{status.served}{close_after}"
 
     def render(url):
-        return subprocess.run([exe, "--headless", "--no-sandbox", "--disable-gpu", f"--user-data-dir={tmp_path / 'p'}",
+        return subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", f"--virtual-time-budget={budget_ms}",
                                "--dump-dom", url + "/"], capture_output=True, text=True, timeout=300).stdout
 
-    dom, _ = serve_and(tmp_path, render)
-    assert "<svg id=\"chart\"" in dom and "missing" in dom and "gatetherm live" in dom
+    async def run():
+        server = await serve_status(status, port)
+        loop = asyncio.get_running_loop()
+        if close_after is not None:
+            page = status.page
+
+            def counted():
+                text = page()
+                if status.served >= close_after:
+                    loop.call_soon_threadsafe(server.close)
+                return text
+            status.page = counted
+        try:
+            return await loop.run_in_executor(None, render, f"http://127.0.0.1:{port}")
+        finally:
+            server.close()
+            await server.wait_closed()
+
+    return asyncio.run(asyncio.wait_for(run(), 600))

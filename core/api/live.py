@@ -60,14 +60,18 @@ def twin(case: Case | str | Path, endpoint: str, speed: float = 1.0, *, schedule
         Returns True when the twin should stop (checked every step).
     **noise
         Fields of :class:`gatetherm.validation.live.twin.TwinParams` (``noise_K``, ``resolution_K``,
-        ``noise_um``, ``resolution_um``, ``step_s``, ``wait``: start the clock once a client has written,
-        ``faults``: (column, from_s, to_s) read as NaN).
+        ``noise_um``, ``resolution_um``, ``step_s``, ``wait``: start the clock once a client has written
+        (every machine's client), ``faults``: (column, from_s, to_s) read as NaN, ``machines``: machines
+        served by this process, machine i in namespace ``urn:gatetherm:machine:i``, a sample each
+        ``step_s`` spread evenly over the step; docs/live.md).
 
     Returns
     -------
     dict
-        ``served`` samples, ``start_s``, ``end_s`` and ``compensated_band_after_10_min_um`` (µm,
-        the twin's true δ with the correction applied).
+        ``served`` samples (all machines), ``machines``, ``start_s``, ``end_s``,
+        ``compensated_band_after_10_min_um`` (µm, the twin's true δ with the correction applied; the
+        largest over the machines), ``clock_start_unix_s`` and ``publish_lag_ms`` (median, p95, max
+        of a sample's publication behind its wall time, ms).
     """
     import math
 
@@ -148,7 +152,7 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
          target: str | None = None, map=None, period: float = 60.0, update: float | None = None,
          until: float | None = None, states: int = 30, schedule=None, guards=None, monitor=None,
          axis: dict | None = None, reference: float | None = None, status_port: int | None = None,
-         on_period=None, on_ready=None) -> dict:
+         on_period=None, on_ready=None, poll: float = 0.05) -> dict:
     """Compensate a machine over OPC UA: read its sensors every period of its clock, write the correction.
 
     Parameters
@@ -194,6 +198,9 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
         Called with each period's logged row (a dict).
     on_ready : callable, optional
         Called once the model is built and the directory locked, before connecting.
+    poll : float
+        Wall time between two reads while waiting for the next period, s (a sample is seen at most
+        this late; each read is a request to the control).
 
     Returns
     -------
@@ -217,13 +224,15 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
     if model is None and case is None:
         raise InputError("--case/--model", "give the machine's case (or a fitted model)", "e.g. --case case.toml")
     guards = guards or service.Guards()
-    params = service.LiveParams(period_s=float(period), until_s=until, guards=guards, monitor=Monitor(**monitor) if isinstance(monitor, dict) else monitor or Monitor())
+    params = service.LiveParams(period_s=float(period), until_s=until, guards=guards, poll_s=poll, monitor=Monitor(**monitor) if isinstance(monitor, dict) else monitor or Monitor())
     service.check(params)
+    if not (isinstance(poll, (int, float)) and 0 < poll < 60):
+        raise InputError("poll", f"must be a wall time in s in (0, 60), got {poll!r}", "e.g. poll=0.05")
     axis = Axis(dict(axis), reference) if axis else None
     if axis is not None and model is None:
         raise InputError("--axis", "needs a fitted --model with a target per probe",
                          "give --model, or leave --axis out (offset only)")
-    case = _case(case)
+    case = _case(case) if case is not None else None
     every = update if update is not None else (300.0 if abs(300.0 / period - round(300.0 / period)) < 1e-9
                                                and period <= 300.0 else period)
     cp = CompensatorParams(sample_interval_s=float(period), update_interval_s=float(every))

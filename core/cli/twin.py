@@ -29,6 +29,9 @@ def register(sub) -> None:
     p.add_argument("--fault", action="append", default=[], metavar="COL:FROM:TO",
                    help="the column reads NaN from .. to (machine s), a sensor fault (repeatable)")
     p.add_argument("--seed", type=int, default=0, metavar="N", help="seed of the sensor noise (default 0)")
+    p.add_argument("--machines", type=int, default=1, metavar="N", help="serve N machines from this process, "
+                   "machine i in namespace urn:gatetherm:machine:i (a map file per service; default 1: the "
+                   "default layout)")
     p.set_defaults(func=run)
 
 
@@ -43,11 +46,13 @@ def run(args) -> int:
         except ValueError:
             raise InputError(f"--fault {text}", "is not COL:FROM:TO", "e.g. --fault theta_A_degC:3600:3720") from None
     res = api.twin(args.case, args.endpoint, args.speed, schedule=args.schedule, until=args.until, start=args.start,
-                   states=args.states, seed=args.seed, actuator=args.actuator, wait=args.wait, faults=tuple(faults))
+                   states=args.states, seed=args.seed, actuator=args.actuator, wait=args.wait, faults=tuple(faults),
+                   machines=args.machines)
     if not res["served"]:
         print("twin: stopped before a client connected")
         return 0
     band = res["compensated_band_after_10_min_um"]
-    print(f"twin: served {res['served']} samples, t = {res['start_s']:g} .. {res['end_s']:g} s; "
+    several = f" of {res['machines']} machines" if res["machines"] > 1 else ""
+    print(f"twin: served {res['served']} samples{several}, t = {res['start_s']:g} .. {res['end_s']:g} s; "
           f"compensated delta after 10 min within +/-{band:.2f} um")
     return 0

@@ -33,6 +33,12 @@ WRITTEN = ("offset_um", "gradient_um_per_m", "reference_m")
 KEYS = ("read", "write", "scale")
 
 
+def machine_namespace(i: int, machines: int = 1) -> str:
+    """The namespace of machine ``i`` (0-based) of a twin serving ``machines``: :data:`NAMESPACE`
+    for one, ``urn:gatetherm:machine:1`` … ``:N`` for several (a map file's ``nsu=`` then names it)."""
+    return NAMESPACE if machines == 1 else f"{NAMESPACE}:{i + 1}"
+
+
 def default_node(name: str) -> str:
     """The default node id of a column: ``nsu=urn:gatetherm:machine;s=<name>``."""
     return f"nsu={NAMESPACE};s={name}"

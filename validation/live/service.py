@@ -9,7 +9,8 @@ the command holds, the reduced model's filter predicts across them, and they are
 
 Guards (:class:`Guards`, each with its default, docs/live.md):
 
-* the correction is clipped to ±``max_offset_um`` and its change to ±``max_change_um`` per period;
+* the correction is clipped to ±``max_offset_um`` and its change to ±``max_change_um`` per period,
+  a gradient's change to ±``max_gradient_change_um_per_m`` per period;
 * a sample with a missing (NaN) value or a jump beyond ``max_jump_K`` (temperatures) or
   ``max_jump_um`` (δ) per period since the last good one holds the last correction (logged);
 * a lost connection is retried with back-off (``retry_first_s`` doubling to ``retry_max_s``) while
@@ -37,6 +38,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.validation.live.journal import Journal
+from gatetherm.validation.live.link import Pace, _close, _connect, _sample, _write
 from gatetherm.validation.live.monitor import Monitor, Watch
 from gatetherm.validation.live.nodes import NodeMap
 
@@ -51,6 +53,9 @@ class Guards:
     """Largest correction written, µm (set it to the control's own limit)."""
     max_change_um: float = 5.0
     """Largest change of the correction per period, µm."""
+    max_gradient_change_um_per_m: float = 5.0
+    """Largest change of the gradient along an axis per period, µm per m (the default: at 1 m from
+    the reference position the gradient's change moves the correction no more than ``max_change_um``)."""
     max_jump_K: float = 1.0
     """Largest change of a temperature per period that a sensor can show, K."""
     max_jump_um: float = 10.0
@@ -64,7 +69,7 @@ class Guards:
     ramp_um_per_s: float = 0.1
     """Rate at which the correction falls to zero while the connection stays lost, µm per wall s."""
     timeout_s: float = 5.0
-    """Timeout of one OPC UA request, s."""
+    """Timeout of one OPC UA request, s (also the interval and timeout of the client's watchdog probe)."""
 
 
 @dataclass(frozen=True)
@@ -160,13 +165,18 @@ class Service:
                             -g.max_offset_um, g.max_offset_um))
         if gradient is not None and target != wanted:  # fallen back: the gradient scaled with the offset
             gradient = gradient * new / self.written if self.written else 0.0
+        gradient_wanted = gradient
+        if gradient is not None:  # its change limited like the offset's, from 0 (what the control holds at first)
+            before, most = self.gradient or 0.0, g.max_gradient_change_um_per_m
+            gradient = float(np.clip(gradient, before - most, before + most))
         self.gradient = gradient
         worse = int(self.watch.worse is not None)
         self.counts["worse"] += worse
-        if abs(new - target) > 1e-12:
+        if abs(new - target) > 1e-12 or (gradient is not None and abs(gradient - gradient_wanted) > 1e-12):
             limited = 1
             self.counts["limited"] += 1
-            self.journal.event(t, f"correction limited: {wanted:.3f} -> {new:.3f} um")
+            self.journal.event(t, f"correction limited: {wanted:.3f} -> {new:.3f} um" + (
+                f", gradient {gradient_wanted:.3f} -> {gradient:.3f} um/m" if gradient != gradient_wanted else ""))
         self.written = new
         self.next = k + 1
         self.counts["periods"] += 1
@@ -180,32 +190,6 @@ class Service:
         return row
 
 
-async def _connect(url: str, nodes: NodeMap, timeout: float):
-    from asyncua import Client, ua
-
-    client = Client(url, timeout=timeout)
-    await client.connect()
-    resolved = {}
-    for table in (nodes.read, nodes.write):
-        for name, text in table.items():
-            nid = ua.NodeId.from_string(text)
-            uri = getattr(nid, "NamespaceUri", None)
-            if uri:
-                nid = ua.NodeId(nid.Identifier, await client.get_namespace_index(uri), nid.NodeIdType)
-            resolved[name] = client.get_node(nid)
-    return client, resolved
-
-
-async def _sample(client, nodes, names, scale) -> dict | None:
-    """One consistent sample (``time_s`` read before and after the rest), or None."""
-    order = ("time_s", *names, "time_s")
-    values = await client.read_values([nodes[n] for n in order])
-    t0, t1 = values[0], values[-1]
-    if t0 is None or t1 is None or not (math.isfinite(t0) and t0 == t1):
-        return None
-    return {n: (math.nan if v is None else float(v) / scale(n)) for n, v in zip(order, values)}
-
-
 async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params: LiveParams,
                 read: tuple[str, ...], on_period=None, stop: asyncio.Event | None = None, status=None) -> dict:
     """Run the loop until ``params.until_s`` or ``stop``; the counts. ``status``: a
@@ -216,6 +200,13 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
     svc, g = Service(stepper, journal, params, read), params.guards
     stop = stop or asyncio.Event()
     client, resolved, wait, lost_at, ever = None, None, g.retry_first_s, None, False
+    pace, nones = Pace(params.poll_s), 0
+
+    async def pause(seconds):  # ended early by stop
+        try:
+            await asyncio.wait_for(stop.wait(), seconds)
+        except asyncio.TimeoutError:
+            pass
     try:
         while not stop.is_set():
             try:
@@ -227,16 +218,19 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     lost_at, wait, ever = None, g.retry_first_s, True
                     await _write(resolved, nodes, svc.written, svc.gradient, svc.reference)
                 sample = await _sample(client, resolved, read, nodes.factor)
-                if sample is None:
-                    await asyncio.sleep(params.poll_s)
+                if sample is None:  # the machine is publishing (or its clock not started: back off to 1 s)
+                    nones += 1
+                    await pause(min(params.poll_s * 2.0 ** (nones - 1), max(params.poll_s, 1.0)))
                     continue
+                nones = 0
                 t = sample.pop("time_s")
                 k = int(round((t - params.t0_s) / params.period_s))
                 if params.until_s is not None and t > params.until_s + 1e-9:
                     break
                 if k < svc.next:
-                    await asyncio.sleep(params.poll_s)
+                    await pause(pace.wait(time.monotonic()))
                     continue
+                pace.handled(k, time.monotonic())
                 row = svc.period(t, k, sample)
                 if status is not None:
                     status.add(row, svc.counts)
@@ -252,10 +246,8 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     lost_at = lost_at or time.monotonic()
                 await _close(client)
                 client, before = None, time.monotonic()
-                try:
-                    await asyncio.wait_for(stop.wait(), wait)
-                except asyncio.TimeoutError:
-                    pass
+                pace.reset()
+                await pause(wait)
                 wait = min(2 * wait, g.retry_max_s)
                 now = time.monotonic()
                 ramping = min(now - before, now - lost_at - g.hold_s)  # wall s of this wait past the hold
@@ -271,29 +263,11 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
     return svc.counts
 
 
-async def _write(resolved, nodes: NodeMap, offset: float, gradient=None, reference=None) -> None:
-    """Write the offset and, where the compensator gives them and the map names them, the gradient
-    and its reference position."""
-    from asyncua import ua
-
-    for name, value in (("offset_um", offset), ("gradient_um_per_m", gradient), ("reference_m", reference)):
-        if name in resolved and name in nodes.write and value is not None and math.isfinite(value):
-            await resolved[name].write_value(ua.DataValue(ua.Variant(value * nodes.factor(name), ua.VariantType.Double)))
-
-
-async def _close(client) -> None:
-    if client is not None:
-        try:
-            await client.disconnect()
-        except Exception:  # noqa: BLE001 - the link is gone already
-            pass
-
-
 def check(params: LiveParams) -> None:
     """InputError on a bad period or guard."""
     if not (math.isfinite(params.period_s) and params.period_s > 0):
         raise InputError("--period", f"must be > 0, got {params.period_s}", "e.g. --period 60")
     g = params.guards
-    if min(g.max_offset_um, g.max_change_um, g.max_jump_K, g.max_jump_um, g.retry_first_s, g.hold_s,
+    if min(g.max_offset_um, g.max_change_um, g.max_gradient_change_um_per_m, g.max_jump_K, g.max_jump_um, g.retry_first_s, g.hold_s,
            g.ramp_um_per_s, g.timeout_s) <= 0:
         raise InputError("live guards", "must be > 0", "see the defaults in docs/live.md")

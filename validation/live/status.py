@@ -3,9 +3,12 @@ looks at instead of reading ``live.csv``.
 
 ``http://127.0.0.1:N/`` shows the last hours of δ, the compensated δ (where the machine reports it)
 and the correction as inline SVG, each sensor's health (its last value; ``missing`` where it was
-NaN, ``held`` where the last period was held), the guards' counts and the last events; it reloads
-itself every few seconds. ``/status.json`` is the same as data. Served by asyncio in the service's
-own loop, on 127.0.0.1 only; no script, no external resource.
+NaN, ``held`` where the last period was held), the guards that fired, their counts and the last
+events. A small inline script fetches the page again every :data:`REFRESH_S` seconds and swaps its
+content in place (no reload, no flicker); when the service stops answering the page keeps what it
+showed and says in red since when it is not updated (an operator must not read a stale page as
+live). Without script it reloads itself. ``/status.json`` is the same as data. Served by asyncio in
+the service's own loop, on 127.0.0.1 only; no external resource.
 """
 from __future__ import annotations
 
@@ -20,6 +23,29 @@ REFRESH_S = 5
 """The page reloads itself after this many seconds."""
 SERIES = (("delta_um", "#c0392b", "δ measured"), ("delta_residual_um", "#2c7a2c", "δ compensated"),
           ("offset_um", "#1f4e9c", "correction"))
+GUARDS = ("missed", "held", "limited", "reconnects", "worse")
+"""The counts that say a guard fired (shown under "fired" when not zero)."""
+SCRIPT = """<script>(function () {
+  var n = 0, link = document.getElementById("link"), ok = new Date();
+  function refresh() {
+    fetch("/", {cache: "no-store"}).then(function (r) {
+      if (!r.ok) throw new Error("HTTP " + r.status);
+      return r.text();
+    }).then(function (text) {
+      var live = new DOMParser().parseFromString(text, "text/html").getElementById("live");
+      if (!live) throw new Error("no content");
+      document.getElementById("live").replaceWith(live);
+      ok = new Date(); n += 1;
+      document.body.setAttribute("data-refreshed", String(n));
+      link.className = ""; link.textContent = "updated " + ok.toLocaleTimeString();
+    }).catch(function (err) {
+      link.className = "stale";
+      link.textContent = "NOT UPDATED since " + ok.toLocaleTimeString() + ": the service does not answer (" + err.message + ")";
+    });
+  }
+  setInterval(refresh, %d);
+})();</script>"""
+"""The page's script: fetch the page every REFRESH_S s and swap ``#live`` in place; say when it is stale."""
 
 
 class Status:
@@ -59,16 +85,23 @@ class Status:
         rows = "".join(f"<tr><td>{html.escape(s)}</td><td>{_number(h['value'])}</td>"
                        f"<td class='{h['state']}'>{h['state']}</td></tr>" for s, h in d["sensors"].items())
         counts = "".join(f"<li>{html.escape(k)}: {v}</li>" for k, v in d["counts"].items())
+        fired = ", ".join(f"{html.escape(k)} ({v})" for k, v in d["counts"].items() if k in GUARDS and v) or "none"
         events = "".join(f"<li>{html.escape(e)}</li>" for e in d["events"]) or "<li>none</li>"
+        last = self.rows[-1] if self.rows else {}
         t = "—" if d["time_s"] is None else f"{d['time_s']:g} s"
-        off = "—" if d["offset_um"] is None else f"{d['offset_um']:.2f} µm"
-        return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><meta http-equiv='refresh' content='{REFRESH_S}'>"
-                "<title>gatetherm live</title><style>body{font-family:sans-serif;margin:1em}"
-                ".missing{color:#c0392b}.held{color:#b7791f}.ok{color:#2c7a2c}td{padding:0 1em}</style></head><body>"
-                f"<h1>gatetherm live</h1><p id='now'>machine time {t}; correction {off}</p>"
+        now = "; ".join(f"{name} {_um(last.get(k))}" for k, _, name in SERIES)
+        return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><noscript><meta http-equiv='refresh' "
+                f"content='{REFRESH_S}'></noscript><title>gatetherm live</title><style>body{{font-family:sans-serif;"
+                "margin:1em}.missing,.stale{color:#c0392b}.held{color:#b7791f}.ok{color:#2c7a2c}td{padding:0 1em}"
+                "</style></head><body><h1>gatetherm live</h1><p id='link'>updated every "
+                f"{REFRESH_S} s</p><div id='live'><p id='now'>machine time {t}; {now}</p>"
                 f"{_chart(d['series'])}<h2>Sensors</h2><table id='sensors'>{rows}</table>"
-                f"<h2>Guards</h2><ul id='counts'>{counts}</ul><h2>Events</h2><ul id='events'>{events}</ul>"
-                "</body></html>")
+                f"<h2>Guards</h2><p id='fired'>fired: {fired}</p><ul id='counts'>{counts}</ul>"
+                f"<h2>Events</h2><ul id='events'>{events}</ul></div>{SCRIPT % (1000 * REFRESH_S)}</body></html>")
+
+
+def _um(v) -> str:
+    return "—" if v is None or not math.isfinite(v) else f"{v:.2f} µm"
 
 
 def _number(v) -> str:

@@ -8,11 +8,18 @@ to their resolution (``resolution_K``), the measured δ (``noise_um``, ``resolut
 compensated δ ``delta_residual_um`` = δ + the ``offset_um`` read from its own node at that instant (an
 ideal axis offset; the twin's truth, without noise). A sample is published with ``time_s`` set to
 NaN first and to its time last, so a reader that sees the same finite ``time_s`` before and after
-the other values in one read has a consistent sample.
+the other values in one read has a consistent sample. ``published_unix_s`` is the wall clock (Unix
+time, s) of the publication, for timing a service (not a data-format channel).
+
+One process serves ``machines`` machines (``TwinParams.machines``), each in its own namespace
+(:func:`~.nodes.machine_namespace`) with its own sensor noise, correction and clock phase: machine
+*i* publishes *i*/N of a step after machine 0, as machines that were not switched on together.
+Their thermal model (one case, one schedule) is the same, marched once per machine.
 """
 from __future__ import annotations
 
 import asyncio
+import copy
 import logging
 import math
 import time
@@ -21,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
-from gatetherm.validation.live.nodes import NAMESPACE, OBJECT, WRITTEN
+from gatetherm.validation.live.nodes import OBJECT, WRITTEN, machine_namespace
 
 log = logging.getLogger(__name__)
 
@@ -52,8 +59,12 @@ class TwinParams:
     """Start the clock only once a client has written ``offset_um`` (a service that is still starting)."""
     faults: tuple[tuple[str, float, float], ...] = ()
     """(column, from_s, to_s): the column reads NaN over that machine time (a sensor fault), s."""
+    machines: int = 1
+    """Machines served by this process, each in its own namespace (docs/live.md)."""
 
     def __post_init__(self):
+        if isinstance(self.machines, bool) or not isinstance(self.machines, int) or not 1 <= self.machines <= 10000:
+            raise InputError("--machines", f"must be a whole number 1..10000, got {self.machines!r}", "e.g. --machines 100")
         if not (math.isfinite(self.speed) and self.speed > 0):
             raise InputError("--speed", f"must be > 0, got {self.speed}", "e.g. --speed 120")
         if not (math.isfinite(self.step_s) and self.step_s > 0):
@@ -123,50 +134,78 @@ class Drive:
 
 
 async def serve(rom, schedule, endpoint: str, params: TwinParams, published, stopped=None, actuator=None) -> dict:
-    """Serve the machine until ``params.until_s`` (or the schedule's end); the summary dict. With
+    """Serve the machines until ``params.until_s`` (or the schedule's end); the summary dict. With
     ``actuator`` (:class:`~gatetherm.studies.control.actuator.ActuatorParams`) the offset drives it;
     without, it is applied exactly."""
     from asyncua import Server, ua
 
     logging.getLogger("asyncua").setLevel(logging.ERROR)  # its warnings about an unencrypted loopback endpoint
-    machine = Machine(rom, schedule, params.step_s, published)
-    until = min(params.until_s if params.until_s is not None else math.inf, machine.times[-1])
-    while machine.times[machine.k] < params.start_s - 1e-9 and machine.k < len(machine.times) - 1:
-        machine.advance()
-    rng = np.random.default_rng(params.seed)
-    drive = Drive(actuator)
+    first = Machine(rom, schedule, params.step_s, published)
+    until = min(params.until_s if params.until_s is not None else math.inf, first.times[-1])
+    while first.times[first.k] < params.start_s - 1e-9 and first.k < len(first.times) - 1:
+        first.advance()
     server = Server()
     await server.init()
     server.set_endpoint(endpoint_url(endpoint))
     server.set_server_name("gatetherm twin")
-    idx = await server.register_namespace(NAMESPACE)
-    obj = await server.nodes.objects.add_object(ua.NodeId(OBJECT, idx), ua.QualifiedName(OBJECT, idx))
-    names = ("time_s", *machine.inputs, *published, "delta_residual_um", *WRITTEN)
-    nodes = {}
-    for name in names:
-        nodes[name] = await obj.add_variable(ua.NodeId(name, idx), ua.QualifiedName(name, idx),
-                                             math.nan, ua.VariantType.Double)
-        if name in WRITTEN:
-            await nodes[name].set_writable()
-    delta = published.index("delta_um")
-    temps = [i for i, n in enumerate(published) if n.endswith("_degC")]
-    worst, late, served = 0.0, 600.0 + params.start_s, 0
+    names = ("time_s", *first.inputs, *published, "delta_residual_um", "published_unix_s", *WRITTEN)
+    plants = []
+    for i in range(params.machines):
+        idx = await server.register_namespace(machine_namespace(i, params.machines))
+        obj = await server.nodes.objects.add_object(ua.NodeId(OBJECT, idx), ua.QualifiedName(OBJECT, idx))
+        nodes = {}
+        for name in names:
+            nodes[name] = await obj.add_variable(ua.NodeId(name, idx), ua.QualifiedName(name, idx),
+                                                 math.nan, ua.VariantType.Double)
+            if name in WRITTEN:
+                await nodes[name].set_writable()
+        plants.append(_Plant(copy.copy(first), nodes, np.random.default_rng(params.seed + i), Drive(actuator)))
     async with server:
-        log.info("twin serving %s from t = %g s at %gx", endpoint, machine.times[machine.k], params.speed)
-        while params.wait and not math.isfinite(await nodes["offset_um"].read_value()):
+        log.info("twin serving %d machine(s) on %s from t = %g s at %gx", len(plants), endpoint,
+                 first.times[first.k], params.speed)
+        while params.wait:
             if stopped is not None and stopped():
-                return {"served": 0}
+                return {"served": 0, "machines": len(plants)}
+            if all([math.isfinite(await p.nodes["offset_um"].read_value()) for p in plants]):
+                break
             await asyncio.sleep(0.05)
-        t_wall0, t_mach0 = time.monotonic(), float(machine.times[machine.k])
+        t_wall0, t_mach0, unix0 = time.monotonic(), float(first.times[first.k]), time.time()
+        lags = []
+        await asyncio.gather(*(p.run(t_wall0 + i * params.step_s / params.speed / len(plants), t_mach0, until,
+                                     params, published, stopped, lags) for i, p in enumerate(plants)))
+    lag = np.array(lags or [math.nan]) * 1e3
+    return {"served": sum(p.served for p in plants), "machines": len(plants), "start_s": t_mach0,
+            "end_s": max(p.t for p in plants), "clock_start_unix_s": unix0,
+            "compensated_band_after_10_min_um": max(p.worst for p in plants),
+            "publish_lag_ms": {"median": float(np.median(lag)), "p95": float(np.percentile(lag, 95)),
+                               "max": float(lag.max())}}
+
+
+class _Plant:
+    """One machine served: its model, nodes, noise and actuator."""
+
+    def __init__(self, machine: Machine, nodes: dict, rng, drive: Drive):
+        self.machine, self.nodes, self.rng, self.drive = machine, nodes, rng, drive
+        self.served, self.worst, self.t = 0, 0.0, math.nan
+
+    async def run(self, t_wall0: float, t_mach0: float, until: float, params: TwinParams, published, stopped,
+                  lags: list) -> None:
+        """Publish a sample every step (machine time ``t_mach0`` at wall ``t_wall0``) until ``until``;
+        each publication's lag behind its wall time (s) goes to ``lags``."""
+        machine, nodes = self.machine, self.nodes
+        delta = published.index("delta_um")
+        temps = [i for i, n in enumerate(published) if n.endswith("_degC")]
+        late = 600.0 + params.start_s
         while True:
-            t = float(machine.times[machine.k])
-            await asyncio.sleep(max(0.0, t_wall0 + (t - t_mach0) / params.speed - time.monotonic()))
+            t = self.t = float(machine.times[machine.k])
+            due = t_wall0 + (t - t_mach0) / params.speed
+            await asyncio.sleep(max(0.0, due - time.monotonic()))
             offset = float(await nodes["offset_um"].read_value())
             y = machine.outputs()
             shown = y.copy()
-            shown[temps] = _quantise(y[temps], rng, params.noise_K, params.resolution_K)
-            shown[delta] = _quantise(y[delta], rng, params.noise_um, params.resolution_um)
-            comp = float(y[delta]) + drive(offset if math.isfinite(offset) else 0.0)
+            shown[temps] = _quantise(y[temps], self.rng, params.noise_K, params.resolution_K)
+            shown[delta] = _quantise(y[delta], self.rng, params.noise_um, params.resolution_um)
+            comp = float(y[delta]) + self.drive(offset if math.isfinite(offset) else 0.0)
             values = {**{k: float(v[machine.k]) for k, v in machine.inputs.items()},
                       **dict(zip(published, map(float, shown))), "delta_residual_um": comp}
             for name, lo, hi in params.faults:
@@ -175,14 +214,15 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
             await nodes["time_s"].write_value(math.nan)
             for name, value in values.items():
                 await nodes[name].write_value(value)
+            await nodes["published_unix_s"].write_value(time.time())
             await nodes["time_s"].write_value(t)
-            served += 1
+            lags.append(time.monotonic() - due)
+            self.served += 1
             if t >= late:
-                worst = max(worst, abs(comp))
+                self.worst = max(self.worst, abs(comp))
             if stopped is not None and stopped():
                 break
             if t >= until - 1e-9 or machine.k >= len(machine.times) - 1:
                 await asyncio.sleep(params.step_s / params.speed)  # the last sample stays readable for a step
                 break
             machine.advance()
-    return {"served": served, "start_s": t_mach0, "end_s": t, "compensated_band_after_10_min_um": worst}
