@@ -248,7 +248,7 @@ BAD = {
     "place_sensors(held_out='x.csv')": (lambda c: gt.place_sensors(c, held_out="x.csv"), TypeError,
                                         "held_out: got str 'x.csv', expected a list of Schedule or None"),
     "live(out=None)": (lambda c: gt.live(c, method="paper", endpoint="opc.tcp://127.0.0.1:4840", out=None), TypeError,
-                       "out: got NoneType None, expected a folder's path"),
+                       "out: got NoneType None, expected a str or path"),
     "plot.sweep(no file)": (lambda c: gt.plot.sweep("nosuch.csv", "x", "y"), InputError,
                             "rows: no such file 'nosuch.csv'"),
 }

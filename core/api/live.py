@@ -2,17 +2,20 @@
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import logging
-import signal
-import threading
+import os
 from pathlib import Path
+from typing import Mapping
 
 import numpy as np
 
-from gatetherm.api.run import PATH, Case
+from gatetherm.api.run import PATH, Case, Schedule
 from gatetherm.api.run import _case as _a_case
 from gatetherm.checks import argument
+from gatetherm.solvers.rom import ReducedModel
+from gatetherm.studies.errormodel.fitted import ErrorModel
+from gatetherm.validation.live.monitor import Monitor
+from gatetherm.validation.live.service import Guards
 
 log = logging.getLogger(__name__)
 
@@ -32,8 +35,9 @@ def _schedule(case: Case, schedule):
     return schedule if hasattr(schedule, "drive") else schedule_file(schedule, case)
 
 
-def twin(case: Case | str | Path, endpoint: str, speed: float = 1.0, *, schedule=None, until: float | None = None,
-         start: float = 0.0, states: int = 30, rom=None, seed: int = 0, actuator: bool = False, stopped=None,
+def twin(case: Case | str | Path, endpoint: str, speed: float = 1.0, *,
+         schedule: Schedule | str | os.PathLike | None = None, until: float | None = None, start: float = 0.0,
+         states: int = 30, rom: ReducedModel | None = None, seed: int = 0, actuator: bool = False, stopped=None,
          **noise) -> dict:
     """Serve a virtual machine over OPC UA: the case's reduced model in ``speed``× real time.
 
@@ -148,9 +152,11 @@ def _stepper(case, method, model, target, params, states, out, sched, axis=None)
     return RegressionStepper(fit_regression(run, THETAS), params), "mlr"
 
 
-def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint: str, out, model=None,
-         target: str | None = None, map=None, period: float = 60.0, update: float | None = None,
-         until: float | None = None, states: int = 30, schedule=None, guards=None, monitor=None,
+def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint: str, out: str | os.PathLike,
+         model: ErrorModel | str | os.PathLike | None = None, target: str | None = None,
+         map: str | os.PathLike | None = None, period: float = 60.0, update: float | None = None,
+         until: float | None = None, states: int = 30, schedule: Schedule | str | os.PathLike | None = None,
+         guards: Guards | None = None, monitor: Monitor | Mapping | None = None,
          axis: dict | None = None, reference: float | None = None, status_port: int | None = None,
          on_period=None, on_ready=None, poll: float = 0.05) -> dict:
     """Compensate a machine over OPC UA: read its sensors every period of its clock, write the correction.
@@ -214,17 +220,18 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
     from gatetherm.studies.control.compensator import CompensatorParams
     from gatetherm.validation.live import journal as jr, service
     from gatetherm.validation.live.nodes import default_map, read_map
+    from gatetherm.validation.live.runner import serve_until_signal
     from gatetherm.validation.live.twin import endpoint_url
 
     from gatetherm import InputError
     from gatetherm.validation.live.axis import Axis
-    from gatetherm.validation.live.monitor import Monitor
 
     endpoint_url(endpoint)
     if model is None and case is None:
         raise InputError("--case/--model", "give the machine's case (or a fitted model)", "e.g. --case case.toml")
     guards = guards or service.Guards()
-    params = service.LiveParams(period_s=float(period), until_s=until, guards=guards, poll_s=poll, monitor=Monitor(**monitor) if isinstance(monitor, dict) else monitor or Monitor())
+    monitor = Monitor(**monitor) if isinstance(monitor, Mapping) else monitor or Monitor()
+    params = service.LiveParams(period_s=float(period), until_s=until, guards=guards, poll_s=poll, monitor=monitor)
     service.check(params)
     if not (isinstance(poll, (int, float)) and 0 < poll < 60):
         raise InputError("poll", f"must be a wall time in s in (0, 60), got {poll!r}", "e.g. poll=0.05")
@@ -255,43 +262,10 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
         if on_ready is not None:
             on_ready()
         try:
-            counts = asyncio.run(_serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period,
-                                                     status_port))
+            counts = asyncio.run(serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period,
+                                                    status_port))
         finally:
             journal.close()
         return jr.summarize(out, counts)
     finally:
         os.close(fd)
-
-
-async def _serve_until_signal(stepper, journal, endpoint, nodes, params, read, on_period, status_port):
-    from gatetherm.validation.live.service import serve
-    from gatetherm.validation.live.status import Status, serve_status
-
-    stop = asyncio.Event()
-    loop = asyncio.get_running_loop()
-    handled = []
-    if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            old = signal.getsignal(sig)
-            with contextlib.suppress(ValueError, RuntimeError):
-                loop.add_signal_handler(sig, stop.set)
-                handled.append((sig, old))
-    status = server = None
-    if status_port is not None:
-        status = Status(journal.dir, stepper.columns)
-        try:
-            server = await serve_status(status, status_port)
-        except OSError as err:
-            from gatetherm import InputError
-
-            raise InputError("--status-port", f"cannot serve on 127.0.0.1:{status_port} ({err.strerror})",
-                             "give a free port") from None
-    try:
-        return await serve(stepper, journal, endpoint, nodes, params, read, on_period, stop, status)
-    finally:
-        if server is not None:
-            server.close()
-        for sig, old in handled:
-            loop.remove_signal_handler(sig)
-            signal.signal(sig, old)
