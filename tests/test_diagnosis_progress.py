@@ -7,9 +7,9 @@ from types import SimpleNamespace
 
 
 import gatetherm.api as gt
-from gatetherm.geometry.frame import MeshParams
+from gatetherm.frame.config import load_config
+from gatetherm.frame.geometry import MeshParams
 from gatetherm.studies.diagnosis.progress import CHECK_RUNS, FIRST_RUNS, ROUND_RUNS, Budget, plan_line
-from gatetherm.studies.run.config import load_config
 from gatetherm.studies.run.timeseries import write_timeseries
 from gatetherm.validation.truth import Case, measured, truth
 
