@@ -43,7 +43,6 @@ gate_frame.__doc__ = _gate_frame.__doc__
 
 
 def load_case(path: str | os.PathLike, mesh_factor: float = 1.0, overrides: dict | None = None) -> Case:
-    argument("path", path, PATH, "the path of a .toml case file")
     number_argument("mesh_factor", mesh_factor, POSITIVE, "e.g. 0.5 for elements half as large")
     argument("overrides", overrides, (Mapping, type(None)), "a dict {dotted key: value} or None",
              'e.g. {"thermal.free.film": 8.0}')
@@ -122,7 +121,6 @@ def nc_schedule(path: str | os.PathLike, step_s: float = 1.0, rapid: float = 30.
     from gatetherm.studies.run.ncprogram import nc_series
     from gatetherm.studies.run.timeseries import write_timeseries
 
-    argument("path", path, PATH, "the path of an NC program")
     step_s, rapid = number_argument("step_s", step_s, POSITIVE, "e.g. 1.0"), number_argument("rapid", rapid, POSITIVE,
                                                                                              "e.g. 30.0")
     if out is not None and Path(argument("out", out, PATH, "a file's path or None")).resolve() == Path(path).resolve():
@@ -178,7 +176,6 @@ def schedule_file(path: str | os.PathLike, case: Case, step_s: float = 60.0) -> 
     -------
     Schedule
     """
-    argument("path", path, PATH, "the path of a time-series file")
     _case(case)
     step_s = number_argument("step_s", step_s, POSITIVE, "e.g. 60")
     return file_schedule(path, sorted(case.inputs()), case.held(), case.defaults, step_s)

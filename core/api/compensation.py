@@ -161,7 +161,6 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
 
     argument("data", data, (*PATH, type(None)), "a time-series file's path or None")
     argument("case", case, (*PATH, Case, type(None)), "a case file's path, a Case or None")
-    argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
     if data is not None and condition is not None:
         raise InputError("data", "and condition are both given", "give one: a measured record, or one of the "
                          "paper's conditions to simulate")

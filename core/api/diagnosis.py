@@ -232,7 +232,6 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out: str | os.PathLike
 
     argument("model", model, Case, "a Case", "make one with gt.diagnosis_model() or gt.load_case(path)")
     argument("data", data, PATH, "a time-series file's path")
-    argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
     if model.time is None:
         raise InputError("model", f"{model.name!r} is steady (no [time]): a diagnosis compares a transient run",
                          "give the case [time] with end and step; the run's times come from the data")

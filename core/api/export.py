@@ -171,7 +171,6 @@ def export_case(case: Case | str | os.PathLike | None = None, *, condition: int 
     from gatetherm.frame.conditions import condition as check_condition
 
     argument("case", case, (Case, *PATH, type(None)), "a Case, a case file's path or None")
-    argument("out", out, (*PATH, type(None)), "a folder's path or None")
     argument("run", run, bool, "True or False")
     if (case is None) == (condition is None):
         raise InputError("case/condition", "give one of the two", "e.g. condition=1, time=900")

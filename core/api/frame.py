@@ -94,7 +94,6 @@ def mesh_frame(dim: int = 2, config: str | os.PathLike | None = None, condition:
     from gatetherm.frame.conditions import condition as check_condition
 
     argument("config", config, (*PATH, type(None)), "a model file's path or None")
-    argument("out", out, (*PATH, type(None)), "a folder's path or None")
     check_condition(condition)  # a bad number fails (naming it) before the model is built
     if out is None:
         return FrameFiles(gate_frame(dim, config, condition), condition, None, config)

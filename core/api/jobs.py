@@ -124,9 +124,6 @@ def run_case(path: str | os.PathLike, out: str | os.PathLike | None = None, *, p
     -------
     RunResult
     """
-    argument("path", path, PATH, "the path of a .toml case file")
-    argument("out", out, (*PATH, type(None)), "a folder's path or None")
-    argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
 
     def make():
         case = load_case(path)
@@ -176,8 +173,6 @@ def simulate(condition: int | None = None, schedule: str | os.PathLike | None = 
     if (condition is None) == (schedule is None):
         raise InputError("condition/schedule", "give one of the two", "e.g. condition=1")
     argument("schedule", schedule, (*PATH, type(None)), "a schedule file's path or None")
-    argument("out", out, (*PATH, type(None)), "a folder's path or None")
-    argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
     every = max(number_argument("fields_every", fields_every, POSITIVE, "e.g. 3600"), 60.0)
 
     def make():

@@ -5,7 +5,7 @@ import dataclasses
 import math
 import os
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Sequence
 
 from gatetherm.api.run import Case, Schedule, _case, condition
 from gatetherm.checks import Range, argument, whole_argument
@@ -225,9 +225,7 @@ def reduce_case(case: Case | str | os.PathLike | None = None, *, dim: int = 2, c
 
     states = whole_argument("states", states, STATES, "e.g. 30")
     argument("case", case, (Case, *PATH, type(None)), "a Case, a case file's path or None")
-    argument("out", out, (*PATH, type(None)), "a folder's path or None")
     argument("check_fe", check_fe, bool, "True or False")
-    argument("on_progress", on_progress, (Callable, type(None)), "a function on_progress(i, n) or None")
     for i, f in enumerate(check):
         argument(f"check[{i}]", f, PATH, "a schedule file's path")
     if not isinstance(case, Case):
