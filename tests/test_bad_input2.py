@@ -416,3 +416,15 @@ def test_an_error_model_fit_that_would_mislead_is_refused(call, needle):
     with pytest.raises(InputError) as info:
         call(_em_record())
     assert needle in str(info.value)
+
+
+@pytest.mark.parametrize("entry, value", [("fit_span", [0, 1]), ("settings", []), ("ranges", 5)])
+def test_a_model_file_entry_of_the_wrong_kind_is_named(tmp_path, entry, value):
+    """A table where a list belongs (or the reverse) raised an AttributeError in the entry checks."""
+    d = json.loads(json.dumps({"format": "gatetherm-errormodel/1", "reference_degC": {"t1_degC": 20.0},
+                               "targets": {"x_um": {"form": "static", "intercept_um": 0.0, "terms": [
+                                   {"kind": "sensor", "column": "t1_degC", "coefficient": 1.0}]}}}))
+    (d["targets"]["x_um"] if entry == "ranges" else d)[entry] = value
+    (tmp_path / "m.json").write_text(json.dumps(d))
+    with pytest.raises(InputError, match=rf"m\.json: (targets\.x_um\.)?{entry}"):
+        load_model(tmp_path / "m.json")

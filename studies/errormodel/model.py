@@ -68,20 +68,23 @@ def _check_document(data: dict, where: str) -> None:
         need(isinstance(d.get("terms"), list) and d["terms"], f"{k}.terms", "must be a non-empty list of terms")
         for i, t in enumerate(d["terms"]):
             need(isinstance(t, dict), f"{k}.terms[{i}]", "must be a table")
-            need(_number(t.get("coefficient")), f"{k}.terms[{i}].coefficient", f"must be a number within ±{COEFFICIENT:g}")
+            need(_number(t.get("coefficient")), f"{k}.terms[{i}].coefficient",
+                 f"must be a number within ±{COEFFICIENT:g}")
             need(name not in (t.get("column"), t.get("other")), f"{k}.terms[{i}].column",
                  f"reads the target {name} itself: a model cannot read the column it predicts")
-        need(all(_number(v, 0.0) for key, v in d.get("interval", {}).items() if key.endswith("_um")),
-             f"{k}.interval", "its widths must be numbers >= 0 µm")
+        interval, ranges = d.get("interval", {}), d.get("ranges", [])
+        widths = [v for key, v in interval.items() if key.endswith("_um")] if isinstance(interval, dict) else [None]
+        need(all(_number(v, 0.0) for v in widths), f"{k}.interval", "its widths must be numbers >= 0 µm")
+        pairs = ranges if isinstance(ranges, list) else [None]
         need(all(isinstance(r, list) and len(r) == 2 and all(_number(v, -1e300, 1e300) for v in r) and r[0] <= r[1]
-                 for r in d.get("ranges", [])), f"{k}.ranges", "each must be [low, high] with low <= high")
-    span = data.get("fit_span", {})
-    need(isinstance(span, dict) and span.get("start_s", 0) <= span.get("end_s", float("inf"))
-         if all(_number(span.get(x, 0), -1e300, 1e300) for x in ("start_s", "end_s")) else False,
-         "fit_span", "start_s and end_s must be numbers (s), start_s <= end_s")
+                 for r in pairs), f"{k}.ranges", "each must be [low, high] with low <= high")
+    span, settings = data.get("fit_span", {}), data.get("settings", {})
+    ends = (span.get("start_s", 0.0), span.get("end_s", 1e300)) if isinstance(span, dict) else (None, None)
+    need(all(_number(v, -1e300, 1e300) for v in ends) and ends[0] <= ends[1], "fit_span",
+         "start_s and end_s must be numbers (s), start_s <= end_s")
     need(_number(data.get("max_gap_s", 300.0), 0.0, 1e300) and data.get("max_gap_s", 300.0) > 0, "max_gap_s",
          "must be a number > 0 s")
-    need(_number(data.get("settings", {}).get("smooth_s", 0.0), 0.0, 1e300), "settings.smooth_s",
+    need(isinstance(settings, dict) and _number(settings.get("smooth_s", 0.0), 0.0, 1e300), "settings.smooth_s",
          "must be a number >= 0 s")
 
 
