@@ -378,6 +378,8 @@ def test_every_cell_of_the_zoo_is_its_pinned_value(contexts, name, capability):
     from gatetherm.validation.zoo.cells import CELLS
 
     status, expected = PINNED[name, capability]
+    if capability == "export ccx" and status == "ok" and shutil.which("ccx") is None:
+        pytest.skip("CalculiX (Debian calculix-ccx) is not installed: the cell runs the deck it exports")
     cell = guarded(CELLS[capability], contexts(name), timeout_s=TIMEOUT_S)
     assert "\n" not in cell["text"]
     assert cell["status"] == status, cell["text"]
