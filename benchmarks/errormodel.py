@@ -106,9 +106,11 @@ def run_gatetherm(inputs, fit_ts, test_ts, first: int):
     t_pred = (time.perf_counter() - t1) / len(test_ts)
     maes = [float(np.nanmean(np.abs(pred[y][first:] - test_ts[y][first:]))) for y in TARGETS]
     band = trust(model, test_ts, pred)  # the 90 % interval as predict writes it (widened where it extrapolates)
-    inside = np.concatenate([(test_ts[y][first:] >= band[y]["lower"][first:])
-                             & (test_ts[y][first:] <= band[y]["upper"][first:]) for y in TARGETS])
-    print(f"    in the 90 % interval: {inside.mean():.1%} of the test samples")
+    each = [(test_ts[y][first:] >= band[y]["lower"][first:]) & (test_ts[y][first:] <= band[y]["upper"][first:])
+            for y in TARGETS]
+    inside = np.concatenate(each)
+    print(f"    in the 90 % interval: {inside.mean():.1%} of the test samples "
+          f"(ch1 ... ch5: {', '.join(f'{v.mean():.1%}' for v in each)})")
     sensors = " ".join(f"{y[:3]}:" + ",".join(s.split("_")[0] for s in model.target(y).sensors) for y in TARGETS)
     for m in model.targets:
         print(f"    {m.target}: {m.form}, {', '.join(t.label for t in m.terms)}; held-out {m.held_out_mae_um:.2f} um")

@@ -293,6 +293,24 @@ def test_forward_interval_grows_with_the_horizon():
     assert horizon_factor({}, t) == pytest.approx(np.ones(100))  # a constant interval (leave one run out)
 
 
+def test_forward_interval_is_a_quantile_over_blocks():
+    """The width is the conformal quantile over the held-out blocks, not over their pooled samples:
+    the ceil(0.9 (B + 1))-th smallest of the blocks' 90 % quantiles, so one block in ten that misses
+    by 5 um sets it (pooled, its samples are the top 10 % and would give 1.4 um)."""
+    from gatetherm.studies.errormodel.trust import block_quantile, calibrate_forward
+
+    assert block_quantile(np.arange(1.0, 21.0)) == 19.0  # ceil(0.9 x 21) = 19th of 20
+    assert block_quantile([3.0, 1.0, 2.0]) == 3.0  # ceil(0.9 x 4) = 4 > 3 blocks: the largest
+    t = np.arange(200.0)
+    blocks = [(100 + 10 * k, 110 + 10 * k) for k in range(10)]
+    res = [np.full(10, 5.0 if k == 4 else 1.0) * (1 + (t[lo:hi] - t[lo - 1]) / (t[lo - 1] - t[0]))
+           for k, (lo, hi) in enumerate(blocks)]
+    iv = calibrate_forward(res, blocks, t)
+    assert iv["half_width_um"] == pytest.approx(5.0) and iv["blocks"] == 10
+    assert np.quantile(np.r_[np.ones(90), np.full(10, 5.0)], 0.9) == pytest.approx(1.4)  # the pooled quantile
+    assert iv["coverage"] == pytest.approx(80 / 90)  # blocks 2..10 checked; block 5 (before any 5-um block) misses
+
+
 def test_choose_latest_picks_on_forward_chaining():
     """choose_latest: held_out_mae_um is the forward-chaining error of the model kept (the model's own
     chain error, recomputed), the interval is calibrated forward and holds the later hours."""
@@ -311,5 +329,6 @@ def test_choose_latest_picks_on_forward_chaining():
     inside = np.mean((y >= band["lower"][900:]) & (y <= band["upper"][900:]))
     assert inside == pytest.approx(1.0, abs=0.005)  # band: >= 0.85 (noise only: the model is exact; wider later)
     assert m.held_out_mae_um == pytest.approx(0.0418, abs=0.003)  # white noise of 0.05 um: E|e| = 0.0399
-    assert m.interval["coverage"] == pytest.approx(0.910, abs=0.01)  # band: 0.85-0.95 (forward, in the fitting span)
-    assert m.interval["half_width_um"] == pytest.approx(0.0759, abs=0.004)  # 1.645 x 0.05 um = 0.082 for white noise
+    assert m.interval["coverage"] == pytest.approx(0.929, abs=0.01)  # band: 0.85-0.95 (forward, in the fitting span)
+    # white noise of 0.05 um: 1.645 x 0.05 = 0.082 um; the largest of the 16 blocks' 90 % quantiles is a little wider
+    assert m.interval["half_width_um"] == pytest.approx(0.0907, abs=0.004) and m.interval["blocks"] == 16

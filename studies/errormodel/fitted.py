@@ -51,8 +51,9 @@ class TargetModel:
     interval: dict = field(default_factory=dict)
     """The 90 % interval from held-out residuals (:func:`~gatetherm.studies.errormodel.trust.calibrate`):
     ``half_width_um`` (um), ``coverage`` (fraction of held-out samples inside, out of sample),
-    ``samples``, ``level``; within one or two runs also ``growth`` ("horizon"), ``fit_end_s`` and
-    ``fit_length_s`` (s): the half-width grows as ``1 + h / fit_length_s``
+    ``samples``, ``level``; within one or two runs also ``blocks`` (the held-out blocks it is a
+    conformal quantile over), ``growth`` ("horizon"), ``fit_end_s`` and ``fit_length_s`` (s): the
+    half-width grows as ``1 + h / fit_length_s``
     (:func:`~gatetherm.studies.errormodel.trust.calibrate_forward`); empty: not calibrated."""
     ranges: tuple = ()
     """Per term its (smallest, largest) value on the fitting rows (the drift detector's reference)."""

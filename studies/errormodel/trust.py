@@ -2,11 +2,14 @@
 held-out data, and a drift detector.
 
 * :func:`calibrate_forward` (one or two runs): the half-width grows with the horizon h since the
-  fit, ``w (1 + h / L)``, w the 90 % quantile of the forward-chaining residuals inside the fitting
-  span scaled the same way by their own horizons; :func:`calibrate` (leave one run out): the 90 %
-  quantile of the held-out absolute residuals. Coverage is checked out of sample: each held-out
-  block's residuals against the quantile of the blocks that end before it starts (forward) or do
-  not overlap it, the fraction inside over all checked samples.
+  fit, ``w (1 + h / L)``; the forward-chaining residuals inside the fitting span are scaled the same
+  way by their own horizons, and w is a conformal quantile over the held-out *blocks* (the unit a
+  later stretch of hours is exchangeable with; the samples inside a block are not independent):
+  each block's 90 % quantile of its scores, and w the ``ceil(0.9 (B + 1))``-th smallest of the B
+  blocks' (:func:`block_quantile`; the largest for 9 … 18 blocks). :func:`calibrate` (leave one run
+  out): the 90 % quantile of the held-out absolute residuals. Coverage is checked out of sample:
+  each held-out block's residuals against the width of the blocks that end before it starts
+  (forward) or do not overlap it, the fraction inside over all checked samples.
 * :func:`trust` widens the interval where the model extrapolates: by the part of the prediction
   that rests on terms beyond their fitted ranges (:func:`beyond`), which the held-out calibration
   cannot vouch for.
@@ -53,6 +56,14 @@ def calibrate(residuals: list[np.ndarray], blocks: list[tuple[int, int]], chain:
     return {"half_width_um": half, "coverage": inside / n if n else None, "samples": n, "level": LEVEL}
 
 
+def block_quantile(quantiles) -> float:
+    """The conformal quantile over blocks: the ``ceil(LEVEL (B + 1))``-th smallest of the B blocks'
+    90 % quantiles (the largest where that exceeds B): a later block exchangeable with these has its
+    own 90 % quantile below it with probability at least :data:`LEVEL`."""
+    q = np.sort(np.asarray(quantiles, float))
+    return float(q[min(q.size, int(np.ceil(LEVEL * (q.size + 1)))) - 1])
+
+
 def calibrate_forward(residuals: list[np.ndarray], blocks: list[tuple[int, int]], t_s: np.ndarray) -> dict:
     """The 90 % interval of a model fitted on one run, growing with the horizon since the fit:
     ``half(h) = half_width_um * (1 + h / fit_length_s)``, h the time since the fitting span's end, s.
@@ -60,24 +71,26 @@ def calibrate_forward(residuals: list[np.ndarray], blocks: list[tuple[int, int]]
     ``residuals`` are the forward-chaining held-out residuals (um) of ``blocks`` (row ranges, each
     predicted by the fit on the rows before it; ``t_s`` the rows' times, s): each sample's score is
     ``|r| / (1 + h / L)``, h its time since the end of its fold's fitting rows and L their length;
-    ``half_width_um`` is the scores' 90 % quantile. ``coverage`` checks it out of sample: each block
-    against the quantile of the scores of the blocks that end before it starts."""
+    ``half_width_um`` is :func:`block_quantile` of the blocks' 90 % quantiles of their scores.
+    ``coverage`` checks it out of sample: each block against :func:`block_quantile` of the blocks
+    that end before it starts."""
     if not residuals:
         return {}
-    scores, ends = [], []
+    scores, q = [], []
     for r, (lo, hi) in zip(residuals, blocks):
         length = max(float(t_s[lo - 1] - t_s[0]), 1e-9)
         h = t_s[lo:hi] - t_s[lo - 1]
         scores.append(np.abs(r) / (1.0 + h / length))
-    half = float(np.quantile(np.concatenate(scores), LEVEL))
+        q.append(float(np.quantile(scores[-1], LEVEL)))
     inside, n = 0, 0
     for i, (lo, _) in enumerate(blocks):
-        earlier = [scores[j] for j, (_, h2) in enumerate(blocks) if h2 <= lo]
+        earlier = [q[j] for j, (_, h2) in enumerate(blocks) if h2 <= lo]
         if earlier:
-            inside += int((scores[i] <= np.quantile(np.concatenate(earlier), LEVEL)).sum())
+            inside += int((scores[i] <= block_quantile(earlier)).sum())
             n += scores[i].size
-    return {"half_width_um": half, "coverage": inside / n if n else None, "samples": n, "level": LEVEL,
-            "growth": "horizon", "fit_end_s": float(t_s[-1]), "fit_length_s": float(t_s[-1] - t_s[0])}
+    return {"half_width_um": block_quantile(q), "coverage": inside / n if n else None, "samples": n, "level": LEVEL,
+            "blocks": len(blocks), "growth": "horizon", "fit_end_s": float(t_s[-1]),
+            "fit_length_s": float(t_s[-1] - t_s[0])}
 
 
 def horizon_factor(interval: dict, t_s: np.ndarray) -> np.ndarray:
