@@ -200,3 +200,12 @@ def test_plots_of_what_a_run_lacks_name_it(tmp_path: Path):
     with pytest.raises(InputError, match="columns: none given"):
         gt.plot.series(run)
     assert np.isfinite(run["T_a_degC"]).all()
+
+
+@pytest.mark.parametrize("setting, needle", [
+    ({"max_inputs": -2}, "max_inputs: -2 is not >= 0"), ({"max_sensors": 0}, "max_sensors: 0 is not >= 1"),
+    ({"input_taus_s": (-60.0,)}, "input_taus_s: -60 is not > 0"), ({"max_gap_s": 0.0}, "max_gap_s: 0 is not > 0"),
+])
+def test_a_bad_fit_setting_is_named_alone(setting, needle):
+    with pytest.raises(InputError, match=needle):
+        FitParams(**setting)
