@@ -209,3 +209,16 @@ def test_plots_of_what_a_run_lacks_name_it(tmp_path: Path):
 def test_a_bad_fit_setting_is_named_alone(setting, needle):
     with pytest.raises(InputError, match=needle):
         FitParams(**setting)
+
+
+def test_meshio_warnings_are_logged_naming_the_file_not_printed(tmp_path: Path, caplog, capfd):
+    from gatetherm.geometry.mesh import load_mesh
+
+    text = ("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+            "$Elements\n1\n1 2 2 1 1 1 2 3\n")  # $Elements not closed
+    (tmp_path / "m.msh").write_text(text)
+    with caplog.at_level(logging.WARNING):
+        fm = load_mesh(tmp_path / "m.msh")  # its one triangle read; the file's fault said
+    assert fm.cells.shape[0] == 1
+    assert "m.msh: meshio: $Elements not closed by $EndElements." in caplog.text
+    assert "Warning" not in capfd.readouterr().err
