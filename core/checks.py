@@ -105,6 +105,11 @@ CELSIUS = Range(ABSOLUTE_ZERO_C, MAX_CELSIUS, lo_open=True, unit="°C")
 ACCELERATION = Range(-1e4, 1e4, unit="m/s²")
 """A component of ``[gravity]``: up to about 1 000 g (a machine on a shaker table, not a
 number that makes every displacement overflow)."""
+BY_UNIT = {"°C": CELSIUS, "N": Range(-1e12, 1e12, unit="N"), "Pa": Range(-1e12, 1e12, unit="Pa"),
+           "m": Range(-1e3, 1e3, unit="m")}
+"""The range of a case file's value of a unit where its key names none: a temperature; a force
+or a pressure (1e12 N, 1 TPa: beyond any machine, short of numbers whose displacements
+overflow); a length or position (1 km). Any other unit: finite."""
 
 
 def admissible(default: Range | None = None, **ranges: Range):
@@ -178,14 +183,14 @@ class NonFiniteError(InputError):
     ``str(err)`` names the file and the quantity (its path in the data) on one line."""
 
 
-def first_nonfinite(data, path: str = "") -> tuple[str, float] | None:
-    """``(path, value)`` of the first NaN or infinite float in nested dicts, lists and tuples
-    (``path`` as ``a.b[2].c``), or None."""
+def first_nonfinite(data, path: str = "") -> tuple[str, float, str] | None:
+    """``(path, value, text)`` of the first NaN or infinite float in nested dicts, lists and
+    tuples (``path`` as ``a.b[2].c``; ``text`` as a JSON file had it), or None."""
     stack = [(path, data)]
     while stack:
         where, value = stack.pop()
         if isinstance(value, (float, np.floating)) and not math.isfinite(value):
-            return where or "the value", float(value)
+            return where or "the value", float(value), getattr(value, "text", str(float(value)))
         if isinstance(value, dict):
             stack.extend((f"{where}.{k}" if where else str(k), v) for k, v in reversed(list(value.items())))
         elif isinstance(value, (list, tuple)):
@@ -216,14 +221,12 @@ def parse_json(text: str, where: str, fix: str):
     :data:`MAX_JSON_DEPTH`."""
     import json
 
-    def constant(name):
-        raise InputError(where, f"holds {name}, not a finite number", fix)
+    def constant(name):  # NaN, Infinity: kept until the entry holding it can be named
+        return _NonFinite(name)
 
     def number(text):
         value = float(text)
-        if not math.isfinite(value):
-            raise InputError(where, f"holds {text}, not a finite number", fix)
-        return value
+        return value if math.isfinite(value) else _NonFinite(text)
 
     def integer(text):
         if len(text.lstrip("-")) > 18:
@@ -249,7 +252,18 @@ def parse_json(text: str, where: str, fix: str):
                 stack.extend((v, depth + 1) for v in (value.values() if isinstance(value, dict) else value))
     if too_deep:
         raise InputError(where, f"nested deeper than {MAX_JSON_DEPTH} levels", fix)
+    bad = first_nonfinite(data)
+    if bad is not None:
+        raise InputError(f"{where}: {bad[0]}", f"holds {bad[2]}, not a finite number", fix)
     return data
+
+
+class _NonFinite(float):
+    """A NaN, an infinity or a number too large for a float as read from a JSON file, its text kept."""
+    def __new__(cls, text: str):
+        value = super().__new__(cls, "nan")
+        value.text = text
+        return value
 
 
 def argument(name: str, value, kinds, expected: str, fix: str = ""):

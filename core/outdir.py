@@ -38,8 +38,9 @@ class OutputError(OSError):
     is writing into it). ``str(err)`` is one line; the command exits with 1."""
 
 
-def _check_path(out: Path, option: str) -> list[Path]:
-    """The directories that must be created for ``out``, deepest last; InputError for a file in the way."""
+def check_path(out: Path, option: str = "--out") -> list[Path]:
+    """The directories that must be created for ``out``, deepest last; InputError for a file in the way
+    (a command whose folder is not an :func:`output_dir` transaction, as ``live``'s, checks it here too)."""
     missing = []
     for p in (out, *out.parents):
         if p.is_dir():
@@ -148,7 +149,7 @@ def output_dir(path: str | os.PathLike, owns=(), keep=(), option: str = "--out")
     points) are written into ``path`` itself, not the stage. Raises InputError (``option``
     names a file) or :class:`OutputError` (cannot write, locked)."""
     out = Path(path)
-    created = _check_path(out, option)
+    created = check_path(out, option)
     _refuse_overwriting(out, owns, keep, option)
     try:
         out.mkdir(parents=True, exist_ok=True)

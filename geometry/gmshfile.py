@@ -153,6 +153,8 @@ def _read(gmsh, spec: MeshSpec) -> int:
             gmsh.merge(str(spec.path))  # (gmsh.open would forget the parameters)
             gmsh.option.setNumber("General.Verbosity", verbosity)
         else:
+            signal.signal(signal.SIGALRM, signal.SIG_DFL)  # a CAD file too large to read: ended as a script is
+            signal.alarm(READ_LIMIT_S)
             gmsh.model.occ.importShapes(str(spec.path))
             gmsh.model.occ.synchronize()
     except Exception as err:  # gmsh reports a bad file as a plain Exception
@@ -188,6 +190,28 @@ def _coarser(gmsh, spec: MeshSpec, names: dict) -> list[str]:
             notes.append(f"mesh.refine[{i}] (near {r.near}): size = {r.size:g} m, but the file's own sizes give "
                          f"{h:.3g} m there already, so it changes nothing; give a smaller size, or remove it")
     return notes
+
+
+STEP_SOLIDS = (b"MANIFOLD_SOLID_BREP(", b"BREP_WITH_VOIDS(")
+"""The entities of a STEP file that are one solid each (counted before gmsh reads it)."""
+
+
+def check_step_parts(path: Path) -> None:
+    """InputError if the STEP file ``path`` holds more than :data:`MAX_PARTS` solids: counted in
+    its text before gmsh reads it (reading 2 000 cubes alone took minutes)."""
+    if path.suffix.lower() not in (".step", ".stp"):
+        return
+    count, tail = 0, b""
+    with open(path, "rb") as f:
+        while chunk := f.read(1 << 22):
+            block = tail + chunk
+            count += sum(block.count(k) for k in STEP_SOLIDS)
+            tail = block[-32:]
+            count -= sum(tail.count(k) for k in STEP_SOLIDS)  # counted again with the next block
+        count += sum(tail.count(k) for k in STEP_SOLIDS)
+    if count > MAX_PARTS:
+        raise InputError(str(path), f"has {count} solids, more than the budget of {MAX_PARTS} parts (making them "
+                         "conformal takes hours)", "merge parts in the CAD model, or mesh a sub-assembly")
 
 
 def _mesh_in_gmsh(spec: MeshSpec, gmsh, own_background: bool = False) -> tuple[dict, dict]:
@@ -246,6 +270,7 @@ def mesh_geometry(spec: MeshSpec) -> FrameMesh:
     """Mesh ``spec.path`` and return the named mesh (2-D if the geometry is planar)."""
     root = spec.root or spec.path.parent
     script = spec.path if spec.path.suffix.lower() == SCRIPT else None
+    check_step_parts(spec.path)
     background = False
     if script is not None:
         read = scan(script, root, spec.include)  # every file it reads inside the case's folder or named

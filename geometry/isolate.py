@@ -47,8 +47,9 @@ STILL_S = 30.0
 """Without ``-v``: a line saying gmsh is still at work after this long, and every twice as long
 since (a mesh of millions of elements takes minutes; nothing on the terminal looked like a hang)."""
 READ_LIMIT_S = 30
-"""Longest a geometry script may take to run, before meshing, s: a script that runs longer (an
-endless loop) is refused (the child ends on SIGALRM). Meshing itself has no time limit."""
+"""Longest a geometry script may take to run (or gmsh to read a CAD file), before meshing, s: a
+file that takes longer (an endless loop) is refused (the child ends on SIGALRM). Meshing itself has
+no time limit."""
 
 
 def _child(work, out: int, logfd: int, sock: socket.socket, go: int, verbose: bool, parent: int) -> None:
@@ -257,7 +258,8 @@ def _result(data: bytes, status: int, label: str, lines) -> tuple[dict, dict[str
     if not data:
         if os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGALRM:
             raise InputError(label, f"gmsh was still reading it after {READ_LIMIT_S} s (an endless loop in the "
-                             "script?)", "end every loop of the script, or simplify the geometry")
+                             "script, or a CAD file too large?)", "end every loop of the script, or simplify the "
+                             "geometry (a sub-assembly of the CAD model)")
         if os.WIFSIGNALED(status):
             sig = os.WTERMSIG(status)
             raise InputError(label, f"gmsh crashed on it ({signal.Signals(sig).name}){said}",

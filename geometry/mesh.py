@@ -218,7 +218,14 @@ def load_mesh(path: str | os.PathLike) -> FrameMesh:
         # the format's reader itself: meshio.read prints an unreadable file's error and exits
         mm = msh22.read_binary(path.read_bytes()) if path.suffix == ".msh" else None
         if mm is None:
-            mm = (meshio.gmsh if path.suffix == ".msh" else meshio.vtu).read(str(path))
+            import contextlib
+            import io
+
+            said = io.StringIO()  # meshio prints its warnings (a section not closed …) to stderr: logged, naming the file
+            with contextlib.redirect_stderr(said):
+                mm = (meshio.gmsh if path.suffix == ".msh" else meshio.vtu).read(str(path))
+            for line in filter(None, (x.strip() for x in said.getvalue().splitlines())):
+                log.warning("%s: meshio: %s", path.name, line.removeprefix("Warning: ")[:200])
         dim = max((b.dim for b in mm.cells if b.type in _CORNERS), default=0)
         if dim < 2:
             raise InputError(str(path), "holds no triangles or tetrahedra", "mesh a surface (2-D) or a volume (3-D)")

@@ -187,7 +187,7 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
         r = min(states, len(hsv) - 1)
         red.reduce(r)
         V[m] = red.V.to_numpy()
-        bound[m] = [float(b) for b in red.error_bounds()[:r]]
+        bound[m] = [2.0 * float(np.sum(hsv))] + [float(b) for b in red.error_bounds()[:r]]  # [0]: no direction
         hankel[m] = [float(x) for x in hsv[:20]]
         secs[f"balancing_{m or 'single'}"] = time.perf_counter() - t0
         log.info("mode %s: Gramian ranks %d/%d, Hankel singular values %s", m or "-",
@@ -204,7 +204,11 @@ def reduce(lhm: LinearHeatModel, states: int = 30, handover: int = 12, horizon_s
     secs["projection"] = time.perf_counter() - t0
     # each mode's BT bound at the number of its balanced directions the union took
     taken = {m: sum(order[j][0] == m for j in used) for m in modes}
-    err_bound = {m: bound[m][taken[m] - 1] if taken[m] else float("inf") for m in modes}
+    err_bound = {m: bound[m][taken[m]] for m in modes}
+    for m in (m for m in modes if not taken[m]):
+        log.warning("states: %d states hold only the inputs' static responses, no balanced direction%s: its error "
+                    "bound is that of none (%.3g); give more states (e.g. 30)", states, f" of mode {m}" if m else "",
+                    err_bound[m])
     d = key[0]
     dc = {m: float(np.max(np.abs(lhm.C[d] @ static[m] - rom.C[d] @ np.linalg.solve(-rom.A[m], rom.B[m]))))
           if lhm.B[m].shape[1] else 0.0 for m in modes}

@@ -27,7 +27,8 @@ import numpy as np
 from gatetherm import InputError
 from gatetherm.checks import _short
 
-CONVENTIONS = {"on_": typing.Optional[abc.Callable], "stopped": typing.Optional[abc.Callable],
+CONVENTIONS = {"on_progress": typing.Optional[abc.Callable[[int, int], None]],
+               "on_step": typing.Optional[abc.Callable[[int, int], None]], "on_": typing.Optional[abc.Callable], "stopped": typing.Optional[abc.Callable],
                "out": typing.Union[str, os.PathLike, None]}
 """Annotations of unannotated parameters by name (a prefix ending in ``_`` or the whole name)."""
 FIXES = {"Case": "make one with gt.load_case(path) or gt.gate_frame()",
@@ -35,6 +36,11 @@ FIXES = {"Case": "make one with gt.load_case(path) or gt.gate_frame()",
          "Run": "make one with gt.run(case)", "Config": "give a model file's path",
          "TimeSeries": "read one with gatetherm.studies.run.timeseries.read_timeseries(path)"}
 """How to make a value of the classes the API takes (by class name), for the TypeError's fix."""
+INFINITE = "infinity allowed"
+"""``Annotated[float, INFINITE]``: a parameter that takes ``math.inf`` (with a meaning its docstring
+gives: ``beam_normalised``'s beta, no tie bar); NaN is refused still."""
+FloatOrInf = typing.Annotated[float, INFINITE]
+"""A float that may be infinite."""
 _SEQUENCES = (list, tuple, set, frozenset, range, np.ndarray, abc.Sequence, abc.Set, abc.KeysView, abc.ValuesView)
 
 
@@ -134,8 +140,10 @@ def check(name: str, value, hint, default=inspect.Parameter.empty) -> None:
         fixes = [FIXES[k.__name__] for k in kinds if getattr(k, "__name__", "") in FIXES]
         raise TypeError(f"{name}: got {type(value).__name__} {_short(value)}, expected {describe(hint)}"
                         + (f"; {fixes[0]}" if fixes else ""))
+    _check_arity(name, value, hint)
     if _number(value, hint, float) and not math.isfinite(value) and not (isinstance(default, float)
-                                                                         and math.isinf(default)):
+                                                                         and math.isinf(default)) \
+            and not (math.isinf(value) and INFINITE in getattr(hint, "__metadata__", ())):
         raise InputError(name, f"got {value!r}, must be a finite number", "give a number")
     if _number(value, hint, int) and not _number(value, hint, float) and not float(value).is_integer():
         raise InputError(name, f"got {value!r}, must be a whole number", "give a whole number")
@@ -143,6 +151,23 @@ def check(name: str, value, hint, default=inspect.Parameter.empty) -> None:
                            else (hint,)) if typing.get_origin(a) is typing.Literal]
     if literal and value is not None and value not in typing.get_args(literal[0]):
         raise InputError(name, f"got {value!r}", f"choose one of {', '.join(map(repr, typing.get_args(literal[0])))}")
+
+
+def _check_arity(name: str, value, hint) -> None:
+    """TypeError naming ``name`` if ``value``, a function where ``hint`` is ``Callable[[A, B], R]``,
+    cannot be called with that many arguments (it would fail inside the work, naming nothing)."""
+    kinds = typing.get_args(hint) if typing.get_origin(hint) in (typing.Union, types.UnionType) else (hint,)
+    params = [typing.get_args(k)[0] for k in kinds if typing.get_origin(k) is abc.Callable and typing.get_args(k)
+              and isinstance(typing.get_args(k)[0], list)]
+    if not params or not callable(value):
+        return
+    try:
+        inspect.signature(value).bind(*range(len(params[0])))
+    except ValueError:  # a builtin without a signature: not checked
+        return
+    except TypeError as err:
+        raise TypeError(f"{name}: {_short(value)} cannot be called with {len(params[0])} arguments ({err}); give a "
+                        f"function of {len(params[0])} arguments, e.g. lambda i, n: print(i, n)") from None
 
 
 def checked(fn):

@@ -164,6 +164,8 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
     if data is not None and condition is not None:
         raise InputError("data", "and condition are both given", "give one: a measured record, or one of the "
                          "paper's conditions to simulate")
+    if not interval_min > 0:
+        raise InputError("interval_min", f"got {interval_min!r}, must be > 0 min", "e.g. interval_min=5.0")
     params = CompensatorParams(update_interval_s=interval_min * 60.0)
     control = PredictiveParams(mode=updates, max_updates=max_updates, interval_s=params.update_interval_s)
     fitted = None

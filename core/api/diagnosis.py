@@ -48,7 +48,7 @@ def diagnosis_model(case: str | os.PathLike | None = None, *, dim: int = 2, conf
         return model
     if mesh_size is not None:
         raise InputError("--case/--mesh-size", "a case file gives its own mesh", "set [mesh] in the case file instead")
-    model = load_case(case, mesh_factor or 1.0)
+    model = load_case(case, 1.0 if mesh_factor is None else mesh_factor)
     if model.time is None:
         raise InputError(f"{case}: time", "a diagnosed case needs [time] (a transient run)",
                          "add [time] with end and step; the run's times come from --data")

@@ -9,7 +9,10 @@ import numbers
 import os
 from pathlib import Path
 
+import numpy as np
+
 from gatetherm import InputError
+from gatetherm.api.boundary import FloatOrInf
 from gatetherm.api.case import PATH, Case, gate_frame
 from gatetherm.checks import argument
 
@@ -124,7 +127,7 @@ class BeamCoefficients:
                 f"Kc/(alpha l_C) = {self.kc_norm:.6g}")
 
 
-def beam_normalised(l_over_l4: float, beta: float) -> BeamCoefficients:
+def beam_normalised(l_over_l4: float, beta: FloatOrInf) -> BeamCoefficients:
     """The paper's normalised beam-theory coefficients for a tie bar at ``l/l4`` and stiffness
     ratio ``beta`` (l1 = l/2, one material; eqs 27-29, Figs. 7-8).
 
@@ -147,5 +150,9 @@ def beam_normalised(l_over_l4: float, beta: float) -> BeamCoefficients:
         raise InputError("l_over_l4", f"must be a finite number > 0, got {l_over_l4!r}", "pass l/l4, e.g. 1.5")
     if isinstance(beta, bool) or not b >= 0:  # also rejects nan
         raise InputError("beta", f"must be >= 0, got {beta!r}", "pass e.g. 0.1")
-    ki, kc = (float(v) for v in normalised(a, b))
+    with np.errstate(all="ignore"):
+        ki, kc = (float(v) for v in normalised(a, b))
+    if not (math.isfinite(ki) and math.isfinite(kc)):  # a and β so large that the closed form overflows
+        raise InputError("l_over_l4, beta", f"{a:g} and {b:g} overflow the closed form (K_i {ki}, K_C {kc})",
+                         "pass a frame's values: l/l4 about 0.1 … 10, beta up to about 1e6 (math.inf: no tie bar)")
     return BeamCoefficients(a, b, ki, kc)

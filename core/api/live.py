@@ -227,6 +227,8 @@ def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint
     from gatetherm.validation.live.axis import Axis
 
     endpoint_url(endpoint)
+    if status_port is not None and not 1 <= status_port <= 65535:
+        raise InputError("--status-port", f"{status_port} is not a port 1..65535", "e.g. --status-port 8080")
     if model is None and case is None:
         raise InputError("--case/--model", "give the machine's case (or a fitted model)", "e.g. --case case.toml")
     guards = guards or service.Guards()

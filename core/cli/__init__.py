@@ -127,10 +127,9 @@ def _run(argv: list[str] | None) -> int:
         return 2
     except SystemExit as done:  # --help
         return done.code if isinstance(done.code, int) else 0
-    logging.basicConfig(
-        level=logging.INFO if args.verbose else logging.WARNING,
-        format="%(levelname)s %(name)s: %(message)s",
-    )
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    if args.verbose:  # gatetherm's own progress details; the libraries' INFO (scikit-fem: every assembly) stays quiet
+        logging.getLogger("gatetherm").setLevel(logging.INFO)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2

@@ -53,7 +53,7 @@ log = logging.getLogger(__name__)
 def fraction_span(t_s: np.ndarray, lo: float, hi: float) -> tuple[float, float]:
     """The span from fraction ``lo`` to ``hi`` of the time from the first to the last sample, s."""
     if not 0 <= lo < hi <= 1:
-        raise InputError("fit span", f"{lo:g}:{hi:g} is not 0 <= start < end <= 1", "e.g. 0:0.6")
+        raise InputError("fit span (--fit-span, span)", f"{lo:g}:{hi:g} is not 0 <= start < end <= 1", "e.g. 0:0.6")
     return t_s[0] + lo * (t_s[-1] - t_s[0]), t_s[0] + hi * (t_s[-1] - t_s[0])
 
 

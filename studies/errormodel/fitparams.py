@@ -83,14 +83,16 @@ class FitParams:
     def __post_init__(self):
         if self.form not in FIT_FORMS:
             raise InputError("form", f"{self.form!r} is not one of {', '.join(FIT_FORMS)}", "e.g. form auto")
-        if self.max_sensors < 1 or self.max_inputs < 0:
-            raise InputError("max_sensors", "must be >= 1 (and max_inputs >= 0)", "e.g. 4")
+        if self.max_sensors < 1:
+            raise InputError("max_sensors", f"{self.max_sensors} is not >= 1", "e.g. 4")
+        if self.max_inputs < 0:
+            raise InputError("max_inputs", f"{self.max_inputs} is not >= 0", "e.g. 2")
         if not self.folds or min(self.folds) < 2:
             raise InputError("folds", "need block counts >= 2", "e.g. (4, 5, 6, 7, 8)")
-        bad = [v for v in (*self.exponents, *self.input_taus_s, *self.sensor_taus_s, self.max_gap_s)
-               if not (np.isfinite(v) and v > 0)]
+        bad = [(k, v) for k in ("exponents", "input_taus_s", "sensor_taus_s", "max_gap_s")
+               for v in np.atleast_1d(getattr(self, k)) if not (np.isfinite(v) and v > 0)]
         if bad:
-            raise InputError("exponents, time constants, max_gap_s", f"{bad[0]} is not > 0", "use positive values")
+            raise InputError(bad[0][0], f"{bad[0][1]:g} is not > 0", "use positive values")
         if not (np.isfinite(self.resolution_K) and self.resolution_K >= 0):
             raise InputError("resolution_K", f"{self.resolution_K} is not >= 0", "e.g. 0.05 (K, a thermocouple)")
         if self.cv not in CV_KINDS:

@@ -47,6 +47,16 @@ COEFFICIENT = 1e9
 """Largest coefficient or intercept a model file may hold (µm, µm/K …): beyond, an edit gone wrong."""
 
 
+MAX_NAME = 100
+"""Longest column name (a target, a sensor) a model file may hold."""
+KELVIN_LIKE = (253.15, 373.15)
+"""References in this band, °C, are temperatures in kelvins (−20 … 100 °C) by mistake."""
+
+
+def _names(columns) -> str:
+    return ", ".join(map(str, columns)) if isinstance(columns, list) and columns else "none"
+
+
 def _number(value, lo: float = -COEFFICIENT, hi: float = COEFFICIENT) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and lo <= value <= hi
 
@@ -61,6 +71,15 @@ def _check_document(data: dict, where: str) -> None:
 
     targets = data.get("targets")
     need(isinstance(targets, dict) and targets, "targets", "must be a non-empty table of the targets' models")
+    refs = data.get("reference_degC")
+    refs = refs if isinstance(refs, dict) else {}
+    for field, name in [("targets", n) for n in targets] + [("reference_degC", n) for n in refs]:
+        need(len(name) <= MAX_NAME and name.isprintable(), f"{field} {name[:40]!r}" + ("…" if len(name) > 40 else ""),
+             f"is not a column name of at most {MAX_NAME} printable characters ({len(name)} characters)")
+    for s, v in refs.items():
+        need(_number(v, -273.15, 1000.0), f"reference_degC.{s}", "must be a temperature in °C, -273.15 … 1000")
+        need(not KELVIN_LIKE[0] <= v <= KELVIN_LIKE[1], f"reference_degC.{s}",
+             f"is {v:g} °C: a temperature in kelvins? the references are °C (the file's fit gives them)")
     for name, d in targets.items():
         k = f"targets.{name}"
         need(isinstance(d, dict), k, "must be a table")
@@ -72,6 +91,11 @@ def _check_document(data: dict, where: str) -> None:
                  f"must be a number within ±{COEFFICIENT:g}")
             need(name not in (t.get("column"), t.get("other")), f"{k}.terms[{i}].column",
                  f"reads the target {name} itself: a model cannot read the column it predicts")
+        read = [c for t in d["terms"] if t.get("kind") not in ("input", "drift")
+                for c in (t.get("column"), t.get("other")) if c is not None]
+        listed = d.get("sensors", read)
+        need(isinstance(listed, list) and set(map(str, listed)) == set(map(str, read)), f"{k}.sensors",
+             f"lists {_names(listed)} but its terms read {_names(read)}: a hand edit of one without the other")
         interval, ranges = d.get("interval", {}), d.get("ranges", [])
         widths = [v for key, v in interval.items() if key.endswith("_um")] if isinstance(interval, dict) else [None]
         need(all(_number(v, 0.0) for v in widths), f"{k}.interval", "its widths must be numbers >= 0 µm")
@@ -141,6 +165,11 @@ def check_leakage(targets, candidates=(), inputs=(), names=("targets", "candidat
     caller calls the three): a model of a channel that reads the channel itself predicts nothing
     (its held-out error would be round-off) and would be silently wrong; also a target named
     twice, or the time column as a target."""
+    for field, given in zip(names, (targets, candidates or (), inputs or ())):
+        long = next((c for c in given if len(str(c)) > MAX_NAME or not str(c).isprintable()), None)
+        if long is not None:
+            raise InputError(f"{field} {str(long)[:40]!r}…", f"is not a column name of at most {MAX_NAME} printable "
+                             f"characters ({len(str(long))} characters)", "rename the column (a model file keeps it)")
     twice = next((t for i, t in enumerate(targets) if t in targets[:i]), None)
     if twice is not None:
         raise InputError(f"{names[0]} {twice}", "is named twice", f"name {twice} once")

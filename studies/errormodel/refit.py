@@ -47,9 +47,19 @@ def refit(model: ErrorModel, columns, window_s: float, applied: dict[str, str] |
         raise InputError("window_s", f"{window_s} is not > 0", "e.g. 86400 (one day)")
     applied = dict(applied or {})
     for target, col in applied.items():
+        if target not in model.names:
+            raise InputError(f"applied correction of {target}", "is not a target of the model",
+                             f"name targets of the model: {', '.join(model.names)}")
+        read = {c for m in model.targets for c in m.columns} | set(model.names)
+        if col in read:  # measured + measured, or a sensor as a correction: the refit would fit nonsense
+            raise InputError(f"applied correction of {target}", f"column {col} is a target or a column the model "
+                             "reads, not the correction the control applied", "name the correction's own column, um")
         if col not in columns:
             raise InputError(f"applied correction of {target}", f"column {col} missing", "name a column of the file")
     values, bad, t = _term_values(model, columns)
+    if t.size and window_s > t[-1] - t[0]:
+        log.warning("window_s: %g s is longer than the data (%g s): the refit window is all of it", window_s,
+                    t[-1] - t[0])
     window = (t >= t[-1] - window_s) & ~bad
     resolution = float(model.settings.get("resolution_K", 0.0))
     step = float(np.median(np.diff(t))) if t.size > 1 else 1.0

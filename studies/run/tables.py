@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.checks import CELSIUS, FINITE, Range
+from gatetherm.checks import BY_UNIT, CELSIUS, FINITE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
 from gatetherm.studies.run.timeseries import alike
 
@@ -98,9 +98,9 @@ class Table:
 
     def value(self, k: str, names, default=None, unit: str = "", rng: Range | None = None) -> Value:
         """The value at ``k``: a number or an expression of ``names``, in ``rng`` (default the range
-        of its ``unit``: °C a temperature, else finite), checked now if it reads no input, else
-        wherever it is evaluated."""
-        rng = rng or (CELSIUS if unit == "°C" else FINITE)
+        of its ``unit``, :data:`gatetherm.checks.BY_UNIT`: °C a temperature, N a force …; else
+        finite), checked now if it reads no input, else wherever it is evaluated."""
+        rng = rng or BY_UNIT.get(unit, FINITE)
         if k not in self.data and default is not None:
             return Value(default, "", self.key(k), rng)
         if k not in self.data:

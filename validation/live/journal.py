@@ -27,7 +27,10 @@ LOG, STATE, EVENTS, LOCK = "live.csv", "state.json", "events.log", "live.lock"
 
 def lock(directory: Path):
     """Hold ``DIR/live.lock`` (released when the process ends, however it ends); InputError if
-    another process holds it."""
+    another process holds it, or for a file in the way."""
+    from gatetherm.outdir import check_path
+
+    check_path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     fd = os.open(directory / LOCK, os.O_RDWR | os.O_CREAT, 0o644)
     try:
@@ -139,6 +142,12 @@ def summarize(directory, counts: dict, settle_s: float = 600.0) -> dict:
     ``settle_s`` of machine time (µm); written to ``summary.json``."""
     from gatetherm.studies.run.timeseries import read_timeseries
 
+    lines = [x for x in (directory / "live.csv").read_text(encoding="utf-8").splitlines() if x and x[0] != "#"]
+    if len(lines) < 2:  # stopped before its first period (no connection yet): nothing to summarise but the counts
+        out = {**counts, "rows": 0, "first_s": None, "last_s": None, "monitor": "inactive (no period)",
+               "worse_verdict": None}
+        write_text_atomic(directory / "summary.json", json.dumps(out, indent=2, allow_nan=False) + "\n")
+        return out
     ts = read_timeseries(directory / "live.csv", required=("time_s",))
     out = {**counts, "rows": len(ts.time_s), "first_s": float(ts.time_s[0]) if len(ts.time_s) else None,
            "last_s": float(ts.time_s[-1]) if len(ts.time_s) else None}

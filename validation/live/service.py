@@ -200,7 +200,7 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
     svc, g = Service(stepper, journal, params, read), params.guards
     stop = stop or asyncio.Event()
     client, resolved, wait, lost_at, ever = None, None, g.retry_first_s, None, False
-    pace, nones = Pace(params.poll_s), 0
+    pace, nones, said = Pace(params.poll_s), 0, -math.inf
 
     async def pause(seconds):  # ended early by stop
         try:
@@ -244,6 +244,12 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     journal.event(None, f"connection lost ({type(err).__name__}: {err}); correction held at "
                                   f"{svc.written:.3f} um")
                     lost_at = lost_at or time.monotonic()
+                    said = -math.inf
+                if time.monotonic() - said >= 60.0:  # on the terminal too, each minute: not a silent hang
+                    log.warning("%s: %s for %.0f s (%s: %s); retrying, Ctrl-C stops", endpoint,
+                                "no connection" if not ever else "connection lost", time.monotonic() - lost_at,
+                                type(err).__name__, str(err)[:200])
+                    said = time.monotonic()
                 await _close(client)
                 client, before = None, time.monotonic()
                 pace.reset()

@@ -69,14 +69,36 @@ class TwinParams:
             raise InputError("--speed", f"must be > 0, got {self.speed}", "e.g. --speed 120")
         if not (math.isfinite(self.step_s) and self.step_s > 0):
             raise InputError("twin step", f"must be > 0, got {self.step_s}", "e.g. 60 s")
-        if min(self.noise_K, self.resolution_K, self.noise_um, self.resolution_um, self.start_s) < 0:
-            raise InputError("twin noise", "negative", "use values >= 0")
+        for name in ("noise_K", "resolution_K", "noise_um", "resolution_um", "start_s"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError("--start" if name == "start_s" else name, f"must be a finite number >= 0, got {value!r}",
+                                 "use values >= 0")
+        for fault in self.faults:
+            if not (len(fault) == 3 and isinstance(fault[0], str) and all(
+                    isinstance(v, (int, float)) and math.isfinite(v) for v in fault[1:]) and fault[1] <= fault[2]):
+                raise InputError("--fault", f"{fault!r} is not (column, from_s, to_s) with from_s <= to_s",
+                                 "e.g. --fault theta_A_degC:3600:7200")
+
+    def check_against(self, columns, end_s: float) -> None:
+        """InputError for a fault of a column the twin does not publish, or a start past ``end_s``."""
+        unknown = [f[0] for f in self.faults if f[0] not in columns]
+        if unknown:
+            raise InputError(f"--fault {unknown[0]}", "is not a column the twin publishes",
+                             f"choose one of {', '.join(sorted(columns))}")
+        if self.start_s > end_s:
+            raise InputError("--start", f"{self.start_s:g} s is past the schedule's end ({end_s:g} s)",
+                             f"give a machine time in 0 .. {end_s:g} s")
 
 
 def endpoint_url(endpoint: str) -> str:
-    """``endpoint`` checked: ``opc.tcp://HOST:PORT``."""
-    if not isinstance(endpoint, str) or not endpoint.startswith("opc.tcp://") or ":" not in endpoint[10:]:
-        raise InputError("--endpoint", f"{endpoint!r} is not opc.tcp://HOST:PORT", "e.g. opc.tcp://127.0.0.1:4840")
+    """``endpoint`` checked: ``opc.tcp://HOST:PORT``, a host name without spaces or slashes and
+    a port 1..65535."""
+    host, _, port = endpoint[10:].rpartition(":") if isinstance(endpoint, str) else ("", "", "")
+    if not (isinstance(endpoint, str) and endpoint.startswith("opc.tcp://") and host and port.isdigit()
+            and 1 <= int(port) <= 65535 and endpoint.isprintable() and not any(c in host for c in " /?#@")):
+        raise InputError("--endpoint", f"{str(endpoint)[:80]!r} is not opc.tcp://HOST:PORT (a port 1..65535)",
+                         "e.g. opc.tcp://127.0.0.1:4840")
     return endpoint
 
 
@@ -114,6 +136,18 @@ class Machine:
         return self.rom.C[r] @ self.x + self.rom.D[r] @ self.u[self.k] + self.rom.y0[r]
 
 
+class _Stopping:
+    """``async with``: stop a started server on the way out."""
+    def __init__(self, server):
+        self.server = server
+
+    async def __aenter__(self):
+        return self.server
+
+    async def __aexit__(self, *exc):
+        await self.server.stop()
+
+
 class Drive:
     """The correction through an actuator model (:mod:`gatetherm.studies.control.actuator`): each new
     offset is one more command of the sequence, driven with the actuator's strategy and hysteresis."""
@@ -139,8 +173,10 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
     without, it is applied exactly."""
     from asyncua import Server, ua
 
-    logging.getLogger("asyncua").setLevel(logging.ERROR)  # its warnings about an unencrypted loopback endpoint
+    logging.getLogger("asyncua").setLevel(logging.CRITICAL)  # its warnings about an unencrypted loopback endpoint;
+    # a failure to serve is raised (below), not logged with its traceback
     first = Machine(rom, schedule, params.step_s, published)
+    params.check_against({*first.inputs, *published}, float(first.times[-1]))
     until = min(params.until_s if params.until_s is not None else math.inf, first.times[-1])
     while first.times[first.k] < params.start_s - 1e-9 and first.k < len(first.times) - 1:
         first.advance()
@@ -160,7 +196,12 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
             if name in WRITTEN:
                 await nodes[name].set_writable()
         plants.append(_Plant(copy.copy(first), nodes, np.random.default_rng(params.seed + i), Drive(actuator)))
-    async with server:
+    try:
+        await server.start()
+    except OSError as err:  # an address not of this machine, a port in use
+        raise InputError("--endpoint", f"cannot serve on {endpoint} ({err.strerror or err})",
+                         "give an address of this machine and a free port, e.g. opc.tcp://127.0.0.1:4840") from None
+    async with _Stopping(server):
         log.info("twin serving %d machine(s) on %s from t = %g s at %gx", len(plants), endpoint,
                  first.times[first.k], params.speed)
         while params.wait:

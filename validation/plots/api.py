@@ -50,6 +50,11 @@ def series(run, *columns: str, ax=None, hours: bool = True):
     cols = run.columns if hasattr(run, "columns") else run
     if not hasattr(cols, "keys"):
         argument("run", run, (), "a Run, a time series or a mapping of columns", "make one with gt.run(case)")
+    if ax is not None and not hasattr(ax, "plot"):
+        _axes(ax)  # TypeError naming ax, before the columns
+    if not columns:
+        raise InputError("columns", "none given: nothing to draw", f"name columns, e.g. gt.plot.series(run, "
+                         f"{next((repr(c) for c in cols.keys() if c != 'time_s'), repr('delta_um'))})")
     missing = [c for c in ("time_s", *columns) if c not in cols.keys()]
     if missing:
         raise InputError("columns", f"{', '.join(map(repr, missing))} not among the run's columns",
@@ -104,6 +109,7 @@ def response(run, axes=None):
     from gatetherm.validation.plots.labels import signal_labels
     from gatetherm.validation.plots.run import plot_response
 
+    _need(run, ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um"), "the four signals of [signals]")
     return plot_response(run.columns, _title(run), axes, _panels(axes), signal_labels(run.case.problem))
 
 
@@ -124,7 +130,19 @@ def fluids(run, ax=None):
     """
     from gatetherm.validation.plots.run import plot_fluids
 
+    if not run.scenario.model.problem.fluids:
+        raise InputError("run", "its case has no [fluids]: no fluid temperature to draw",
+                         "draw a run of a case with [fluids.NAME], or its columns with gt.plot.series")
     return plot_fluids(run.columns, run.scenario.model.problem, _title(run), _axes(ax))
+
+
+def _need(run, columns, what: str) -> None:
+    """InputError naming the columns a plot needs that ``run`` lacks."""
+    cols = run.columns if hasattr(run, "columns") else run
+    missing = [c for c in columns if c not in cols.keys()]
+    if missing:
+        raise InputError("run", f"has no {', '.join(missing)} ({what})",
+                         "draw a run of a case that has them, or its columns with gt.plot.series")
 
 
 def field(run, name: str = "T", t: float | None = None, ax=None):
