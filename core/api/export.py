@@ -9,6 +9,8 @@ from gatetherm import InputError, write_text_atomic
 from gatetherm.checks import argument, json_text
 from gatetherm.api.run import PATH, Case, Schedule, _case
 
+PUBLIC = ("Export", "export_case", "export_ccx")  # offered as gt.NAME (gatetherm.api finds them here)
+
 
 def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *, schedule: Schedule | None = None,
                title: str | None = None, run: bool = False, on_step=None) -> dict:

@@ -17,6 +17,8 @@ from gatetherm.studies.errormodel.fitted import ErrorModel
 from gatetherm.validation.live.monitor import Monitor
 from gatetherm.validation.live.service import Guards
 
+PUBLIC = ("live", "twin")  # offered as gt.NAME (gatetherm.api finds them here)
+
 log = logging.getLogger(__name__)
 
 SENSORS = ("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um")

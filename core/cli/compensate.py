@@ -55,6 +55,8 @@ from gatetherm.api import COMPENSATE_OUTPUTS as OUTPUTS  # noqa: F401 - what a r
 from gatetherm.api import COMPENSATION_METHODS, K_SOURCES, THERMOCOUPLES, InputError, compensate_run
 from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
 
+ORDER = 60  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
 
+ORDER = 120  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 DESCRIPTION = (
     "Write DIR/job.inp for CalculiX 2.20 (run 'ccx job' in DIR) and DIR/gatetherm.json with gatetherm's own "
     "displacements at the probes. Written: the mesh (3-D: C3D4, C3D10 at order 2; 2-D plane strain: CPE3/CPE6 of "

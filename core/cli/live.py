@@ -15,6 +15,8 @@ from __future__ import annotations
 
 from gatetherm.api import InputError
 
+ORDER = 150  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("live", help="compensate a machine over OPC UA, a compensator step every period",
