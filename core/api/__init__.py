@@ -57,6 +57,7 @@ from gatetherm.api.compensation import WRITTEN  # noqa: F401 - for the command l
 from gatetherm.api.diagnosis import OUTPUTS as DIAGNOSE_OUTPUTS  # noqa: F401 - for the command line
 from gatetherm.checks import POSITIVE, Range  # noqa: F401
 from gatetherm.solvers.errors import SolverError  # noqa: F401 - with these below, for the command line's dispatcher
+from gatetherm.studies.run.formats import FORMATS  # noqa: F401 - the command line's export formats
 from gatetherm.studies.sweeps.runner import PointsFailed  # noqa: F401
 
 from gatetherm.studies.control.methods import K_SOURCES, METHODS  # noqa: F401 - the command line's choices
