@@ -60,13 +60,10 @@ from gatetherm.solvers.errors import SolverError  # noqa: F401 - with these belo
 from gatetherm.studies.run.formats import FORMATS  # noqa: F401 - the command line's export formats
 from gatetherm.studies.sweeps.runner import PointsFailed  # noqa: F401
 
-from gatetherm.studies.control.methods import K_SOURCES, METHODS  # noqa: F401 - the command line's choices
+from gatetherm.studies.control.methods import K_SOURCES  # noqa: F401 - the command line's choices
 from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - the command line's default
 
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
-
-COMPENSATION_METHODS = METHODS[:3]
-"""The methods ``gatetherm compensate --method`` offers (the fourth, errormodel, is its --model)."""
 
 
 def _discover() -> list[str]:
@@ -107,7 +104,16 @@ _check_arguments()
 
 def __getattr__(name: str):
     """``gatetherm.api.plot``: the plots (:mod:`gatetherm.validation.plots.api`, as ``gt.plot``),
-    imported on first use."""
+    imported on first use; the compensation methods (:mod:`gatetherm.studies.control.method`), read
+    when asked: ``METHODS`` every one, ``COMPENSATION_METHODS`` those ``gatetherm compensate
+    --method`` offers (errormodel is its --model), ``METHOD_SUMMARIES`` their summaries by name,
+    ``STEPWISE_METHODS`` those of ``gatetherm live``."""
+    from gatetherm.studies.control import method
+
+    if name in ("METHODS", "COMPENSATION_METHODS", "STEPWISE_METHODS", "METHOD_SUMMARIES"):
+        return {"METHODS": method.names, "COMPENSATION_METHODS": method.offered,
+                "STEPWISE_METHODS": lambda: method.offered(stepwise=True),
+                "METHOD_SUMMARIES": lambda: {m.name: m.summary for m in method.methods() if m.offered}}[name]()
     if name == "plot":
         import importlib
 

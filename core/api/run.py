@@ -16,8 +16,8 @@ from gatetherm.api.case import PATH, Case, Schedule, _case  # noqa: F401 - PATH,
 from gatetherm.api.case import beam_coefficients, condition, gate_frame, load_case, nc_schedule, \
     schedule_file  # noqa: F401 - for the API's modules
 from gatetherm.checks import POSITIVE, Range, argument, number_argument
-from gatetherm.options import SolverOptions
-from gatetherm.process import configure
+from gatetherm.options import SolverOptions  # noqa: F401 - offered (PUBLIC)
+from gatetherm.process import configure  # noqa: F401 - offered (PUBLIC)
 from gatetherm.studies.run.scenario import ScenarioRun, run_scenario
 
 PUBLIC = ("Run", "SolverOptions", "configure", "run")  # offered as gt.NAME (gatetherm.api finds them here)
