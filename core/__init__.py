@@ -22,13 +22,14 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-def _api() -> tuple[str, ...]:
-    """The names :mod:`gatetherm.api` offers: the ``PUBLIC`` of each of its modules, read from their
-    sources (importing the API costs seconds; this a few milliseconds, once)."""
+def _api(folders=None) -> tuple[str, ...]:
+    """The names :mod:`gatetherm.api` offers: the ``PUBLIC`` of each of its modules (in ``folders``,
+    default the package's), read from their sources (importing the API costs seconds; this a few
+    milliseconds, once)."""
     import ast
 
     names = []
-    for path in sorted((Path(__file__).parent / "api").glob("*.py")):
+    for path in sorted(p for folder in folders or [Path(__file__).parent / "api"] for p in Path(folder).glob("*.py")):
         for node in ast.parse(path.read_text(encoding="utf-8")).body:
             if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "PUBLIC" for t in node.targets):
                 names += ast.literal_eval(node.value)

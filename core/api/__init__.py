@@ -66,10 +66,11 @@ from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - t
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
 
 
-def _discover() -> list[str]:
-    """Import every module of this package and offer the names of its ``PUBLIC`` here: a new
-    task is one module (``core/api/TASK.py`` with ``PUBLIC = ("task", "TaskResult")``), found
-    without a list to edit. ``gatetherm.API`` reads the same ``PUBLIC`` from the sources."""
+def _discover(namespace: dict) -> list[str]:
+    """Import every module of this package and offer the names of its ``PUBLIC`` in ``namespace``
+    (this module's): a new task is one module (``core/api/TASK.py`` with ``PUBLIC = ("task",
+    "TaskResult")``), found without a list to edit. ``gatetherm.API`` reads the same ``PUBLIC``
+    from the sources."""
     import importlib
     import pkgutil
 
@@ -79,12 +80,12 @@ def _discover() -> list[str]:
         for name in getattr(module, "PUBLIC", ()):
             if name in names:
                 raise ImportError(f"{module.__name__}: {name} is offered by another module of gatetherm.api too")
-            globals()[name] = getattr(module, name)
+            namespace[name] = getattr(module, name)
             names.append(name)
     return sorted(names)
 
 
-__all__ = _discover()
+__all__ = _discover(globals())
 
 
 def _check_arguments() -> None:

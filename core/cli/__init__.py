@@ -20,16 +20,17 @@ def _commands() -> tuple[str, ...]:
     """The sub-command modules of this package: every module with a top-level ``def register(``, in
     ``--help`` order (its ``ORDER = N``, then its name). Read from the sources, not imported: a
     command's run imports its own module only. A new command is one module, ``NAME.py``."""
-    here = os.path.dirname(os.path.abspath(__file__))
-    found = []
-    for entry in sorted(os.listdir(here)):
-        if entry.endswith(".py") and not entry.startswith("_"):
-            with open(os.path.join(here, entry), encoding="utf-8") as f:
-                lines = f.read().splitlines()
-            if any(line.startswith("def register(") for line in lines):
-                order = next((line.split("=")[1].split("#")[0] for line in lines if line.startswith("ORDER = ")), "")
-                found.append((int(order) if order.strip().isdigit() else 10 ** 6, entry[:-3]))
-    return tuple(name for _, name in sorted(found))
+    found = {}
+    for here in __path__:
+        for entry in sorted(os.listdir(here)):
+            if entry.endswith(".py") and not entry.startswith("_") and entry[:-3] not in found:
+                with open(os.path.join(here, entry), encoding="utf-8") as f:
+                    lines = f.read().splitlines()
+                if any(line.startswith("def register(") for line in lines):
+                    order = next((line.split("=")[1].split("#")[0] for line in lines if line.startswith("ORDER = ")),
+                                 "")
+                    found[entry[:-3]] = int(order) if order.strip().isdigit() else 10 ** 6
+    return tuple(sorted(found, key=lambda name: (found[name], name)))
 
 
 COMMAND_MODULES = _commands()
