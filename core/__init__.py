@@ -22,20 +22,29 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-API = ("BeamCoefficients", "Case", "CompensationRun", "DiagnosisRun", "DriftReport", "ErrorModelFit", "Export",
-       "FrameFiles", "Prediction", "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule", "SensorStudy",
-       "SolverOptions", "SweepResult", "Validation", "beam_coefficients", "beam_normalised", "check_placement",
-       "check_rom", "check_schedules", "compensate", "compensate_run", "condition", "configure", "diagnose",
-       "diagnose_run", "diagnosis_hypotheses", "diagnosis_model", "drift_report", "errormodel_fit",
-       "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live", "load_case",
-       "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
-       "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",
-       "write_reduction")
-"""Names of :mod:`gatetherm.api` offered here (imported on first use)."""
+def _api(folders=None) -> tuple[str, ...]:
+    """The names :mod:`gatetherm.api` offers: the ``PUBLIC`` of each of its modules (in ``folders``,
+    default the package's), read from their sources (importing the API costs seconds; this a few
+    milliseconds, once)."""
+    import ast
+
+    names = []
+    for path in sorted(p for folder in folders or [Path(__file__).parent / "api"] for p in Path(folder).glob("*.py")):
+        for node in ast.parse(path.read_text(encoding="utf-8")).body:
+            if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "PUBLIC" for t in node.targets):
+                names += ast.literal_eval(node.value)
+    return tuple(sorted(names))
 
 
 def __getattr__(name: str):
-    if name in API or name == "plot":
+    """``gatetherm.API``: the names of :mod:`gatetherm.api` offered here (imported on first use), and
+    each of them, and ``plot``."""
+    if name == "API":
+        globals()["API"] = value = _api()
+        return value
+    here = Path(__file__).parent
+    module = (here / f"{name}.py").exists() or (here / name / "__init__.py").exists()  # `from gatetherm import checks`
+    if name == "plot" or (not name.startswith("_") and not module and name in __getattr__("API")):
         import importlib
 
         value = (importlib.import_module("gatetherm.validation.plots.api") if name == "plot"

@@ -316,10 +316,9 @@ def test_the_api_call_check_sees_a_command_that_bypasses_the_api(tmp_path):
 #: concept (CONTRIBUTING.md) and remove them here. Why each is still one module: run.case holds the
 #: Case type and its one reader (21 modules import load_case from it); the diagnosis's discrepancy,
 #: select and calibrate are each one algorithm (the search, the selection with its back-tracking, the
-#: fit of a piece) whose helpers are used nowhere else; control.methods is the table of the four
-#: compensation methods with their fit and replay.
+#: fit of a piece) whose helpers are used nowhere else.
 LONG_MODULES = {
-    "gatetherm.studies.control.methods": 320, "gatetherm.studies.diagnosis.calibrate": 303,
+    "gatetherm.studies.diagnosis.calibrate": 303,
     "gatetherm.studies.diagnosis.discrepancy": 362, "gatetherm.studies.diagnosis.select": 305,
     "gatetherm.studies.run.case": 427,
 }

@@ -95,7 +95,7 @@ def test_a_negative_constant_load_is_read_with_a_word(tmp_path, caplog):
 
 
 def test_a_guide_friction_above_one_is_refused():
-    from gatetherm.studies.run.case_sources import FRICTION
+    from gatetherm.solvers.elements.guide import FRICTION
     assert FRICTION.admits(0.003) and not FRICTION.admits(3.0) and not FRICTION.admits(-0.001)
 
 

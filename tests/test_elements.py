@@ -1,4 +1,4 @@
-"""Machine elements' losses (solvers/elements.py) and their sources in a case file: each formula
+"""Machine elements' losses (solvers/elements/) and their sources in a case file: each formula
 against its hand calculation, each expression against its function, and an insulated block
 heated by a bearing's Palmgren loss at P/(m c)."""
 from __future__ import annotations

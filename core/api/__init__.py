@@ -53,45 +53,39 @@ Anything else is a defect of gatetherm: please report it.
 """
 from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
 from gatetherm.api.compensation import OUTPUTS as COMPENSATE_OUTPUTS  # noqa: F401 - for the command line
-from gatetherm.api.compensation import WRITTEN, CompensationRun, compensate_run  # noqa: F401 - WRITTEN: cli
-from gatetherm.api.control import compensate, diagnose
+from gatetherm.api.compensation import WRITTEN  # noqa: F401 - for the command line
 from gatetherm.api.diagnosis import OUTPUTS as DIAGNOSE_OUTPUTS  # noqa: F401 - for the command line
-from gatetherm.api.diagnosis import DiagnosisRun, diagnose_run, diagnosis_hypotheses, diagnosis_model
-from gatetherm.api.errormodel import ErrorModelFit, Prediction, Refit, errormodel_fit, errormodel_predict, \
-    errormodel_refit
-from gatetherm.api.export import Export, export_case, export_ccx
-from gatetherm.api.frame import BeamCoefficients, FrameFiles, beam_normalised, mesh_frame
-from gatetherm.api.jobs import RunResult, run_case, simulate
-from gatetherm.api.live import live, twin
-from gatetherm.api.reduction import ReductionRun, check_rom, check_schedules, reduce, reduce_case, write_reduction
-from gatetherm.api.run import Case, Run, Schedule, SolverOptions, beam_coefficients, condition, configure, \
-    gate_frame, load_case, nc_schedule, run, schedule_file
-from gatetherm.api.reports import DriftReport, Report, drift_report, report
-from gatetherm.api.sensors import SensorStudy, check_placement, place_sensors, sensor_study, write_placement
-from gatetherm.api.study import SweepResult, sweep
-from gatetherm.api.validate_study import Validation, validate
-from gatetherm.api.zoo import validate_zoo
 from gatetherm.checks import POSITIVE, Range  # noqa: F401
 from gatetherm.solvers.errors import SolverError  # noqa: F401 - with these below, for the command line's dispatcher
+from gatetherm.studies.run.formats import FORMATS  # noqa: F401 - the command line's export formats
 from gatetherm.studies.sweeps.runner import PointsFailed  # noqa: F401
 
-from gatetherm.studies.control.methods import K_SOURCES, METHODS  # noqa: F401 - the command line's choices
+from gatetherm.studies.control.methods import K_SOURCES  # noqa: F401 - the command line's choices
 from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - the command line's default
 
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
 
-COMPENSATION_METHODS = METHODS[:3]
-"""The methods ``gatetherm compensate --method`` offers (the fourth, errormodel, is its --model)."""
 
-__all__ = ["BeamCoefficients", "Case", "CompensationRun", "DiagnosisRun", "DriftReport", "ErrorModelFit", "Export",
-           "FrameFiles", "Prediction", "ReductionRun", "Refit", "Report", "Run", "RunResult", "Schedule",
-           "SensorStudy", "SolverOptions", "SweepResult", "Validation", "beam_coefficients", "beam_normalised",
-           "check_placement", "check_rom", "check_schedules", "compensate", "compensate_run", "condition", "configure",
-           "diagnose", "diagnose_run", "diagnosis_hypotheses", "diagnosis_model", "drift_report", "errormodel_fit",
-           "errormodel_predict", "errormodel_refit", "export_case", "export_ccx", "gate_frame", "live", "load_case",
-           "mesh_frame", "nc_schedule", "place_sensors", "reduce", "reduce_case", "report", "run", "run_case",
-           "schedule_file", "sensor_study", "simulate", "sweep", "twin", "validate", "validate_zoo", "write_placement",
-           "write_reduction"]
+def _discover(namespace: dict) -> list[str]:
+    """Import every module of this package and offer the names of its ``PUBLIC`` in ``namespace``
+    (this module's): a new task is one module (``core/api/TASK.py`` with ``PUBLIC = ("task",
+    "TaskResult")``), found without a list to edit. ``gatetherm.API`` reads the same ``PUBLIC``
+    from the sources."""
+    import importlib
+    import pkgutil
+
+    names = []
+    for info in pkgutil.iter_modules(__path__):
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        for name in getattr(module, "PUBLIC", ()):
+            if name in names:
+                raise ImportError(f"{module.__name__}: {name} is offered by another module of gatetherm.api too")
+            namespace[name] = getattr(module, name)
+            names.append(name)
+    return sorted(names)
+
+
+__all__ = _discover(globals())
 
 
 def _check_arguments() -> None:
@@ -111,7 +105,16 @@ _check_arguments()
 
 def __getattr__(name: str):
     """``gatetherm.api.plot``: the plots (:mod:`gatetherm.validation.plots.api`, as ``gt.plot``),
-    imported on first use."""
+    imported on first use; the compensation methods (:mod:`gatetherm.studies.control.method`), read
+    when asked: ``METHODS`` every one, ``COMPENSATION_METHODS`` those ``gatetherm compensate
+    --method`` offers (errormodel is its --model), ``METHOD_SUMMARIES`` their summaries by name,
+    ``STEPWISE_METHODS`` those of ``gatetherm live``."""
+    from gatetherm.studies.control import method
+
+    if name in ("METHODS", "COMPENSATION_METHODS", "STEPWISE_METHODS", "METHOD_SUMMARIES"):
+        return {"METHODS": method.names, "COMPENSATION_METHODS": method.offered,
+                "STEPWISE_METHODS": lambda: method.offered(stepwise=True),
+                "METHOD_SUMMARIES": lambda: {m.name: m.summary for m in method.methods() if m.offered}}[name]()
     if name == "plot":
         import importlib
 

@@ -17,6 +17,9 @@ from gatetherm.frame.conditions import CONDITIONS, condition_schedule
 from gatetherm.frame.conditions import condition as _condition
 from gatetherm.studies.run.schedules import Schedule, file_schedule
 
+PUBLIC = ("Case", "Schedule", "beam_coefficients", "condition", "gate_frame", "load_case", "nc_schedule",
+          "schedule_file")  # offered as gt.NAME (gatetherm.api finds them here)
+
 __all__ = ["Case", "Schedule", "beam_coefficients", "condition", "gate_frame", "load_case", "nc_schedule",
            "schedule_file"]
 

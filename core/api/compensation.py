@@ -14,6 +14,8 @@ from gatetherm.api.run import PATH, Case
 from gatetherm.checks import argument, json_text
 from gatetherm.outdir import output_dir
 
+PUBLIC = ("CompensationRun", "compensate_run")  # offered as gt.NAME (gatetherm.api finds them here)
+
 log = logging.getLogger(__name__)
 
 WRITTEN = ("u_piezo_um", "delta_pred_um", "delta_comp_um")

@@ -9,6 +9,8 @@ from gatetherm.checks import argument
 from gatetherm.studies.control.actuator import ActuatorParams
 from gatetherm.studies.run.timeseries import TimeSeries
 
+PUBLIC = ("compensate", "diagnose")  # offered as gt.NAME (gatetherm.api finds them here)
+
 
 def compensate(series: TimeSeries | Run, case: Case | None = None, method: str = "paper", *,
                actuator: ActuatorParams | str | None = "case", **settings):

@@ -12,6 +12,8 @@ from gatetherm import InputError, write_text_atomic
 from gatetherm.api.run import PATH, Case
 from gatetherm.checks import argument
 
+PUBLIC = ("DiagnosisRun", "diagnose_run", "diagnosis_hypotheses", "diagnosis_model")
+
 #: What a diagnosis writes into its output directory; a rerun replaces all of it.
 OUTPUTS = ("residuals.png", "scores.png", "before_after.png", "model.toml", "report.md", "diagnosis.json")
 

@@ -20,6 +20,8 @@ from gatetherm.studies.errormodel.trust import trust
 from gatetherm.studies.errormodel.refit import refit
 from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
 
+PUBLIC = ("ErrorModelFit", "Prediction", "Refit", "errormodel_fit", "errormodel_predict", "errormodel_refit")
+
 log = logging.getLogger(__name__)
 
 

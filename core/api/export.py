@@ -1,4 +1,5 @@
-"""Export a state for another code: a CalculiX input deck (:mod:`gatetherm.api`)."""
+"""Export a state for another code: a deck of an output format of
+:mod:`gatetherm.studies.run.formats` (CalculiX's ``ccx``), :mod:`gatetherm.api`."""
 from __future__ import annotations
 
 import dataclasses
@@ -8,6 +9,9 @@ from pathlib import Path
 from gatetherm import InputError, write_text_atomic
 from gatetherm.checks import argument, json_text
 from gatetherm.api.run import PATH, Case, Schedule, _case
+from gatetherm.studies.run.formats import FORMATS, INFO, check_time, get
+
+PUBLIC = ("Export", "export_case", "export_ccx")  # offered as gt.NAME (gatetherm.api finds them here)
 
 
 def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *, schedule: Schedule | None = None,
@@ -54,8 +58,7 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
         ``run``: ``calculix``, CalculiX's ``probes_m`` and ``relative_m`` and ``worst`` (the
         largest probe difference over gatetherm's largest displacement).
     """
-    from gatetherm.studies.run.ccx import check_time, export_state
-
+    fmt = FORMATS["ccx"]
     _case(case)
     out = Path(argument("out", out, PATH, "a folder's path"))
     if out.exists() and not out.is_dir():
@@ -68,29 +71,34 @@ def export_ccx(case: Case, out: str | os.PathLike, time: float | None = None, *,
     argument("run", run, bool, "True or False")
     schedule = case.schedule if schedule is None else schedule
     t = check_time(schedule, float(schedule.times[-1]) if time is None else float(time))
-    inp, info = export_state(case, schedule, t, title or f"gatetherm {case.name}, t = {t / 60:g} min", on_step)
+    inp, info = fmt.writer().export_state(case, schedule, t, title or f"gatetherm {case.name}, t = {t / 60:g} min",
+                                          on_step)
     out.mkdir(parents=True, exist_ok=True)
-    return _write_deck(out, inp, info, run)
+    return _write_deck(fmt.name, out, inp, info, run)
 
 
-def _write_deck(out: Path, inp: str, info: dict, run: bool) -> dict:
-    """``out/job.inp`` and ``out/gatetherm.json``; with ``run``, CalculiX run there (its results in the dict)."""
-    from gatetherm.studies.run.ccx import run_ccx
-
-    write_text_atomic(out / "job.inp", inp)
-    write_text_atomic(out / "gatetherm.json", json_text(info, "gatetherm.json", indent=2))
+def _write_deck(format: str, out: Path, inp: str, info: dict, run: bool) -> dict:
+    """``out/DECK`` and ``out/gatetherm.json``; with ``run``, the other code run there (its results in
+    the dict under the format's code, lower case: ``calculix``)."""
+    fmt = FORMATS[format]
+    write_text_atomic(out / fmt.deck, inp)
+    write_text_atomic(out / INFO, json_text(info, INFO, indent=2))
     if run:
-        info = {**info, "calculix": run_ccx(out, info)}
+        if not fmt.runner:
+            raise InputError("run", f"gatetherm cannot run {fmt.code}", f"run '{fmt.command}' in {out} yourself")
+        info = {**info, fmt.code.lower(): getattr(fmt.writer(), fmt.runner)(out, info)}
     return info
 
 
-OUTPUTS = ("job.inp", "gatetherm.json", "ccx.log")
-"""What :meth:`Export.write` writes; writing again replaces all of it (CalculiX's own files are left)."""
+OUTPUTS = FORMATS["ccx"].outputs
+"""What :meth:`Export.write` of a CalculiX deck writes (each format's: ``Format.outputs``); writing
+again replaces all of it (CalculiX's own files are left)."""
 
 
 @dataclasses.dataclass(frozen=True)
 class Export:
-    """A state exported for CalculiX by :func:`export_case`, and the folder it was written into."""
+    """A state exported for another code (CalculiX) by :func:`export_case`, and the folder it was
+    written into."""
 
     deck: str
     """``job.inp``'s text."""
@@ -102,10 +110,12 @@ class Export:
     """Input files the written folder must keep."""
     folder: str | None = None
     """The folder it was written into, as given (None: not written)."""
+    format: str = "ccx"
+    """The output format (:mod:`gatetherm.studies.run.formats`)."""
 
     def write(self, out: str | os.PathLike) -> "Export":
-        """Write ``out/job.inp`` and ``out/gatetherm.json`` (with :attr:`run`, run ``ccx job`` there)
-        in one transaction.
+        """Write ``out/job.inp`` (the format's deck) and ``out/gatetherm.json`` (with :attr:`run`, run
+        ``ccx job`` there) in one transaction.
 
         Returns
         -------
@@ -114,30 +124,31 @@ class Export:
         """
         from gatetherm.outdir import output_dir
 
-        with output_dir(out, OUTPUTS, keep=self.files) as stage:
-            info = _write_deck(stage, self.deck, self.info, self.run)
+        with output_dir(out, FORMATS[self.format].outputs, keep=self.files) as stage:
+            info = _write_deck(self.format, stage, self.deck, self.info, self.run)
         return dataclasses.replace(self, info=info, folder=str(out))
 
     def summary(self) -> str:
         """The lines ``gatetherm export ccx`` prints (no final newline)."""
-        info, ccx = self.info, self.info.get("calculix")
-        lines = [f"wrote {self.folder}/job.inp ({info['element']}, {info['nodes']} nodes) and gatetherm.json"
-                 + ("" if self.run else f"; run: cd {self.folder} && ccx job")]
+        fmt = FORMATS[self.format]
+        info, other = self.info, self.info.get(fmt.code.lower())
+        lines = [f"wrote {self.folder}/{fmt.deck} ({info['element']}, {info['nodes']} nodes) and {INFO}"
+                 + ("" if self.run else f"; run: cd {self.folder} && {fmt.command}")]
         for name, v in info["relative_m"].items():
             lines.append(f"gatetherm {name}: {v * 1e6:.6g} um" + (
-                f", CalculiX {ccx['relative_m'][name] * 1e6:.6g} um ({ccx['relative_m'][name] / v - 1:+.1e})"
-                if ccx and v else ""))
-        if ccx:
-            lines.append(f"CalculiX against gatetherm at the probes: largest difference {ccx['worst']:.1e} of the "
+                f", {fmt.code} {other['relative_m'][name] * 1e6:.6g} um ({other['relative_m'][name] / v - 1:+.1e})"
+                if other and v else ""))
+        if other:
+            lines.append(f"{fmt.code} against gatetherm at the probes: largest difference {other['worst']:.1e} of the "
                          "largest displacement")
         return "\n".join(lines)
 
 
 def export_case(case: Case | str | os.PathLike | None = None, *, condition: int | None = None,
                 time: float | None = None, dim: int = 2, config: str | os.PathLike | None = None, run: bool = False,
-                out: str | os.PathLike | None = None, on_progress=None) -> Export:
-    """A case file's state (or the paper's frame's under a condition) as a CalculiX deck: what
-    ``gatetherm export ccx`` does (:func:`export_ccx` for what the deck holds and refuses).
+                out: str | os.PathLike | None = None, on_progress=None, format: str = "ccx") -> Export:
+    """A case file's state (or the paper's frame's under a condition) as a deck for another code:
+    what ``gatetherm export FORMAT`` does (:func:`export_ccx` for what CalculiX's deck holds and refuses).
 
     Parameters
     ----------
@@ -158,6 +169,8 @@ def export_case(case: Case | str | os.PathLike | None = None, *, condition: int 
         to ``time``.
     on_progress : callable, optional
         ``on_progress(i, n)`` after each of the ``n`` samples of the run to ``time``.
+    format : str
+        The output format, a name of :data:`gatetherm.studies.run.formats.FORMATS` (``"ccx"``: CalculiX).
 
     Returns
     -------
@@ -167,9 +180,9 @@ def export_case(case: Case | str | os.PathLike | None = None, *, condition: int 
     from gatetherm.api.case import PATH, gate_frame, load_case
     from gatetherm.checks import argument
     from gatetherm.outdir import output_dir
-    from gatetherm.studies.run.ccx import check_time, export_state
     from gatetherm.frame.conditions import condition as check_condition
 
+    fmt = get(format)
     argument("case", case, (Case, *PATH, type(None)), "a Case, a case file's path or None")
     argument("run", run, bool, "True or False")
     if (case is None) == (condition is None):
@@ -187,11 +200,11 @@ def export_case(case: Case | str | os.PathLike | None = None, *, condition: int 
     files = (config, *case.files)
 
     def made() -> Export:
-        return Export(*export_state(case, schedule, t, title, on_progress), run, files)
+        return Export(*fmt.writer().export_state(case, schedule, t, title, on_progress), run, files, format=fmt.name)
 
     if out is None:
         return made()
-    with output_dir(out, OUTPUTS, keep=files) as stage:
+    with output_dir(out, fmt.outputs, keep=files) as stage:
         result = made()
-        info = _write_deck(stage, result.deck, result.info, run)
+        info = _write_deck(fmt.name, stage, result.deck, result.info, run)
     return dataclasses.replace(result, info=info, folder=str(out))

@@ -16,6 +16,8 @@ from gatetherm.api.boundary import FloatOrInf
 from gatetherm.api.case import PATH, Case, gate_frame
 from gatetherm.checks import argument
 
+PUBLIC = ("BeamCoefficients", "FrameFiles", "beam_normalised", "mesh_frame")
+
 MESH_FILES = ("mesh.msh", "mesh.vtu")
 """The frame's mesh as written by :meth:`FrameFiles.write`."""
 OUTPUTS = (*MESH_FILES, "case.toml", "schedule.csv")

@@ -10,6 +10,8 @@ from gatetherm.api.case import PATH, Schedule, gate_frame, load_case, schedule_f
 from gatetherm.api.run import Run, run
 from gatetherm.checks import POSITIVE, argument, number_argument
 
+PUBLIC = ("RunResult", "run_case", "simulate")  # offered as gt.NAME (gatetherm.api finds them here)
+
 FIELD_FILES = ("fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf", "fields/fields.h5")
 """The field files of a run in its folder (studies.run.output.write_fields)."""
 OUTPUTS = ("timeseries.csv", "summary.json", *FIELD_FILES, "channels.png", "oil_temperatures.png", "response.png",

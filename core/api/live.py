@@ -2,12 +2,11 @@
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import logging
 import os
 from pathlib import Path
 from typing import Mapping
-
-import numpy as np
 
 from gatetherm.api.run import PATH, Case, Schedule
 from gatetherm.api.run import _case as _a_case
@@ -16,6 +15,8 @@ from gatetherm.solvers.rom import ReducedModel
 from gatetherm.studies.errormodel.fitted import ErrorModel
 from gatetherm.validation.live.monitor import Monitor
 from gatetherm.validation.live.service import Guards
+
+PUBLIC = ("live", "twin")  # offered as gt.NAME (gatetherm.api finds them here)
 
 log = logging.getLogger(__name__)
 
@@ -108,48 +109,32 @@ def _case(case) -> Case:
 
 
 def _stepper(case, method, model, target, params, states, out, sched, axis=None):
+    """The step-wise compensator of ``method`` (:mod:`gatetherm.studies.control.method`), or of the
+    error model ``model``, and its label."""
     from gatetherm import InputError
-    from gatetherm.studies.control.methods import METHODS, Settings, coefficients
-    from gatetherm.studies.control.predictive import PredictiveParams
-    from gatetherm.studies.control.regression import THETAS, fit_regression
-    from gatetherm.studies.control.stepwise import PaperStepper, RegressionStepper, error_model_stepper
-    from gatetherm.studies.run.scenario import run_scenario
-    from gatetherm.studies.run.timeseries import TimeSeries
+    from gatetherm.studies.control import method as methods
 
+    setup = methods.Setup(case, params, states, out, sched, target=target)
     if model is not None:
         from gatetherm.studies.errormodel.model import load_model
-        from gatetherm.studies.errormodel.replay import loop_target
 
         m = load_model(model) if isinstance(model, (str, Path)) else model
         if axis is not None:
+            from gatetherm.studies.control.stepwise import error_model_stepper
             from gatetherm.validation.live.axis import AxisStepper
 
             probes = {k: error_model_stepper(m, m.target(k).target, params) for k in axis.positions_m}
             return AxisStepper(probes, axis), f"errormodel {model} along an axis ({len(probes)} probes)"
-        return error_model_stepper(m, loop_target(m, target), params), f"errormodel {model}"
+        return methods.get("errormodel").stepper(dataclasses.replace(setup, model=m))[0], f"errormodel {model}"
     if axis is not None:
         raise InputError("--axis", f"the {method} method gives delta at one point, not along an axis",
                          "give a --model with a target per probe, or leave --axis out (offset only)")
-    if method not in METHODS[:3]:
-        raise InputError("--method", f"unknown method {method!r}", "choose paper, mlr or rom, or give --model")
+    offered = methods.offered(stepwise=True)
+    if method not in offered:
+        raise InputError("--method", f"unknown method {method!r}", f"choose {methods.either(offered)}, or give --model")
     if case is None:
         raise InputError("--case", f"the {method} method needs the machine's case", "give --case CASE.toml")
-    if method == "rom":
-        from gatetherm.studies.control.stepwise_rom import RomStepper
-        from gatetherm.studies.run.reduce import cached_rom
-
-        rom = cached_rom(case, states, out)
-        end = float(sched.times[-1])
-        t = params.sample_interval_s * np.arange(int(np.floor(end / params.sample_interval_s + 1e-9)) + 1)
-        rows = [dict(sched.drive(float(x))) for x in t]
-        plan = TimeSeries({"time_s": t, **{k: np.array([r[k] for r in rows], float) for k in rows[0]}})
-        control = PredictiveParams(interval_s=params.update_interval_s)
-        return RomStepper(rom, plan, params, control), f"rom ({rom.states} states)"
-    run = run_scenario(case).series({})
-    if method == "paper":
-        ki, kc, source = coefficients(case, run, Settings())
-        return PaperStepper(ki, kc, params), f"paper (K_i {ki:.4g}, K_C {kc:.4g} um/K, {source})"
-    return RegressionStepper(fit_regression(run, THETAS), params), "mlr"
+    return methods.get(method).stepper(setup)
 
 
 def live(case: Case | str | Path | None = None, method: str = "rom", *, endpoint: str, out: str | os.PathLike,

@@ -11,6 +11,8 @@ from gatetherm.api.run import Case, Schedule, _case, condition
 from gatetherm.checks import Range, argument, whole_argument
 from gatetherm.solvers.rom import ReducedModel, Reduction
 
+PUBLIC = ("ReductionRun", "check_rom", "check_schedules", "reduce", "reduce_case", "write_reduction")
+
 STATES = Range(2, 200, whole=True)
 """States a reduced model may have (``gatetherm reduce --states``)."""
 

@@ -10,6 +10,8 @@ from typing import Sequence
 
 from gatetherm.validation.report.registry import SECTIONS
 
+PUBLIC = ("DriftReport", "Report", "drift_report", "report")
+
 PAGE = ("index.html", "validation.md")
 """What a report run replaces in its folder; the sections' folders (the cache) are kept."""
 DRIFT = ("index.html", "drift.png")

@@ -13,19 +13,19 @@ import numpy as np
 
 from gatetherm import InputError, UnknownName
 from gatetherm.api.case import PATH, Case, Schedule, _case  # noqa: F401 - PATH, _case: for the API's modules
-from gatetherm.api.case import beam_coefficients, condition, gate_frame, load_case, nc_schedule, schedule_file
+from gatetherm.api.case import beam_coefficients, condition, gate_frame, load_case, nc_schedule, \
+    schedule_file  # noqa: F401 - for the API's modules
 from gatetherm.checks import POSITIVE, Range, argument, number_argument
-from gatetherm.options import SolverOptions
-from gatetherm.process import configure
+from gatetherm.options import SolverOptions  # noqa: F401 - offered (PUBLIC)
+from gatetherm.process import configure  # noqa: F401 - offered (PUBLIC)
 from gatetherm.studies.run.scenario import ScenarioRun, run_scenario
+
+PUBLIC = ("Run", "SolverOptions", "configure", "run")  # offered as gt.NAME (gatetherm.api finds them here)
 
 log = logging.getLogger(__name__)
 
 STATE_BUDGET_BYTES = 512e6
 """Heat states a :class:`Run` keeps at every sample up to this size; beyond, only at the field times."""
-
-__all__ = ["Case", "Run", "STATE_BUDGET_BYTES", "Schedule", "SolverOptions", "beam_coefficients", "condition",
-           "configure", "gate_frame", "load_case", "nc_schedule", "run", "schedule_file"]
 
 WRITTEN = ("timeseries.csv", "summary.json", "fields/fields_*.vtu", "fields/fields.pvd", "fields/fields.xdmf",
            "fields/fields.h5", "channels.png", "oil_temperatures.png", "response.png", "deformed.png")

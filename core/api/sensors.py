@@ -14,6 +14,8 @@ from gatetherm.checks import POSITIVE, Range, argument, number_argument, whole_a
 from gatetherm.studies.sensors.check import FECheck
 from gatetherm.studies.sensors.result import Placement
 
+PUBLIC = ("SensorStudy", "check_placement", "place_sensors", "sensor_study", "write_placement")
+
 SPAN = Range(-1e9, 1e9)
 """What a bound of ``ranges`` may be, in the input's unit (°C, W, 1/min …)."""
 

@@ -10,6 +10,8 @@ from pathlib import Path
 
 from gatetherm.checks import Range
 
+PUBLIC = ("SweepResult", "sweep")  # offered as gt.NAME (gatetherm.api finds them here)
+
 _WORKERS = Range(1, whole=True)
 OUTPUTS = ("table.csv", "study.json", "*_vs_*.png")
 """What a sweep writes into its output directory besides the point files (kept: a rerun resumes

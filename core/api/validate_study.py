@@ -9,6 +9,8 @@ from pathlib import Path
 
 from gatetherm import InputError
 
+PUBLIC = ("Validation", "validate")  # offered as gt.NAME (gatetherm.api finds them here)
+
 
 @dataclass(frozen=True)
 class Validation:

@@ -8,6 +8,8 @@ from typing import Sequence
 from gatetherm import InputError
 from gatetherm.checks import POSITIVE, argument, number_argument
 
+PUBLIC = ("validate_zoo",)  # offered as gt.NAME (gatetherm.api finds them here)
+
 
 def validate_zoo(out: str | os.PathLike, machines: Sequence[str] | None = None, *,
                  capabilities: Sequence[str] | None = None, timeout_s: float | None = None,

@@ -15,9 +15,26 @@ import signal
 import sys
 import threading
 
-#: Sub-command modules of this package, in ``--help`` order.
-COMMAND_MODULES = ("run", "mesh", "simulate", "beam", "reduce", "compensate", "sweep", "validate", "diagnose",
-                   "errormodel", "sensors", "export", "report", "twin", "live")
+
+def _commands() -> tuple[str, ...]:
+    """The sub-command modules of this package: every module with a top-level ``def register(``, in
+    ``--help`` order (its ``ORDER = N``, then its name). Read from the sources, not imported: a
+    command's run imports its own module only. A new command is one module, ``NAME.py``."""
+    found = {}
+    for here in __path__:
+        for entry in sorted(os.listdir(here)):
+            if entry.endswith(".py") and not entry.startswith("_") and entry[:-3] not in found:
+                with open(os.path.join(here, entry), encoding="utf-8") as f:
+                    lines = f.read().splitlines()
+                if any(line.startswith("def register(") for line in lines):
+                    order = next((line.split("=")[1].split("#")[0] for line in lines if line.startswith("ORDER = ")),
+                                 "")
+                    found[entry[:-3]] = int(order) if order.strip().isdigit() else 10 ** 6
+    return tuple(sorted(found, key=lambda name: (found[name], name)))
+
+
+COMMAND_MODULES = _commands()
+"""Sub-command modules of this package, in ``--help`` order (:func:`_commands`)."""
 
 
 class Terminated(BaseException):

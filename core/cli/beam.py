@@ -4,6 +4,8 @@ from __future__ import annotations
 import argparse
 import math
 
+ORDER = 40  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(subparsers) -> None:
     p = subparsers.add_parser(

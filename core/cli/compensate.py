@@ -52,8 +52,10 @@ import argparse
 import math
 
 from gatetherm.api import COMPENSATE_OUTPUTS as OUTPUTS  # noqa: F401 - what a run writes into --out
-from gatetherm.api import COMPENSATION_METHODS, K_SOURCES, THERMOCOUPLES, InputError, compensate_run
+from gatetherm.api import K_SOURCES, THERMOCOUPLES, InputError, compensate_run
 from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
+
+ORDER = 60  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
 
 
 def register(subparsers) -> None:
@@ -81,9 +83,11 @@ def register(subparsers) -> None:
                    help="actuator update interval in minutes (default 5, as in the paper)")
     p.add_argument("--no-actuator", action="store_true",
                    help="ideal actuator: the stroke equals the command")
-    p.add_argument("--method", choices=COMPENSATION_METHODS, default="paper",
-                   help="paper (default): the paper's procedure; mlr: regression baseline; rom: Kalman filter "
-                   "and predictive control on the reduced model")
+    from gatetherm.api import METHOD_SUMMARIES  # read now: every method registered (studies/control/method/)
+
+    p.add_argument("--method", choices=tuple(METHOD_SUMMARIES), default="paper",
+                   help="; ".join(f"{name}{' (default)' if name == 'paper' else ''}: {summary}"
+                                  for name, summary in METHOD_SUMMARIES.items()))
     p.add_argument("--rom", metavar="ROM.npz", help="rom: reduced model from 'gatetherm reduce' (default: build "
                    "one from the model and keep it in DIR)")
     p.add_argument("--states", type=int, default=30, metavar="N", help="rom: states when building (default 30)")

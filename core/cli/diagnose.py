@@ -17,6 +17,8 @@ from gatetherm.api import DIAGNOSE_OUTPUTS as OUTPUTS  # noqa: F401 - what a run
 from gatetherm.api import POSITIVE, InputError, diagnose_run, diagnosis_hypotheses, diagnosis_model
 from gatetherm.cli.options import Progress, add_model_options, number, refuse_model_options
 
+ORDER = 90  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 DIM_HELP = ("2-D section (default) or 3-D solid. A 3-D diagnosis replays the 3-D model for every hypothesis "
             "(about 100 runs, each up to a 3-D condition's build and march, about 25 s at the default 3-D mesh by the "
             "scaling table in docs/performance.md: tens of minutes, not timed). A 2-D diagnosis of a 3-D "

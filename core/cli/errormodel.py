@@ -16,6 +16,8 @@ from gatetherm.api.errormodel import CV_KINDS, FIT_FORMS, FIT_OUTPUTS, PREDICT_O
     errormodel_predict, errormodel_refit
 from gatetherm.cli.options import Progress
 
+ORDER = 100  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 __all__ = ["FIT_OUTPUTS", "PREDICT_OUTPUTS", "register"]
 
 

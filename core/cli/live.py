@@ -15,12 +15,16 @@ from __future__ import annotations
 
 from gatetherm.api import InputError
 
+ORDER = 150  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("live", help="compensate a machine over OPC UA, a compensator step every period",
                        description=__doc__.splitlines()[0])
     p.add_argument("--case", metavar="CASE.toml", help="the machine's case file (paper, mlr, rom)")
-    p.add_argument("--method", choices=("paper", "mlr", "rom"), default="rom", help="compensation method (default rom)")
+    from gatetherm.api import STEPWISE_METHODS  # read now: every method registered (studies/control/method/)
+
+    p.add_argument("--method", choices=STEPWISE_METHODS, default="rom", help="compensation method (default rom)")
     p.add_argument("--model", metavar="MODEL.json", help="a model from 'gatetherm errormodel fit' instead of --method")
     p.add_argument("--target", metavar="COL", help="--model: the compensated channel")
     p.add_argument("--endpoint", required=True, metavar="URL", help="the control's OPC UA server, opc.tcp://HOST:PORT")

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from gatetherm.cli.options import add_model_options
 
+ORDER = 20  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("mesh", help="mesh the frame; write DIR/mesh.msh, mesh.vtu and the frame as DIR/case.toml")

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from gatetherm.cli.options import Progress, add_model_options, refuse_model_options
 
+ORDER = 50  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 MAX_STATES = 200
 
 

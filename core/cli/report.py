@@ -9,6 +9,8 @@ from gatetherm.api import InputError
 from gatetherm.api.reports import DRIFT, PAGE, SECTION_KEYS, drift_report, report
 from gatetherm.cli.options import WORKERS, Progress, number
 
+ORDER = 130  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 __all__ = ["DRIFT", "PAGE", "register", "run"]
 
 

@@ -5,6 +5,8 @@ from pathlib import Path
 
 from gatetherm.cli.options import Progress
 
+ORDER = 10  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("run", help="run a case file (any machine): time series, summary, fields",

@@ -12,6 +12,8 @@ from gatetherm.api import POSITIVE, InputError, Range
 from gatetherm.api.sensors import OUTPUTS, sensor_study
 from gatetherm.cli.options import Progress, add_model_options, number, refuse_model_options
 
+ORDER = 110  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 __all__ = ["OUTPUTS", "register", "run"]
 COUNT, LOADS, STATES = Range(1, 50, whole=True), Range(0, 500, whole=True), Range(2, 200, whole=True)
 NOISE, LENGTH = Range(0.0, unit="K"), Range(0.0, unit="m")

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from gatetherm.cli.options import Progress, add_model_options, number
 
+ORDER = 30  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="simulate the paper's frame under a condition; write time series, fields, "

@@ -11,6 +11,8 @@ from pathlib import Path
 from gatetherm.api.study import OUTPUTS, sweep
 from gatetherm.cli.options import Progress, add_parallel_options
 
+ORDER = 70  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 __all__ = ["OUTPUTS", "register", "run"]
 
 

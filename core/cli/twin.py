@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from gatetherm.api import InputError
 
+ORDER = 140  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("twin", help="a virtual machine over OPC UA: a case's reduced model in K x real time",

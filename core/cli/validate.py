@@ -12,6 +12,8 @@ from gatetherm.api import POSITIVE, InputError, Range
 from gatetherm.api.validate_study import TARGETS as STUDIES, validate
 from gatetherm.cli.options import WORKERS, Progress, add_model_options, add_parallel_options, number
 
+ORDER = 80  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
+
 
 def register(sub) -> None:
     p = sub.add_parser("validate", help="regenerate a validation study (" + ", ".join(TARGETS) + ")",

@@ -324,7 +324,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         sources = []
         for r in src.data:
             sources.append(case_sources.read_source(
-                src.sub(r, KEYS["sources.REGION"]), r, names,
+                src.sub(r, case_sources.KEYS["sources.REGION"]), r, names,
                 lambda r=r: case_mech.revolved_volume(fm, r) if plane == "axisymmetric" else
                 region_volume(fm, r, thickness.get(r, 1.0)), fm.dim, r not in fm.regions))
         kw["sources"] = tuple(sources)

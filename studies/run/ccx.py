@@ -31,6 +31,7 @@ from skfem import CellBasis
 
 from gatetherm import InputError
 from gatetherm.solvers.model import Model, prescribed_at
+from gatetherm.studies.run.formats import check_time  # noqa: F401 - also offered here
 from gatetherm.studies.run.ccx_mesh import connectivity, element_type, faces, interpolation, set_name, twin_groups
 
 _set = set_name
@@ -215,14 +216,6 @@ def read_dat(text: str) -> dict[str, dict[int, np.ndarray]]:
 def probe_set(name: str) -> str:
     """The node set of a probe in ``job.inp``."""
     return f"P_{_set(name)}"
-
-
-def check_time(schedule, t: float) -> float:
-    """The step of ``schedule`` at ``t`` (s, within 1e-6 s); InputError if there is none."""
-    near = [float(s) for s in schedule.times if abs(t - s) < 1e-6]
-    if not near:
-        raise InputError("--time", f"{t / 60:g} min is not a step of the run", "give a whole minute of the run")
-    return near[0]
 
 
 def export_state(case, schedule, t: float, title: str, on_step=None) -> tuple[str, dict]:
