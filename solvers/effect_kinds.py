@@ -164,16 +164,21 @@ def catalogue_json(targets: Targets = Targets(), keys=None) -> list[dict]:
                     "acts_on": r.effect.acts_on, "target": r.target, "doc": r.doc})
     return out
 
+BEYOND = 1e3
+"""A value more than this many times the largest end of its plausible range is refused: no
+effect's physics reaches it (a factor of 1e300 overflowed the temperatures it then named)."""
+
+
 def checked(r: Resolved, value, where: str) -> float:
     """``value`` if it is a finite number the effect's physics accepts (positive for positive
-    ranges), else InputError."""
+    ranges, within :data:`BEYOND` times the plausible range), else InputError."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise InputError(where, f"expected a number in {r.unit}, got {value!r}")
     positive = r.lo > 0
-    if not np.isfinite(value) or (positive and value <= 0):
+    if not np.isfinite(value) or (positive and value <= 0) or abs(value) > BEYOND * max(abs(r.lo), abs(r.hi)):
         raise InputError(where, f"{r.key}.{r.effect.param} = {value:g} is not physical",
-                         f"give a {'positive' if positive else 'finite'} value in {r.unit} "
-                         f"(plausible: {r.lo:g} … {r.hi:g})")
+                         f"give a {'positive' if positive else 'finite'} value in {r.unit}, at most "
+                         f"{BEYOND:g} × the plausible {r.lo:g} … {r.hi:g} in size")
     return float(value)
 
 

@@ -19,7 +19,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from gatetherm.geometry.measure import region_volume
-from gatetherm.solvers.effects import ActiveEffects, apply_effects
+from gatetherm.solvers.effects import ActiveEffects, apply_effects, checked, resolve
 from gatetherm.solvers.heat import HeatSolver, environment
 from gatetherm.solvers.model import Model, build
 from gatetherm.solvers.sensors import apply_faults
@@ -32,7 +32,11 @@ log = logging.getLogger(__name__)
 
 
 def active(case: Case, effects: Mapping[str, float] | None = None) -> ActiveEffects:
-    """The case's effects, then ``effects`` (these win), resolved against its names."""
+    """The case's effects, then ``effects`` (these win), resolved against its names; each of
+    ``effects`` checked against its kind (InputError naming ``effects[KEY]``)."""
+    for key, value in dict(effects or {}).items():
+        where = f"effects[{key!r}]"
+        checked(resolve(key, case.targets, where), value, where)
     return ActiveEffects({**case.effects, **dict(effects or {})}, case.targets)
 
 
