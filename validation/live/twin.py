@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.process import frozen_heap
 from gatetherm.validation.live.nodes import OBJECT, WRITTEN, machine_namespace
 
 log = logging.getLogger(__name__)
@@ -160,6 +161,13 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
             if name in WRITTEN:
                 await nodes[name].set_writable()
         plants.append(_Plant(copy.copy(first), nodes, np.random.default_rng(params.seed + i), Drive(actuator)))
+    with frozen_heap():  # the address space (~0.5 M objects at 100 machines) out of the full collections
+        return await _serve(server, endpoint, plants, first, until, params, published, stopped)
+
+
+async def _serve(server, endpoint, plants, first, until, params, published, stopped) -> dict:
+    """Serve the plants until ``until`` (machine s): the clock started (once every ``offset_um`` is written
+    with ``params.wait``), each plant publishing its samples; the summary dict."""
     async with server:
         log.info("twin serving %d machine(s) on %s from t = %g s at %gx", len(plants), endpoint,
                  first.times[first.k], params.speed)
