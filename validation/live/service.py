@@ -44,6 +44,10 @@ from gatetherm.validation.live.nodes import NodeMap
 
 log = logging.getLogger(__name__)
 
+NOT_STARTED_S = 0.25
+"""Longest wait between reads while the machine's clock reads NaN (not started, or publishing), s:
+its first sample is seen at most this late (at 1 s, the first period of a 1-s clock was late)."""
+
 
 @dataclass(frozen=True)
 class Guards:
@@ -218,9 +222,9 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     lost_at, wait, ever = None, g.retry_first_s, True
                     await _write(resolved, nodes, svc.written, svc.gradient, svc.reference)
                 sample = await _sample(client, resolved, read, nodes.factor)
-                if sample is None:  # the machine is publishing (or its clock not started: back off to 1 s)
+                if sample is None:  # the machine is publishing (or its clock not started: back off to NOT_STARTED_S)
                     nones += 1
-                    await pause(min(params.poll_s * 2.0 ** (nones - 1), max(params.poll_s, 1.0)))
+                    await pause(min(params.poll_s * 2.0 ** (nones - 1), max(params.poll_s, NOT_STARTED_S)))
                     continue
                 nones = 0
                 t = sample.pop("time_s")
