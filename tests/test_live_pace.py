@@ -11,7 +11,7 @@ def test_pace_waits_until_shortly_before_the_next_sample():
     pace = Pace(0.05)
     assert pace.wait(0.0) == 0.05  # nothing seen yet: poll
     pace.handled(0, 10.00)
-    assert pace.wait(10.01) == 0.05  # one period seen: no interval yet
+    assert [pace.wait(10.01) for _ in range(5)] == [0.05, 0.1, 0.2, 0.25, 0.25]  # one period: back off to 0.25 s
     pace.handled(1, 11.00)
     # 1-s periods: wait until 0.1 s (two polls) before the next is due at 12.00
     assert pace.wait(11.02) == pytest.approx(12.00 - 0.10 - 11.02, abs=1e-12)
@@ -26,10 +26,10 @@ def test_pace_waits_until_shortly_before_the_next_sample():
         pace2.handled(k, wall)
     assert pace2.wait(120.1) == pytest.approx(180.0 - 3.0 - 120.1, abs=1e-12)
     pace2.handled(5, 300.0)  # periods missed: the intervals start again
-    assert pace2.wait(300.1) == 0.05
+    assert [pace2.wait(300.1) for _ in range(4)] == [0.05, 0.1, 0.2, 0.25]
     pace2.handled(6, 360.0)
     pace2.reset()  # the link lost
-    assert pace2.wait(360.1) == 0.05
+    assert [pace2.wait(360.1) for _ in range(3)] == [0.05, 0.05, 0.05]  # poll until a period is seen
 
 
 def test_a_clock_not_started_is_read_every_quarter_second_at_most(monkeypatch, tmp_path):
