@@ -80,6 +80,7 @@ def role_live(a) -> None:
 
     out = Path(a.dir) / f"m{a.index + 1:03d}"
     record_gc(out / "gc.csv")
+    os.nice(a.service_nice)  # behind the twin, which stands for the machines' own controls
     if a.no_freeze:
         _unfrozen()
     handled = open(out / "handled.csv", "w", buffering=1)
@@ -142,6 +143,9 @@ def main() -> None:
     ap.add_argument("--port", type=int, default=48850)
     ap.add_argument("--batch", type=int, default=10, help="services started at a time (default 10)")
     ap.add_argument("--keep", type=Path, help="keep the run's directories here")
+    ap.add_argument("--service-nice", type=int, default=0,
+                    help="the services' niceness above the twin's (default 0: the same): the twin stands for N "
+                         "machines' own controls, one process against N services in the scheduler")
     ap.add_argument("--no-freeze", action="store_true", help="the heaps not frozen (as before 7 Dec 2026), to compare")
     ap.add_argument("--role", choices=("twin", "live"), help=argparse.SUPPRESS)
     ap.add_argument("--index", type=int, help=argparse.SUPPRESS)
@@ -177,7 +181,7 @@ def main() -> None:
     endpoint = f"opc.tcp://127.0.0.1:{a.port}"
     common = [sys.executable, __file__, "--dir", str(directory), "--until", repr(until), "--endpoint", endpoint,
               "--machines", str(n), "--states", str(a.states), "--poll", repr(a.poll), "--method", a.method,
-              *(("--no-freeze",) if a.no_freeze else ())]
+              "--service-nice", str(a.service_nice), *(("--no-freeze",) if a.no_freeze else ())]
     logs = open(directory / "processes.log", "w")
     t_launch = time.time()
     twin = subprocess.Popen([*common, "--role", "twin"], stdout=logs, stderr=subprocess.STDOUT)
@@ -214,7 +218,7 @@ def main() -> None:
     print(f"after: {load_after}")
     codes = [p.returncode for p in procs]
     res = summarize(directory, n, until, samples, codes)
-    res.update({"machines": n, "method": a.method, "seconds": a.seconds, "heap_frozen": not a.no_freeze, "until_s": until, "states": a.states, "poll_s": a.poll,
+    res.update({"machines": n, "method": a.method, "seconds": a.seconds, "heap_frozen": not a.no_freeze, "service_nice": a.service_nice, "until_s": until, "states": a.states, "poll_s": a.poll,
                 "speed": SPEED, "step_s": STEP, "uptime_before": load_before, "uptime_after": load_after,
                 "startup_s": None if started is None else started - t_launch,
                 "arrangement": "one twin process serving all machines, one live process per machine",

@@ -89,7 +89,7 @@ class Pace:
         self.last, self.waits = (k, wall), 0
 
     def reset(self) -> None:
-        """The link was lost: poll until two periods are seen again."""
+        """The link was lost: poll until a period is seen, then back off until the interval is known."""
         self.last = None
         self.intervals.clear()
 

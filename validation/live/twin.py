@@ -161,7 +161,7 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
             if name in WRITTEN:
                 await nodes[name].set_writable()
         plants.append(_Plant(copy.copy(first), nodes, np.random.default_rng(params.seed + i), Drive(actuator)))
-    with frozen_heap():  # the address space (~0.5 M objects at 100 machines) out of the full collections
+    with frozen_heap():  # the address space out of the full collections (~220 CPU-ms each at 100 machines)
         return await _serve(server, endpoint, plants, first, until, params, published, stopped)
 
 
