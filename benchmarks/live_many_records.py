@@ -95,7 +95,10 @@ def analyse(directory: Path, n: int, speed: float, step: float) -> dict:
     last = float(np.nanmax(done))
     tgc = _gc(directory / "gc.csv", u0, last)
     sgc = {i: _gc(directory / f"m{i + 1:03d}" / "gc.csv", u0, last) for i in range(n)}
-    res = {"latency_from_due_ms": _q(1e3 * total), "twin_lag_ms": _q(1e3 * twin_lag),
+    parts = ((0, 10), (10, 30), (30, 60), (60, 90), (90, int(sec.max()) + 1))
+    res = {"twin_lag_ms_median_by_part": {f"{a}-{b} s": float(np.median(1e3 * twin_lag[(sec >= a) & (sec < b)]))
+                                          for a, b in parts if np.any((sec >= a) & (sec < b))},
+           "latency_from_due_ms": _q(1e3 * total), "twin_lag_ms": _q(1e3 * twin_lag),
            "service_latency_ms": _q(1e3 * service), "late_from_due": int(np.sum(total > per)),
            "gc_twin": _gcsum(tgc), "gc_twin_before_clock": _gcsum(_gc(directory / "gc.csv", 0.0, u0)), "gc_services": _gcsum(np.concatenate(list(sgc.values()) or [np.zeros((0, 3))]))}
     for name, late in (("late", service > per), ("late_from_due", total > per)):
@@ -131,6 +134,8 @@ def report(r: dict) -> None:
     print(f"of which the twin's lag (due -> published): median {r['twin_lag_ms']['median']:.0f} ms, max "
           f"{r['twin_lag_ms']['max']:.0f} ms; the service's (published -> written): median "
           f"{r['service_latency_ms']['median']:.0f} ms, max {r['service_latency_ms']['max']:.0f} ms")
+    print("the twin's lag, median by part of the run (wall s after the clock's start): "
+          + ", ".join(f"{k} {v:.0f} ms" for k, v in r["twin_lag_ms_median_by_part"].items()))
     for name in ("late", "late_from_due"):
         print(f"{name}: by class {r[f'{name}_by_class']}; worst wall seconds after the clock's start "
               f"[second, periods] {r[f'{name}_worst_seconds']}; worst machines {r[f'{name}_worst_machines']}")
