@@ -51,10 +51,23 @@ def _map(directory: Path, i: int, machines: int, names) -> Path:
     return p
 
 
+def _unfrozen() -> None:
+    """``--no-freeze``: the twin's and the services' heaps not frozen (as before), for comparison."""
+    import contextlib
+
+    from gatetherm.validation.live import runner, twin
+
+    runner.frozen_heap = twin.frozen_heap = contextlib.nullcontext
+
+
 def role_twin(a) -> None:
     import gatetherm as gt
     from gatetherm.studies.run.reduce import load_rom
+    from live_many_records import record_gc
 
+    record_gc(Path(a.dir) / "gc.csv")
+    if a.no_freeze:
+        _unfrozen()
     res = gt.twin(str(CASE), a.endpoint, SPEED, until=a.until, rom=load_rom(Path(a.dir) / "rom" / "rom.npz"),
                   wait=True, machines=a.machines, step_s=STEP)
     res["rusage"] = _rusage()
@@ -63,8 +76,13 @@ def role_twin(a) -> None:
 
 def role_live(a) -> None:
     import gatetherm as gt
+    from live_many_records import record_gc
 
     out = Path(a.dir) / f"m{a.index + 1:03d}"
+    record_gc(out / "gc.csv")
+    os.nice(a.service_nice)  # behind the twin, which stands for the machines' own controls
+    if a.no_freeze:
+        _unfrozen()
     handled = open(out / "handled.csv", "w", buffering=1)
 
     def on_period(row):
@@ -76,6 +94,9 @@ def role_live(a) -> None:
             on_period=on_period, poll=a.poll)
     handled.close()
     (out / "rusage.json").write_text(json.dumps(_rusage()))
+    # every service ends in the same second here (a fleet does not): the interpreter's teardown, a full
+    # collection of each service's heap (gc.csv), would stall the machines still in their last period
+    os._exit(0)
 
 
 def _rusage() -> dict:
@@ -122,6 +143,10 @@ def main() -> None:
     ap.add_argument("--port", type=int, default=48850)
     ap.add_argument("--batch", type=int, default=10, help="services started at a time (default 10)")
     ap.add_argument("--keep", type=Path, help="keep the run's directories here")
+    ap.add_argument("--service-nice", type=int, default=0,
+                    help="the services' niceness above the twin's (default 0: the same): the twin stands for N "
+                         "machines' own controls, one process against N services in the scheduler")
+    ap.add_argument("--no-freeze", action="store_true", help="the heaps not frozen (as before 7 Dec 2026), to compare")
     ap.add_argument("--role", choices=("twin", "live"), help=argparse.SUPPRESS)
     ap.add_argument("--index", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--dir", help=argparse.SUPPRESS)
@@ -155,7 +180,8 @@ def main() -> None:
     until = STEP * round(a.seconds * SPEED / STEP)
     endpoint = f"opc.tcp://127.0.0.1:{a.port}"
     common = [sys.executable, __file__, "--dir", str(directory), "--until", repr(until), "--endpoint", endpoint,
-              "--machines", str(n), "--states", str(a.states), "--poll", repr(a.poll), "--method", a.method]
+              "--machines", str(n), "--states", str(a.states), "--poll", repr(a.poll), "--method", a.method,
+              "--service-nice", str(a.service_nice), *(("--no-freeze",) if a.no_freeze else ())]
     logs = open(directory / "processes.log", "w")
     t_launch = time.time()
     twin = subprocess.Popen([*common, "--role", "twin"], stdout=logs, stderr=subprocess.STDOUT)
@@ -170,12 +196,18 @@ def main() -> None:
     print(f"{n} services launched in {time.time() - t_launch:.0f} s")
     procs = [twin, *lives]
     samples = []  # (wall, busy, total, [(cpu, rss) per process])
-    started = ended = None
+    started = ended = twin_ended = None
     while any(p.poll() is None for p in procs):
         if all(p.poll() is not None for p in lives):
             ended = ended or time.time()
             if time.time() - ended > 30 and twin.poll() is None:
                 twin.terminate()  # every service ended (or failed) 30 s ago: the twin would wait for ever
+        if twin.poll() is not None:
+            twin_ended = twin_ended or time.time()
+            if time.time() - twin_ended > 30:
+                for p in lives:  # a service still reconnecting to a twin that has ended: SIGTERM, state saved
+                    if p.poll() is None:
+                        p.terminate()
         if started is None and _started(directory, n):
             started = time.time()
             print(f"all {n} services stepping {started - t_launch:.0f} s after launch")
@@ -186,7 +218,7 @@ def main() -> None:
     print(f"after: {load_after}")
     codes = [p.returncode for p in procs]
     res = summarize(directory, n, until, samples, codes)
-    res.update({"machines": n, "method": a.method, "seconds": a.seconds, "until_s": until, "states": a.states, "poll_s": a.poll,
+    res.update({"machines": n, "method": a.method, "seconds": a.seconds, "heap_frozen": not a.no_freeze, "service_nice": a.service_nice, "until_s": until, "states": a.states, "poll_s": a.poll,
                 "speed": SPEED, "step_s": STEP, "uptime_before": load_before, "uptime_after": load_after,
                 "startup_s": None if started is None else started - t_launch,
                 "arrangement": "one twin process serving all machines, one live process per machine",
@@ -237,11 +269,14 @@ def summarize(directory: Path, n: int, until: float, samples, codes) -> dict:
         per_machine_p95.append(float(np.percentile(ms, 95)) if ms.size else float("nan"))
         del summary
     lat = np.concatenate(lat) if lat else np.array([np.nan])
+    from live_many_records import analyse
+
     res = {"periods_expected": expected * n, "rows": rows, "held": held, "missed": missed, "late": late,
            "latency_ms": {"median": float(np.median(lat)), "p95": float(np.percentile(lat, 95)),
                           "p99": float(np.percentile(lat, 99)), "max": float(lat.max())},
            "worst_machine_p95_ms": float(np.nanmax(per_machine_p95)) if per_machine_p95 else None,
            "exit_codes_nonzero": sum(c != 0 for c in codes), "twin_exit_code": codes[0]}
+    res["periods"] = analyse(directory, n, SPEED, STEP)
     twin = directory / "twin.json"
     res["twin"] = json.loads(twin.read_text()) if twin.exists() else None
     if len(samples) >= 2:
@@ -259,6 +294,8 @@ def summarize(directory: Path, n: int, until: float, samples, codes) -> dict:
 
 
 def report(r: dict) -> None:
+    from live_many_records import report as report_periods
+
     lat, s, tw = r["latency_ms"], r.get("steady", {}), r.get("twin") or {}
     on_time = r["periods_expected"] - r["missed"] - r["late"]
     print(f"{r['machines']} machines ({r['method']}), 1-s period, {r['seconds']:g} s ({r['until_s']:g} s of machine time at "
@@ -280,6 +317,7 @@ def report(r: dict) -> None:
               f"{s['computer_busy_pct_of_2_cores']:.0f} % busy (2 cores, other work included)")
     print(f"startup (launch to every service stepping): {r['startup_s']:.0f} s; processes with a non-zero exit: "
           f"{r['exit_codes_nonzero']}")
+    report_periods(r.get("periods") or {})
 
 
 if __name__ == "__main__":

@@ -44,6 +44,12 @@ from gatetherm.validation.live.nodes import NodeMap
 
 log = logging.getLogger(__name__)
 
+NOT_STARTED_S = 0.25
+"""Longest wait between reads while the machine's clock reads NaN (not started, or publishing), and
+after a period while the wall time between periods is not yet known (:class:`~.link.Pace`), s: a
+sample is seen at most this late (at 1 s, the first period of a 1-s clock was late; at every 0.05 s,
+100 services starting together asked one twin for 2000 reads a second)."""
+
 
 @dataclass(frozen=True)
 class Guards:
@@ -200,7 +206,7 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
     svc, g = Service(stepper, journal, params, read), params.guards
     stop = stop or asyncio.Event()
     client, resolved, wait, lost_at, ever = None, None, g.retry_first_s, None, False
-    pace, nones, said = Pace(params.poll_s), 0, -math.inf
+    pace, nones, said = Pace(params.poll_s, NOT_STARTED_S), 0, -math.inf
 
     async def pause(seconds):  # ended early by stop
         try:
@@ -218,9 +224,9 @@ async def serve(stepper, journal: Journal, endpoint: str, nodes: NodeMap, params
                     lost_at, wait, ever = None, g.retry_first_s, True
                     await _write(resolved, nodes, svc.written, svc.gradient, svc.reference)
                 sample = await _sample(client, resolved, read, nodes.factor)
-                if sample is None:  # the machine is publishing (or its clock not started: back off to 1 s)
+                if sample is None:  # the machine is publishing (or its clock not started: back off to NOT_STARTED_S)
                     nones += 1
-                    await pause(min(params.poll_s * 2.0 ** (nones - 1), max(params.poll_s, 1.0)))
+                    await pause(min(params.poll_s * 2.0 ** (nones - 1), max(params.poll_s, NOT_STARTED_S)))
                     continue
                 nones = 0
                 t = sample.pop("time_s")

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gatetherm import InputError
+from gatetherm.process import frozen_heap
 from gatetherm.validation.live.nodes import OBJECT, WRITTEN, machine_namespace
 
 log = logging.getLogger(__name__)
@@ -201,6 +202,14 @@ async def serve(rom, schedule, endpoint: str, params: TwinParams, published, sto
     except OSError as err:  # an address not of this machine, a port in use
         raise InputError("--endpoint", f"cannot serve on {endpoint} ({err.strerror or err})",
                          "give an address of this machine and a free port, e.g. opc.tcp://127.0.0.1:4840") from None
+    with frozen_heap():  # the address space out of the full collections (~220 CPU-ms each at 100 machines)
+        return await _serve(server, endpoint, plants, first, until, params, published, stopped)
+
+
+async def _serve(server, endpoint, plants, first, until, params, published, stopped) -> dict:
+    """Serve the plants until ``until`` (machine s): the clock started (once every ``offset_um`` is written
+    with ``params.wait``), each plant publishing its samples; the summary dict. The server is stopped
+    on the way out."""
     async with _Stopping(server):
         log.info("twin serving %d machine(s) on %s from t = %g s at %gx", len(plants), endpoint,
                  first.times[first.k], params.speed)
