@@ -13,7 +13,6 @@ import dataclasses
 import logging
 import math
 import os
-import tomllib
 import types
 import typing
 from dataclasses import dataclass, field
@@ -21,7 +20,7 @@ from importlib import resources
 
 from gatetherm import InputError
 from gatetherm.checks import check_fields
-from gatetherm.files import read_text
+from gatetherm.files import parse_toml, read_text
 from gatetherm.frame.geometry import FrameParams, MeshParams, check_tie_depth, validate
 from gatetherm.frame.problem import TARGETS, ModelConfig, ThermalParams
 from gatetherm.solvers.effects import effects_from_table, effects_table
@@ -172,10 +171,9 @@ def load_config(path: str | os.PathLike | None = None, option: str = "--config")
         source = f"gatetherm:{PAPER_TOML}"
     else:
         text, source = read_text(path, option, "give a TOML model file"), str(path)
+    data = parse_toml(text, source, "fix the model file's syntax")
     try:
-        return parse_config(tomllib.loads(text), source)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(source, f"not valid TOML ({err})") from None
+        return parse_config(data, source)
     except InputError as err:
         raise err.at(source) from None
 

@@ -5,12 +5,11 @@ Every table and key is documented in docs/sweep.md (``tests/test_sweep_docs.py``
 to :data:`KEYS` and :data:`FREE`)."""
 from __future__ import annotations
 
-import tomllib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gatetherm import InputError
-from gatetherm.files import read_text
+from gatetherm.files import parse_toml, read_text
 
 if TYPE_CHECKING:
     from gatetherm.studies.sweeps.sweep import FramePoints, Study
@@ -158,10 +157,7 @@ def load_study(path, frame: FramePoints | None = None) -> Study:
     ``frame``: the frame's side of a study (:data:`gatetherm.frame.sweeppoint.FRAME`, passed in by the
     API); without it only a case study is read."""
     p = Path(path)
-    try:
-        data = tomllib.loads(read_text(p, "STUDY.toml", "give a study file"))
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(str(p), f"not valid TOML ({err})") from None
+    data = parse_toml(read_text(p, "STUDY.toml", "give a study file"), str(p), "fix the study file's syntax")
     try:
         head = data.setdefault("study", {})
         if not isinstance(head, dict):

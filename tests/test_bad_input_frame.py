@@ -1,0 +1,62 @@
+"""The third audit of the paper frame's commands and the files they read (issue 55, part A:
+cases the earlier audits had not shown). One test per class it found, at the boundary where the
+input is read: a TOML file nested thousands deep (tomllib's recursion) and an effect given twice
+on the command line are each one line naming the file or the option and the fix."""
+from __future__ import annotations
+
+import pytest
+
+from gatetherm import InputError
+from gatetherm.cli import main
+from gatetherm.files import MAX_TOML_DEPTH, parse_toml
+
+COARSE = "[mesh]\nsize = 0.03\nsize_3d = 0.04\n"
+
+
+def refused(capsys, code: int, argv, *needles: str) -> str:
+    """Run the command; assert exit ``code``, exactly one line on stderr holding every needle."""
+    got = main([str(a) for a in argv])
+    err = capsys.readouterr().err
+    assert got == code, err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+DEEP = {
+    "arrays": "[effects]\nx = " + "[" * 3000 + "]" * 3000 + "\n",
+    "inline tables": "a = " + "{b = " * 500 + "1" + "}" * 500 + "\n",
+    "tables": "[" + ".".join(f"t{i}" for i in range(MAX_TOML_DEPTH + 1)) + "]\nx = 1\n",
+}
+
+
+@pytest.mark.parametrize("body", DEEP.values(), ids=DEEP)
+def test_a_toml_file_nested_too_deep_is_one_line(tmp_path, capsys, body):
+    """Arrays 3 000 deep ended in tomllib's RecursionError (a traceback); every TOML reader
+    (model, study, case, map, solver files) goes through one parser that refuses them."""
+    cfg = tmp_path / "deep.toml"
+    cfg.write_text(body)
+    refused(capsys, 2, ["simulate", "--condition", "1", "--config", cfg, "--out", tmp_path / "o"],
+            f"gatetherm: error: {cfg}: nested deeper than {MAX_TOML_DEPTH} levels; fix the model file's syntax")
+    study = tmp_path / "study.toml"
+    study.write_text('[study]\ncompute = ["coefficients"]\n' + body)
+    refused(capsys, 2, ["sweep", study, "--out", tmp_path / "o"], f"{study}: nested deeper than {MAX_TOML_DEPTH} levels")
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_toml_file_at_the_depth_limit_is_read():
+    doc = parse_toml("x = " + "[" * (MAX_TOML_DEPTH - 1) + "1" + "]" * (MAX_TOML_DEPTH - 1) + "\n", "f.toml")
+    assert isinstance(doc["x"], list)
+    with pytest.raises(InputError, match="not valid TOML"):
+        parse_toml("[mesh\n", "f.toml")
+
+
+def test_an_effect_given_twice_is_refused(tmp_path, capsys):
+    """--effect piezo_heat:power=1 --effect piezo_heat=2 ran with 2 W without a word."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(COARSE)
+    refused(capsys, 2, ["simulate", "--condition", "1", "--config", cfg, "--no-pictures", "--out", tmp_path / "o",
+                        "--effect", "piezo_heat:power=1", "--effect", "piezo_heat=2"],
+            "gatetherm: error: --effect: piezo_heat is given more than once; give each effect once")
+    assert not (tmp_path / "o").exists()
