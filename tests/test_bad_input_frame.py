@@ -60,3 +60,19 @@ def test_an_effect_given_twice_is_refused(tmp_path, capsys):
                         "--effect", "piezo_heat:power=1", "--effect", "piezo_heat=2"],
             "gatetherm: error: --effect: piezo_heat is given more than once; give each effect once")
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("body, needle", [
+    ("[mesh]\nsize = 50.0\n", "mesh.size: 50 m is larger than the whole frame (0.85 m); lengths are in m; "
+                             "choose an element size below 0.085 m"),
+    ("[mesh]\nsize_3d = 2.0\n", "mesh.size_3d: 2 m is larger than the whole frame"),
+    ("[geometry]\ndepth = 1e20\n", "geometry.depth: got 1e+20, must be a number in (0, 100] m"),
+], ids=["size 50 m", "3-D size 2 m", "depth 1e20"])
+def test_a_frame_size_no_machine_has_is_refused_naming_the_model_file(tmp_path, capsys, body, needle):
+    """[mesh] size = 50 meshed the frame with 69 elements (first peak 3 µm instead of 48 µm), and
+    a 2-D depth of 1e20 m gave a swing of 1e-12 µm, both without a word."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(body)
+    dim = "3" if "3d" in body else "2"
+    refused(capsys, 2, ["mesh", "--dim", dim, "--config", cfg, "--out", tmp_path / "o"], f"gatetherm: error: {cfg}: {needle}")
+    assert not (tmp_path / "o").exists()
