@@ -76,3 +76,67 @@ def test_a_frame_size_no_machine_has_is_refused_naming_the_model_file(tmp_path, 
     dim = "3" if "3d" in body else "2"
     refused(capsys, 2, ["mesh", "--dim", dim, "--config", cfg, "--out", tmp_path / "o"], f"gatetherm: error: {cfg}: {needle}")
     assert not (tmp_path / "o").exists()
+
+
+# ---- compensate: options its method does not read, coefficients no machine has ----------------------
+
+REC = "# format: gatetherm-timeseries/1\ntime_s,theta_A_degC,theta_B_degC,theta_C_degC,delta_um\n" + "".join(
+    f"{60 * i},{20 + 0.1 * i},{20 + 0.05 * i},{20 + 0.01 * i},{0.3 * i}\n" for i in range(20))
+
+
+@pytest.mark.parametrize("extra, needle", [
+    (["--Ki", "2", "--Kc", "1", "--target", "delta_um"],
+     "--target: is read by --model MODEL.json only: --method paper would ignore it"),
+    (["--Ki", "2", "--Kc", "1", "--correction"], "--correction: is read by --model MODEL.json only"),
+    (["--rom", "x.npz"], "--rom: is read by --method rom only: --method paper would ignore it; drop --rom"),
+    (["--method", "mlr", "--states", "5"], "--states: is read by --method rom only: --method mlr would ignore it"),
+    (["--updates", "fixed"], "--updates: is read by --method rom only"),
+    (["--method", "rom", "--Ki", "1", "--Kc", "2"], "--Ki: is read by --method paper only: --method rom would ignore it"),
+    (["--Ki", "1e308", "--Kc", "1"], "--Ki/--Kc: got 1e+308, 1, must be within ±1e+06 um/K"),
+], ids=["target", "correction", "rom file", "states with mlr", "updates", "Ki with rom", "Ki 1e308"])
+def test_compensate_refuses_an_option_its_method_would_ignore(tmp_path, capsys, extra, needle):
+    """--target and --correction without --model, rom's options with paper or mlr, --Ki with rom:
+    each ran without a word; --Ki 1e308 overflowed into a 'report it' error after the run."""
+    data = tmp_path / "d.csv"
+    data.write_text(REC)
+    refused(capsys, 2, ["compensate", "--data", data, "--out", tmp_path / "o", *extra], f"gatetherm: error: {needle}")
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_library_refuses_a_setting_its_method_would_ignore(tmp_path):
+    import gatetherm as gt
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    (tmp_path / "r.csv").write_text(REC)
+    with pytest.raises(InputError, match="--Ki: is read by --method paper only: --method mlr would ignore it"):
+        gt.compensate(read_timeseries(tmp_path / "r.csv", required=("time_s",)), None, "mlr", Ki=1.0, Kc=1.0)
+
+
+# ---- time-series files and the beam command ------------------------------------------------------
+
+def test_a_field_too_long_for_the_csv_reader_is_one_line(tmp_path, capsys):
+    """A 10-MB field ended in _csv.Error (a traceback); a long number is shown shortened."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(COARSE)
+    head = "# format: gatetherm-timeseries/1\ntime_s,oil_degC,pump\n0,40,1\n3600,40,0\n"
+    sched = tmp_path / "s.csv"
+    sched.write_text(head + "1" * 200_000 + "\n")
+    refused(capsys, 2, ["simulate", "--schedule", sched, "--config", cfg, "--out", tmp_path / "o"],
+            f"{sched}, line 5: not CSV (field larger than field limit (131072)); give one number per field")
+    sched.write_text(head + "7200," + "9" * 100_000 + ",1\n")
+    err = refused(capsys, 2, ["simulate", "--schedule", sched, "--config", cfg, "--out", tmp_path / "o"],
+                  "column oil_degC: non-numeric value '99999999999999999999999999999999999...")
+    assert len(err) < 400, err
+
+
+def test_beam_takes_an_infinite_beta_as_documented(capsys):
+    """'inf = no tie bar' (its help) was refused by the API's boundary check as not finite."""
+    import math
+
+    import gatetherm as gt
+
+    assert main(["beam", "--l-over-l4", "2", "--beta", "inf", "--json"]) == 0
+    assert capsys.readouterr().out.strip() == '{"Ki_norm": 1.0, "Kc_norm": 0.0}'
+    assert (gt.beam_normalised(2, math.inf).ki_norm, gt.beam_normalised(2, math.inf).kc_norm) == (1.0, 0.0)
+    with pytest.raises(InputError, match="beta: got nan"):
+        gt.beam_normalised(2, math.nan)

@@ -35,6 +35,9 @@ FIXES = {"Case": "make one with gt.load_case(path) or gt.gate_frame()",
          "Run": "make one with gt.run(case)", "Config": "give a model file's path",
          "TimeSeries": "read one with gatetherm.studies.run.timeseries.read_timeseries(path)"}
 """How to make a value of the classes the API takes (by class name), for the TypeError's fix."""
+INFINITE = "may be infinite"
+"""The mark of a float whose infinities are admissible, ``Annotated[float, INFINITE]``
+(``beam_normalised(beta=math.inf)``: no tie bar); NaN is still refused."""
 _SEQUENCES = (list, tuple, set, frozenset, range, np.ndarray, abc.Sequence, abc.Set, abc.KeysView, abc.ValuesView)
 
 
@@ -137,6 +140,9 @@ def check(name: str, value, hint, default=inspect.Parameter.empty) -> None:
     if _number(value, hint, float) and not math.isfinite(value) and not (isinstance(default, float)
                                                                          and math.isinf(default)):
         raise InputError(name, f"got {value!r}, must be a finite number", "give a number")
+    if typing.get_origin(hint) is typing.Annotated and INFINITE in typing.get_args(hint)[1:] and \
+            _number(value, float, float) and math.isnan(value):
+        raise InputError(name, "got nan, must be a number (or infinite)", "give a number")
     if _number(value, hint, int) and not _number(value, hint, float) and not float(value).is_integer():
         raise InputError(name, f"got {value!r}, must be a whole number", "give a whole number")
     literal = [a for a in (typing.get_args(hint) if typing.get_origin(hint) in (typing.Union, types.UnionType)

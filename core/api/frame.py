@@ -8,8 +8,10 @@ import math
 import numbers
 import os
 from pathlib import Path
+from typing import Annotated
 
 from gatetherm import InputError
+from gatetherm.api.boundary import INFINITE
 from gatetherm.api.case import PATH, Case, gate_frame
 from gatetherm.checks import argument
 
@@ -124,7 +126,7 @@ class BeamCoefficients:
                 f"Kc/(alpha l_C) = {self.kc_norm:.6g}")
 
 
-def beam_normalised(l_over_l4: float, beta: float) -> BeamCoefficients:
+def beam_normalised(l_over_l4: float, beta: Annotated[float, INFINITE]) -> BeamCoefficients:
     """The paper's normalised beam-theory coefficients for a tie bar at ``l/l4`` and stiffness
     ratio ``beta`` (l1 = l/2, one material; eqs 27-29, Figs. 7-8).
 
