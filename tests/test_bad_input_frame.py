@@ -140,3 +140,14 @@ def test_beam_takes_an_infinite_beta_as_documented(capsys):
     assert (gt.beam_normalised(2, math.inf).ki_norm, gt.beam_normalised(2, math.inf).kc_norm) == (1.0, 0.0)
     with pytest.raises(InputError, match="beta: got nan"):
         gt.beam_normalised(2, math.nan)
+
+
+@pytest.mark.parametrize("option, value", [("--effects", ""), ("--effects", ","), ("--parameters", " , "),
+                                           ("--uncertain", ",")])
+def test_a_diagnose_list_naming_nothing_is_refused(tmp_path, capsys, option, value):
+    """--effects "" ran as if no --effects were given (all effects), without a word."""
+    data = tmp_path / "d.csv"
+    data.write_text(REC)
+    refused(capsys, 2, ["diagnose", "--data", data, option, value, "--out", tmp_path / "o"],
+            f"gatetherm: error: {option}: {value!r} names nothing; give names separated by commas, or '{option} none'")
+    assert not (tmp_path / "o").exists()
