@@ -151,3 +151,20 @@ def test_a_diagnose_list_naming_nothing_is_refused(tmp_path, capsys, option, val
     refused(capsys, 2, ["diagnose", "--data", data, option, value, "--out", tmp_path / "o"],
             f"gatetherm: error: {option}: {value!r} names nothing; give names separated by commas, or '{option} none'")
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("edit, needle", [
+    ('[grid]\n' + "".join(f'"geometry.{k}" = [{", ".join(str(0.1 + 0.001 * i) for i in range(40))}]\n'
+                         for k in ("l4", "l_C", "h")),
+     "grid: 40 x 40 x 40 = 64000 points, more than the budget of 10000; sweep fewer values, or split the study"),
+    ('compute = []\n[grid]\n"geometry.l4" = [0.25, 0.3]\n', "study.compute: expected a non-empty list, got []"),
+    ('compute = 3\n[grid]\n"geometry.l4" = [0.25, 0.3]\n', "study.compute: expected a non-empty list, got 3"),
+    ('name = 12\n[grid]\n"geometry.l4" = [0.25, 0.3]\n', "study.name: expected a string, got 12"),
+], ids=["64000 points", "compute nothing", "compute 3", "name 12"])
+def test_a_study_file_beyond_a_budget_or_computing_nothing_is_refused(tmp_path, capsys, edit, needle):
+    """40^4 points planned for more than 180 s with no output (no progress); compute = [] ran
+    and computed nothing, compute = 3 was a TypeError, a number as the name was taken."""
+    study = tmp_path / "s.toml"
+    study.write_text("[study]\n" + edit)
+    refused(capsys, 2, ["sweep", study, "--no-plots", "--out", tmp_path / "o"], f"gatetherm: error: {study}: {needle}")
+    assert not (tmp_path / "o").exists()

@@ -10,6 +10,7 @@ faults as ``CHANNEL = {FAULT = VALUE}``. :func:`config_toml` writes a file that
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 import os
@@ -117,9 +118,15 @@ def _section_table(data: dict, name: str) -> dict:
     return {k: v for k, v in node.items() if not any(s.name == f"{name}.{k}" for s in SCHEMA)}
 
 
+@functools.cache
+def _hints(cls) -> dict:
+    """The type hints of a section's dataclass (resolved once: a sweep plans thousands of points)."""
+    return typing.get_type_hints(cls)
+
+
 def _apply(sec: Section, table: dict, current):
     """``current`` (an instance of ``sec.cls``) with the keys of ``table`` applied."""
-    hints = typing.get_type_hints(sec.cls)
+    hints = _hints(sec.cls)
     known = sec.keys or tuple(f.name for f in dataclasses.fields(sec.cls))
     changes = {}
     for key, value in table.items():
