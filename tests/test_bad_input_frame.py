@@ -168,3 +168,11 @@ def test_a_study_file_beyond_a_budget_or_computing_nothing_is_refused(tmp_path, 
     study.write_text("[study]\n" + edit)
     refused(capsys, 2, ["sweep", study, "--no-plots", "--out", tmp_path / "o"], f"gatetherm: error: {study}: {needle}")
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("study", ["hidden-effects", "compound", "case-diagnosis"])
+def test_a_negative_seed_of_a_validation_study_is_one_line(tmp_path, capsys, study):
+    """validate hidden-effects --seed -1 ended in numpy's ValueError (a traceback) after its setup."""
+    refused(capsys, 2, ["validate", study, "--seed", "-1", "--out", tmp_path / "o"],
+            f"gatetherm validate {study}: error: argument --seed: got -1, must be a whole number in [0, 4.29497e+09]")
+    assert not (tmp_path / "o").exists()
