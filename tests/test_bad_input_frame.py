@@ -204,3 +204,14 @@ def test_a_sigterm_during_metis_waits_for_it_to_return():
     out = subprocess.run([sys.executable, "-c", DEFERRED], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[] [15]"
+
+
+@pytest.mark.parametrize("value", ["4_0", "４０", "infinity", "0x28"])
+def test_a_number_only_python_reads_is_refused_in_a_data_file(tmp_path, capsys, value):
+    """'4_0' was read as 40 (Python's float takes underscores and other scripts' digits)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(COARSE)
+    sched = tmp_path / "s.csv"
+    sched.write_text(f"# format: gatetherm-timeseries/1\ntime_s,oil_degC,pump\n0,40,1\n3600,{value},0\n7200,40,1\n")
+    refused(capsys, 2, ["simulate", "--schedule", sched, "--config", cfg, "--out", tmp_path / "o"],
+            f"{sched}, line 4 (data row 2), column oil_degC: non-numeric value '{value}'; write a decimal number")

@@ -152,6 +152,10 @@ def validate_complete(ts: TimeSeries, names, source: str = "") -> None:
                          "this analysis needs every sample; fill or remove the row")
 
 
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+"""A number as a data file writes it: decimal digits, a point, an exponent."""
+
+
 def _csv_rows(path: Path, lines: list[str], first: int):
     """(line number, fields) of the CSV ``lines`` from index ``first`` on; a line the csv module
     cannot read (a field of more than 128 kB) is one line naming it."""
@@ -169,7 +173,7 @@ def _parse_value(text: str, where: str) -> float:
     if not text:
         return math.nan
     try:
-        value = float(text)
+        value = float(text) if _DECIMAL.fullmatch(text) else math.nan  # not Python's 4_0, ４０ or 'infinity'
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
