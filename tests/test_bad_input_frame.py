@@ -215,3 +215,21 @@ def test_a_number_only_python_reads_is_refused_in_a_data_file(tmp_path, capsys, 
     sched.write_text(f"# format: gatetherm-timeseries/1\ntime_s,oil_degC,pump\n0,40,1\n3600,{value},0\n7200,40,1\n")
     refused(capsys, 2, ["simulate", "--schedule", sched, "--config", cfg, "--out", tmp_path / "o"],
             f"{sched}, line 4 (data row 2), column oil_degC: non-numeric value '{value}'; write a decimal number")
+
+
+def test_a_model_files_sensors_that_disagree_with_its_terms_are_refused(tmp_path, capsys):
+    """'sensors': 'theta_A_degC' (a string, or any list other than the terms' sensors) was read
+    without a word: the field is derived from the terms and nothing checked it."""
+    import json
+
+    data = tmp_path / "d.csv"
+    data.write_text(REC)
+    assert main(["errormodel", "fit", "--data", data, "--targets", "delta_um", "--out", tmp_path / "m"]) == 0
+    capsys.readouterr()
+    model = json.loads((tmp_path / "m" / "model.json").read_text())
+    sensors = model["targets"]["delta_um"]["sensors"]
+    model["targets"]["delta_um"]["sensors"] = sensors[0]
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(model))
+    refused(capsys, 2, ["errormodel", "predict", bad, "--data", data, "--out", tmp_path / "o"],
+            f"gatetherm: error: {bad}: targets.delta_um.sensors: is {sensors[0]!r}, but its terms read {sensors!r}")

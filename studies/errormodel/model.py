@@ -122,6 +122,11 @@ def from_dict(data: dict, where: str = "model") -> ErrorModel:
     for key in ("start_s", "end_s"):  # read back as numbers by predict: a string would fail there
         if key in model.fit_span:
             FINITE.check(f"{where}: fit_span.{key}", model.fit_span[key], "give a model.json from 'gatetherm errormodel fit'")
+    for m in model.targets:  # written for the reader, derived from the terms: it must agree with them
+        given = data["targets"][m.target].get("sensors", list(m.sensors))
+        if given != list(m.sensors):
+            raise InputError(f"{where}: targets.{m.target}.sensors", f"is {given!r}, but its terms read "
+                             f"{list(m.sensors)}", "give a model.json from 'gatetherm errormodel fit'")
     missing = [s for m in model.targets for s in m.sensors if s not in ref]
     if missing and not model.run_reference:
         raise InputError(f"{where}: reference_degC", f"no reference for {missing[0]}", "add its reference temperature")
