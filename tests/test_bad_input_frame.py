@@ -224,7 +224,7 @@ def test_a_model_files_sensors_that_disagree_with_its_terms_are_refused(tmp_path
 
     data = tmp_path / "d.csv"
     data.write_text(REC)
-    assert main(["errormodel", "fit", "--data", data, "--targets", "delta_um", "--out", tmp_path / "m"]) == 0
+    assert main(["errormodel", "fit", "--data", str(data), "--targets", "delta_um", "--out", str(tmp_path / "m")]) == 0
     capsys.readouterr()
     model = json.loads((tmp_path / "m" / "model.json").read_text())
     sensors = model["targets"]["delta_um"]["sensors"]
