@@ -222,8 +222,12 @@ def test_a_model_files_sensors_that_disagree_with_its_terms_are_refused(tmp_path
     without a word: the field is derived from the terms and nothing checked it."""
     import json
 
+    import math
+
     data = tmp_path / "d.csv"
-    data.write_text(REC)
+    data.write_text("# format: gatetherm-timeseries/1\ntime_s,theta_A_degC,theta_B_degC,delta_um\n" + "".join(
+        f"{60 * i},{20 + math.sin(i / 10):.4f},{20 + math.cos(i / 7):.4f},{3 * math.sin(i / 10) - 2 * math.cos(i / 7):.4f}\n"
+        for i in range(200)))
     assert main(["errormodel", "fit", "--data", str(data), "--targets", "delta_um", "--out", str(tmp_path / "m")]) == 0
     capsys.readouterr()
     model = json.loads((tmp_path / "m" / "model.json").read_text())
