@@ -237,3 +237,17 @@ def test_a_model_files_sensors_that_disagree_with_its_terms_are_refused(tmp_path
     bad.write_text(json.dumps(model))
     refused(capsys, 2, ["errormodel", "predict", bad, "--data", data, "--out", tmp_path / "o"],
             f"gatetherm: error: {bad}: targets.delta_um.sensors: is {sensors[0]!r}, but its terms read {sensors!r}")
+
+
+def test_a_short_write_names_the_file(tmp_path):
+    """On a nearly full disk numpy's tofile (meshio's .msh) raised OSError('7488 requested and
+    4579 written'), and the command's one line named neither the file nor the cause."""
+    from gatetherm import atomic_path
+
+    target = tmp_path / "mesh.msh"
+    with pytest.raises(OSError) as info:
+        with atomic_path(target):
+            raise OSError("7488 requested and 4579 written")
+    assert (info.value.filename, info.value.strerror) == (
+        str(target), "cannot write it all (7488 requested and 4579 written; is the disk full?)")
+    assert list(tmp_path.iterdir()) == []
