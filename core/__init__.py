@@ -14,6 +14,7 @@ error handling almost at once, and a notebook pays only for what it uses.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 from pathlib import Path
 
@@ -131,6 +132,8 @@ def atomic_path(path: str | os.PathLike):
             os.unlink(tmp)
         if isinstance(err, OSError) and err.errno is not None:
             raise OSError(err.errno, err.strerror, str(path)) from err
+        if type(err) is OSError:  # numpy's short write names neither the file nor the cause
+            raise OSError(errno.EIO, f"cannot write it all ({err}; is the disk full?)", str(path)) from err
         raise
 
 

@@ -42,3 +42,30 @@ def read_text(path: str | os.PathLike, option: str = "", fix: str = "give a text
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
         raise InputError(line(err.start), f"byte 0x{data[err.start]:02x} is not UTF-8 text", utf8) from None
+
+
+MAX_TOML_DEPTH = 32
+"""Deepest nesting of tables and arrays a TOML input file may have."""
+
+
+def parse_toml(text: str, where: str, fix: str = "fix the file's syntax", what: str = "valid TOML") -> dict:
+    """The document of the TOML text of the file ``where``: InputError (one line) for text that is
+    not TOML and for nesting deeper than :data:`MAX_TOML_DEPTH` (arrays thousands deep would
+    otherwise exhaust the parser's recursion)."""
+    import tomllib
+
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(where, f"not {what} ({err})", fix) from None
+    except RecursionError:
+        data = None
+    stack = [(data, 1)]
+    while stack:
+        value, depth = stack.pop()
+        if value is None or depth > MAX_TOML_DEPTH:
+            raise InputError(where, f"nested deeper than {MAX_TOML_DEPTH} levels", fix)
+        if isinstance(value, (dict, list)):
+            stack.extend((v, depth + 1) for v in (value.values() if isinstance(value, dict) else value)
+                         if isinstance(v, (dict, list)))
+    return data

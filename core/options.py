@@ -21,7 +21,6 @@ import contextlib
 import contextvars
 import math
 import os
-import tomllib
 from dataclasses import dataclass, fields, replace
 
 from gatetherm import InputError
@@ -84,13 +83,10 @@ class SolverOptions:
     def from_file(cls, path, base: SolverOptions | None = None) -> SolverOptions:
         """The options of the ``[solver]`` table of a TOML file (keys: the field names), the
         others those of ``base`` (default: the defaults)."""
-        try:
-            with open(path, "rb") as f:
-                table = tomllib.load(f).get("solver", {})
-        except OSError as err:
-            raise InputError(str(path), err.strerror or str(err), "give a readable TOML file") from None
-        except tomllib.TOMLDecodeError as err:
-            raise InputError(str(path), f"not TOML ({err})", "fix the file's syntax") from None
+        from gatetherm.files import parse_toml, read_text
+
+        table = parse_toml(read_text(path, str(path), "give a readable TOML file"), str(path),
+                           what="TOML").get("solver", {})
         names = {f.name for f in fields(cls)}
         if not isinstance(table, dict) or set(table) - names:
             raise InputError(f"{path}: [solver]", f"unknown keys {sorted(set(table) - names)}",

@@ -15,7 +15,11 @@ solver option ``backend`` (``GATETHERM_SPD_BACKEND``) forces one. When to factor
 solvers built on the factors, are :mod:`gatetherm.solvers.linsolve`."""
 from __future__ import annotations
 
+import contextlib
 import logging
+import os
+import signal
+import threading
 from typing import Callable
 
 import numpy as np
@@ -65,9 +69,45 @@ def nd_order(A: sp.spmatrix, block: int = 1) -> np.ndarray | None:
     G.sort_indices()
     # one refinement pass per level, not METIS's ten: on the 3-D frame's nodes 0.35 s against 0.48 s
     # (benchmarks/assembly_parts.py); the heat steps factored in it as fast (benchmarks/peer.py's parts)
-    perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr.astype(np.int32), G.indices.astype(np.int32)),
-                                        options=pymetis.Options(niter=1))
+    with _signals_deferred():
+        perm, _ = pymetis.nested_dissection(pymetis.CSRAdjacency(G.indptr.astype(np.int32),
+                                                                 G.indices.astype(np.int32)),
+                                            options=pymetis.Options(niter=1))
     return expand_order(np.asarray(perm, dtype=np.int64), block)
+
+
+@contextlib.contextmanager
+def _signals_deferred():
+    """SIGINT and SIGTERM held back while METIS orders: its GKlib traps SIGTERM and SIGABRT with a
+    longjmp, which, landing in the middle of a malloc, left the process waiting on the allocator's
+    lock for ever (a SIGTERM'd run that never ended). Blocked in the only thread of the process, a
+    signal waits and reaches Python's handler when METIS returns. Only where every other native
+    thread blocks them too (the command line starts the libraries' threads so): else the kernel
+    would hand the signal to one of those, into GKlib's handler on the wrong stack."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    alone = threading.current_thread() is threading.main_thread() and _others_block(held)
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held) if alone else None
+    try:
+        yield
+    finally:
+        if old is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _others_block(held) -> bool:
+    """Whether every other thread of this process, those of C libraries included, blocks the
+    signals ``held`` (Linux: /proc; False where it cannot be told)."""
+    bits, me = sum(1 << (int(s) - 1) for s in held), threading.get_native_id()
+    try:
+        for task in os.listdir("/proc/self/task"):
+            if int(task) != me:
+                with open(f"/proc/self/task/{task}/status") as f:
+                    blocked = next(int(line.split()[1], 16) for line in f if line.startswith("SigBlk:"))
+                if blocked & bits != bits:
+                    return False
+    except (OSError, StopIteration, ValueError):
+        return False
+    return True
 
 
 def expand_order(order: np.ndarray | None, block: int) -> np.ndarray | None:

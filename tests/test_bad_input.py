@@ -50,8 +50,9 @@ def _write(path, body: str | bytes):
 # ---- model files -------------------------------------------------------------------------------
 
 MODEL_FILES = {
-    "h inf": ("[geometry]\nh = inf\n", "geometry.h: got inf, must be a finite number > 0"),
-    "depth inf": ("[geometry]\ndepth = inf\n", "geometry.depth: got inf, must be a finite number > 0"),
+    "h inf": ("[geometry]\nh = inf\n", "geometry.h: got inf, must be a number in (0, 100] m"),
+    "depth inf": ("[geometry]\ndepth = inf\n", "geometry.depth: got inf, must be a number in (0, 100] m"),
+    "depth in mm": ("[geometry]\ndepth = 120\n", "geometry.depth: got 120, must be a number in (0, 100] m"),
     "tie bar deeper than the column": ("[geometry]\nA_C = 0.01\n",
                                        "geometry.A_C: tie-bar depth A_C/t_C = 0.25 m exceeds the column depth"),
     "h_oil_on nan": ("[thermal]\nh_oil_on = nan\n", "thermal.h_oil_on: got nan, must be a finite number >= 0"),
@@ -158,7 +159,7 @@ def test_a_mesh_that_cannot_fit_in_memory_is_refused_before_gmsh(tmp_path, capsy
     monkeypatch.setattr(gmsh, "initialize", lambda *a, **k: pytest.fail("gmsh ran"))
     cfg = _write(tmp_path / "fine.toml", "[mesh]\nsize = 1e-6\n")
     refused(capsys, 2, ["mesh", "--config", cfg, "--out", tmp_path / "o"],
-            "gatetherm: error: mesh.size: 1e-06 m gives about 8e+11 triangles", "raise it to at least")
+            f"gatetherm: error: {cfg}: mesh.size: 1e-06 m gives about 8e+11 triangles", "raise it to at least")
     assert not (tmp_path / "o").exists()
 
 

@@ -64,6 +64,7 @@ from gatetherm.studies.control.methods import K_SOURCES  # noqa: F401 - the comm
 from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - the command line's default
 
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
+SEED = Range(0, 2**32 - 1, whole=True)  # a random seed: the command line's --seed (not in the reference)
 
 
 def _discover(namespace: dict) -> list[str]:

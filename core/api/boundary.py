@@ -145,6 +145,9 @@ def check(name: str, value, hint, default=inspect.Parameter.empty) -> None:
                                                                          and math.isinf(default)) \
             and not (math.isinf(value) and INFINITE in getattr(hint, "__metadata__", ())):
         raise InputError(name, f"got {value!r}, must be a finite number", "give a number")
+    if typing.get_origin(hint) is typing.Annotated and INFINITE in typing.get_args(hint)[1:] and \
+            _number(value, float, float) and math.isnan(value):
+        raise InputError(name, "got nan, must be a number (or infinite)", "give a number")
     if _number(value, hint, int) and not _number(value, hint, float) and not float(value).is_integer():
         raise InputError(name, f"got {value!r}, must be a whole number", "give a whole number")
     literal = [a for a in (typing.get_args(hint) if typing.get_origin(hint) in (typing.Union, types.UnionType)

@@ -178,6 +178,7 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
         fitted = load_model(model)
         loop_target(fitted, settings.get("target"))
     s = Settings("errormodel" if fitted else method, params, control=control, model=fitted, **settings)
+    _refuse_unused(s, rom=rom, updates=updates, max_updates=max_updates)
     if condition is not None:
         from gatetherm.frame.conditions import condition as check_condition
 
@@ -246,3 +247,26 @@ def _own_run(case: Case, condition: int | None, on_progress) -> tuple:
             "dim": str(case.dim), "config": case.source}
     return res.scenario.series({**meta, **({"condition": str(condition)} if condition else {})}), \
         len(schedule.times) + 1
+
+
+#: The settings that only one method reads (the option, its methods): given with another method
+#: they would be ignored without a word.
+ONLY_FOR = {"target": ("--target", ("errormodel",)), "correction": ("--correction", ("errormodel",)),
+            "Ki": ("--Ki", ("paper",)), "Kc": ("--Kc", ("paper",)), "k_source": ("--k-source", ("paper",)),
+            "states": ("--states", ("rom",)), "sensors": ("--sensors", ("rom",)), "rom": ("--rom", ("rom",)),
+            "updates": ("--updates", ("rom",)), "max_updates": ("--max-updates", ("rom",))}
+
+
+def _refuse_unused(s, **given) -> None:
+    """InputError naming a setting given (not its default) that the method of ``s`` does not read."""
+    import dataclasses
+    import inspect
+
+    defaults = {f.name: f.default for f in dataclasses.fields(s)}
+    defaults.update({k: p.default for k, p in inspect.signature(compensate_run).parameters.items() if k in given})
+    values = {**{k: getattr(s, k) for k in ONLY_FOR if hasattr(s, k)}, **given}
+    for key, (option, methods) in ONLY_FOR.items():
+        if key in values and s.method not in methods and values[key] != defaults[key]:
+            what = "--model" if s.method == "errormodel" else f"--method {s.method}"
+            use = "--model MODEL.json" if methods == ("errormodel",) else f"--method {methods[0]}"
+            raise InputError(option, f"is read by {use} only: {what} would ignore it", f"drop {option}, or use {use}")

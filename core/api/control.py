@@ -52,6 +52,7 @@ def compensate(series: TimeSeries | Run, case: Case | None = None, method: str =
         before the record ends, whose time is ``budget_exhausted_s``, s; paper and mlr: ``sensor_noise_um``, what
         the thermocouples' noise adds to the prediction, one standard deviation, um).
     """
+    from gatetherm.api.compensation import _refuse_unused
     from gatetherm.studies.control.methods import Settings, compensate as methods_compensate
     from gatetherm.studies.run.timeseries import TimeSeries
 
@@ -63,7 +64,9 @@ def compensate(series: TimeSeries | Run, case: Case | None = None, method: str =
     rom = settings.pop("rom", None)
     chosen = (case.actuator if case is not None else None) if actuator == "case" else actuator
     settings_argument(Settings, settings, "compensate")
-    return methods_compensate(series, case, Settings(method=method, **settings), chosen, rom=rom)
+    s = Settings(method=method, **settings)
+    _refuse_unused(s, rom=rom)
+    return methods_compensate(series, case, s, chosen, rom=rom)
 
 
 def diagnose(case: Case, measured: TimeSeries | str | os.PathLike, **settings):

@@ -181,7 +181,11 @@ def simulate(condition: int | None = None, schedule: str | os.PathLike | None = 
         if condition is not None:
             check_condition(condition)  # 0 is no condition (it would run condition 1)
         case = gate_frame(dim, config, 1 if condition is None else condition)
-        extra = dict(parse_effect(s, case.targets) for s in effects)  # on top of the model file's
+        pairs = [parse_effect(s, case.targets) for s in effects]
+        extra = dict(pairs)  # on top of the model file's
+        if len(extra) < len(pairs):
+            twice = next(k for i, (k, _) in enumerate(pairs) if k in dict(pairs[:i]))
+            raise InputError("--effect", f"{twice} is given more than once", "give each effect once")
         sched = schedule_file(schedule, case) if schedule else case.schedule
         return case, sched, (config, schedule), every, {"effects": extra, "fields_every": every}
 

@@ -150,7 +150,13 @@ def _run(argv: list[str] | None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from gatetherm.api import InputError, PointsFailed, SolverError, SolverOptions, configure
+    # The libraries' native threads (BLAS) start with SIGINT and SIGTERM blocked: a signal then
+    # reaches the main thread only, which may defer it around C code that traps it (METIS).
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, set(_Signals.CODES))
+    try:
+        from gatetherm.api import InputError, PointsFailed, SolverError, SolverOptions, configure
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
     logging.captureWarnings(True)  # the numerical libraries' warnings: in the log, shown with -v
     logging.getLogger("py.warnings").setLevel(logging.INFO if args.verbose else logging.ERROR)

@@ -67,7 +67,8 @@ def _signature(obj) -> str:
         star = star or p.kind in (P.KEYWORD_ONLY, P.VAR_POSITIONAL)
         text = {P.VAR_POSITIONAL: "*", P.VAR_KEYWORD: "**"}.get(p.kind, "") + p.name
         if p.annotation is not P.empty:
-            text += f": {p.annotation if isinstance(p.annotation, str) else inspect.formatannotation(p.annotation)}"
+            hint = p.annotation if isinstance(p.annotation, str) else inspect.formatannotation(p.annotation)
+            text += ": " + re.sub(r"Annotated\[(\w+), \w+\]", r"\1", hint)  # the boundary's marks are not types
         if p.default is not P.empty:
             text += f" = {p.default!r}" if p.annotation is not P.empty else f"={p.default!r}"
         out.append(text)

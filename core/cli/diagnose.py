@@ -62,17 +62,22 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _names(text: str | None, default: tuple) -> tuple:
+def _names(text: str | None, default: tuple, option: str) -> tuple:
+    """The names of a comma-separated list (``none``: none; absent: ``default``); one naming
+    nothing (``""``, ``","``) is refused: it would mean none or all without a word."""
     if text is None:
         return default
-    return () if text.strip() == "none" else tuple(e.strip() for e in text.split(",") if e.strip())
+    names = tuple(e.strip() for e in text.split(",") if e.strip())
+    if not names:
+        raise InputError(option, f"{text!r} names nothing", f"give names separated by commas, or '{option} none'")
+    return () if names == ("none",) else names
 
 
 def settings_from(args) -> dict:
     """Workflow settings from the command line (checked by :func:`gatetherm.api.diagnose_run`)."""
-    return dict(train_fraction=args.train_fraction, effects=_names(args.effects, None),
-                parameters=_names(args.parameters, None), sensors=not args.no_sensors,
-                uncertain=_names(args.uncertain, ()), refine=not args.keep_order)
+    return dict(train_fraction=args.train_fraction, effects=_names(args.effects, None, "--effects"),
+                parameters=_names(args.parameters, None, "--parameters"), sensors=not args.no_sensors,
+                uncertain=_names(args.uncertain, (), "--uncertain"), refine=not args.keep_order)
 
 
 def load_model(args):
@@ -85,7 +90,7 @@ def load_model(args):
 
 def run(args: argparse.Namespace) -> int:
     if args.list_effects:
-        print(diagnosis_hypotheses(load_model(args), _names(args.uncertain, ()), args.json))
+        print(diagnosis_hypotheses(load_model(args), _names(args.uncertain, (), "--uncertain"), args.json))
         return 0
     if args.json:
         raise InputError("--json", "only goes with --list-effects", "add --list-effects or drop --json")

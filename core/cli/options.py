@@ -85,5 +85,7 @@ def number(rng):
     return parse
 
 
+SEED = "SEED"
+"""A random seed: a whole number from 0 to 2^32 - 1 (numpy's range), as ``gatetherm.api.SEED``."""
 WORKERS = "WORKERS"
 """Worker processes: :data:`gatetherm.api.WORKERS`, for :func:`number`."""

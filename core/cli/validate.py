@@ -10,7 +10,7 @@ import argparse
 
 from gatetherm.api import POSITIVE, InputError, Range
 from gatetherm.api.validate_study import TARGETS as STUDIES, validate
-from gatetherm.cli.options import WORKERS, Progress, add_model_options, add_parallel_options, number
+from gatetherm.cli.options import SEED, WORKERS, Progress, add_model_options, add_parallel_options, number
 
 ORDER = 80  # its place in `gatetherm --help` (gatetherm.cli finds the command here)
 
@@ -94,7 +94,7 @@ def run_rom(args):
 
 def _hidden_arguments(p) -> None:
     p.add_argument("--workers", type=number(WORKERS), default=2, metavar="N", help="worker processes (default 2)")
-    p.add_argument("--seed", type=int, default=6, help="seed of the strengths and the noise (default 6)")
+    p.add_argument("--seed", type=number(SEED), default=6, metavar="N", help="seed of the strengths and the noise (default 6)")
     p.add_argument("--conditions", type=_conditions, default=(1, 2, 3),
                    help="conditions, comma separated (default 1,2,3)")
     p.add_argument("--effects", metavar="NAME,...",
@@ -110,7 +110,7 @@ def run_hidden(args):
 
 def _compound_arguments(p) -> None:
     p.add_argument("--workers", type=number(WORKERS), default=2, metavar="N", help="worker processes (default 2)")
-    p.add_argument("--seed", type=int, default=14, help="seed of the pairs, strengths and noise (default 14)")
+    p.add_argument("--seed", type=number(SEED), default=14, metavar="N", help="seed of the pairs, strengths and noise (default 14)")
     p.add_argument("--pairs", type=number(Range(1, whole=True)), default=48, metavar="N", help="two-piece cases (default 48)")
     p.add_argument("--no-single", action="store_true", help="skip the single-piece cases of the hidden-effect study")
     p.add_argument("--mesh-size", type=number(POSITIVE), metavar="M", help="diagnosis element size, m (default: the model's)")
@@ -123,7 +123,7 @@ def run_compound(args):
 
 def _case_diagnosis_arguments(p) -> None:
     p.add_argument("--case", metavar="CASE.toml", help="case file (default: the C-frame example)")
-    p.add_argument("--seed", type=int, default=10, help="seed of the noise (default 10)")
+    p.add_argument("--seed", type=number(SEED), default=10, metavar="N", help="seed of the noise (default 10)")
 
 
 def run_case_diagnosis(args):

@@ -12,6 +12,7 @@ import math
 
 from gatetherm.frame.geometry import (Box, FrameParams, MeshParams, part_boxes, sensor_points, tank_box, validate,
                                       validate_mesh)
+from gatetherm import InputError
 from gatetherm.geometry.extract import extract_mesh
 from gatetherm.geometry.isolate import gmsh_session, run_isolated  # noqa: F401 (gmsh_session: the API's)
 from gatetherm.geometry.mesh import FrameMesh, from_arrays, to_arrays
@@ -134,4 +135,9 @@ def element_estimate(p: FrameParams, m: MeshParams, dim: int) -> float:
 def check_mesh_size(p: FrameParams, m: MeshParams, dim: int) -> None:
     """Raise InputError naming the element size if the mesh would need more memory than the machine has."""
     key, s = ("mesh.size", m.size) if dim == 2 else ("mesh.size_3d", m.size_3d)
+    boxes = part_boxes(p, dim).values()
+    extent = max(max(b[2 * i + 1] for b in boxes) - min(b[2 * i] for b in boxes) for i in range(dim))
+    if s > extent:  # gmsh would mesh the frame with its coarsest elements, resolving nothing
+        raise InputError(key, f"{s:g} m is larger than the whole frame ({extent:.3g} m); lengths are in m",
+                         f"choose an element size below {extent / 10:.2g} m")
     check_estimate(element_estimate(p, m, dim), dim, key, s)

@@ -69,13 +69,17 @@ def gate_frame(dim: int = 2, config: Config | str | os.PathLike | None = None, c
 def frame_case(cfg: Config, dim: int, number: int = 1, mesh: FrameMesh | None = None) -> Case:
     """The frame of ``cfg`` in ``dim`` dimensions (on ``mesh``, else meshed) under condition ``number``."""
     cond = condition(number)
-    fm = build_mesh(cfg.model.frame, dim, cfg.model.mesh) if mesh is None else check_mesh(mesh, cfg.model.frame, dim)
+    from_file = not cfg.source.startswith(("gatetherm:", "defaults"))
+    try:
+        fm = build_mesh(cfg.model.frame, dim, cfg.model.mesh) if mesh is None else check_mesh(mesh, cfg.model.frame, dim)
+    except InputError as err:  # a [mesh] size the budgets refuse: name the model file, as its other keys are
+        raise err.at(cfg.source) if from_file and err.field.startswith("mesh.") else err from None
     problem = frame_problem(cfg.model, fm)
     return Case(f"gate frame {dim}-D", problem, fm, TimeSettings(cond.duration, 60.0, 60.0, 3600.0),
                 condition_schedule(number, cfg.supply), FrameOrigin(cfg, dim, number), frame_targets(cfg.model, fm.regions),
                 defaults={AMBIENT: cfg.supply.T_room}, actuator=ActuatorParams(), parameters=cfg.model,
                 effects=dict(cfg.effects), sensors=dict(cfg.sensors),
-                path=None if cfg.source.startswith(("gatetherm:", "defaults")) else Path(cfg.source), source=cfg.source)
+                path=Path(cfg.source) if from_file else None, source=cfg.source)
 
 
 def _mesh_inputs(cfg: Config) -> tuple:

@@ -10,10 +10,10 @@ faults as ``CHANNEL = {FAULT = VALUE}``. :func:`config_toml` writes a file that
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import math
 import os
-import tomllib
 import types
 import typing
 from dataclasses import dataclass, field
@@ -21,7 +21,7 @@ from importlib import resources
 
 from gatetherm import InputError
 from gatetherm.checks import check_fields
-from gatetherm.files import read_text
+from gatetherm.files import parse_toml, read_text
 from gatetherm.frame.geometry import FrameParams, MeshParams, check_tie_depth, validate
 from gatetherm.frame.problem import TARGETS, ModelConfig, ThermalParams
 from gatetherm.solvers.effects import effects_from_table, effects_table
@@ -118,9 +118,15 @@ def _section_table(data: dict, name: str) -> dict:
     return {k: v for k, v in node.items() if not any(s.name == f"{name}.{k}" for s in SCHEMA)}
 
 
+@functools.cache
+def _hints(cls) -> dict:
+    """The type hints of a section's dataclass (resolved once: a sweep plans thousands of points)."""
+    return typing.get_type_hints(cls)
+
+
 def _apply(sec: Section, table: dict, current):
     """``current`` (an instance of ``sec.cls``) with the keys of ``table`` applied."""
-    hints = typing.get_type_hints(sec.cls)
+    hints = _hints(sec.cls)
     known = sec.keys or tuple(f.name for f in dataclasses.fields(sec.cls))
     changes = {}
     for key, value in table.items():
@@ -172,10 +178,9 @@ def load_config(path: str | os.PathLike | None = None, option: str = "--config")
         source = f"gatetherm:{PAPER_TOML}"
     else:
         text, source = read_text(path, option, "give a TOML model file"), str(path)
+    data = parse_toml(text, source, "fix the model file's syntax")
     try:
-        return parse_config(tomllib.loads(text), source)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(source, f"not valid TOML ({err})") from None
+        return parse_config(data, source)
     except InputError as err:
         raise err.at(source) from None
 

@@ -13,12 +13,17 @@ import dataclasses
 from dataclasses import dataclass
 
 from gatetherm import InputError
-from gatetherm.checks import NONNEGATIVE, POSITIVE, Range, admissible, check_fields
+from gatetherm.checks import POSITIVE, Range, admissible, check_fields
 
 Box = tuple[float, float, float, float, float, float]  # x0, x1, y0, y1, z0, z1
 
 
-@admissible(POSITIVE, l4_2=NONNEGATIVE)
+MAX_LENGTH = 100.0
+"""Largest dimension of a frame, m: beyond any machine tool (a length in mm read as m is refused)."""
+LENGTH = Range(0.0, MAX_LENGTH, lo_open=True, unit="m")
+
+
+@admissible(LENGTH, l4_2=Range(0.0, MAX_LENGTH, unit="m"), A_C=Range(0.0, MAX_LENGTH, lo_open=True, unit="m²"))
 @dataclass(frozen=True)
 class FrameParams:
     """Dimensions of the frame, all in metres (areas in m²)."""

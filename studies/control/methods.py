@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -116,8 +115,8 @@ def _coefficients(case, ts, s: Settings, cache) -> tuple[float, float, str, str]
         if s.Ki is None or s.Kc is None or s.k_source:
             raise InputError("--Ki/--Kc", "give both, and not together with --k-source",
                              "e.g. --Ki 2.1 --Kc 0.8, or --k-source fit")
-        if not (math.isfinite(s.Ki) and math.isfinite(s.Kc)):
-            raise InputError("--Ki/--Kc", "must be finite numbers", "e.g. --Ki 2.1 --Kc 0.8")
+        if not (abs(s.Ki) <= 1e6 and abs(s.Kc) <= 1e6):  # finite and below 1 m/K (NaN fails too)
+            raise InputError("--Ki/--Kc", f"got {s.Ki:g}, {s.Kc:g}, must be within ±1e+06 um/K", "e.g. --Ki 2.1 --Kc 0.8")
         return s.Ki, s.Kc, "explicit", ""
     # the paper frame's origin offers its beam theory and FE load cases (gatetherm.frame.case.FrameOrigin)
     beam = getattr(case.origin, "coefficients", None) if case is not None and case.parameters is not None else None

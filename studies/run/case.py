@@ -16,7 +16,6 @@ puts the case together.
 from __future__ import annotations
 
 import dataclasses
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -24,7 +23,7 @@ import numpy as np
 
 from gatetherm import InputError
 from gatetherm.checks import CELSIUS, Range, argument, ranges
-from gatetherm.files import read_text
+from gatetherm.files import parse_toml, read_text
 from gatetherm.geometry.measure import region_volume
 from gatetherm.geometry.mesh import FrameMesh, facet_keys
 from gatetherm.solvers.effects import Targets
@@ -271,10 +270,7 @@ def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> 
     """
     path = Path(path)
     text = read_text(path, "CASE.toml", "give the path of a .toml case file")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(str(path), f"not valid TOML ({err})") from None
+    data = parse_toml(text, str(path), "fix the case file's syntax")
     return case_from_document(overlay(data, nested(overrides or {})), path, mesh_factor)
 
 

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError, atomic_path
-from gatetherm.checks import CELSIUS, Range, show
+from gatetherm.checks import CELSIUS, Range, _short, show
 from gatetherm.files import read_text
 
 log = logging.getLogger(__name__)
@@ -152,16 +152,32 @@ def validate_complete(ts: TimeSeries, names, source: str = "") -> None:
                          "this analysis needs every sample; fill or remove the row")
 
 
+_DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+"""A number as a data file writes it: decimal digits, a point, an exponent."""
+
+
+def _csv_rows(path: Path, lines: list[str], first: int):
+    """(line number, fields) of the CSV ``lines`` from index ``first`` on; a line the csv module
+    cannot read (a field of more than 128 kB) is one line naming it."""
+    reader = csv.reader(lines[first:])
+    try:
+        for fields in reader:
+            yield first + reader.line_num, fields
+    except csv.Error as err:
+        raise InputError(f"{path}, line {first + reader.line_num}", f"not CSV ({err})",
+                         "give one number per field (docs/data-format.md)") from None
+
+
 def _parse_value(text: str, where: str) -> float:
     text = text.strip()
     if not text:
         return math.nan
     try:
-        value = float(text)
+        value = float(text) if _DECIMAL.fullmatch(text) else math.nan  # not Python's 4_0, ４０ or 'infinity'
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
-        raise InputError(where, f"non-numeric value {text!r}",
+        raise InputError(where, f"non-numeric value {_short(text)}",
                          "write a decimal number, or leave the field empty for a missing sample")
     return value
 
@@ -181,7 +197,7 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS, named_by: dic
         lineno += 1
     if lineno == len(lines):
         raise InputError(str(path), "no header row", "add a header line naming the columns")
-    header = [h.strip() for h in next(csv.reader([lines[lineno]]))]
+    header = [h.strip() for h in next(_csv_rows(path, lines, lineno))[1]]
     header_line = lineno + 1
     fmt = metadata.get("format", FORMAT)
     if fmt != FORMAT:
@@ -202,7 +218,7 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS, named_by: dic
         log.info("%s: keeping columns not in %s: %s", path, FORMAT, ", ".join(unknown))
 
     rows, linenos = [], []
-    for k, fields in enumerate(csv.reader(lines[lineno + 1:]), start=lineno + 2):
+    for k, fields in _csv_rows(path, lines, lineno + 1):
         if not fields or (len(fields) == 1 and not fields[0].strip()):
             continue
         where = f"{path}, line {k} (data row {len(rows) + 1})"

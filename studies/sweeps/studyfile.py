@@ -5,12 +5,12 @@ Every table and key is documented in docs/sweep.md (``tests/test_sweep_docs.py``
 to :data:`KEYS` and :data:`FREE`)."""
 from __future__ import annotations
 
-import tomllib
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gatetherm import InputError
-from gatetherm.files import read_text
+from gatetherm.files import parse_toml, read_text
 
 if TYPE_CHECKING:
     from gatetherm.studies.sweeps.sweep import FramePoints, Study
@@ -21,6 +21,9 @@ KEYS = {"study": ("name", "case", "dim", "config", "compute", "fit_frame"), "plo
 FREE = {"set": "KEY", "grid": "KEY"}
 """The tables whose keys are the parameters a point sets (a case file's dotted key, ``effect.…``,
 or the frame's), by the placeholder docs/sweep.md names them with."""
+MAX_POINTS = 10_000
+"""Most points a study's grid may have: about three hours of 2-D runs at a second each; planning
+them (each point's model file and key) takes seconds."""
 TABLES = ("study", "set", "grid", "plot")
 """The study file's tables, in the order docs/sweep.md documents them."""
 
@@ -83,6 +86,8 @@ def parse_study(data: dict, source: str = "<study>", base=None, case: str | None
     compute = head.get("compute", ["coefficients"])
     if isinstance(compute, str):
         compute = [compute]
+    if not isinstance(compute, list) or not compute:
+        raise InputError("study.compute", f"expected a non-empty list, got {compute!r}", f"give a list of {', '.join(COMPUTE)}")
     for c in compute:
         if c not in COMPUTE:
             raise InputError("study.compute", f"unknown computation {c!r}", f"choose from {', '.join(COMPUTE)}")
@@ -132,6 +137,10 @@ def _set_and_grid(data: dict, example: str) -> tuple[dict, list]:
         grid.append((key, tuple(_scalar(f"grid.{key}", v) for v in values)))
     if not grid:
         raise InputError("grid", "no swept key", f"add e.g. {example} under [grid]")
+    points = math.prod(len(v) for _, v in grid)
+    if points > MAX_POINTS:
+        raise InputError("grid", f"{' x '.join(str(len(v)) for _, v in grid)} = {points} points, more than the "
+                         f"budget of {MAX_POINTS}", "sweep fewer values, or split the study into several files")
     return fixed, grid
 
 
@@ -158,15 +167,13 @@ def load_study(path, frame: FramePoints | None = None) -> Study:
     ``frame``: the frame's side of a study (:data:`gatetherm.frame.sweeppoint.FRAME`, passed in by the
     API); without it only a case study is read."""
     p = Path(path)
-    try:
-        data = tomllib.loads(read_text(p, "STUDY.toml", "give a study file"))
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(str(p), f"not valid TOML ({err})") from None
+    data = parse_toml(read_text(p, "STUDY.toml", "give a study file"), str(p), "fix the study file's syntax")
     try:
         head = data.setdefault("study", {})
         if not isinstance(head, dict):
             raise InputError("study", "expected a [study] table")
-        head.setdefault("name", p.stem)
+        if not isinstance(head.setdefault("name", p.stem), str):
+            raise InputError("study.name", f"expected a string, got {head['name']!r}", 'e.g. name = "tie-bar height"')
         case = head.pop("case", None)
         if case is not None:
             if not isinstance(case, str):

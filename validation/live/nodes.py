@@ -19,12 +19,11 @@ name -> factor, the control's unit per gatetherm's (``offset_um = 0.001`` for a 
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.files import read_text
+from gatetherm.files import parse_toml, read_text
 
 NAMESPACE = "urn:gatetherm:machine"
 OBJECT = "Machine"
@@ -71,10 +70,7 @@ def read_map(path, columns) -> NodeMap:
     """The map file at ``path`` over the default layout of ``columns``; InputError naming the key."""
     where = str(path)
     text = read_text(Path(path), "--map", "give a TOML map file (docs/live.md)")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(where, f"not TOML ({err})", "see the examples in docs/live.md") from None
+    data = parse_toml(text, where, "see the examples in docs/live.md", what="TOML")
     for key in data:
         if key not in KEYS:
             raise InputError(f"{where}: [{key}]", "unknown table", f"use {', '.join(KEYS)}")
