@@ -203,3 +203,23 @@ def test_prepare_runs_in_the_process_that_draws_the_picture_needing_it(tmp_path)
     assert out["needing"] == out["renderer"] != out["other"] and out["renderer_s"] <= out["fourth_s"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["first.png", "fourth.png", "marks", "needing", "other",
                                                           "ready", "renderer", "second.png", "third.png"]  # no "here"
+
+
+def test_a_process_ended_inside_an_import_is_stopped_not_failed():
+    """SIGTERM (SystemExit) while matplotlib's C extension was being imported came out as
+    "ImportError: initialization failed" and was logged as a failure with its traceback, on the
+    stderr of a command refused within its first second (the audit's STEP file of 2000 solids)."""
+    from gatetherm.validation.plots.painter import _stopped
+
+    def wrapped():
+        try:
+            try:
+                raise SystemExit(1)
+            except SystemExit as stop:
+                raise ImportError("initialization failed") from stop
+        except ImportError as err:
+            return err
+
+    assert _stopped(wrapped()) and _stopped(SystemExit(1))
+    assert not _stopped(ImportError("initialization failed"))
+    assert not _stopped(RuntimeError("a picture failed"))

@@ -54,6 +54,19 @@ def _warm() -> None:
     fig.savefig(io.BytesIO(), format="png", dpi=20)
 
 
+def _stopped(err: BaseException) -> bool:
+    """Whether ``err`` came of the SIGTERM that ends a painting process (:func:`end_with_parent`'s
+    SystemExit, perhaps wrapped by the import it interrupted: matplotlib's C extension says
+    "ImportError: initialization failed"): an ended process, not a failed one."""
+    seen = set()
+    while err is not None and id(err) not in seen:
+        if isinstance(err, SystemExit):
+            return True
+        seen.add(id(err))
+        err = err.__cause__ or err.__context__
+    return False
+
+
 def _serve(jobs: int, replies: int) -> None:
     """A painting process's life: draw every job on ``jobs``, answer each on ``replies``
     (``(is OSError, error text)``, the text empty once the PNG is written)."""
@@ -141,8 +154,9 @@ class Painter:
                 code = 0
             except SystemExit:
                 pass
-            except BaseException:  # noqa: BLE001 - the caller reports the pictures not drawn
-                log.exception("the painting process failed")
+            except BaseException as err:  # noqa: BLE001 - the caller reports the pictures not drawn
+                if not _stopped(err):  # SIGTERM inside an extension's import comes out as an ImportError
+                    log.exception("the painting process failed")
             finally:
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)  # a second SIGTERM here: no SystemExit out of the child
                 if child:
