@@ -257,9 +257,11 @@ def _result(data: bytes, status: int, label: str, lines) -> tuple[dict, dict[str
     said = f": {quiet(errors[-1])}" if errors else ""
     if not data:
         if os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGALRM:
-            raise InputError(label, f"gmsh was still reading it after {READ_LIMIT_S} s (an endless loop in the "
-                             "script, or a CAD file too large?)", "end every loop of the script, or simplify the "
-                             "geometry (a sub-assembly of the CAD model)")
+            if str(label).lower().endswith(".geo"):
+                raise InputError(label, f"gmsh was still reading it after {READ_LIMIT_S} s (an endless loop in "
+                                 "the script?)", "end every loop of the script")
+            raise InputError(label, f"gmsh was still reading it after {READ_LIMIT_S} s (a CAD file too large?)",
+                             "simplify the geometry (a sub-assembly of the CAD model)")
         if os.WIFSIGNALED(status):
             sig = os.WTERMSIG(status)
             raise InputError(label, f"gmsh crashed on it ({signal.Signals(sig).name}){said}",
