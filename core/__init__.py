@@ -23,18 +23,28 @@ TEMP_PREFIX = ".gatetherm-tmp."
 run left in its output directory (:mod:`gatetherm.outdir`)."""
 
 
-def _api(folders=None) -> tuple[str, ...]:
-    """The names :mod:`gatetherm.api` offers: the ``PUBLIC`` of each of its modules (in ``folders``,
-    default the package's), read from their sources (importing the API costs seconds; this a few
-    milliseconds, once)."""
+def _api_modules(folders=None) -> dict[str, str]:
+    """Where :mod:`gatetherm.api` finds each name it offers: name -> the module (of ``folders``,
+    default the package's) whose ``PUBLIC`` offers it, read from the sources (importing the API
+    costs seconds; this a few milliseconds). A name offered by two modules is an ImportError."""
     import ast
 
-    names = []
+    where = {}
     for path in sorted(p for folder in folders or [Path(__file__).parent / "api"] for p in Path(folder).glob("*.py")):
         for node in ast.parse(path.read_text(encoding="utf-8")).body:
             if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "PUBLIC" for t in node.targets):
-                names += ast.literal_eval(node.value)
-    return tuple(sorted(names))
+                for name in ast.literal_eval(node.value):
+                    if name in where and where[name] != path.stem:
+                        raise ImportError(f"gatetherm.api.{path.stem}: {name} is offered by gatetherm.api."
+                                          f"{where[name]} too")
+                    where[name] = path.stem
+    return where
+
+
+def _api(folders=None) -> tuple[str, ...]:
+    """The names :mod:`gatetherm.api` offers: the ``PUBLIC`` of each of its modules (in ``folders``,
+    default the package's), read from their sources (:func:`_api_modules`)."""
+    return tuple(sorted(_api_modules(folders)))
 
 
 def __getattr__(name: str):

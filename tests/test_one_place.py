@@ -184,14 +184,15 @@ def test_a_command_is_its_task_module_and_its_command_module(monkeypatch, tmp_pa
     monkeypatch.setattr(api, "__path__", [*api.__path__, str(tmp_path / "api")])
     monkeypatch.setattr(cli, "__path__", [*cli.__path__, str(tmp_path / "cli")])
     try:
-        namespace = {}
-        names = api._discover(namespace)
-        assert names == sorted([*gt.API, "hello"]) and "hello" in gt._api([*api.__path__])
-        monkeypatch.setattr(api, "hello", namespace["hello"], raising=False)
-        monkeypatch.setattr(api, "__all__", names)
+        where = gt._api_modules([*api.__path__])
+        assert sorted(where) == sorted([*gt.API, "hello"]) and where["hello"] == "hello"
+        assert "hello" in gt._api([*api.__path__])
+        monkeypatch.setattr(api, "_WHERE", where)
+        monkeypatch.setattr(api, "__all__", sorted(where))
         monkeypatch.setattr(cli, "COMMAND_MODULES", cli._commands())
         assert cli.COMMAND_MODULES[:3] == ("run", "hello", "mesh")
         assert cli.main(["hello", "world"]) == 0 and capsys.readouterr().out == "hello, world\n"
+        assert api.hello.__checked__ and "hello" in dir(api)  # imported on first use, its arguments checked
         assert "## `gatetherm hello`" in cli_page() and "### `gt.hello(name: str) -> str`" in api_page()
     finally:
         monkeypatch.undo()

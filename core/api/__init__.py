@@ -21,7 +21,8 @@ run``, ``simulate``), :mod:`gatetherm.api.frame` (``mesh``, ``beam``), :mod:`gat
 :mod:`gatetherm.api.diagnosis` (the commands ``compensate`` and ``diagnose``), :mod:`gatetherm.api.errormodel`,
 :mod:`gatetherm.api.sensors`, :mod:`gatetherm.api.study` (sweeps), :mod:`gatetherm.api.reports`,
 :mod:`gatetherm.api.validate_study`, :mod:`gatetherm.api.export`, :mod:`gatetherm.api.live` and
-:mod:`gatetherm.api.zoo`; every public name is offered here.
+:mod:`gatetherm.api.zoo`; every public name is offered here, its module imported when the name is
+first used (a script or a service pays for the tasks it uses).
 
 ### Errors
 
@@ -51,73 +52,97 @@ before any work); ranges and names from each function:
 
 Anything else is a defect of gatetherm: please report it.
 """
-from gatetherm import InputError  # noqa: F401 - with the ranges below, for the command line's checks
-from gatetherm.api.compensation import OUTPUTS as COMPENSATE_OUTPUTS  # noqa: F401 - for the command line
-from gatetherm.api.compensation import WRITTEN  # noqa: F401 - for the command line
-from gatetherm.api.diagnosis import OUTPUTS as DIAGNOSE_OUTPUTS  # noqa: F401 - for the command line
-from gatetherm.checks import POSITIVE, Range  # noqa: F401
-from gatetherm.solvers.errors import SolverError  # noqa: F401 - with these below, for the command line's dispatcher
-from gatetherm.studies.run.formats import FORMATS  # noqa: F401 - the command line's export formats
-from gatetherm.studies.sweeps.runner import PointsFailed  # noqa: F401
+import sys
+import types
 
-from gatetherm.studies.control.methods import K_SOURCES  # noqa: F401 - the command line's choices
-from gatetherm.studies.control.predictive import THERMOCOUPLES  # noqa: F401 - the command line's default
+from gatetherm import InputError, _api_modules  # noqa: F401 - InputError with the ranges below, for the command line
+from gatetherm.checks import POSITIVE, Range  # noqa: F401
 
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
 SEED = Range(0, 2**32 - 1, whole=True)  # a random seed: the command line's --seed (not in the reference)
 
+_CONSTANTS = {
+    "COMPENSATE_OUTPUTS": ("gatetherm.api.compensation", "OUTPUTS"),  # what `compensate` writes into --out
+    "WRITTEN": ("gatetherm.api.compensation", "WRITTEN"),
+    "DIAGNOSE_OUTPUTS": ("gatetherm.api.diagnosis", "OUTPUTS"),
+    "SolverError": ("gatetherm.solvers.errors", "SolverError"),  # with PointsFailed: the command line's dispatcher
+    "PointsFailed": ("gatetherm.studies.sweeps.runner", "PointsFailed"),
+    "FORMATS": ("gatetherm.studies.run.formats", "FORMATS"),  # the command line's export formats
+    "K_SOURCES": ("gatetherm.studies.control.methods", "K_SOURCES"),  # the command line's choices
+    "THERMOCOUPLES": ("gatetherm.studies.control.predictive", "THERMOCOUPLES"),  # the command line's default
+}
+"""The command line's constants (not in the reference): name -> (module, its name there), imported on first use."""
 
-def _discover(namespace: dict) -> list[str]:
-    """Import every module of this package and offer the names of its ``PUBLIC`` in ``namespace``
-    (this module's): a new task is one module (``core/api/TASK.py`` with ``PUBLIC = ("task",
-    "TaskResult")``), found without a list to edit. ``gatetherm.API`` reads the same ``PUBLIC``
-    from the sources."""
-    import importlib
-    import pkgutil
+_WHERE = _api_modules(__path__)
+"""Each offered name -> the module of this package whose ``PUBLIC`` offers it, read from the sources
+(:func:`gatetherm._api_modules`, as ``gatetherm.API``): a new task is one module (``core/api/TASK.py``
+with ``PUBLIC = ("task", "TaskResult")``), found without a list to edit, imported when one of its
+names is first used (:func:`__getattr__`)."""
 
-    names = []
-    for info in pkgutil.iter_modules(__path__):
-        module = importlib.import_module(f"{__name__}.{info.name}")
-        for name in getattr(module, "PUBLIC", ()):
-            if name in names:
-                raise ImportError(f"{module.__name__}: {name} is offered by another module of gatetherm.api too")
-            namespace[name] = getattr(module, name)
-            names.append(name)
-    return sorted(names)
-
-
-__all__ = _discover(globals())
+__all__ = sorted(_WHERE)
 
 
-def _check_arguments() -> None:
-    """Every public function checks its arguments' types where it is called
-    (:func:`gatetherm.api.boundary.checked`)."""
+def _offer(module: types.ModuleType) -> None:
+    """Put the names of ``module``'s ``PUBLIC`` into this module's globals, each function wrapped to
+    check its arguments' types where it is called (:func:`gatetherm.api.boundary.checked`). A name
+    already set here (a test's monkeypatch) is left as it is."""
     import inspect
 
     from gatetherm.api.boundary import checked
 
-    for name in __all__:
-        if inspect.isfunction(globals()[name]) and not hasattr(globals()[name], "__checked__"):
-            globals()[name] = checked(globals()[name])
+    here = globals()
+    for name in getattr(module, "PUBLIC", ()):
+        value = getattr(module, name)
+        if inspect.isfunction(value) and not hasattr(value, "__checked__"):
+            value = checked(value)
+        current = here.get(name)
+        if current is None or current is module:  # not yet offered, or the submodule of the same name
+            here[name] = value
 
 
-_check_arguments()
+class _Api(types.ModuleType):
+    """This module: a task module imported by anyone (``from gatetherm.api.live import …``) whose
+    name is also an offered name (``live``, ``run``) leaves the function offered here, not the
+    submodule, as the attribute (the import system sets the submodule on its package)."""
+
+    def __setattr__(self, name, value):
+        if isinstance(value, types.ModuleType) and value.__name__ == f"{__name__}.{name}" and name in _WHERE:
+            _offer(value)
+            if globals().get(name) is not value:
+                return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Api
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__, *_CONSTANTS, "plot", "METHODS", "COMPENSATION_METHODS",
+                   "STEPWISE_METHODS", "METHOD_SUMMARIES"})
 
 
 def __getattr__(name: str):
-    """``gatetherm.api.plot``: the plots (:mod:`gatetherm.validation.plots.api`, as ``gt.plot``),
-    imported on first use; the compensation methods (:mod:`gatetherm.studies.control.method`), read
-    when asked: ``METHODS`` every one, ``COMPENSATION_METHODS`` those ``gatetherm compensate
-    --method`` offers (errormodel is its --model), ``METHOD_SUMMARIES`` their summaries by name,
-    ``STEPWISE_METHODS`` those of ``gatetherm live``."""
-    from gatetherm.studies.control import method
+    """Each offered name (``__all__``): the module of this package offering it imported on first use,
+    its names cached here. ``gatetherm.api.plot``: the plots (:mod:`gatetherm.validation.plots.api`,
+    as ``gt.plot``); the compensation methods (:mod:`gatetherm.studies.control.method`), read when
+    asked: ``METHODS`` every one, ``COMPENSATION_METHODS`` those ``gatetherm compensate --method``
+    offers (errormodel is its --model), ``METHOD_SUMMARIES`` their summaries by name,
+    ``STEPWISE_METHODS`` those of ``gatetherm live``; the command line's constants (``_CONSTANTS``)."""
+    import importlib
 
+    if name in _WHERE:
+        _offer(importlib.import_module(f"{__name__}.{_WHERE[name]}"))
+        return globals()[name]
+    if name in _CONSTANTS:
+        module, attribute = _CONSTANTS[name]
+        globals()[name] = value = getattr(importlib.import_module(module), attribute)
+        return value
     if name in ("METHODS", "COMPENSATION_METHODS", "STEPWISE_METHODS", "METHOD_SUMMARIES"):
+        from gatetherm.studies.control import method
+
         return {"METHODS": method.names, "COMPENSATION_METHODS": method.offered,
                 "STEPWISE_METHODS": lambda: method.offered(stepwise=True),
                 "METHOD_SUMMARIES": lambda: {m.name: m.summary for m in method.methods() if m.offered}}[name]()
     if name == "plot":
-        import importlib
-
         return importlib.import_module("gatetherm.validation.plots.api")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,7 +22,6 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter, lfilter_zi
 
 from gatetherm import InputError
 
@@ -86,6 +85,8 @@ def lag(t_s: np.ndarray, signal: np.ndarray, tau_s: float) -> np.ndarray:
     if s.size < 2:
         return s.copy()
     if np.ptp(h) <= 1e-9 * h[0]:  # uniform sampling: one C-level recursion
+        from scipy.signal import lfilter, lfilter_zi  # here: a service stepping a model imports no scipy.signal
+
         a = np.exp(-h[0] / tau_s)
         c1 = 1.0 - tau_s * (1.0 - a) / h[0]
         b, den = [c1, 1.0 - a - c1], [1.0, -a]

@@ -8,7 +8,6 @@ import dataclasses
 import logging
 
 import numpy as np
-from scipy.optimize import minimize
 
 from gatetherm.studies.errormodel import select
 from gatetherm.studies.errormodel.fitparams import FitParams
@@ -67,6 +66,8 @@ def tune_lags(terms, data: Runs, y_all, rows, params: FitParams):
 
     out = list(terms)
     if lagged:
+        from scipy.optimize import minimize  # here: a service stepping a model imports no scipy.optimize
+
         grid = {j: params.input_taus_s if terms[j].kind == "input" else params.sensor_taus_s for j in lagged}
         bounds = [(np.log(min(grid[j]) / SQRT2), np.log(max(grid[j]) * SQRT2)) for j in lagged]
         res = minimize(sse, np.log([terms[j].tau_s for j in lagged]), method="L-BFGS-B", bounds=bounds)
