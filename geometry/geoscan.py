@@ -26,6 +26,9 @@ COMMANDS = {"System": "runs a program", "SystemCall": "runs a program", "NonBloc
             "Abort": "ends gmsh", "SendToServer": "talks to a server", "RenameFile": "renames a file",
             "DeleteFile": "deletes a file"}
 """Identifiers refused wherever they appear (with ``commands``)."""
+ENDS = ("Abort",)
+"""Commands that end the reading of a script and leave gmsh meshing what was read so far: refused
+always, with or without ``commands`` (``Exit`` ends gmsh, which the sandbox reports)."""
 DATA = {".step", ".stp", ".brep", ".iges", ".igs", ".stl", ".msh", ".vtk", ".vtu", ".med", ".unv", ".mesh",
         ".inp", ".bdf", ".nas", ".obj", ".ply", ".off", ".x3d", ".xao", ".cgns", ".p3d", ".pos.bin"}
 """Formats gmsh reads with another reader than its script parser (not scanned)."""
@@ -89,6 +92,9 @@ def scan(path: Path, root: Path, allowed=(), commands: bool = False) -> list[Pat
                                      f"copy it beside the case or name it in the case: [mesh] include = [\"{name}\"]")
                 if target.suffix.lower() not in DATA:
                     todo.append(target)
+            elif tok in ENDS:  # even in the sandbox: what follows it would be dropped without a word
+                raise InputError(str(f), f"line {line}: {tok} ends gmsh's reading of the script there (the "
+                                 "groups after it would be missing)", "remove it")
             elif not commands:
                 continue
             elif tok in COMMANDS:

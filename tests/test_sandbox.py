@@ -325,3 +325,12 @@ def test_a_long_meshing_says_gmsh_is_still_at_work(monkeypatch, caplog):
     assert meta["n"] == 1
     assert re.search(r"big\.step: gmsh is still at work after \d+ s \(a large mesh; Ctrl-C stops it", caplog.text)
     assert caplog.text.count("gmsh is still at work") <= 1 + 5  # then at 1, 2, 4 … s: a handful, not a flood
+
+
+def test_abort_in_a_script_is_refused_by_its_line(tmp_path):
+    """gmsh's Abort ended the reading without a word and gmsh meshed what was read so far: the
+    case's groups after it were reported missing ('materials.bed: unknown key'), the script unnamed."""
+    (tmp_path / "a.geo").write_text('SetFactory("OpenCASCADE");\nRectangle(1) = {0, 0, 0, 1, 1};\nAbort;\n'
+                                    'Physical Surface("plate") = {1};\n')
+    with pytest.raises(InputError, match=r"a.geo: line 3: Abort ends gmsh's reading of the script there"):
+        mesh_geometry(MeshSpec(tmp_path / "a.geo", 0.25))
