@@ -272,8 +272,8 @@ class Problem:
 def values(problem: Problem) -> list[Value]:
     """The values of the problem's conditions, sources and fluids (the ones a run evaluates)."""
     out = [f.ambient for f in problem.films] + [f.value for f in (*problem.fixed, *problem.fluxes)]
+    out += [v for s in problem.sources for v in s.parts]  # before the losses they make: the named cause first
     out += [s.density for s in problem.sources] + ([problem.faces.ambient] if problem.faces else [])
-    out += [v for s in problem.sources for v in s.parts]
     out += [s.position for s in problem.sources if s.position is not None]
     out += [f.law.speed for f in problem.films if f.law is not None]  # a correlation's speed
     out += [v for f in problem.fluids for v in (f.supply, f.pump, f.ambient)]

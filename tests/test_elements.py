@@ -122,7 +122,7 @@ def test_a_factor_on_an_element_loss_is_the_diagnosis_parameter_of_its_source(tm
     ('speed = 0.1\npower = 3.0', "sources.plate.speed"),
     ('factor = 2.0\npower = 3.0', "sources.plate.factor"),
     ('kind = "motor"\nspeed = 3000.0\ntorque = 2.0\nefficiency = 1.5', "sources.plate.efficiency"),
-    ('kind = "motor"\nspeed = 3000.0\ntorque = 2.0\nefficiency = "3/2"', "sources.plate.kind"),
+    ('kind = "motor"\nspeed = 3000.0\ntorque = 2.0\nefficiency = "3/2"', "sources.plate.efficiency: '3/2' is 1.5"),
 ])
 def test_bad_element_source_is_one_line(tmp_path, body, where):
     shutil.copy(DATA / "two_names.geo", tmp_path)

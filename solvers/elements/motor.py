@@ -27,11 +27,12 @@ def motor_text(n: str, torque: str, efficiency: str, idle: float) -> str:
 
 def read(t, text) -> str:
     """The loss of a motor's ``[sources.REGION]`` table (:class:`~gatetherm.solvers.elements.ElementKind`);
-    a constant efficiency is checked here, an expression where it is evaluated."""
+    a constant efficiency is checked here, an expression over the run (``parts``)."""
     if t.data.get("efficiency") is not None and not isinstance(t.data["efficiency"], str):
         EFFICIENCY.check(t.key("efficiency"), t.data["efficiency"])
     return motor_text(text("speed", "1/min"), text("torque", "N m"), text("efficiency", "1"),
                       t.number("idle", Range(0.0, unit="W"), 0.0))
 
 
-KINDS = (ElementKind("motor", ("speed", "torque", "efficiency", "idle"), read, 50),)
+KINDS = (ElementKind("motor", ("speed", "torque", "efficiency", "idle"), read, 50,
+                     parts=(("efficiency", "1", EFFICIENCY),)),)
