@@ -124,6 +124,30 @@ def fork() -> int:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
+NATIVE = ("numpy", "scipy.linalg", "scipy.sparse.linalg", "pymklpardiso._mkl_pardiso")
+"""The libraries whose import starts native threads (their BLAS); optional ones may be missing."""
+
+
+def start_libraries(signals=None) -> None:
+    """Import :data:`NATIVE` with ``signals`` (default SIGINT, SIGTERM) blocked, so that the threads
+    they start never take them: a signal then reaches the main thread only, which may defer it
+    around C code that traps it (METIS: :func:`gatetherm.solvers.cholesky._signals_deferred`).
+    The command line calls it first, with the signals already blocked while it imports
+    :mod:`gatetherm.api` (which imports numpy); the API imports the rest when first used."""
+    import importlib
+    import signal
+
+    if not hasattr(signal, "pthread_sigmask"):
+        return
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, signals or {signal.SIGINT, signal.SIGTERM})
+    try:
+        for name in NATIVE:
+            with contextlib.suppress(ImportError):
+                importlib.import_module(name)
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
 @contextlib.contextmanager
 def frozen_heap():
     """While the block runs, the objects alive at its start are left out of the garbage

@@ -180,9 +180,11 @@ def test_a_negative_seed_of_a_validation_study_is_one_line(tmp_path, capsys, stu
 
 DEFERRED = """
 import os, signal, sys
-held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})  # as gatetherm.cli imports the libraries
-import gatetherm.api
+held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})  # as gatetherm.cli does first
+from gatetherm.api import start_libraries
+start_libraries()
 signal.pthread_sigmask(signal.SIG_SETMASK, held)
+import gatetherm.api.run  # a task's modules, imported when first used
 from gatetherm.solvers.cholesky import _others_block, _signals_deferred
 got = []
 signal.signal(signal.SIGTERM, lambda n, f: got.append(n))

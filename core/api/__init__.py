@@ -57,6 +57,7 @@ import types
 
 from gatetherm import InputError, _api_modules  # noqa: F401 - InputError with the ranges below, for the command line
 from gatetherm.checks import POSITIVE, Range  # noqa: F401
+from gatetherm.process import start_libraries  # noqa: F401 - the command line's first step
 
 WORKERS = Range(1, whole=True)  # worker processes: the command line's --workers (not in the reference)
 SEED = Range(0, 2**32 - 1, whole=True)  # a random seed: the command line's --seed (not in the reference)

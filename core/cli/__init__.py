@@ -154,7 +154,9 @@ def _run(argv: list[str] | None) -> int:
     # reaches the main thread only, which may defer it around C code that traps it (METIS).
     held = signal.pthread_sigmask(signal.SIG_BLOCK, set(_Signals.CODES))
     try:
-        from gatetherm.api import InputError, PointsFailed, SolverError, SolverOptions, configure
+        from gatetherm.api import InputError, PointsFailed, SolverError, SolverOptions, configure, start_libraries
+
+        start_libraries(set(_Signals.CODES))  # the API imports the rest when first used
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, held)
 
