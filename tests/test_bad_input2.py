@@ -428,3 +428,20 @@ def test_a_model_file_entry_of_the_wrong_kind_is_named(tmp_path, entry, value):
     (tmp_path / "m.json").write_text(json.dumps(d))
     with pytest.raises(InputError, match=rf"m\.json: (targets\.x_um\.)?{entry}"):
         load_model(tmp_path / "m.json")
+
+
+def test_a_point_off_the_body_names_the_parameters_that_shaped_it(tmp_path):
+    """A [mesh.parameters] value that shrank the body left a point group outside it: the message
+    named the point only, not the parameter that was the cause (audit B's cf-param-neg)."""
+    (tmp_path / "p.geo").write_text('If (!Exists(w)) w = 1.0; EndIf\nSetFactory("OpenCASCADE");\nRectangle(1) = {0, 0, 0, w, 1};\n'
+                                    'Point(10) = {0.9, 0.5, 0};\nPhysical Surface("body") = {1};\n'
+                                    'Physical Curve("left") = {4};\nPhysical Point("table") = {10};\n')
+    case = ('[mesh]\nfile = "p.geo"\nsize = 0.2\n[mesh.parameters]\nw = {w}\n[materials.body]\nk = 50.0\n'
+            '[thermal.left]\ntemperature = 30.0\n')
+    (tmp_path / "c.toml").write_text(case.format(w=1.0))
+    gt.load_case(tmp_path / "c.toml")  # the point inside: read at its nearest node
+    (tmp_path / "c.toml").write_text(case.format(w=0.2))
+    with pytest.raises(InputError) as info:
+        gt.load_case(tmp_path / "c.toml")
+    assert "mesh point table: at (0.9, 0.5" in str(info.value) and \
+        str(info.value).endswith("the geometry was made with [mesh.parameters] w = 0.2: check them")

@@ -76,10 +76,16 @@ def _parameters_read(params: Table, scripts) -> None:
 
 
 def _in_case(top: Table, read, arg) -> FrameMesh:
-    """``read(arg)``, its errors about case keys (``mesh.…``, ``--mesh-factor``) naming the case file."""
+    """``read(arg)``, its errors about case keys (``mesh.…``, ``--mesh-factor``) naming the case file;
+    where ``[mesh.parameters]`` shaped the geometry, the fix names them too (a point off the body
+    may be a parameter's doing: its value is the cause the message can name)."""
     try:
         return read(arg)
     except InputError as err:
+        given = ", ".join(f"{k} = {v:g}" for k, v in getattr(arg, "parameters", {}).items())
+        if given:
+            err = type(err)(err.field, err.problem, "; ".join(filter(None, (
+                err.fix, f"the geometry was made with [mesh.parameters] {given}: check them"))))
         raise err.at(str(top.file)) if err.field.startswith(("mesh", "--")) else err from None
 
 
