@@ -85,8 +85,11 @@ def test_paper_condition_and_beam_theory(tmp_path):
 def test_compensation(tmp_path):
     lines, _ = run_example("04_compensation.py", tmp_path)
     bands = {line.split(":")[0].strip(): numbers(line) for line in lines}
-    assert bands == {"paper": [2.35, 0.38, 73], "mlr": [2.56, 0.50, 73], "rom": [1.10, 0.00, 41]}
-    assert all(b[0] < 3.0 and b[2] <= 73 for b in bands.values())  # acceptance: ≤ 3 µm, one update per 5 min
+    # mlr 2.56 -> 3.05 um since 246c8b6: theta_A and theta_B span 0.47 K, under ten resolutions, and get
+    # no weight (least squares gave them +-1390 um/K, which 0.05 K of noise turns into tens of um)
+    assert bands == {"paper": [2.35, 0.35, 73], "mlr": [3.05, 0.82, 73], "rom": [1.10, 0.00, 41]}
+    # acceptance: ≤ 3 µm, one update per 5 min; mlr misses it by 0.05 µm since 246c8b6 (open)
+    assert all(b[0] < 3.0 and b[2] <= 73 for b in bands.values()), bands
 
 
 @pytest.mark.slow
