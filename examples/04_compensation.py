@@ -4,8 +4,9 @@ The C-frame's run drives its actuator (the case's ``[actuator]``: a piezo stack 
 hysteresis) with three predictors of δ: ``paper`` (the seed paper's δ = R_i K_i (θ_A − θ_B) −
 R_C K_C θ_C, K fitted, R adapted on line, updated every 5 min), ``mlr`` (a static regression on
 θ_A, θ_B, θ_C) and ``rom`` (a reduced heat model with a Kalman filter and predictive updates).
-Prints each method's residual band (what is left of δ) and its updates; draws the compensated δ
-(``compensation.png``).
+Prints each method's residual band (what is left of δ), its updates and what it left out (the
+regression gives no weight to a thermocouple spanning under ten resolutions); draws the
+compensated δ (``compensation.png``).
 
     python examples/04_compensation.py [OUT_DIR]
 """
@@ -24,6 +25,8 @@ for method in ("paper", "mlr", "rom"):
     s = result.summary
     print(f"{method:>5}: residual band {s['residual_band_um']:.2f} um, prediction error band "
           f"{s['prediction_error_band_um']:.2f} um, {s['updates']} updates")
+    for note in s["warnings"]:  # what the method left out or bounded, and why
+        print(f"       {note}")
     ax.plot(result.loop.t_s / 3600, result.loop.delta_comp_um, label=f"compensated, {method}")
 ax.legend(fontsize="small")
 ax.set_title(f"C-frame: δ = {run['delta_um'].max():.0f} µm at most, and what is left")

@@ -142,3 +142,26 @@ def test_a_later_set_that_does_not_hold_either_does_not_replace_the_named_one():
     assert sel.stand_ins == {JOINT: (0.4, "implausible"), DRIFT: (0.3, LATER)}
     sel, named, chk = select_confirmed(pick_with(True), judge, [FILM, JOINT, DRIFT])
     assert named == {FILM: 1.1, DRIFT: 0.3} and chk.holds and set(sel.stand_ins) == {JOINT}
+
+
+def test_a_later_set_that_only_partly_explains_does_not_replace_a_first_that_named_nothing():
+    """3-D data on the 2-D frame (tests/test_diagnosis_studies.py, three_d): every piece of the
+    first selection is a stand-in, the retry names one piece that leaves a significant residual.
+    Nothing is named (the verdict: unexplained) and the retry's piece is a stand-in too; a retry
+    that explains the run is named (issue 51's room drift)."""
+    def pick_with(explains_later: bool):
+        def pick(pool, dropped):
+            values = {FILM: 1.2, JOINT: 0.4} if JOINT in pool else {DRIFT: 0.3}
+            s = Scored(values, 0.0, 0.0, {}, explains_later and JOINT not in pool)
+            return Selection(s, s, list(values))
+        return pick
+
+    def judge(sel):
+        stand = {p: (v, "implausible") for p, v in sel.final.values.items() if p in (FILM, JOINT)}
+        return {p: v for p, v in sel.final.values.items() if p not in stand}, stand, SimpleNamespace(holds=True)
+
+    sel, named, _ = select_confirmed(pick_with(False), judge, [FILM, JOINT, DRIFT])
+    assert named == {} and sel.stand_ins == {FILM: (1.2, "implausible"), JOINT: (0.4, "implausible"),
+                                             DRIFT: (0.3, LATER)}
+    sel, named, _ = select_confirmed(pick_with(True), judge, [FILM, JOINT, DRIFT])
+    assert named == {DRIFT: 0.3} and set(sel.stand_ins) == {FILM, JOINT}

@@ -22,15 +22,17 @@ def select_confirmed(pick, judge, candidates: list[Piece], tries: int = 3):
     ``stand_ins`` {piece: (value, why)} that do not). While the judge rejects stand-ins, they
     leave the candidates and the selection runs again on the rest (the model runs made so far
     are kept), ``tries`` selections at most: a pair of stand-ins chosen first no longer hides the
-    piece that alone explains the data (issue 51). A later selection replaces an earlier one that
-    named pieces only where it explains the run: no stand-in, no significant residual left
-    (``selection.final.explains``) and holding on every phase fitted on the others (``checks.holds``,
-    or no checks); else its pieces are stand-ins too (:data:`LATER`). Each try draws from fewer
-    candidates: a set that only partly explains the run after the first was rejected is no better
-    evidence than the first, and where the cause lies outside every hypothesis, several such sets
-    fit in part. Naming them would name more wrong causes, each looking confirmed (the C-frame's
-    unmarked spindle length: conductivity, then, once a source factor joined the hypotheses, a third
-    selection's source ×0.90 + expansion ×1.10 + conductivity ×0.85, holding on every phase).
+    piece that alone explains the data (issue 51). A later selection replaces the first only where
+    it explains the run: no stand-in, no significant residual left (``selection.final.explains``)
+    and holding on every phase fitted on the others (``checks.holds``, or no checks); else its
+    pieces are stand-ins too (:data:`LATER`), whether the first named pieces or none. Each try
+    draws from fewer candidates: a set that only partly explains the run after the first was
+    rejected is no better evidence than the first, and where the cause lies outside every
+    hypothesis, several such sets fit in part. Naming them would name more wrong causes, each
+    looking confirmed (the C-frame's unmarked spindle length: conductivity, then, once a source
+    factor joined the hypotheses, a third selection's source ×0.90 + expansion ×1.10 + conductivity
+    ×0.85, holding on every phase; 3-D data on the 2-D frame: every piece of the first selection a
+    stand-in, then conductivity alone, leaving a significant residual).
 
     Returns
     -------
@@ -45,7 +47,7 @@ def select_confirmed(pick, judge, candidates: list[Piece], tries: int = 3):
         named, stand, chk = judge(sel)
         rejected.update(stand)
         explains = not stand and sel.final.explains and (chk is None or chk.holds)
-        if best is None or not best[1] or (named and explains):
+        if best is None or (named and explains):
             best = (sel, named, chk)
         else:  # the earlier named set stays: this one does not explain the run either
             rejected.update({p: (v, LATER) for p, v in named.items() if p not in best[1]})
