@@ -135,3 +135,18 @@ def fit_regression_stub():
     from gatetherm.studies.control.regression import LinearModel
 
     return LinearModel(THETAS, (1.0, -1.0, 0.5), 0.0)
+
+
+def test_a_live_stepper_says_what_its_fit_left_out(caplog):
+    """`gatetherm live --method mlr|paper` fits on the case's own run as the batch form does, and says,
+    in its journal's label and as a warning, which thermocouples got no weight (the C-frame's θ_A, θ_B
+    span 0.47 K, its θ_A − θ_B 0.003 K: under ten 0.05-K resolutions)."""
+    from gatetherm.studies.control import method as methods
+
+    setup = methods.Setup(gt.load_case(CASE), PARAMS)
+    with caplog.at_level("WARNING"):
+        (mlr, mlr_label), (paper, paper_label) = (methods.get(m).stepper(setup) for m in ("mlr", "paper"))
+    assert mlr.beta[1:3].tolist() == [0.0, 0.0] and paper.Ki == 0.0
+    assert "no weight for theta_A_degC (spans 0.471 K), theta_B_degC (spans 0.468 K)" in mlr_label
+    assert "no weight for theta_A - theta_B (spans 0.00326 K)" in paper_label
+    assert sum("no weight for" in r.message for r in caplog.records) == 2

@@ -3,8 +3,12 @@ forecasting one sample ahead from the extrapolated temperatures (the paper's lat
 baseline); step-wise :class:`~gatetherm.studies.control.stepwise.RegressionStepper`."""
 from __future__ import annotations
 
+import logging
+
 from gatetherm import InputError
 from gatetherm.studies.control.method import Batch, Job, Method, Setup
+
+log = logging.getLogger(__name__)
 
 
 def batch(job: Job) -> Batch:
@@ -39,12 +43,15 @@ def batch(job: Job) -> Batch:
 
 
 def stepper(setup: Setup):
-    """The regression fitted on the case's own run."""
+    """The regression fitted on the case's own run; the label says what the fit left out or bounded."""
     from gatetherm.studies.control.regression import THETAS, fit_regression
     from gatetherm.studies.control.stepwise import RegressionStepper
     from gatetherm.studies.run.scenario import run_scenario
 
-    return RegressionStepper(fit_regression(run_scenario(setup.case).series({}), THETAS), setup.params), "mlr"
+    mlr = fit_regression(run_scenario(setup.case).series({}), THETAS)
+    if mlr.warning:
+        log.warning("%s (on the case's own run)", mlr.warning)
+    return RegressionStepper(mlr, setup.params), "mlr" + (f" ({mlr.warning})" if mlr.warning else "")
 
 
 METHOD = Method("mlr", batch, stepper, order=20, summary="regression baseline", doc=__doc__)

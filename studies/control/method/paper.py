@@ -3,7 +3,11 @@ K_C given, from the beam theory (``theory``), from FE load cases (``fe``) or fit
 itself (``fit``); step-wise :class:`~gatetherm.studies.control.stepwise.PaperStepper`."""
 from __future__ import annotations
 
+import logging
+
 from gatetherm.studies.control.method import Batch, Job, Method, Setup
+
+log = logging.getLogger(__name__)
 
 
 def batch(job: Job) -> Batch:
@@ -35,13 +39,17 @@ def batch(job: Job) -> Batch:
 
 
 def stepper(setup: Setup):
-    """K_i, K_C as the batch form chooses them by default, on the case's own run."""
-    from gatetherm.studies.control.methods import Settings, coefficients
+    """K_i, K_C as the batch form chooses them by default, on the case's own run; the label says what
+    the fit left out (a difference spanning under ten resolutions gets no weight)."""
+    from gatetherm.studies.control.methods import Settings, _coefficients
     from gatetherm.studies.control.stepwise import PaperStepper
     from gatetherm.studies.run.scenario import run_scenario
 
-    ki, kc, source = coefficients(setup.case, run_scenario(setup.case).series({}), Settings())
-    return PaperStepper(ki, kc, setup.params), f"paper (K_i {ki:.4g}, K_C {kc:.4g} um/K, {source})"
+    ki, kc, source, note = _coefficients(setup.case, run_scenario(setup.case).series({}), Settings(), None)
+    if note:
+        log.warning("%s (on the case's own run)", note)
+    return PaperStepper(ki, kc, setup.params), f"paper (K_i {ki:.4g}, K_C {kc:.4g} um/K, {source})" + \
+        (f"; {note}" if note else "")
 
 
 METHOD = Method("paper", batch, stepper, order=10, summary="the paper's procedure", doc=__doc__)
