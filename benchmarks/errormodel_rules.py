@@ -73,8 +73,8 @@ def scored_pools(fit_ts, test_ts, first: int, targets, sensors, inputs, params, 
                 for terms in models:
                     X = np.column_stack([np.ones(data.time.size)] + [data.column(t) for t in terms])
                     var, eye = variances(terms, data, prm), np.eye(X.shape[1])
-                    err = {cv: held_out(X[rows], y_all[rows], data, rows, dataclasses.replace(prm, cv=cv), var).error(eye)
-                           for cv in ("chain", "blocked")}
+                    err = {cv: held_out(X[rows], y_all[rows], data, rows, dataclasses.replace(prm, cv=cv),
+                                        var).error(eye) for cv in ("chain", "blocked")}
                     c = select.noisy_least_squares(X[rows], y_all[rows], var)
                     out.append({"smooth": s, "target": y, "form": form, "n": len(terms), **err,
                                 "test": float(np.nanmean(np.abs(X[first:] @ c - measured)))})
