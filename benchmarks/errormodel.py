@@ -18,7 +18,9 @@ dataset's authors on the 16 absolute temperatures: ``rf raw``/``xgb raw``, and `
 on those plus their means over the 8 previous samples (32 features; the first 8 rows of a file have
 none).
 Seeds are fixed (``random_state=0``); defaults otherwise (100 trees), 2 threads.
-``--cv chain`` selects gatetherm's terms by forward chaining instead (docs/errormodel.md).
+``--cv chain`` selects gatetherm's terms by forward chaining instead (docs/errormodel.md);
+``--latest-score mean`` scores the candidates on the latest blocks by the mean of their forward-chaining
+and blocked errors (not the default: docs/errormodel.md, "Issue 56: ch5 on 0-40 %").
 ``--peers-from benchmarks/results/errormodel.json`` takes the peers' figures of the same splits as
 recorded there (where their environment is missing) and prints the checks against them.
 ``--smooth-s S`` fixes gatetherm's smoothing of the readings (no choice); ``--inner`` (with
@@ -142,6 +144,8 @@ def main() -> None:
     ap.add_argument("--no-peers", action="store_true", help="run gatetherm only")
     ap.add_argument("--cv", choices=("blocked", "chain"), default=ROBUST.cv,
                     help="gatetherm's held-out error within the fitting span (default: the API's)")
+    ap.add_argument("--latest-score", choices=("chain", "mean"), default=ROBUST.latest_score,
+                    help="gatetherm's score on the latest blocks: forward chaining, or its mean with the blocked error")
     ap.add_argument("--test-data", help="also fit on all of --data and test on this file (a later part)")
     ap.add_argument("--smooth-s", type=float, metavar="S",
                     help="gatetherm's readings smoothed over S s, no choice (default: the API's choice)")
@@ -153,7 +157,7 @@ def main() -> None:
     ap.add_argument("--json", default=str(Path(__file__).resolve().parent / "results" / "errormodel.json"))
     args = ap.parse_args()
     global PARAMS
-    PARAMS = dataclasses.replace(PARAMS, cv=args.cv)
+    PARAMS = dataclasses.replace(PARAMS, cv=args.cv, latest_score=args.latest_score)
     if args.smooth_s is not None:
         PARAMS = dataclasses.replace(PARAMS, smooth_s=args.smooth_s, smooth_grid_s=())
     if args.inner and not args.no_peers:

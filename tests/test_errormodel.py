@@ -332,3 +332,21 @@ def test_choose_latest_picks_on_forward_chaining():
     assert m.interval["coverage"] == pytest.approx(0.929, abs=0.01)  # band: 0.85-0.95 (forward, in the fitting span)
     # white noise of 0.05 um: 1.645 x 0.05 = 0.082 um; the largest of the 16 blocks' 90 % quantiles is a little wider
     assert m.interval["half_width_um"] == pytest.approx(0.0907, abs=0.004) and m.interval["blocks"] == 16
+
+
+def test_latest_score_mean_is_half_chain_half_blocked():
+    """latest_score="mean" (not the default; docs/errormodel.md, "Issue 56"): the kept model's
+    held_out_mae_um is the mean of its forward-chaining and blocked errors, recomputed here."""
+    from gatetherm.studies.errormodel import select
+    from gatetherm.studies.errormodel.model import _term_values
+
+    fit = synthetic(n=900)
+    params = FitParams(resolution_K=0.0, choose_latest=True, latest_score="mean")
+    model = fit_error_model(fit, ["d_um"], SENSORS, ("spindle_rpm",), params)
+    values, _, _ = _term_values(model, fit)  # the kept terms' columns on the fitting rows
+    X = np.column_stack([np.ones(len(fit))] + list(values["d_um"]))
+    y = np.asarray(fit["d_um"])
+    errs = [select.CrossValidation(X, y, params.folds, chain=c).error(np.eye(X.shape[1])) for c in (True, False)]
+    assert model.target("d_um").held_out_mae_um == pytest.approx(np.mean(errs), rel=1e-6)
+    with pytest.raises(InputError, match="latest_score"):
+        FitParams(latest_score="blocked")

@@ -240,18 +240,23 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
 
 def _latest(pool: dict, data: Runs, y_all, rows, params: FitParams):
     """The candidate of ``pool`` (form -> lists of terms) chosen by the forward-chaining error on the
-    latest blocks of the fitting rows (``params.choose_latest``): the one of the fewest terms (ties: the
-    first listed) whose error is within ``min_gain`` of the lowest. Its terms, that error and its form."""
+    latest blocks of the fitting rows (``params.choose_latest``; with ``latest_score="mean"`` the mean of
+    that and the blocked error): the one of the fewest terms (ties: the first listed) whose error is
+    within ``min_gain`` of the lowest. Its terms, that error and its form."""
     chain = dataclasses.replace(params, cv="chain")
     scored = []
     for form, models in pool.items():
         for terms in models:
             X = np.column_stack([np.ones(data.time.size)] + [data.column(term) for term in terms])
-            err = held_out(X[rows], y_all[rows], data, rows, chain, variances(terms, data, params)).error(
-                np.eye(X.shape[1]))
+            var = variances(terms, data, params)
+            err = held_out(X[rows], y_all[rows], data, rows, chain, var).error(np.eye(X.shape[1]))
+            if params.latest_score == "mean":  # fixed weights: half the latest blocks', half the whole span's
+                blocked = dataclasses.replace(params, cv="blocked")
+                err = 0.5 * (err + held_out(X[rows], y_all[rows], data, rows, blocked, var).error(np.eye(X.shape[1])))
             scored.append((len(terms), len(scored), err, terms, form))
     lowest = min(s[2] for s in scored)
     _, _, err, terms, form = min(s for s in scored if s[2] <= lowest * (1 + params.min_gain))
-    log.info("chosen on the latest blocks: %s, %s (forward-chaining error %.4g; lowest %.4g)", form,
-             ", ".join(t.label for t in terms), err, lowest)
+    log.info("chosen on the latest blocks: %s, %s (%s error %.4g; lowest %.4g)", form,
+             ", ".join(t.label for t in terms), "forward-chaining" if params.latest_score == "chain" else "mean", err,
+             lowest)
     return terms, err, form

@@ -11,6 +11,7 @@ from gatetherm import InputError
 
 FIT_FORMS = ("auto", "static", "dynamic", "paper")
 CV_KINDS = ("blocked", "chain")
+LATEST_SCORES = ("chain", "mean")
 #: A temperature term spanning fewer resolutions than this in the fitting span is not offered.
 SPAN_RESOLUTIONS = 10
 
@@ -75,6 +76,11 @@ class FitParams:
     latest blocks (as a control uses it): the candidates are every model on each form's forward-selection
     path (ordered by ``cv``) and the refined pick, and the one of the lowest forward-chaining error is
     kept; ``held_out_mae_um`` is then that error, and so is what ``smooth_grid_s`` compares."""
+    latest_score: str = "chain"
+    """With ``choose_latest``, the score of a candidate: ``chain``, its forward-chaining error on the latest
+    blocks; ``mean``, the mean of that and its blocked cross-validation error over the whole span (fixed
+    weights, one half each; docs/errormodel.md, "Issue 56: ch5 on 0-40 %"). ``held_out_mae_um`` and the
+    smoothing's comparison are then that score."""
     drift: bool = False
     """With several runs, also offer a slow drift, the hours since each run's start (kept only where
     it earns ``min_gain`` on the held-out runs); within one run a trend in time is confounded with
@@ -99,5 +105,8 @@ class FitParams:
             raise InputError("cv", f"{self.cv!r} is not one of {', '.join(CV_KINDS)}", "e.g. cv chain")
         if not all(np.isfinite(v) and v >= 0 for v in (self.smooth_s, self.anchor_s, *self.smooth_grid_s)):
             raise InputError("smooth_s, anchor_s", "must be >= 0", "e.g. 300 (s), 0 = off")
+        if self.latest_score not in LATEST_SCORES:
+            raise InputError("latest_score", f"{self.latest_score!r} is not one of {', '.join(LATEST_SCORES)}",
+                             "e.g. latest_score chain")
         if not 0 <= self.min_gain < 1:
             raise InputError("min_gain", f"{self.min_gain} is outside [0, 1)", "e.g. 0.03")
