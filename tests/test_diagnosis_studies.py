@@ -44,8 +44,10 @@ def test_a_hidden_dimension_is_named_as_itself(key):
     value = next(iter(row["fitted"].values()))
     assert abs(value - model * factor) <= 0.2 * abs(model * factor - model) and row["within_20pct"]  # the band
     assert value == pytest.approx(fitted, rel=4e-4)  # achieved (4 digits)
+    # after: the residual at the noise floor, where the fit stops; it moves by 2.6e-3 from machine to
+    # machine with the same libraries (geometry.h 0.1076 here, 0.1079 on another EPYC host)
     assert (row["rms_before_um"], row["rms_after_um"]) == (pytest.approx(before, rel=1e-3),
-                                                           pytest.approx(after, rel=1e-3))
+                                                           pytest.approx(after, rel=5e-3))
 
 
 #: (effect, which of its cases) -> held-out δ RMS before, after (µm): the same before the model-form
