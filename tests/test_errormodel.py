@@ -96,6 +96,12 @@ def test_paper_form_finds_its_three_sensors():
     assert m.coefficients == pytest.approx((2.0, -0.7), abs=1e-9)
     assert m.intercept_um == 0.0 and m.held_out_mae_um < 1e-9
 
+    flat = {s: ts[s][0] + 0.001 * th[s] / np.ptp(th[s]) for s in SENSORS}  # each spans 1 mK
+    with pytest.raises(InputError, match=r"no two of the \d+ temperature columns differ by 0.5 K .*form 'static'"):
+        fit_error_model(ts.with_columns(d_um=d, **flat), ["d_um"], SENSORS, params=FitParams(form="paper"))
+    with pytest.raises(InputError, match="needs at least 3 temperature columns"):
+        fit_error_model(ts.with_columns(d_um=d), ["d_um"], SENSORS[:2], params=FitParams(form="paper"))
+
 
 def test_a_difference_is_one_term_for_two_sensors():
     ts = synthetic(noise_um=0.0)

@@ -28,8 +28,12 @@ def fit_paper_form(cv: select.CrossValidation, name: str, base: list[Term], B: n
              if select.informative(B[rows] @ W(a, b, a)[:, 0], min_span_K)]
     triples = [(a, b, c) for a, b in pairs for c in plain
                if c not in (a, b) and select.informative(B[rows, c + 1], min_span_K)]
-    if not triples:
+    if len(plain) < 3:
         raise InputError("candidates", "the paper's form needs at least 3 temperature columns", "name 3 or more")
+    if not triples:
+        raise InputError("candidates", f"no two of the {len(plain)} temperature columns differ by {min_span_K:g} K "
+                         f"(ten sensor resolutions) with a third spanning as much, in the fitting span: the paper's "
+                         f"form has nothing to weigh", "name other thermocouples, or use form 'static' or 'dynamic'")
     ranked = select.exhaustive(cv, ((abc, W(*abc)) for abc in triples))
     cv_mae, (a, b, c) = ranked[0]
     X = B[:, [a + 1, b + 1, c + 1]]
