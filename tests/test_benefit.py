@@ -202,3 +202,31 @@ def test_the_verdict_counts_the_displacement_resolution(left_um, verdict):
             guard(b, "m", False, "leave the axis uncompensated")
     b, warning = guard(b, "m", True, "")
     assert (warning is None) == (verdict == "better") and b.forced == (verdict == "worse")
+
+
+def test_the_correction_as_applied_is_checked_too():
+    """A refitted check that says `better` does not stand for a correction that, as applied, is worse
+    on the same held-out span (a new user's column on a bed: the paper method's factors ran away on the
+    whole record's K, 72.24 against 60.91 um, checked `better` at 49.59); one worse only while it adapts
+    is said in a warning."""
+    from types import SimpleNamespace
+
+    from gatetherm.studies.control import benefit as held
+
+    t = np.arange(0.0, 36000.0 + 1, 60.0)
+    delta = 60.0 * t / t[-1]
+    loop = SimpleNamespace(t_s=t, delta_um=delta, delta_comp_um=np.where(t > 0.7 * t[-1], 1.2 * delta, 0.1 * delta))
+    refit = held.Benefit(49.59, 60.0, 0.3, 0.7 * t[-1], "better", "K_i, K_C fitted on the first 70 %")
+    b = held.as_applied(refit, loop)
+    assert (b.verdict, round(b.held_out_um, 2), b.uncompensated_um) == ("worse", 72.0, 60.0)
+    assert b.basis == "as applied (the check with K_i, K_C fitted on the first 70 % said better, 49.59 um)"
+    with pytest.raises(InputError, match=r"paper would leave δ 72.00 um > 60.00 um uncompensated"):
+        held.guard(b, "paper", False, "leave the axis uncompensated")
+    good = SimpleNamespace(t_s=t, delta_um=delta, delta_comp_um=0.1 * delta)
+    assert held.as_applied(refit, good) is refit and held.over_record(good, 600.0, "paper") == ""
+    early = SimpleNamespace(t_s=t, delta_um=delta,
+                            delta_comp_um=np.where((t > 0.1 * t[-1]) & (t < 0.3 * t[-1]), 80.0, 0.1 * delta))
+    assert held.as_applied(refit, early) is refit
+    assert held.over_record(early, 600.0, "paper") == ("paper as applied leaves |δ| up to 80.00 um over the record "
+                                                       "after 10 min, more than the 60.00 um uncompensated: worse while "
+                                                       "it adapts")

@@ -12,9 +12,11 @@ held-out benefit cannot be known from this record.
 
 Verdict, with the displacement sensor's resolution r (:data:`RESOLUTION_UM`, 0.1 um): ``worse`` when
 ``held_out_um > uncompensated_um + r``, ``no-gain`` within r of it (a difference no sensor can see),
-else ``better``. A worse correction is refused (:func:`guard`, one line naming the figures and a
-better choice) unless forced; forced, it runs with a warning in the log and in the summary. A
-correction of no measurable gain, or one that could not be checked, runs with a warning.
+else ``better``. The correction as applied is checked on the same span too (:func:`as_applied`):
+where it is worse there, the verdict is ``worse`` whatever a refitted check says. A worse correction
+is refused (:func:`guard`, one line naming the figures and a better choice) unless forced; forced, it
+runs with a warning in the log and in the summary. A correction of no measurable gain, or one that
+could not be checked, runs with a warning.
 """
 from __future__ import annotations
 
@@ -95,6 +97,34 @@ def benefit(loop, fraction: float, basis: str) -> Benefit:
     held = float(np.max(comp))
     verdict = "worse" if held > unc + RESOLUTION_UM else "no-gain" if held >= unc - RESOLUTION_UM else "better"
     return Benefit(held, unc, fraction, start, verdict, basis)
+
+
+def as_applied(b: Benefit, loop) -> Benefit:
+    """``b``, or ``worse`` where the correction as applied (``loop``) leaves a larger |δ| than no
+    compensation on the same held-out span: what a check with a refit says does not stand for the
+    correction the user gets (a paper method whose on-line factors run away on the whole record's K)."""
+    if b.verdict == "worse" or b.basis.startswith("as applied"):
+        return b
+    applied = benefit(loop, b.fraction, "as applied")
+    if applied.verdict != "worse":
+        return b
+    return dataclasses.replace(applied, basis=f"as applied (the check with {b.basis} said {b.verdict}, "
+                               f"{'unknown' if b.held_out_um is None else f'{b.held_out_um:.2f} um'})")
+
+
+def over_record(loop, settle_s: float, method: str) -> str:
+    """A warning where the correction as applied leaves a larger |δ| over the record after its first
+    ``settle_s`` than no compensation there ('' where it does not): a method that adapts on line can be
+    worse while it adapts and better on the held-out span."""
+    late = loop.t_s >= loop.t_s[0] + settle_s
+    comp = np.abs(loop.delta_comp_um[late])
+    if not late.any() or not np.isfinite(comp).any():
+        return ""
+    left, unc = float(np.nanmax(comp)), float(np.max(np.abs(loop.delta_um[late])))
+    if left <= unc + RESOLUTION_UM:
+        return ""
+    return (f"{method} as applied leaves |δ| up to {left:.2f} um over the record after {settle_s / 60:g} min, more than "
+            f"the {unc:.2f} um uncompensated: worse while it adapts")
 
 
 def unchecked(loop, fraction: float, why: str) -> Benefit:

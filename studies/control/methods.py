@@ -180,8 +180,13 @@ def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, hea
     """The compensation with its held-out benefit, refused (InputError) where it would make δ worse
     unless forced (:func:`.benefit.guard`)."""
     name = registry.get(s.method).title or s.method
+    b = held.as_applied(b, loop)
     better = _better(ts, s, actuator) if b.verdict == "worse" and not s.force else ""
     b, warning = held.guard(b, name, s.force, better)
+    early = held.over_record(loop, s.params.settle_s, name)
+    if early:
+        log.warning("%s", early)
+        notes = (*notes, early)
     summary = {**summarize(loop, s.params.settle_s), "method": s.method, **extra,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(s.params),
                "actuator": dataclasses.asdict(actuator) if actuator else None, "benefit": b.as_dict(),
