@@ -194,3 +194,20 @@ def test_the_paper_frame_as_a_case_finds_its_tank_film(tmp_path, capsys):
     assert d["verdict"] == "explained" and list(d["fitted"]) == ["tank_oil_film_on.film_on"]
     assert d["fitted"]["tank_oil_film_on.film_on"] == pytest.approx(150.0, rel=0.005)
     assert d["rms_before"]["T_hose_degC"] == 0.0 and len(d["channels"]) == 23
+
+
+def test_the_study_on_another_case_leaves_out_the_c_frames_own_scenarios(tmp_path, caplog):
+    """`validate case-diagnosis --case` on a lathe headstock: the scenarios hiding the C-frame's spindle
+    source and length are left out with a warning each, before any model run; none left: refused."""
+    from gatetherm import InputError
+    from gatetherm.validation.case_diagnosis import lacking, run_study
+
+    other = Path(__file__).resolve().parent / "data" / "headstock" / "case.toml"
+    hs = load_case(other, MESH_FACTOR)
+    assert {n: lacking(hs, SCENARIOS[n][0]) for n in SCENARIOS if lacking(hs, SCENARIOS[n][0])} == {
+        "source+expansion": "source_spindle", "spindle length, marked": SPINDLE, "spindle length, not marked": SPINDLE}
+    with pytest.raises(InputError, match="no scenario of the study hides pieces this case has"):
+        run_study(tmp_path, other, scenarios=("source+expansion", "spindle length, marked"))
+    assert [r.message.split(":")[1].strip() for r in caplog.records if "left out" in r.message] == [
+        "scenario 'source+expansion' left out", "scenario 'spindle length, marked' left out"]
+    assert not list(tmp_path.iterdir())
