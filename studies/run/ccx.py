@@ -228,7 +228,10 @@ def export_state(case, schedule, t: float, title: str, on_step=None) -> tuple[st
     from gatetherm.studies.run.scenario import run_scenario
 
     t = check_time(schedule, t)
-    refuse(case.problem)  # before the run
+    try:  # before the run
+        refuse(case.problem)
+    except InputError as err:
+        raise err.at(str(case.path or "")) from None
     env = environment(schedule.drive, t)
     run = run_scenario(case, schedule, keep_times=[t], on_step=on_step)
     model = run.model
