@@ -102,6 +102,9 @@ NONNEGATIVE = Range(0.0)
 FINITE = Range()
 CELSIUS = Range(ABSOLUTE_ZERO_C, MAX_CELSIUS, lo_open=True, unit="°C")
 """A temperature: above absolute zero and at most :data:`MAX_CELSIUS`."""
+KELVIN_LIKE = (253.15, 373.15)
+"""Temperatures in °C that are a machine's surroundings written in kelvins (−20 … 100 °C in K) by
+mistake: a case file's are read with a warning, a model file's references refused."""
 ACCELERATION = Range(-1e4, 1e4, unit="m/s²")
 """A component of ``[gravity]``: up to about 1 000 g (a machine on a shaker table, not a
 number that makes every displacement overflow)."""

@@ -28,7 +28,8 @@ from gatetherm import InputError
 from gatetherm.checks import _short
 
 CONVENTIONS = {"on_progress": typing.Optional[abc.Callable[[int, int], None]],
-               "on_step": typing.Optional[abc.Callable[[int, int], None]], "on_": typing.Optional[abc.Callable], "stopped": typing.Optional[abc.Callable],
+               "on_step": typing.Optional[abc.Callable[[int, int], None]], "on_": typing.Optional[abc.Callable],
+               "stopped": typing.Optional[abc.Callable],
                "out": typing.Union[str, os.PathLike, None]}
 """Annotations of unannotated parameters by name (a prefix ending in ``_`` or the whole name)."""
 FIXES = {"Case": "make one with gt.load_case(path) or gt.gate_frame()",

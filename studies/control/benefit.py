@@ -123,8 +123,8 @@ def over_record(loop, settle_s: float, method: str) -> str:
     left, unc = float(np.nanmax(comp)), float(np.max(np.abs(loop.delta_um[late])))
     if left <= unc + RESOLUTION_UM:
         return ""
-    return (f"{method} as applied leaves |δ| up to {left:.2f} um over the record after {settle_s / 60:g} min, more than "
-            f"the {unc:.2f} um uncompensated: worse while it adapts")
+    return (f"{method} as applied leaves |δ| up to {left:.2f} um over the record after {settle_s / 60:g} min, "
+            f"more than the {unc:.2f} um uncompensated: worse while it adapts")
 
 
 def unchecked(loop, fraction: float, why: str) -> Benefit:

@@ -13,7 +13,7 @@ import dataclasses
 from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
-from gatetherm.checks import FINITE, first_nonfinite, json_text, parse_json
+from gatetherm.checks import FINITE, KELVIN_LIKE, first_nonfinite, json_text, parse_json
 from gatetherm.files import read_text
 from gatetherm.studies.errormodel.fitted import (  # noqa: F401 (re-exported)
     FORMS, ErrorModel, TargetModel, residual_stats)
@@ -49,8 +49,6 @@ COEFFICIENT = 1e9
 
 MAX_NAME = 100
 """Longest column name (a target, a sensor) a model file may hold."""
-KELVIN_LIKE = (253.15, 373.15)
-"""References in this band, °C, are temperatures in kelvins (−20 … 100 °C) by mistake."""
 
 
 def _names(columns) -> str:

@@ -7,7 +7,7 @@ import logging
 from pathlib import Path
 
 from gatetherm import InputError
-from gatetherm.checks import BY_UNIT, CELSIUS, FINITE, Range
+from gatetherm.checks import BY_UNIT, CELSIUS, FINITE, KELVIN_LIKE, Range
 from gatetherm.solvers.expr import ExpressionError, Value
 from gatetherm.studies.run.timeseries import alike
 
@@ -17,9 +17,6 @@ MAX_TEXT = 200
 """Longest string a case file's value may be (a name, a file's path, a choice)."""
 COLUMN_UNSAFE = ',"#'
 """Characters a name that becomes a data-format column may not hold (docs/data-format.md)."""
-KELVIN_LIKE = (253.15, 373.15)
-"""Temperatures in °C that are a machine's surroundings written in kelvins (-20 … 100 °C in K):
-read, with a warning."""
 
 
 class Inputs(tuple):
