@@ -103,16 +103,15 @@ FINITE = Range()
 CELSIUS = Range(ABSOLUTE_ZERO_C, MAX_CELSIUS, lo_open=True, unit="°C")
 """A temperature: above absolute zero and at most :data:`MAX_CELSIUS`."""
 KELVIN_LIKE = (253.15, 373.15)
-"""Temperatures in °C that are a machine's surroundings written in kelvins (−20 … 100 °C in K) by
-mistake: a case file's are read with a warning, a model file's references refused."""
+"""°C values that are surroundings written in kelvins by mistake (−20 … 100 °C in K): read from
+a case file with a warning, refused as a model file's reference."""
 ACCELERATION = Range(-1e4, 1e4, unit="m/s²")
 """A component of ``[gravity]``: up to about 1 000 g (a machine on a shaker table, not a
 number that makes every displacement overflow)."""
 BY_UNIT = {"°C": CELSIUS, "N": Range(-1e12, 1e12, unit="N"), "Pa": Range(-1e12, 1e12, unit="Pa"),
            "m": Range(-1e3, 1e3, unit="m")}
-"""The range of a case file's value of a unit where its key names none: a temperature; a force
-or a pressure (1e12 N, 1 TPa: beyond any machine, short of numbers whose displacements
-overflow); a length or position (1 km). Any other unit: finite."""
+"""The range of a case file's value of a unit where its key names none: a temperature; a force or
+pressure (1e12 N, 1 TPa: beyond any machine, short of overflow); a length (1 km). Else: finite."""
 
 
 def admissible(default: Range | None = None, **ranges: Range):
