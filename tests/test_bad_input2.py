@@ -78,10 +78,17 @@ def test_the_read_limit_holds_under_a_callers_alarm_handler(tmp_path, monkeypatc
     assert "gmsh was still reading it after 2 s" in str(info.value)
 
 
-def test_a_temperature_in_kelvins_is_read_with_a_warning(tmp_path, caplog):
+def test_a_temperature_in_kelvins_is_read_with_a_warning_once(tmp_path, caplog):
+    """Said once: the case made again (the quadratic-element check, a sweep, a diagnosis) repeats
+    none of its reading's warnings, but says what an override newly brings."""
+    said = "thermal.jacket.ambient: 293.15 °C reads like a temperature in kelvins (20 °C)"
     with caplog.at_level(logging.WARNING):
-        gt.load_case(spindle(tmp_path, "ambient = 20.0", "ambient = 293.15"))
-    assert "thermal.jacket.ambient: 293.15 °C reads like a temperature in kelvins (20 °C)" in caplog.text
+        case = gt.load_case(spindle(tmp_path, "ambient = 20.0", "ambient = 293.15"))
+        case.with_order(2).with_overrides({"materials.housing.k": 40.0})
+    assert caplog.text.count(said) == 1
+    with caplog.at_level(logging.WARNING):
+        case.with_overrides({"thermal.jacket.ambient": 300.0})
+    assert caplog.text.count(said) == 1 and "ambient: 300 °C reads like a temperature in kelvins" in caplog.text
 
 
 def test_a_negative_constant_load_is_read_with_a_word(tmp_path, caplog):

@@ -224,9 +224,30 @@ def test_the_correction_as_applied_is_checked_too():
         held.guard(b, "paper", False, "leave the axis uncompensated")
     good = SimpleNamespace(t_s=t, delta_um=delta, delta_comp_um=0.1 * delta)
     assert held.as_applied(refit, good) is refit and held.over_record(good, 600.0, "paper") == ""
-    early = SimpleNamespace(t_s=t, delta_um=delta,
+    early = SimpleNamespace(t_s=t, delta_um=delta, delta_pred_um=0.9 * delta,
                             delta_comp_um=np.where((t > 0.1 * t[-1]) & (t < 0.3 * t[-1]), 80.0, 0.1 * delta))
     assert held.as_applied(refit, early) is refit
-    assert held.over_record(early, 600.0, "paper") == ("paper as applied leaves |δ| up to 80.00 um over the record "
-                                                       "after 10 min, more than the 60.00 um uncompensated: worse while "
-                                                       "it adapts")
+    said = "paper as applied leaves |δ| up to 80.00 um over the record after 10 min, more than the 60.00 um " \
+        "uncompensated: "
+    assert held.over_record(early, 600.0, "paper") == said + "worse while it adapts"
+    # a prediction that misses δ by more than δ itself (a new user's column compensated with the paper
+    # frame's beam-theory K: 173.71 against 102.96 um) is said to be the model's, not the adaptation's
+    foreign = SimpleNamespace(**{**vars(early), "delta_pred_um": -delta})
+    assert held.over_record(foreign, 600.0, "paper", "K_i, K_C from the beam theory of case 'f'") == said + (
+        "its prediction misses δ by up to 120.00 um, more than δ itself; the prediction (K_i, K_C from the beam "
+        "theory of case 'f') does not describe this record: one of another machine? give that machine's case")
+    assert held.over_record(foreign, 600.0, "paper").endswith(
+        "; the method does not describe this machine: leave the axis uncompensated")
+
+
+def test_a_record_in_minutes_is_said_to_be(machine):
+    """A record whose time_s is in minutes (a new user's 4-h run as 240 "s" against the case's 4-h
+    [time]) is compensated with a warning naming the factor; one in seconds is not."""
+    case, own, measured = machine
+    minutes = measured.with_columns(time_s=measured.time_s / 60.0)
+    [line] = [w for w in compensate(minutes, case, Settings("mlr")).summary["warnings"] if "time_s" in w]
+    assert line == (f"--data: time_s spans 480 s, 1/{case.time.end / 480:.3g} of the [time] end of case "
+                    f"{case.name!r}, {case.time.end:g} s; a record in minutes? give time_s in seconds (minutes × 60)")
+    assert not any("time_s" in w for w in compensate(measured, case, Settings("mlr")).summary["warnings"])
+    ms = measured.with_columns(time_s=measured.time_s * 1000.0)
+    assert "a record in milliseconds?" in compensate(ms, case, Settings("mlr")).summary["warnings"][-1]

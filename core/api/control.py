@@ -93,10 +93,12 @@ def diagnose(case: Case, measured: TimeSeries | str | os.PathLike, **settings):
         would fit what stays unexplained), ``.summary()``; docs/diagnosis.md.
     """
     from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose as run_diagnosis
+    from gatetherm.studies.run.scenario import span_note
     from gatetherm.studies.run.timeseries import TimeSeries, read_timeseries
 
     _case(case)
     argument("measured", measured, (TimeSeries, *PATH), "a TimeSeries or a time-series file's path")
     settings_argument(Settings, settings, "diagnose")
     ts = measured if isinstance(measured, TimeSeries) else read_timeseries(measured, required=("time_s",))
+    span_note(case, ts, ts.source or "measured", warn=True)
     return run_diagnosis(case, ts, Settings(**settings))

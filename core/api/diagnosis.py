@@ -229,7 +229,7 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out: str | os.PathLike
         ``.diagnosis``, ``.write(out)``, ``.summary()``.
     """
     from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose as run_diagnosis
-    from gatetherm.studies.run.scenario import measured_schedule
+    from gatetherm.studies.run.scenario import measured_schedule, span_note
     from gatetherm.studies.run.timeseries import read_timeseries
 
     argument("model", model, Case, "a Case", "make one with gt.diagnosis_model() or gt.load_case(path)")
@@ -241,6 +241,7 @@ def diagnose_run(model: Case, data: str | os.PathLike, *, out: str | os.PathLike
     keep = (config, str(data), *model.files)
     ts = read_timeseries(data, required=("time_s",))
     measured_schedule(model, ts, str(data))  # every input the case reads is in the file
+    span_note(model, ts, str(data), warn=True)
 
     def diagnosed() -> DiagnosisRun:
         diag = run_diagnosis(model, ts, choices, on_progress)

@@ -112,10 +112,11 @@ def as_applied(b: Benefit, loop) -> Benefit:
                                f"{'unknown' if b.held_out_um is None else f'{b.held_out_um:.2f} um'})")
 
 
-def over_record(loop, settle_s: float, method: str) -> str:
+def over_record(loop, settle_s: float, method: str, model: str = "") -> str:
     """A warning where the correction as applied leaves a larger |δ| over the record after its first
-    ``settle_s`` than no compensation there ('' where it does not): a method that adapts on line can be
-    worse while it adapts and better on the held-out span."""
+    ``settle_s`` than no compensation there ('' where it does not), and why: a prediction that misses δ
+    by more than δ itself (``model``, what of a case it comes from, describes another machine or
+    another record), or a method that adapts on line, worse while it adapts and better on the held-out span."""
     late = loop.t_s >= loop.t_s[0] + settle_s
     comp = np.abs(loop.delta_comp_um[late])
     if not late.any() or not np.isfinite(comp).any():
@@ -123,8 +124,13 @@ def over_record(loop, settle_s: float, method: str) -> str:
     left, unc = float(np.nanmax(comp)), float(np.max(np.abs(loop.delta_um[late])))
     if left <= unc + RESOLUTION_UM:
         return ""
+    missed = float(np.nanmax(np.abs(loop.delta_um[late] - loop.delta_pred_um[late])))
+    fix = f"the prediction ({model}) does not describe this record: one of another machine? give that machine's " \
+        "case" if model else "the method does not describe this machine: leave the axis uncompensated"
+    why = "worse while it adapts" if missed <= unc + RESOLUTION_UM else \
+        f"its prediction misses δ by up to {missed:.2f} um, more than δ itself; {fix}"
     return (f"{method} as applied leaves |δ| up to {left:.2f} um over the record after {settle_s / 60:g} min, "
-            f"more than the {unc:.2f} um uncompensated: worse while it adapts")
+            f"more than the {unc:.2f} um uncompensated: {why}")
 
 
 def unchecked(loop, fraction: float, why: str) -> Benefit:

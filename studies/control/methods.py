@@ -41,7 +41,7 @@ from gatetherm.studies.control.observer import ObserverParams
 from gatetherm.studies.control.predictive import THERMOCOUPLES, PredictiveParams
 from gatetherm.studies.control.regression import RESOLUTION_K, fit_coefficients_noted
 from gatetherm.studies.run.case import Case
-from gatetherm.studies.run.scenario import ScenarioCache, prepare
+from gatetherm.studies.run.scenario import ScenarioCache, prepare, span_note
 from gatetherm.studies.run.timeseries import TimeSeries
 
 log = logging.getLogger(__name__)
@@ -165,7 +165,10 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         check_loop, basis = out.checked
         b = held.unchecked(out.loop, s.held_out, basis) if check_loop is None else \
             held.benefit(check_loop, s.held_out, basis)
-    return _checked(ts, out.loop, b, s, actuator, out.extra, out.label, out.head, out.notes)
+    model = f"{out.model} of case {case.name!r}" if out.model and case is not None else ""
+    span = span_note(case, ts, source) if model else ""  # the case's time scale matters to what it predicts
+    return _checked(ts, out.loop, b, s, actuator, out.extra, out.label, out.head, (*out.notes, *filter(None, [span])),
+                    model)
 
 
 def refitted(make, basis: str):
@@ -176,17 +179,16 @@ def refitted(make, basis: str):
         return None, f"{basis} failed: {err}"
 
 
-def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head, notes=()) -> Compensation:
+def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head, notes=(), model: str = ""
+             ) -> Compensation:
     """The compensation with its held-out benefit, refused (InputError) where it would make δ worse
     unless forced (:func:`.benefit.guard`)."""
     name = registry.get(s.method).title or s.method
     b = held.as_applied(b, loop)
     better = _better(ts, s, actuator) if b.verdict == "worse" and not s.force else ""
     b, warning = held.guard(b, name, s.force, better)
-    early = held.over_record(loop, s.params.settle_s, name)
-    if early:
-        log.warning("%s", early)
-        notes = (*notes, early)
+    early = held.over_record(loop, s.params.settle_s, name, model)
+    notes = (*notes, early) if early else notes
     summary = {**summarize(loop, s.params.settle_s), "method": s.method, **extra,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(s.params),
                "actuator": dataclasses.asdict(actuator) if actuator else None, "benefit": b.as_dict(),

@@ -34,7 +34,7 @@ from gatetherm.studies.run import case_mech, case_mesh, case_sources, case_table
 from gatetherm.studies.run.origin import ModelParameters, Origin
 from gatetherm.studies.run.parameters import UNCERTAIN_FIX, mesh_parameter
 from gatetherm.studies.run.schedules import STEADY, Schedule, series_drive, timed_schedule
-from gatetherm.studies.run.tables import Inputs, Table
+from gatetherm.studies.run.tables import Inputs, Said, Table
 from gatetherm.studies.run.timeseries import read_timeseries
 
 SECTIONS = ("case", "mesh", "materials", "initial", "temperature", "thermal", "faces", "sources", "fluids",
@@ -81,9 +81,8 @@ class TimeSettings:
 class Case:
     """A model ready to run: a problem on its named mesh, what drives it, and how it was made.
 
-    A case file is read into one (:func:`load_case`); so is the paper's frame
-    (:func:`gatetherm.frame.case.gate_frame`). Every command, study and API
-    function runs a Case; nothing downstream asks which of the two it came from."""
+    A case file is read into one (:func:`load_case`); so is the paper's frame (:func:`gatetherm.frame.case.gate_frame`).
+    Every command, study and API function runs a Case; nothing downstream asks which of the two it came from."""
 
     name: str
     problem: Problem
@@ -102,8 +101,7 @@ class Case:
     actuator: ActuatorParams | None = None
     """The compensation actuator (``[actuator]``), None: ideal (a correction sent to the control as an offset)."""
     parameters: ModelParameters | None = None
-    """What a generator made the case from (the frame's ModelConfig), for analyses that only such a
-    model has (beam theory); None for a case file."""
+    """What a generator made the case from (the frame's ModelConfig) for what only it has (beam theory); None: a file"""
     effects: dict = field(default_factory=dict)
     """Effects switched on, {key: value} (:mod:`gatetherm.solvers.effects`)."""
     sensors: dict = field(default_factory=dict)
@@ -179,13 +177,14 @@ class CaseFile:
     path: Path
     document: dict = field(repr=False, compare=False)
     mesh_factor: float = 1.0
+    said: Said = field(default_factory=Said, repr=False, compare=False)  # its reading's warnings: a remake's are not
     ORDER = "case.order"
     """The key of the element order."""
 
     def remake(self, overrides: dict, previous: Case | None = None) -> Case:
         doc = overlay(self.document, nested(overrides))
         same_mesh = previous is not None and doc.get("mesh") == self.document.get("mesh")
-        return case_from_document(doc, self.path, self.mesh_factor, previous.mesh if same_mesh else None)
+        return case_from_document(doc, self.path, self.mesh_factor, previous.mesh if same_mesh else None, self.said)
 
     def parameters(self, case: Case) -> tuple:
         from gatetherm.studies.run.parameters import case_parameters
@@ -274,9 +273,10 @@ def load_case(path, mesh_factor: float = 1.0, overrides: dict | None = None) -> 
     return case_from_document(overlay(data, nested(overrides or {})), path, mesh_factor)
 
 
-def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: FrameMesh | None = None) -> Case:
-    """The case of a parsed case file ``data`` read from ``path`` (``mesh``: its mesh, already made)."""
-    top = Table(path, "", data, SECTIONS)
+def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: FrameMesh | None = None,
+                       said: Said | None = None) -> Case:
+    """The case of a parsed case file ``data`` read from ``path`` (``mesh``: already made; ``said``: warnings given)."""
+    top = Table(path, "", data, SECTIONS, said=Said(said or ()))
     head = top.sub("case", KEYS["case"])
     uncertain = head.data.get("uncertain", [])
     bad = [k for k in uncertain if mesh_parameter(data, k) is None] if isinstance(uncertain, list) else [uncertain]
@@ -351,7 +351,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                  "hold the body with [supports.BOUNDARY] tables")
     kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
     quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
-    probes = case_tables.probes(top, fm, quantities, quiet=mesh is not None)  # a remake: said when first read
+    probes = case_tables.probes(top, fm, quantities)
     relative = case_tables.relative(top, probes, fm.dim) if elastic or "relative" in data else ()
     means = top.sub("means", None)
     mean_pairs = tuple((k, means.name(k, fm.boundaries, "boundary")) for k in means.data)
@@ -370,9 +370,9 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                               label=str(time.schedule)) if schedule_ts is not None else (lambda _: {}))
         schedule = timed_schedule(time.end, time.step, time.output, drive,
                                   f"schedule {time.schedule}" if time.schedule else "no schedule")
-    return Case(head.string("name", path.stem), problem, fm, time, schedule, CaseFile(path, data, mesh_factor),
-                case_targets(problem, fm), actuator=case_tables.actuator(top), path=path, source=str(path),
-                unmountable=_unmountable(top, fm),
+    return Case(head.string("name", path.stem), problem, fm, time, schedule,
+                CaseFile(path, data, mesh_factor, top.said), case_targets(problem, fm),
+                actuator=case_tables.actuator(top), path=path, source=str(path), unmountable=_unmountable(top, fm),
                 files=(path, path.parent / data["mesh"]["file"], *([time.schedule] if time and time.schedule else [])))
 
 

@@ -48,7 +48,7 @@ def vector(t: Table, k: str, names, dim: int, free: bool = False, unit: str = ""
             out.append(None)
             continue
         key = f"{k}[{i + 1}]"
-        out.append(Table(t.file, t.where, {key: x}).value(key, names, unit=unit))
+        out.append(Table(t.file, t.where, {key: x}, said=t.said).value(key, names, unit=unit))
     return out
 
 

@@ -42,7 +42,7 @@ def read_mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
     params = m.sub("parameters")
     refine = []
     for i, r in enumerate(m.data.get("refine", [])):
-        rt = Table(top.file, f"mesh.refine[{i + 1}]", r, KEYS["mesh.refine"])
+        rt = Table(top.file, f"mesh.refine[{i + 1}]", r, KEYS["mesh.refine"], top.said)
         refine.append(Refinement(rt.string("near"), factor * rt.number("size", METRES),
                                  rt.number("distance", METRES)))
     include = m.data.get("include", [])
@@ -59,8 +59,9 @@ def read_mesh(top: Table, base: Path, factor: float = 1.0) -> FrameMesh:
         _parameters_read(params, [path, *(base / f for f in include)])
     for i, r in enumerate(refine):
         if size and r.size >= size:
-            log.warning("%s: mesh.refine[%d].size %g m is not finer than [mesh] size %g m: it changes nothing; give a "
-                        "smaller size, or remove the refinement", top.file, i + 1, r.size / factor, size / factor)
+            top.said.warn(log, "%s: mesh.refine[%d].size %g m is not finer than [mesh] size %g m: it changes nothing; "
+                          "give a smaller size, or remove the refinement", top.file, i + 1, r.size / factor,
+                          size / factor)
     return _in_case(top, mesh_geometry, MeshSpec(path, size, {k: params.number(k) for k in params.data},
                                                  tuple(refine), groups, tuple(base / f for f in include), base, factor))
 

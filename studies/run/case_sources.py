@@ -46,7 +46,7 @@ LOSS = Range(0.0, unit="W")
 def _text(t: Table, k: str, names, default=None, unit: str = "", rng: Range | None = None) -> str:
     v = t.value(k, names, default, unit, rng)
     if k in ("speed", "load") and v.is_constant and float(v.constant) < 0:  # a signed column is read as |x|
-        log.warning("%s = %g %s: its sign is ignored (a loss depends on the magnitude); give %g", t.key(k),
+        t.said.warn(log, "%s = %g %s: its sign is ignored (a loss depends on the magnitude); give %g", t.key(k),
                     float(v.constant), unit, -float(v.constant))
     return v.text or repr(v.constant)
 
@@ -78,8 +78,8 @@ def warn_sizes(src: Table, extent: float) -> None:
         for k in sizes:
             v = data.get(k) if isinstance(data, dict) else None
             if isinstance(v, (int, float)) and not isinstance(v, bool) and v > extent > 0:
-                log.warning("%s: %g m is larger than the whole body (%.3g m); lengths are in m (%g mm = %g m)",
-                            src.sub(r).key(k), v, extent, v, v / 1000.0)
+                src.said.warn(log, "%s: %g m is larger than the whole body (%.3g m); lengths are in m (%g mm = %g m)",
+                              src.sub(r).key(k), v, extent, v, v / 1000.0)
 
 
 def moving(t: Table, names, dim: int) -> dict:

@@ -70,7 +70,7 @@ def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
         materials[region] = Material(**given)
         for k, (lo, hi) in PLAUSIBLE.items():
             if k in t.data and not lo <= given[k] <= hi:
-                log.warning("%s = %g %s is outside what the solids of machines have (%g to %g): check its unit "
+                t.said.warn(log, "%s = %g %s is outside what the solids of machines have (%g to %g): check its unit "
                             "(SI: %s)", t.key(k), given[k], MATERIAL_KEYS[k], lo, hi, MATERIAL_KEYS[k])
         if "thickness" in t.data:
             if fm.dim == 3:
@@ -84,7 +84,7 @@ def _plausible_thickness(t: Table, fm: FrameMesh, value: float) -> None:
     """Warn of a section deeper than :data:`THICK` times the body's largest in-plane extent (mm meant)."""
     extent = float(np.ptp(fm.points, axis=0).max())
     if value > THICK * extent:
-        log.warning("%s: %g m is more than %g times the body's largest in-plane extent (%.3g m); the thickness "
+        t.said.warn(log, "%s: %g m is more than %g times the body's largest in-plane extent (%.3g m); the thickness "
                     "is in m (%g mm = %g m)", t.key("thickness"), value, THICK, extent, value, value / 1000)
 
 
@@ -172,9 +172,8 @@ def _normal_axis(t: Table, fm: FrameMesh, boundary: str) -> int:
     return int(flat[0])
 
 
-def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool = False) -> tuple:
-    """The probes; coordinates off the elements by round-off are read on the body with a warning
-    (``quiet``: none, for a case made again on the same mesh, which said it when first read)."""
+def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
+    """The probes; coordinates off the elements by round-off are read on the body with a warning."""
     pr = top.sub("probes")
     out = []
     finder = None
@@ -195,7 +194,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool =
             try:
                 finder(*np.array(xyz)[:, None])
             except (ValueError, IndexError):  # outside (IndexError: far outside, in skfem's search)
-                xyz = _onto_body(t, fm, xyz, quiet)
+                xyz = _onto_body(t, fm, xyz)
                 finder(*np.array(xyz)[:, None])  # in its element now (a ValueError here is a defect)
         else:
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
@@ -208,7 +207,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...], quiet: bool =
     return tuple(out)
 
 
-def _onto_body(t: Table, fm: FrameMesh, xyz: tuple, quiet: bool = False) -> tuple:
+def _onto_body(t: Table, fm: FrameMesh, xyz: tuple) -> tuple:
     """Coordinates outside the elements: read at the nearest point of the body if within the
     tolerance of a point group (a warning gives the distance), else refused with the distance
     and the nearest point."""
@@ -219,7 +218,7 @@ def _onto_body(t: Table, fm: FrameMesh, xyz: tuple, quiet: bool = False) -> tupl
         t.fail("point", f"{list(xyz)} lies outside the mesh, {near.distance:.3g} m from the body (more than the "
                f"tolerance {near.tolerance:.3g} m); the nearest point on it is [{at}]",
                "give a point inside the body")
-    (log.debug if quiet else log.warning)("%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
+    t.said.warn(log, "%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
                 "the body, [%s]", t.key("point"), list(xyz), near.distance, near.tolerance, at)
     return tuple(float(v) for v in near.inside)
 

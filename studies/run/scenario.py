@@ -56,6 +56,32 @@ def measured_schedule(case: Case, ts: TimeSeries, label: str = "measured inputs"
     return series_schedule(ts, sorted(case.inputs()), case.held(), case.defaults, label)
 
 
+SPAN_RATIO = 20.0
+"""A record spanning this many times less (or 2.5 × this more) than its case's ``[time] end``
+is taken for one whose ``time_s`` is not in seconds (minutes: 60 ×; milliseconds: 1000 ×)."""
+
+
+def span_note(case: Case, ts: TimeSeries, label: str, warn: bool = False) -> str:
+    """A warning where a record's span is far from its case's ``[time] end`` (``time_s`` written in
+    minutes, hours or milliseconds), else ''; logged with ``warn``."""
+    span = float(ts.time_s[-1] - ts.time_s[0]) if len(ts.time_s) else 0.0
+    if case.time is None or span <= 0.0:
+        return ""
+    end = case.time.end
+    if span * SPAN_RATIO <= end:
+        how = f"1/{end / span:.3g} of"
+        fix = "a record in minutes? give time_s in seconds (minutes × 60)"
+    elif span >= 2.5 * SPAN_RATIO * end:
+        how = f"{span / end:.3g} ×"
+        fix = "a record in milliseconds? give time_s in seconds (ms / 1000)"
+    else:
+        return ""
+    note = f"{label}: time_s spans {span:g} s, {how} the [time] end of case {case.name!r}, {end:g} s; {fix}"
+    if warn:
+        log.warning("%s", note)
+    return note
+
+
 class ScenarioCache:
     """Assembled models with their heat solvers (factorisations), and finished runs, by what
     they depend on; the least recently used are dropped beyond ``size``. A study that runs one
@@ -193,4 +219,4 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
 
 
 __all__ = ["STEADY", "Prepared", "ScenarioCache", "ScenarioRun", "Schedule", "active", "effective",
-           "file_schedule", "measured_schedule", "prepare", "run_scenario"]
+           "file_schedule", "measured_schedule", "prepare", "run_scenario", "span_note"]

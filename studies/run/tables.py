@@ -30,11 +30,22 @@ class Inputs(tuple):
         return self
 
 
-class Table:
-    """One table of the case file; remembers where it is for the error messages."""
+class Said(set):
+    """The warnings one reading of a case file gave; a case made again from its document (with
+    overrides: a sweep, a diagnosis, the quadratic-element check) repeats none of them."""
 
-    def __init__(self, file: Path, where: str, data, known=None):
+    def warn(self, logger, fmt: str, *args) -> None:
+        text = fmt % args
+        (logger.debug if text in self else logger.warning)("%s", text)
+        self.add(text)
+
+
+class Table:
+    """One table of the case file; remembers where it is for the error messages, and what was said."""
+
+    def __init__(self, file: Path, where: str, data, known=None, said: Said | None = None):
         self.file, self.where = file, where
+        self.said = Said() if said is None else said
         if not isinstance(data, dict):
             raise InputError(f"{file}: {where}", f"expected a table, got {data!r}", f"write [{where}] with key = value")
         self.data = data
@@ -63,8 +74,8 @@ class Table:
     def _kelvin(self, k: str, celsius: float) -> None:
         """Warn of a temperature in °C that reads as one in K (a room at 293.15 °C)."""
         if KELVIN_LIKE[0] <= celsius <= KELVIN_LIKE[1]:
-            log.warning("%s: %g °C reads like a temperature in kelvins (%g °C); temperatures are in °C",
-                        self.key(k), celsius, celsius - 273.15)
+            self.said.warn(log, "%s: %g °C reads like a temperature in kelvins (%g °C); temperatures are in °C",
+                           self.key(k), celsius, celsius - 273.15)
 
     def string(self, k: str, default=None, choices=None) -> str:
         if k not in self.data:
@@ -121,4 +132,4 @@ class Table:
         return v
 
     def sub(self, k: str, known=None) -> "Table":
-        return Table(self.file, f"{self.where}.{k}" if self.where else k, self.data.get(k, {}), known)
+        return Table(self.file, f"{self.where}.{k}" if self.where else k, self.data.get(k, {}), known, self.said)

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from gatetherm import InputError, atomic_path
-from gatetherm.checks import CELSIUS, Range, _short, show
+from gatetherm.checks import CELSIUS, KELVIN_LIKE, Range, _short, show
 from gatetherm.files import read_text
 
 log = logging.getLogger(__name__)
@@ -255,7 +255,7 @@ def read_timeseries(path, required=INPUT_COLUMNS + OUTPUT_COLUMNS, named_by: dic
         if len(bad):
             fail(int(bad[0]), name, f"got {show(values[bad[0]])}, must be {rng}", "check the value and its unit")
         finite = values[np.isfinite(values)]
-        if name.endswith("_degC") and finite.size and 253.15 <= finite.min() and finite.max() <= 373.15:
+        if name.endswith("_degC") and finite.size and KELVIN_LIKE[0] <= finite.min() and finite.max() <= KELVIN_LIKE[1]:
             log.warning("%s, column %s: every value lies in 253-373, a machine's surroundings in kelvins "
                         "(%.6g K is %.6g °C); the column is in °C", path, name, finite[0], finite[0] - 273.15)
     return TimeSeries(cols, metadata, str(path))

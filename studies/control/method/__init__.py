@@ -57,6 +57,9 @@ class Batch:
     """The held-out :class:`~gatetherm.studies.control.benefit.Benefit`, where the method measures it itself."""
     notes: tuple = ()
     """Warnings for the summary."""
+    model: str = ""
+    """What of the case the correction uses ('' nothing: fitted on the record), named where its
+    prediction misses more than δ itself (:func:`gatetherm.studies.control.benefit.over_record`)."""
 
 
 @dataclass(frozen=True)

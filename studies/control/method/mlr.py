@@ -39,7 +39,7 @@ def batch(job: Job) -> Batch:
     label = f"regression on theta_A, theta_B, theta_C ({case.schedule.label} of the model), 1-sample forecast, " \
         f"update every {params.update_interval_s / 60:g} min"
     return Batch(loop, extra, label, f"mlr ({label}; {s.resolution_K:g}-K sensor noise adds ±{noise:.2g} um)",
-                 checked, notes=notes)
+                 checked, notes=notes, model="the regression trained on its run")
 
 
 def stepper(setup: Setup):

@@ -35,7 +35,9 @@ def batch(job: Job) -> Batch:
     return Batch(loop, {"Ki_um_per_K": ki, "Kc_um_per_K": kc, "k_source": source, "sensor_noise_um": noise},
                  f"K_i {ki:.6g} um/K, K_C {kc:.6g} um/K ({source}), {every}",
                  f"K_i {ki:.4g}, K_C {kc:.4g} um/K ({source}; {s.resolution_K:g}-K sensor noise adds ±{noise:.2g} um)",
-                 checked, notes=(note,) if note else ())
+                 checked, notes=(note,) if note else (),
+                 model=f"K_i, K_C from the {'beam theory' if source == 'theory' else 'FE load cases'}"
+                 if source in ("theory", "fe") else "")
 
 
 def stepper(setup: Setup):

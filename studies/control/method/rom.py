@@ -19,7 +19,7 @@ def batch(job: Job) -> Batch:
     notes = (extra.pop("budget_warning"),) if extra.get("budget_warning") else ()
     return Batch(loop, extra, label, f"rom ({label})",
                  (loop, "as applied (the reduced model and its causal Kalman filter fit nothing on the record)"),
-                 notes=notes)
+                 notes=notes, model="the reduced model")
 
 
 def _reduced_model(job: Job):
