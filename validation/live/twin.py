@@ -33,6 +33,10 @@ from gatetherm.validation.live.nodes import OBJECT, WRITTEN, machine_namespace
 
 log = logging.getLogger(__name__)
 
+LAST_WAIT_S = 10.0
+"""With ``wait``: how long (wall s) the last sample stays readable for the service's correction for it,
+at most (a loaded machine answers late; without an answer the twin stops after one step)."""
+
 
 @dataclass(frozen=True)
 class TwinParams:
@@ -57,7 +61,8 @@ class TwinParams:
     seed: int = 0
     """Random seed of the sensor noise."""
     wait: bool = False
-    """Start the clock only once a client has written ``offset_um`` (a service that is still starting)."""
+    """Start the clock only once a client has written ``offset_um`` (a service that is still starting), and
+    keep the last sample until it has answered it (at most :data:`LAST_WAIT_S`)."""
     faults: tuple[tuple[str, float, float], ...] = ()
     """(column, from_s, to_s): the column reads NaN over that machine time (a sensor fault), s."""
     machines: int = 1
@@ -261,6 +266,9 @@ class _Plant:
             for name, lo, hi in params.faults:
                 if lo <= t <= hi:
                     values[name] = math.nan
+            last = t >= until - 1e-9 or machine.k >= len(machine.times) - 1
+            if last and params.wait:  # the service's correction for the last sample is awaited below
+                await nodes["offset_um"].write_value(math.nan)
             await nodes["time_s"].write_value(math.nan)
             for name, value in values.items():
                 await nodes[name].write_value(value)
@@ -272,7 +280,11 @@ class _Plant:
                 self.worst = max(self.worst, abs(comp))
             if stopped is not None and stopped():
                 break
-            if t >= until - 1e-9 or machine.k >= len(machine.times) - 1:
-                await asyncio.sleep(params.step_s / params.speed)  # the last sample stays readable for a step
+            if last:  # the last sample stays readable for a step, and with a service waited for until it answers
+                end = time.monotonic() + max(params.step_s / params.speed, LAST_WAIT_S if params.wait else 0.0)
+                await asyncio.sleep(params.step_s / params.speed)
+                while params.wait and time.monotonic() < end and not math.isfinite(
+                        await nodes["offset_um"].read_value()) and not (stopped is not None and stopped()):
+                    await asyncio.sleep(0.05)
                 break
             machine.advance()
