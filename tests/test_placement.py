@@ -379,13 +379,15 @@ schedule = "schedule.csv"
 @pytest.mark.slow
 def test_a_3d_case_places_and_checks(tmp_path):
     """A 3-D steel bar (547 nodes, tetrahedra), heated through one end, clamped at the other: the
-    candidates are the nodes of its outer triangles; 2 sensors; the FE check within 10 %."""
+    candidates are the nodes of its outer triangles but the 24 inside the clamped face; 2 sensors; the
+    FE check within 10 %."""
     (tmp_path / "block.geo").write_text(BLOCK_3D_GEO)
     (tmp_path / "case.toml").write_text(BLOCK_3D)
     (tmp_path / "schedule.csv").write_text('time_s,heat_W,room_degC\n0,0,20\n1800,400,20.5\n3600,400,21\n5400,0,21\n7200,0,20.5\n')
     case = gt.load_case(tmp_path / "case.toml")
     p = gt.place_sensors(case, 2, loads=4, states=10)
-    assert case.dim == 3 and len(case.mesh.points) == 547 and len(p.candidates) == 448
+    assert case.dim == 3 and len(case.mesh.points) == 547
+    assert len(p.candidates) == 424 and p.candidates.excluded == {"cold": 24}
     assert all(len(s.xyz) == 3 for s in p.sensors)
     check = gt.check_placement(case, p)
     assert 0.9 < check.ratio["lift_um"] < 1.1 and check.ratio["lift_um"] == pytest.approx(0.926, abs=0.01)  # achieved
@@ -453,13 +455,14 @@ def test_screening_loses_little_against_every_candidate(coarse):
 
 @pytest.mark.slow
 def test_paper_frame_three_points_beat_A_B_and_the_C_mean():
-    """2-D frame, 3 sensors from its whole outer surface (824 nodes), trained on 20 generated duty
-    cycles: the held-out δ error over conditions 1-3 is below the same family's given A, B and the
-    C mean (the acceptance band); the points lie on A's face, on B's face and at the tool tip F_L."""
+    """2-D frame, 3 sensors from its outer surface (824 nodes but the 56 on its mounting face), trained
+    on 20 generated duty cycles: the held-out δ error over conditions 1-3 is below the same family's
+    given A, B and the C mean (the acceptance band); the points lie on A's face, on B's face and at
+    the tool tip F_L."""
     frame = gt.gate_frame(2)
     p = gt.place_sensors(frame, 3)
     assert [x.label.split(":")[0] for x in p.held_out] == ["condition 1", "condition 2", "condition 3"]
-    assert len(p.candidates) == 824 and len(p.training) == 20
+    assert len(p.candidates) == 768 and p.candidates.excluded == {"mounting_face": 56} and len(p.training) == 20
     ours, paper = p.curve[-1].held_out_mae_um["delta_um"], p.signals["held_out_mae_um"]["delta_um"]
     assert ours <= paper
     assert ours == pytest.approx(0.849, abs=0.01) and paper == pytest.approx(1.368, abs=0.01)  # achieved 0.849, 1.368 um
@@ -480,7 +483,7 @@ def test_a_5000_node_case_with_6_sensors_and_20_loads_in_under_2_minutes():
     seconds = time.perf_counter() - t0
     assert len(p.training) == 21 and len(p.sensors) == 6
     held = [c.held_out_mean_um for c in p.curve]
-    assert not p.stopped and held == sorted(held, reverse=True)  # achieved 0.651 ... 0.209 um
+    assert not p.stopped and held == sorted(held, reverse=True)  # achieved 0.651 ... 0.208 um
     assert seconds < 120  # achieved 18.5 s in pytest at load 11 on the 2 cores (11.5 s in the command)
 
 

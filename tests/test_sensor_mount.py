@@ -79,7 +79,24 @@ def test_placement_puts_no_sensor_on_the_spindle(headstock):
     spindle = unmountable_nodes(headstock.mesh, ["spindle"])["spindle"]
     placed = gt.place_sensors(headstock, 2, loads=4, held_out_loads=2, states=12)
     assert len(placed.sensors) == 2 and not np.isin([s.node for s in placed.sensors], spindle).any()
-    assert placed.summary()["excluded"] == {"spindle": 63}
+    assert placed.summary()["excluded"] == {"spindle": 63, "feet_fixed": 7, "feet_sliding": 7}
+
+
+def test_no_sensor_between_a_foot_and_the_bed(headstock):
+    """The feet stand on the bed (one fixed, one sliding): the nodes between a foot and the bed are no
+    candidates; those of its edges, on its free side too, are, named by that side; a face named as
+    the candidates stays one."""
+    from gatetherm.studies.sensors.candidates import boundary_names, seated_nodes
+    from gatetherm.studies.sensors.place import supported_faces
+
+    mesh, seats = headstock.mesh, supported_faces(headstock)
+    assert seats == ("feet_fixed", "feet_sliding") and supported_faces(headstock, ("feet_fixed",)) == ("feet_sliding",)
+    seated = seated_nodes(mesh, seats)
+    for name in seats:
+        face = np.unique(mesh.boundaries[name])
+        edges = np.setdiff1d(face, seated[name])
+        assert len(seated[name]) == len(face) - 2 and len(edges) == 2  # a 2-D foot: its two corners stay
+        assert set(boundary_names(mesh, edges, seats)) == {"free"} and set(boundary_names(mesh, edges)) == {name}
 
 
 @pytest.mark.slow
@@ -93,12 +110,14 @@ def test_placement_puts_no_sensor_on_the_spindle_and_says_so(headstock, tmp_path
     assert np.isin([s.node for s in free.sensors], spindle).any()  # what the key prevents
     placed = gt.place_sensors(headstock, 3, loads=6, held_out_loads=2, states=16)
     assert not np.isin([s.node for s in placed.sensors], spindle).any()
-    assert placed.summary()["excluded"] == {"spindle": 63}
+    assert placed.summary()["excluded"] == {"spindle": 63, "feet_fixed": 7, "feet_sliding": 7}
     assert placed.curve[-1].held_out_mae_um["delta_um"] == pytest.approx(0.101, abs=0.02)  # band: < 0.5 µm
     for f in FILES:
         shutil.copy(DATA / f, tmp_path / f)
     assert main(["sensors", "--case", str(tmp_path / "headstock.toml"), "--out", str(tmp_path / "s"), "--count", "2",
                  "--loads", "4", "--states", "12"]) == 0
     out = capsys.readouterr().out
-    assert "excluded ([sensors] exclude, cannot carry a sensor): spindle (63 candidate nodes left out)" in out
-    assert "# none on spindle (63 candidate nodes) ([sensors] exclude)" in (tmp_path / "s" / "sensors.toml").read_text()
+    assert "excluded (cannot carry a sensor: [sensors] exclude, or a face a support holds): spindle (63 candidate " \
+        "nodes left out), feet_fixed (7 candidate nodes left out), feet_sliding (7 candidate nodes left out)" in out
+    assert "# none on spindle (63 candidate nodes), feet_fixed (7 candidate nodes), feet_sliding (7 candidate nodes) " \
+        "(cannot carry a sensor: [sensors] exclude, or a face a support holds)" in (tmp_path / "s" / "sensors.toml").read_text()

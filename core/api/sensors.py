@@ -12,7 +12,7 @@ from gatetherm.api.boundary import settings_argument
 from gatetherm.api.run import Case, Schedule, _case
 from gatetherm.checks import POSITIVE, Range, argument, number_argument, whole_argument
 from gatetherm.studies.sensors.check import FECheck
-from gatetherm.studies.sensors.result import Placement
+from gatetherm.studies.sensors.result import NO_SENSOR, Placement
 
 PUBLIC = ("SensorStudy", "check_placement", "place_sensors", "sensor_study", "write_placement")
 
@@ -130,7 +130,7 @@ def check_placement(case: Case, placement: Placement):
         loads (``.temperature_error_K``, K), ``.runs``, ``.seconds``.
     """
     from gatetherm.studies.sensors.check import fe_check
-    from gatetherm.studies.sensors.result import Placement
+    from gatetherm.studies.sensors.result import NO_SENSOR, Placement
 
     _case(case)
     argument("placement", placement, Placement, "a Placement", "what gt.place_sensors(case) returns")
@@ -165,7 +165,7 @@ def write_placement(out: str | os.PathLike, placement: Placement, case: Case, ch
         The summary.
     """
     from gatetherm.validation.plots import figure, save
-    from gatetherm.studies.sensors.result import Placement
+    from gatetherm.studies.sensors.result import NO_SENSOR, Placement
     from gatetherm.validation.plots.api import sensor_curve, sensors
 
     argument("placement", placement, Placement, "a Placement", "what gt.place_sensors(case) returns")
@@ -268,7 +268,7 @@ class SensorStudy:
                  f"{len(p.training)} training loads, judged on {len(p.held_out)} held-out loads; wrote {out}/"
                  "sensors.toml, model.json, curve.csv, curve.png, machine.png, summary.json"]
         if excluded:
-            lines.append("excluded ([sensors] exclude, cannot carry a sensor): "
+            lines.append(f"excluded ({NO_SENSOR}): "
                          + ", ".join(f"{k} ({v} candidate nodes left out)" for k, v in excluded.items()))
         for c in p.curve:
             errs = ", ".join(f"{k} {v:.3g}" for k, v in c.held_out_mae_um.items())

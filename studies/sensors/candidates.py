@@ -10,6 +10,7 @@ end); else the first named boundary that holds it.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from itertools import combinations
 
@@ -45,7 +46,8 @@ class Candidates:
     boundary: tuple[str, ...]
     """The boundary each lies on."""
     excluded: dict[str, int] = field(default_factory=dict)
-    """Per part that cannot carry a sensor (``[sensors] exclude``): the candidate nodes it took away."""
+    """Per part that cannot carry a sensor (``[sensors] exclude``, a face a support holds): the candidate
+    nodes it took away."""
 
     def __len__(self) -> int:
         return len(self.nodes)
@@ -54,6 +56,16 @@ class Candidates:
         """The candidates at the mask or indices ``keep``."""
         idx = np.flatnonzero(keep) if np.asarray(keep).dtype == bool else np.asarray(keep, int)
         return Candidates(self.nodes[idx], self.xyz[idx], tuple(self.boundary[i] for i in idx), self.excluded)
+
+    def without(self, parts: dict[str, np.ndarray]) -> tuple[np.ndarray, Candidates]:
+        """The mask of the candidates on none of ``parts`` ({name: its nodes}), and those candidates,
+        the count each part took in :attr:`excluded` (a part that takes none is not listed)."""
+        keep, excluded = np.ones(len(self.nodes), bool), dict(self.excluded)
+        for name, nodes in parts.items():
+            on = np.isin(self.nodes, nodes) & keep
+            excluded.update({name: int(on.sum())} if on.any() else {})
+            keep &= ~on
+        return keep, dataclasses.replace(self.subset(keep), excluded=excluded)
 
 
 def outer_facets(cells: np.ndarray) -> np.ndarray:
@@ -64,11 +76,12 @@ def outer_facets(cells: np.ndarray) -> np.ndarray:
     return uniq[count == 1]
 
 
-def boundary_names(mesh, nodes: np.ndarray) -> tuple[str, ...]:
-    """The boundary each of ``nodes`` lies on (module docstring)."""
+def boundary_names(mesh, nodes: np.ndarray, skip=()) -> tuple[str, ...]:
+    """The boundary each of ``nodes`` lies on (module docstring); one of ``skip`` only where it lies on no other."""
     facets = outer_facets(mesh.cells)
     outer = {tuple(f) for f in facets}
-    is_outer = {b: all(tuple(sorted(f)) in outer for f in mesh.boundaries[b]) for b in mesh.boundaries}
+    is_outer = {b: b not in skip and all(tuple(sorted(f)) in outer for f in mesh.boundaries[b])
+                for b in mesh.boundaries}
     label = dict.fromkeys(np.unique(facets).tolist(), UNNAMED)
     for b in reversed([b for b in mesh.boundaries if is_outer[b]]):  # the first in mesh order wins
         label.update(dict.fromkeys(np.unique(mesh.boundaries[b]).tolist(), b))
@@ -124,6 +137,14 @@ def part_at(mesh, names, xyz, tol: float = 1e-9) -> str | None:
         if inside.any():
             return n
     return None
+
+
+def seated_nodes(mesh, names) -> dict[str, np.ndarray]:
+    """The nodes of each boundary of ``names`` (faces a support holds) on no free outer facet: between the
+    face and what holds it. Its edges' nodes, on a free face too, stay (the side of a foot, at its seat)."""
+    held = {tuple(f) for n in names for f in np.sort(np.asarray(mesh.boundaries[n]), axis=1)}
+    free = np.unique([f for f in outer_facets(mesh.cells) if tuple(f) not in held])
+    return {n: np.setdiff1d(np.unique(np.ravel(mesh.boundaries[n])), free) for n in names}
 
 
 def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: str = "--candidates",

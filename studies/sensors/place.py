@@ -19,6 +19,7 @@
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass
@@ -31,7 +32,7 @@ from gatetherm.studies.run.reduce import build_rom
 from gatetherm.studies.run.scenario import ScenarioCache, prepare
 from gatetherm.studies.run.simulate import column
 from gatetherm.studies.sensors import greedy
-from gatetherm.studies.sensors.candidates import Box, candidates as find_candidates
+from gatetherm.studies.sensors.candidates import Box, boundary_names, candidates as find_candidates, seated_nodes
 from gatetherm.studies.sensors.loads import duty_cycles, input_ranges
 from gatetherm.studies.sensors.models import error_model, held_out_mae, lag_columns, lag_terms, settings_of
 from gatetherm.studies.sensors.reduced import candidate_rows, simulate
@@ -133,6 +134,27 @@ def _ticker(on_progress, n: int):
     return tick
 
 
+def supported_faces(case, named=()) -> tuple[str, ...]:
+    """The boundaries a support holds (bolted to a bed, resting on a foundation or a slide, a symmetry
+    plane), but those ``named`` as the candidates: no thermocouple goes between a face and what holds it.
+    Their nodes shape the screening (the field is there) and are never chosen."""
+    return tuple(dict.fromkeys(b.boundary for b in case.problem.supports
+                               if b.boundary in case.mesh.boundaries and b.boundary not in named))
+
+
+def _screened(case, s: PlacementSettings, X, Y, rows, cand):
+    """The shortlist (indices into the candidates; all of them with ``neighbours=None``), the candidates'
+    rows and the candidates, without the nodes of the :func:`supported_faces`: screened with the field
+    there, never chosen; the nodes of their edges stay, named by their free face."""
+    sl = np.arange(len(cand)) if s.neighbours is None else screen(X, Y, rows, cand.xyz, s.noise_K, s.neighbours)[0]
+    seats = supported_faces(case, s.boundaries)
+    keep, cand = cand.without(seated_nodes(case.mesh, seats))
+    if not keep[sl].any():
+        raise InputError("--candidates", "every candidate lies on a face a support holds", "name other boundaries")
+    cand = dataclasses.replace(cand, boundary=boundary_names(case.mesh, cand.nodes, seats)) if seats else cand
+    return (np.cumsum(keep) - 1)[sl[keep[sl]]], rows[keep], cand
+
+
 def place_sensors(case, settings: PlacementSettings = PlacementSettings(), schedules=None, held_out=None,
                   cache: ScenarioCache | None = None, on_progress=None) -> Placement:
     """Choose ``settings.count`` thermocouple locations of ``case`` (module docstring).
@@ -187,7 +209,7 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
     secs["loads"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    sl = np.arange(len(cand)) if s.neighbours is None else screen(X, Y, rows, cand.xyz, s.noise_K, s.neighbours)[0]
+    sl, rows, cand = _screened(case, s, X, Y, rows, cand)
     keys = [f"node {n}" for n in cand.nodes[sl]]
 
     def temps(loads, idx):  # rises of shortlist members idx over loads, with their noise

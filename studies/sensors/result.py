@@ -136,12 +136,16 @@ def sensors_toml(p: Placement) -> str:
              f"candidates, {p.curve[-1].form} error model (model.json), held-out MAE "
              + ", ".join(f"{k} {v:.3g} um" for k, v in p.curve[-1].held_out_mae_um.items())]
     if p.candidates.excluded:
-        lines.append(f"# none on {excluded_text(p.candidates.excluded)} ([sensors] exclude)")
+        lines.append(f"# none on {excluded_text(p.candidates.excluded)} ({NO_SENSOR})")
     lines.append("")
     for s in p.sensors:
         lines += [f"[probes.{s.name}]", f"point = [{', '.join(repr(float(v)) for v in s.xyz)}]   # node {s.node}, "
                   f"on boundary \"{s.boundary}\"", 'quantities = ["T"]', ""]
     return "\n".join(lines)
+
+
+NO_SENSOR = "cannot carry a sensor: [sensors] exclude, or a face a support holds"
+"""Why a part's nodes are no candidates (:attr:`~gatetherm.studies.sensors.candidates.Candidates.excluded`)."""
 
 
 def excluded_text(excluded: dict[str, int]) -> str:
