@@ -48,8 +48,10 @@ def compensate(series: TimeSeries | Run, case: Case | None = None, method: str =
         ``benefit``: ``held_out_um`` and ``uncompensated_um``, the largest |δ| on the held-out span with
         and without it, um, ``verdict`` better, no-gain, worse or unchecked, ``forced``; ``warning`` where forced
         or unchecked; ``warnings``, a list of one-line notes: what the K_i, K_C or mlr fit dropped or bounded
-        for the thermocouples' noise, ``resolution_K`` (default 0.05 K), and a rom update budget used up
-        before the record ends, whose time is ``budget_exhausted_s``, s; paper and mlr: ``sensor_noise_um``, what
+        for the thermocouples' noise, ``resolution_K`` (default 0.05 K), a rom update budget used up
+        before the record ends, whose time is ``budget_exhausted_s``, s, a correction worse than none
+        earlier in the record (and whether the model's prediction misses δ by more than δ itself), a
+        record whose time_s is far from the case's [time] (minutes as seconds); paper and mlr: ``sensor_noise_um``, what
         the thermocouples' noise adds to the prediction, one standard deviation, um).
     """
     from gatetherm.api.compensation import _refuse_unused
