@@ -280,3 +280,20 @@ def test_a_moving_band_on_an_insulated_strip_adds_its_energy_exactly(tmp_path):
     for t, U in march(heat, case.schedule.drive, case.schedule.times, case.problem.scheme):
         energy = float(np.sum(heat.M @ (U - 20.0)))
         assert energy == pytest.approx(P * t, rel=1e-10, abs=1e-9)
+
+
+def test_a_band_whose_centre_leaves_its_region_is_said_once(tmp_path, caplog):
+    """A position offset by mistake (a new user's rail at z + 2.2 m on a 0.6 … 2.1 m rail) is read with
+    one warning naming the key, when and where; a band that stays on is read without one."""
+    import logging
+
+    with caplog.at_level(logging.WARNING):
+        _strip(tmp_path)
+    assert "band" not in caplog.text
+    (tmp_path / "strip.geo").write_text(STRIP_GEO.format(lc=0.05, L=1.0, w=0.1))
+    text = STRIP.replace("end = 700.0", "end = 100.0").replace("output = 700.0", "output = 100.0")
+    (tmp_path / "c.toml").write_text(text.replace('position = "0.3 + ', 'position = "0.95 + '))
+    with caplog.at_level(logging.WARNING):
+        gt.load_case(tmp_path / "c.toml").with_order(1)
+    assert caplog.text.count("c.toml: sources.strip.position: the band's centre leaves its region (0 to 1 m along "
+                             "its direction) from t = 28 s (position 1.006 m): more than half its 0.004 m is off") == 1

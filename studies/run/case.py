@@ -234,8 +234,7 @@ def _time(top: Table, base: Path):
 
 
 def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
-    """Every value that reads the schedule, at the schedule's samples within the run
-    (where its columns are recorded): in the range of its key; every column it reads recorded."""
+    """Every value that reads the schedule, at its samples within the run (where recorded): in its key's range."""
     t = np.asarray(ts.time_s - ts.time_s[0], float)
     env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
     for v in values(problem):
@@ -363,6 +362,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
     case_mech.check_assembly(top, fm, problem, time is None)
     if schedule_ts is not None:
         _check_schedule(problem, schedule_ts, time)
+    case_sources.warn_bands(top, fm, problem, schedule_ts, time)
     if time is None:
         schedule = STEADY
     else:

@@ -13,6 +13,8 @@ import logging
 import math
 from typing import Callable
 
+import numpy as np
+
 from gatetherm.checks import Range
 from gatetherm.solvers import elements
 from gatetherm.solvers.expr import Value
@@ -128,3 +130,31 @@ def read_source(t: Table, region: str, names, volume: Callable[[], float], dim: 
     if "density" in t.data:
         return Source(region, t.value("density", names, unit="W/m³"))
     return Source(region, t.value("power", names, unit="W"), 1.0 if on_boundary else 1.0 / volume(), **band)
+
+
+def warn_bands(top: Table, fm, problem, ts, time) -> None:
+    """Warn of a source that moves whose band's centre leaves its region along its direction at a sample
+    of the case's own run (``ts``: its schedule, or None; ``time``: its [time]): more than half the band
+    is off, and its power is spread over the part inside, denser than the band says. A band wholly off
+    is refused when the run reaches it (:class:`gatetherm.solvers.moving.MovingLoad`)."""
+    if time is None:
+        return
+    if ts is None:
+        t, env = np.arange(0.0, time.end + time.step, time.step), {}
+    else:
+        t, env = np.asarray(ts.time_s - ts.time_s[0], float), {k: ts[k] for k in ts.names if k != "time_s"}
+    env["t"] = t
+    for s in (s for s in problem.sources if s.position is not None):
+        on = np.asarray(fm.boundaries[s.region]) if s.on_boundary else fm.cells[np.asarray(fm.regions[s.region], int)]
+        along = fm.points[np.unique(on)] @ np.asarray(s.direction, float)
+        lo, hi = float(along.min()), float(along.max())
+        names = s.position.names() | {"t"}
+        rows = (t <= time.end) & np.logical_and.reduce([np.isfinite(env[n]) for n in names])
+        p = np.broadcast_to(np.asarray(s.position({n: env[n][rows] for n in names}), float), (int(rows.sum()),))
+        off = (p < lo) | (p > hi)
+        if off.any():
+            k = int(np.argmax(off))
+            top.said.warn(log, "%s: the band's centre leaves its region (%g to %g m along its direction) from "
+                          "t = %g s (position %g m): more than half its %g m is off, its power spread over the part "
+                          "inside; keep the position within %g to %g m", s.position.key, lo, hi, t[rows][k], p[k],
+                          s.length, lo, hi)
