@@ -70,8 +70,10 @@ def check_methods(case, ts, train, rom, control, only=None):
         model = fit_error_model(ts, ("delta_um",), inputs=inputs, params=FitParams(form="dynamic" if inputs else "static",
                                                                               sensor_taus_s=(900.0,)))
         assert not inputs or any(t.tau_s for t in model.target("delta_um").terms)  # a lag is stepped
-        # the paper's form on the tool's thermocouple too: the C-frame's theta_A - theta_B spans 0.003 K
-        paper_model = fit_error_model(ts, ("delta_um",), THETAS + ("T_tool_degC",), params=FitParams(form="paper"))
+        # the paper's form on the tool's thermocouple too where there is one: the C-frame's theta_A - theta_B
+        # spans 0.003 K
+        tool = tuple(n for n in ("T_tool_degC",) if n in ts.names)
+        paper_model = fit_error_model(ts, ("delta_um",), THETAS + tool, params=FitParams(form="paper"))
     loop = loop_r = None
     cases = {"paper": (lambda: PaperStepper(ki, kc, PARAMS), batch),
              "mlr": (lambda: RegressionStepper(mlr, PARAMS), ext),
