@@ -34,6 +34,19 @@ def test_nearest_on_body_closed_form_2d_and_3d():
     assert n.point == pytest.approx([0.0, 0.0, 0.5]) and n.distance == pytest.approx(np.sqrt(2.0))
 
 
+def test_a_relative_displacement_of_one_point_is_refused():
+    """A tool probe written 2 cm in front of a ram's nose, read at the nearest point of the body, which
+    was the workpiece's face (a new user's boring mill): δ read 1e-12 µm at exit 0; now refused."""
+    import gatetherm as gt
+
+    c_frame = Path(__file__).resolve().parents[1] / "validation" / "examples" / "c_frame" / "case.toml"
+    case = gt.load_case(c_frame)
+    xyz = [float(v) for v in case.mesh.points[case.mesh.sensors["table_top"]]]
+    with pytest.raises(InputError, match=r"case.toml: relative.delta.b: probe 'tool' reads the same point as "
+                                         r"'table_top', \[.*\]: the relative displacement would be 0 at all times"):
+        gt.load_case(c_frame, overrides={"probes.tool.point": xyz})
+
+
 def test_probe_on_the_boundary_read_with_a_warning(tmp_path: Path, caplog):
     from gatetherm.studies.run.case import load_case
 
@@ -44,7 +57,7 @@ def test_probe_on_the_boundary_read_with_a_warning(tmp_path: Path, caplog):
     assert probe.xyz == pytest.approx((0.05, 0.01), abs=1e-9)
     assert "probes.target.point: [0.05, 0.010000001] lies 1e-09 m outside the mesh (within the tolerance 0.0112 m)" \
         in caplog.text
-    assert "read at the nearest point on the body, [0.05, 0.01]" in caplog.text
+    assert "read at the nearest point on the body, [0.05, 0.01], in region 'bar'" in caplog.text
     with caplog.at_level(logging.WARNING):
         p2 = case.with_order(2)  # made again on the same mesh (the order check): said once
     assert caplog.text.count("outside the mesh") == 1 and p2.problem.probes[0].xyz == probe.xyz

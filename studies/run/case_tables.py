@@ -194,8 +194,7 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
             try:
                 finder(*np.array(xyz)[:, None])
             except (ValueError, IndexError):  # outside (IndexError: far outside, in skfem's search)
-                xyz = _onto_body(t, fm, xyz)
-                finder(*np.array(xyz)[:, None])  # in its element now (a ValueError here is a defect)
+                xyz = _onto_body(t, fm, xyz, finder)
         else:
             t.fail("point", f"expected a point group name or {fm.dim} coordinates, got {point!r}",
                    'e.g. point = "A" or point = [0.1, 0.2]')
@@ -207,10 +206,10 @@ def probes(top: Table, fm: FrameMesh, quantities: tuple[str, ...]) -> tuple:
     return tuple(out)
 
 
-def _onto_body(t: Table, fm: FrameMesh, xyz: tuple) -> tuple:
+def _onto_body(t: Table, fm: FrameMesh, xyz: tuple, finder) -> tuple:
     """Coordinates outside the elements: read at the nearest point of the body if within the
-    tolerance of a point group (a warning gives the distance), else refused with the distance
-    and the nearest point."""
+    tolerance of a point group (a warning gives the distance and the region read), else refused
+    with the distance and the nearest point."""
     with np.errstate(over="ignore"):  # a point 1e300 away: an infinite distance, refused below
         near = nearest_on_body(fm.points, fm.cells, xyz)
     at = ", ".join(f"{v:.6g}" for v in near.point)
@@ -218,9 +217,12 @@ def _onto_body(t: Table, fm: FrameMesh, xyz: tuple) -> tuple:
         t.fail("point", f"{list(xyz)} lies outside the mesh, {near.distance:.3g} m from the body (more than the "
                f"tolerance {near.tolerance:.3g} m); the nearest point on it is [{at}]",
                "give a point inside the body")
+    inside = tuple(float(v) for v in near.inside)
+    cell = int(np.ravel(finder(*np.array(inside)[:, None]))[0])  # in its element now (a ValueError: a defect)
+    region = next((r for r, cells in fm.regions.items() if cell in np.asarray(cells)), "?")
     t.said.warn(log, "%s: %s lies %.3g m outside the mesh (within the tolerance %.3g m): read at the nearest point on "
-                "the body, [%s]", t.key("point"), list(xyz), near.distance, near.tolerance, at)
-    return tuple(float(v) for v in near.inside)
+                "the body, [%s], in region %r", t.key("point"), list(xyz), near.distance, near.tolerance, at, region)
+    return inside
 
 
 def relative(top: Table, probes, dim: int) -> tuple:
@@ -233,6 +235,11 @@ def relative(top: Table, probes, dim: int) -> tuple:
         if a == b:  # its displacement is zero at every time: a δ that can never say anything
             t.fail("b", f"is {b!r}, the same probe as a: the relative displacement would be 0 at all times",
                    "give two different probes")
+        at = {p.name: p.xyz for p in probes}
+        if np.allclose(at[a], at[b], rtol=0.0, atol=1e-9):  # a probe read on the body at the other's point
+            where = ", ".join(f"{v:.6g}" for v in at[a])
+            t.fail("b", f"probe {b!r} reads the same point as {a!r}, [{where}]: the relative displacement would be 0 "
+                   "at all times", "move one of them (one outside the mesh is read at the nearest point on the body)")
         out.append(Relative(name, a, b, AXES.index(t.string("axis", choices=tuple(AXES[:dim])))))
     return tuple(out)
 
