@@ -108,15 +108,13 @@ def test_default_range_works_both_ways_and_covers_the_paper_swing():
     assert hysteresis_cost_um(PRELOADED) == pytest.approx(3 * 3.04343, abs=1e-4)  # at the cutting area
 
 
-def test_apply_commands_saturates_and_transmits(caplog):
+def test_apply_commands_saturates_and_transmits():
     _, achieved = apply_commands(PRELOADED, [5.0, -40.0, 20.0])
     np.testing.assert_allclose(achieved, [5.0, -40.0, 20.0], atol=1e-12)  # both ways from the bias
-    assert not caplog.text
     commands = [30.0, -80.0, -10.0]
     _, achieved = apply_commands(PRELOADED, commands)
     np.testing.assert_allclose(achieved, [*stroke_range(PRELOADED)[::-1], -10.0], atol=1e-12)  # clipped
-    assert saturated_commands(PRELOADED, commands).tolist() == [True, True, False]
-    assert "2 of 3 piezo commands outside" in caplog.text
+    assert saturated_commands(PRELOADED, commands).tolist() == [True, True, False]  # said by compensate, once
     zero_ref = replace(PRELOADED, bias_voltage_V=0.0, transmission=1.0)
     _, achieved = apply_commands(zero_ref, [5.0, -40.0])
     assert achieved[0] == 0.0  # cannot push the tool towards the workpiece from a 0 V reference

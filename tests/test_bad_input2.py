@@ -452,3 +452,12 @@ def test_a_point_off_the_body_names_the_parameters_that_shaped_it(tmp_path):
         gt.load_case(tmp_path / "c.toml")
     assert "mesh point table: at (0.9, 0.5" in str(info.value) and \
         str(info.value).endswith("the geometry was made with [mesh.parameters] w = 0.2: check them")
+
+
+def test_a_run_that_leaves_the_temperature_range_names_the_case_file(tmp_path):
+    """A bearing's mean diameter in mm (82.5 for 0.0825 m): warned as larger than the body, then the
+    run's temperatures leave the range; the refusal names the case file (a new user's ram: it named
+    only 'temperature')."""
+    case = gt.load_case(spindle(tmp_path, "dm = 0.0825", "dm = 82.5"))
+    with pytest.raises(InputError, match=r"^.*spindle/case.toml: temperature: the solution reaches .* °C at t = "):
+        gt.run(case, keep=())

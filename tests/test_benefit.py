@@ -251,3 +251,20 @@ def test_a_record_in_minutes_is_said_to_be(machine):
     assert not any("time_s" in w for w in compensate(measured, case, Settings("mlr")).summary["warnings"])
     ms = measured.with_columns(time_s=measured.time_s * 1000.0)
     assert "a record in milliseconds?" in compensate(ms, case, Settings("mlr")).summary["warnings"][-1]
+
+
+def test_commands_beyond_the_actuators_reach_are_said_once(machine, caplog):
+    """The applied correction's clipped commands are one warning of the summary (mlr's separate check
+    clips its own: 8 and then 14 were logged for a new user's ram, the summary saying 8)."""
+    import logging
+
+    from gatetherm.studies.control.actuator import ActuatorParams, with_stroke
+
+    case, own, measured = machine
+    short = with_stroke(ActuatorParams(), -2.0, 1.0)  # δ reaches about 9 µm
+    with caplog.at_level(logging.WARNING):
+        s = compensate(noisy(measured, 7), case, Settings("mlr"), short).summary
+    [line] = [w for w in s["warnings"] if "piezo" in w]
+    assert line == f"{s['piezo_saturated_updates']} of {s['updates']} piezo commands outside the reachable -2 .. 1 um; " \
+        "clipped" and s["piezo_saturated_updates"] > 0
+    assert "piezo" not in caplog.text

@@ -43,7 +43,6 @@ with a bias moves the tool briefly by ``transmission * x_bias`` towards the work
 """
 from __future__ import annotations
 
-import logging
 import math
 from dataclasses import dataclass, replace
 
@@ -51,7 +50,6 @@ import numpy as np
 
 from gatetherm import InputError
 
-log = logging.getLogger(__name__)
 
 STRATEGIES = ("reset", "direct")
 
@@ -200,14 +198,11 @@ def apply_commands(p: ActuatorParams, commands_um) -> tuple[np.ndarray, np.ndarr
     """Voltages and achieved cutting-area displacements (um) for displacement commands (um).
 
     Commands are the displacement to add to delta (``-delta_et``); each is converted with
-    the reset-calibrated inverse and then driven with ``p.strategy`` in sequence.
+    the reset-calibrated inverse and then driven with ``p.strategy`` in sequence; those beyond
+    :func:`stroke_range` are clipped (:func:`saturated_commands` says which).
     """
     u = np.asarray(commands_um, float)
     x_bias = float(reset_curve(p, p.bias_voltage_V))
-    saturated = int(np.sum(saturated_commands(p, u)))
-    if saturated:
-        log.warning("%d of %d piezo commands outside the reachable %.3g .. %.3g um; clipped",
-                    saturated, u.size, *stroke_range(p))
     volts = voltage_for(p, x_bias - u / p.transmission)
     return volts, -p.transmission * (sweep(p, volts) - x_bias)
 

@@ -33,7 +33,7 @@ from pathlib import Path
 from gatetherm import InputError
 from gatetherm.studies.control import benefit as held
 from gatetherm.studies.control import method as registry
-from gatetherm.studies.control.actuator import ActuatorParams
+from gatetherm.studies.control.actuator import ActuatorParams, stroke_range
 from gatetherm.studies.control.compensator import NEEDED, ClosedLoop, CompensatorParams, compensate as paper_loop, \
     summarize
 from gatetherm.studies.control.method.errormodel import SAME_INSTANT, overlaps  # noqa: F401 - offered here too
@@ -189,6 +189,9 @@ def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, hea
     b, warning = held.guard(b, name, s.force, better)
     early = held.over_record(loop, s.params.settle_s, name, model)
     notes = (*notes, early) if early else notes
+    if loop.saturated_updates:  # the correction applied (a separate check's loop clips its own)
+        notes = (*notes, f"{loop.saturated_updates} of {loop.update_t_s.size} piezo commands outside the reachable "
+                 "{:.3g} .. {:.3g} um; clipped".format(*stroke_range(actuator)))
     summary = {**summarize(loop, s.params.settle_s), "method": s.method, **extra,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(s.params),
                "actuator": dataclasses.asdict(actuator) if actuator else None, "benefit": b.as_dict(),

@@ -18,6 +18,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from gatetherm import InputError
 from gatetherm.geometry.measure import region_volume
 from gatetherm.solvers.effects import ActiveEffects, apply_effects, checked, resolve
 from gatetherm.solvers.heat import HeatSolver, environment
@@ -195,10 +196,13 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
     target = effective(case, eff)
 
     def run(p: Prepared) -> RunResult:
-        if p.model.heat is None or len(schedule.times) == 1:
-            return _once(p, schedule)
-        return run_model(p.model, schedule.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver,
-                         solve_at=solve_at, solve_first_peak=solve_first_peak)
+        try:
+            if p.model.heat is None or len(schedule.times) == 1:
+                return _once(p, schedule)
+            return run_model(p.model, schedule.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver,
+                             solve_at=solve_at, solve_first_peak=solve_first_peak)
+        except InputError as err:  # a temperature out of range: the case's heat inputs, named with its file
+            raise err.at(case.source) if err.field == "temperature" and case.source else err
 
     if cache is not None and U0 is None and not keep_times:
         key = (repr(target.problem), id(case.mesh), schedule.label, schedule.times.tobytes())
