@@ -265,6 +265,6 @@ def test_commands_beyond_the_actuators_reach_are_said_once(machine, caplog):
     with caplog.at_level(logging.WARNING):
         s = compensate(noisy(measured, 7), case, Settings("mlr"), short).summary
     [line] = [w for w in s["warnings"] if "piezo" in w]
-    assert line == f"{s['piezo_saturated_updates']} of {s['updates']} piezo commands outside the reachable -2 .. 1 um; " \
-        "clipped" and s["piezo_saturated_updates"] > 0
+    assert line == f"{s['piezo_saturated_updates']} of {s['updates']} piezo commands outside the reachable " \
+        "-2 .. 1 um; clipped" and s["piezo_saturated_updates"] > 0
     assert "piezo" not in caplog.text

@@ -120,4 +120,5 @@ def test_placement_puts_no_sensor_on_the_spindle_and_says_so(headstock, tmp_path
     assert "excluded (cannot carry a sensor: [sensors] exclude, or a face a support holds): spindle (63 candidate " \
         "nodes left out), feet_fixed (7 candidate nodes left out), feet_sliding (7 candidate nodes left out)" in out
     assert "# none on spindle (63 candidate nodes), feet_fixed (7 candidate nodes), feet_sliding (7 candidate nodes) " \
-        "(cannot carry a sensor: [sensors] exclude, or a face a support holds)" in (tmp_path / "s" / "sensors.toml").read_text()
+        "(cannot carry a sensor: [sensors] exclude, or a face a support holds)" in (tmp_path / "s" / "sensors.toml"
+                                                                                  ).read_text()

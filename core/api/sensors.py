@@ -130,7 +130,7 @@ def check_placement(case: Case, placement: Placement):
         loads (``.temperature_error_K``, K), ``.runs``, ``.seconds``.
     """
     from gatetherm.studies.sensors.check import fe_check
-    from gatetherm.studies.sensors.result import NO_SENSOR, Placement
+    from gatetherm.studies.sensors.result import Placement
 
     _case(case)
     argument("placement", placement, Placement, "a Placement", "what gt.place_sensors(case) returns")
@@ -165,7 +165,7 @@ def write_placement(out: str | os.PathLike, placement: Placement, case: Case, ch
         The summary.
     """
     from gatetherm.validation.plots import figure, save
-    from gatetherm.studies.sensors.result import NO_SENSOR, Placement
+    from gatetherm.studies.sensors.result import Placement
     from gatetherm.validation.plots.api import sensor_curve, sensors
 
     argument("placement", placement, Placement, "a Placement", "what gt.place_sensors(case) returns")

@@ -43,10 +43,10 @@ correction or a separate check refitted before the held-out span (mlr, --k-sourc
 
 Never silently unsure: what the K_i, K_C fit (--k-source fit) or the mlr regression dropped or
 bounded for the thermocouples' noise (0.05 K), a rom update budget used up before the record
-ends (with the time), commands clipped at the actuator's reach, a correction worse than none earlier in the record (and whether its
-prediction misses δ by more than δ itself: a record of another machine) and a record whose
-time_s is far from the case's [time] (minutes written as seconds) are each printed as one
-``warning:`` line and listed in summary.json's ``warnings``.
+ends (with the time), commands clipped at the actuator's reach, a correction worse than none
+earlier in the record (and whether its prediction misses δ by more than δ itself: a record of
+another machine) and a record whose time_s is far from the case's [time] (minutes written as
+seconds) are each printed as one ``warning:`` line and listed in summary.json's ``warnings``.
 """
 from __future__ import annotations
 
