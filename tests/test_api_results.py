@@ -92,7 +92,8 @@ def test_sensor_placement_reports_progress(tmp_path):
     assert study.check is None and len(study.placement.sensors) == 1
     study.write(tmp_path / "o")
     assert sorted(p.name for p in (tmp_path / "o").iterdir()) == sorted(gt.api.sensors.OUTPUTS)
-    assert study.summary(tmp_path / "o").splitlines()[1].startswith("K=1 ")
+    excluded, k1 = study.summary(tmp_path / "o").splitlines()[1:3]
+    assert excluded.endswith("a face a support holds): cold (4 candidate nodes left out)") and k1.startswith("K=1 ")
 
 
 def test_report_reports_progress_over_the_sections(tmp_path, monkeypatch):

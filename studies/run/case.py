@@ -198,8 +198,7 @@ class CaseFile:
         return marked(case, keys)
 
     def model_file(self, case: Case, header: str = "") -> None:
-        """None: a case file is not rewritten (its comments and layout are the user's); the
-        diagnosis report lists the values to put into it."""
+        """None: a case file is not rewritten (its layout is the user's); the diagnosis report lists the values."""
         return None
 
 
@@ -233,8 +232,11 @@ def _time(top: Table, base: Path):
     return TimeSettings(end, step, output, t.number("fields", within, end), schedule), scheme, ts
 
 
-def _check_schedule(problem: Problem, ts, time: TimeSettings) -> None:
-    """Every value that reads the schedule, at its samples within the run (where recorded): in its key's range."""
+def _check_schedule(top: Table, fm: FrameMesh, problem: Problem, ts, time: TimeSettings | None) -> None:
+    """A band off its region warned of; each value that reads the schedule in its key's range at the run's samples."""
+    case_sources.warn_bands(top, fm, problem, ts, time)
+    if ts is None:
+        return
     t = np.asarray(ts.time_s - ts.time_s[0], float)
     env = {"t": t, **{k: ts[k] for k in ts.names if k != "time_s"}}
     for v in values(problem):
@@ -360,9 +362,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
                       signals=case_tables.signals(top, probes, relative), elastic=elastic, scheme=scheme,
                       thermal=not mechanical, **kw)
     case_mech.check_assembly(top, fm, problem, time is None)
-    if schedule_ts is not None:
-        _check_schedule(problem, schedule_ts, time)
-    case_sources.warn_bands(top, fm, problem, schedule_ts, time)
+    _check_schedule(top, fm, problem, schedule_ts, time)
     if time is None:
         schedule = STEADY
     else:
