@@ -42,8 +42,21 @@ def snap_points(points: np.ndarray, cells: np.ndarray, sensors: dict[str, int]) 
                              "put the point on the meshed body (embed it in gmsh)")
         out[name] = near
         notes.append(f"mesh point {name} at ({where}) is not a node of the mesh's elements: read at the nearest "
-                     f"node, {dist.min():.3g} m away (embed the point in gmsh to read it exactly)")
+                     f"node, {dist.min():.3g} m away (embed the point in gmsh to read it exactly)" if _inside(
+                         points, cells, points[node]) else f"mesh point {name} at ({where}) lies outside the meshed "
+                     f"body: read at its nearest node, {dist.min():.3g} m away; move the point onto the body")
     return out, notes
+
+
+def _inside(points: np.ndarray, cells: np.ndarray, x: np.ndarray, tol: float = 1e-9) -> bool:
+    """Whether ``x`` lies in one of the elements ``cells`` (faces included, to ``tol`` of their size)."""
+    v = points[cells]  # (E, dim+1, dim)
+    near = np.flatnonzero(((v.min(axis=1) <= x + tol) & (v.max(axis=1) >= x - tol)).all(axis=1))
+    if not near.size:
+        return False
+    v = v[near]
+    lam = np.einsum("skd,sd->sk", np.linalg.pinv(np.swapaxes(v[:, 1:] - v[:, :1], 1, 2)), x - v[:, 0])
+    return bool(((lam >= -tol) & (lam.sum(axis=1, keepdims=True) <= 1 + tol)).all(axis=1).any())
 
 
 CHUNK = 1 << 15

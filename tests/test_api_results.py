@@ -69,6 +69,13 @@ def test_prediction_and_refit_write_and_say_what_the_commands_do(record, tmp_pat
     new, report = refit  # unpacks as before
     assert report["d_um"]["kept"] and new is refit.model
     assert refit.summary().startswith("d_um: kept the current coefficients: on the window's last quarter 0.0432 um")
+    from gatetherm.studies.run.timeseries import read_timeseries
+
+    t = read_timeseries(record, required=("time_s",)).time_s
+    span = float(t[-1] - t[0])  # a window longer than the file: all of it, and said so
+    whole = gt.errormodel_refit(model, record, 10 * span)
+    assert whole.window_s == span and whole.summary(tmp_path / "r").startswith(f"wrote {tmp_path / 'r' / 'model.json'} "
+                                                                                f"(refitted on the last {span / 3600:g} h)")
     with pytest.raises(InputError, match="^applied: 2 columns for 1 targets"):
         gt.errormodel_refit(model, record, 3600.0, ["a_um", "b_um"])
 

@@ -91,7 +91,7 @@ def test_drift_warning_when_the_machine_leaves_the_fitting_data():
     odd = run(5, 1.0, 4500.0, k1=3.0)  # the machine changed: s1 weighs 3 um/K now
     hot = odd.with_columns(s1_degC=odd["s1_degC"] + np.linspace(0.0, 30.0, len(odd)))  # and s1 far beyond its range
     result = gt.errormodel_predict(model, hot)
-    assert len(result.warnings) == 1 and result.warnings[0].startswith("d_um: the machine no longer behaves")
+    assert len(result.warnings) == 1 and result.warnings[0].startswith("d_um: the record is unlike the fitting data")
     assert result.scores["d_um"]["share_outside"] > 0.5
     assert gt.errormodel_predict(model, RUNS[0]).warnings == ()
 
@@ -125,7 +125,7 @@ def test_cli_fit_several_runs_predict_and_refit(tmp_path, capsys):
     assert main(["errormodel", "predict", str(tmp_path / "fit" / "model.json"), "--data", str(tmp_path / "odd.csv"),
                  "--out", str(tmp_path / "pred")]) == 0
     out = capsys.readouterr().out
-    assert sum(line.startswith("warning: d_um: the machine no longer behaves") for line in out.splitlines()) == 1
+    assert sum(line.startswith("warning: d_um: the record is unlike the fitting data") for line in out.splitlines()) == 1
     summary = json.loads((tmp_path / "pred" / "summary.json").read_text())
     assert len(summary["warnings"]) == 1
     assert main(["errormodel", "refit", str(tmp_path / "fit" / "model.json"), "--data", files[0], "--window-h", "8",

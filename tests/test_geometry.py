@@ -364,6 +364,11 @@ def test_a_point_group_off_the_nodes_is_snapped_or_refused(tmp_path, caplog):
     assert np.linalg.norm(got - [0.5037, 0.4991]) == d.min() < 0.1  # the nearest node of the mesh
     assert "mesh point loose at (0.5037, 0.4991) is not a node of the mesh's elements: read at the nearest node, " \
            f"{d.min():.3g} m away" in caplog.text
+    (tmp_path / "c.geo").write_text(POINTS.replace("0.5037, 0.4991", "1.02, 0.5"))  # off the plate, within tolerance
+    fm = mesh_geometry(MeshSpec(tmp_path / "c.geo", 0.1))
+    assert fm.points[fm.sensors["loose"]].tolist() == [1.0, 0.5]  # a new user read δ 25 mm from its point
+    assert "mesh point loose at (1.02, 0.5) lies outside the meshed body: read at its nearest node, 0.02 m away; move " \
+           "the point onto the body" in caplog.text
     (tmp_path / "b.geo").write_text(POINTS.replace("0.5037, 0.4991", "3, 3"))
     with pytest.raises(InputError, match=r"mesh point loose: at \(3, 3\) is 2\.83 m from the nearest node .* more "
                                          r"than the tolerance 0\.\d+ m"):

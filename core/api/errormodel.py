@@ -211,8 +211,10 @@ def errormodel_refit(model: ErrorModel | ErrorModelFit | str | os.PathLike, data
             raise InputError(named_as, f"{len(applied)} columns for {len(model.names)} targets",
                              f"one per target, in the order {', '.join(model.names)}")
         applied = dict(zip(model.names, applied))
-    new, report = refit(model, _read(data), window_s, applied)
-    return Refit(new, report, window_s, files)
+    ts = _read(data)
+    new, report = refit(model, ts, window_s, applied)
+    span = float(ts.time_s[-1] - ts.time_s[0]) if len(ts.time_s) else window_s
+    return Refit(new, report, min(window_s, span), files)  # the window used: all of a shorter file
 
 
 def _same_record(a: TimeSeries, b: TimeSeries, columns) -> bool:

@@ -85,7 +85,7 @@ class Prediction:
     gaps: dict = field(default_factory=dict)
     """Per column with gaps its :class:`~gatetherm.studies.errormodel.terms.GapReport`."""
     warnings: tuple[str, ...] = ()
-    """One line per target that no longer behaves like the fitting data."""
+    """One line per target whose record is unlike the fitting data."""
     model: ErrorModel | None = None
     """The model applied."""
     data: object = None
@@ -145,7 +145,7 @@ class Refit:
     """Per target ``kept`` (bool), ``current_mae_um``, ``refit_mae_um`` (um, on the window's last
     quarter) and ``samples``."""
     window_s: float
-    """The refit window at the end of the data, s."""
+    """The refit window at the end of the data, s (the file's span where shorter)."""
     files: tuple[str, ...] = ()
     """The input files (kept by :meth:`write`: never overwritten)."""
 

@@ -5,8 +5,8 @@
 held-out error and 90 % interval; ``predict`` writes ``DIR/prediction.csv`` (``time_s``,
 ``<target>_pred``, ``<target>_lo``, ``<target>_hi`` (the 90 % interval), and ``<target>`` where the
 file has it), ``DIR/summary.json`` (MAE and RMS per measured target, the drift check, the filled
-gaps) and ``DIR/prediction.png``, and prints one warning line per target that no longer behaves
-like the fitting data; ``refit`` writes ``DIR/model.json`` with the coefficients refitted on the
+gaps) and ``DIR/prediction.png``, and prints one warning line per target whose record is unlike
+the fitting data; ``refit`` writes ``DIR/model.json`` with the coefficients refitted on the
 data's last window.
 """
 from __future__ import annotations

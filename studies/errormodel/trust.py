@@ -17,7 +17,8 @@ held-out data, and a drift detector.
   where a term (not the drift term, which always grows) leaves its range by more than
   :data:`MARGIN` of the range's width. A file whose share of outside samples exceeds
   :data:`MAX_OUTSIDE`, or whose measured target leaves the 90 % interval on more than
-  :data:`MAX_MISSED` of its samples, no longer behaves like the fitting data.
+  :data:`MAX_MISSED` of its samples, is unlike the fitting data (another duty cycle or room, or a
+  changed machine).
 """
 from __future__ import annotations
 
@@ -134,7 +135,7 @@ def beyond(values: list[np.ndarray], ranges, coefficients) -> np.ndarray:
 
 
 def drift_warning(target: str, share_outside: float, share_missed: float | None) -> str | None:
-    """One line if the data no longer behave like the fitting data (module docstring), else None."""
+    """One line if the data are unlike the fitting data (module docstring), else None."""
     why = []
     if share_outside > MAX_OUTSIDE:
         why.append(f"{share_outside:.0%} of the samples outside the fitting data's range")
@@ -142,7 +143,8 @@ def drift_warning(target: str, share_outside: float, share_missed: float | None)
         why.append(f"{share_missed:.0%} of the measured samples outside the 90 % interval")
     if not why:
         return None
-    return f"{target}: the machine no longer behaves like the fitting data ({'; '.join(why)}): refit"
+    return (f"{target}: the record is unlike the fitting data ({'; '.join(why)}): a duty cycle, room or range the fit "
+            "did not see, or a changed machine; refit on data that hold it")
 
 
 def trust(model: ErrorModel, columns, predicted: dict[str, np.ndarray] | None = None) -> dict[str, dict]:
