@@ -180,3 +180,25 @@ def test_compensate_with_a_schedule_for_data_exits_2_naming_the_file(tmp_path: P
     err = capsys.readouterr().err
     assert got == 2 and err.count("\n") == 1 and "Traceback" not in err
     assert f"{example / 'schedule.csv'}: column theta_A_degC: missing; add a theta_A_degC column" in err, err
+
+
+def test_a_fitted_factor_is_printed_without_a_unit():
+    """``factor = 1.3 ± 0.00038 1`` read as a stray 1 to a new user: a factor has no unit; others keep theirs."""
+    import types
+
+    from gatetherm.api.diagnosis import DiagnosisRun
+
+    def piece(label, param, unit):
+        return types.SimpleNamespace(kind="parameter", label=label, param=param, unit=unit)
+
+    found = [types.SimpleNamespace(piece=piece("source_motor", "factor", "1"), value=1.2997, sigma=0.00038, share=0.9,
+                                   alternatives=()),
+             types.SimpleNamespace(piece=piece("film_free", "h", "W/(m2 K)"), value=7.974, sigma=0.15, share=0.1,
+                                   alternatives=())]
+    diag = types.SimpleNamespace(verdict="explained", pieces=found, groups=(), dropped=(), cause="", too_coarse=(),
+                                 stand_ins=((piece("conductivity", "factor", "1"), 0.9, "a stand-in"),),
+                                 summary=lambda: {"best_rejected": None, "rms_after_um": None})
+    lines = DiagnosisRun(diag, None, "d.csv", {}, {}, ()).summary().splitlines()
+    assert lines[1:] == ["  parameter source_motor: factor = 1.3 ± 0.00038, 90 % of the held-out residual",
+                         "  parameter film_free: h = 7.974 ± 0.15 W/(m2 K), 10 % of the held-out residual",
+                         "  stand-in, not a cause: conductivity factor = 0.9 (a stand-in)"]

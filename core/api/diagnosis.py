@@ -96,6 +96,11 @@ def diagnosis_hypotheses(model: Case, uncertain: Sequence[str] = (), as_json: bo
     return "\n".join(rows)
 
 
+def _with_unit(number: str, unit: str) -> str:
+    """``number`` and its unit, none for a factor (unit 1)."""
+    return number if unit in ("", "1") else f"{number} {unit}"
+
+
 def order_warning(diag, metadata: dict) -> str:
     """The warning of a model whose discretisation error exceeds the resolution; where it was replayed
     with P2 and the data are gatetherm's own run (metadata ``source: gatetherm``), the hint to --keep-order."""
@@ -176,11 +181,12 @@ class DiagnosisRun:
         s = diag.summary()
         lines = [f"verdict: {diag.verdict}"]
         for r in diag.pieces:
-            lines.append(f"  {r.piece.kind} {r.piece.label}: {r.piece.param} = {r.value:.4g} ± {r.sigma:.2g} "
-                         f"{r.piece.unit}, {100 * r.share:.0f} % of the held-out residual"
+            lines.append(f"  {r.piece.kind} {r.piece.label}: {r.piece.param} = "
+                         f"{_with_unit(f'{r.value:.4g} ± {r.sigma:.2g}', r.piece.unit)}, "
+                         f"{100 * r.share:.0f} % of the held-out residual"
                          + (f" (or: {', '.join(q.label for q in r.alternatives)})" if r.alternatives else ""))
         lines += [f"  cannot be told apart: {g.sentence()}" for g in diag.groups]
-        lines += [f"  stand-in, not a cause: {p.label} {p.param} = {v:.4g} {p.unit} ({why})"
+        lines += [f"  stand-in, not a cause: {p.label} {p.param} = {_with_unit(f'{v:.4g}', p.unit)} ({why})"
                   for p, v, why in diag.stand_ins]
         lines += [f"  dropped, the model refuses it: {p.label} ({why})" for p, why in diag.dropped]
         if diag.cause:
