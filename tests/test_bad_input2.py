@@ -327,12 +327,13 @@ def test_a_zoo_cell_ends_quietly_on_the_commands_signal():
 
 
 def test_a_correlation_film_refused_by_the_reduction_names_its_equivalent(tmp_path):
-    """A reduced model is linear: a film that follows the temperature is refused, and the
-    message names a number to give instead (the law's reference coefficient)."""
+    """A reduced model is linear: a film that follows the temperature is refused, naming the case file,
+    and the message names a number to give instead (the law's reference coefficient)."""
     case = gt.load_case(spindle(tmp_path, "reference = 40.0", "reference = 40.0"))
     with pytest.raises(InputError) as info:
         gt.reduce(case)
-    assert str(info.value).startswith("film of 'nose': follows the temperature (a correlation or radiation)")
+    assert str(info.value).startswith(f"{case.source}: film of 'nose': follows the temperature (a correlation or "
+                                      "radiation)")
     assert "give each such film as a number to reduce the case (at the law's reference: nose 40 W/(m² K)" \
         in str(info.value)
 

@@ -137,7 +137,10 @@ def test_the_paper_frame_as_a_case_runs_like_simulate(tmp_path):
 
 
 BAD = {
-    "misspelt group": ("[thermal.tank_wal]\ntemperature = 1.0\n", "thermal.tank_wal: unknown key; known keys: "),
+    "misspelt group": ("[thermal.tank_wal]\ntemperature = 1.0\n",
+                       "thermal.tank_wal: 'tank_wal' is not a boundary of the mesh; boundaries: "),
+    "misspelt region": ("[materials.plat]\nk = 1.0\n",
+                        "materials.plat: 'plat' is not a region of the mesh; regions: plate; names alike: plate"),
     "unknown key": ("[materials.plate]\nk = 1.0\nkappa = 2.0\n", "materials.plate.kappa: unknown key"),
     "no material": ("", "materials.plate: region without a material"),
     "two conditions": ("[thermal.base]\ntemperature = 1.0\nfilm = 5.0\nambient = 0.0\n",

@@ -9,7 +9,8 @@ ORDER = 20  # its place in `gatetherm --help` (gatetherm.cli finds the command h
 
 
 def register(sub) -> None:
-    p = sub.add_parser("mesh", help="mesh the frame; write DIR/mesh.msh, mesh.vtu and the frame as DIR/case.toml")
+    p = sub.add_parser("mesh", help="mesh the paper's frame (a case file's mesh is made by run); write DIR/mesh.msh, "
+                                    "mesh.vtu and the frame as DIR/case.toml")
     add_model_options(p)
     p.add_argument("--condition", type=int, default=1, metavar="N",
                    help="the paper's condition written as the case's schedule.csv (default 1)")

@@ -317,7 +317,7 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
             kw["prescribed_regions"] = {r: reg.number(r, CELSIUS) for r in reg.data}
     else:
         kw.update(case_tables.boundary_conditions(top, fm, names))
-        src = top.sub("sources", tuple(fm.regions) + tuple(b for b in fm.boundaries if b not in fm.regions))
+        src = top.sub("sources", case_sources.where(fm))
         sources = []
         for r in src.data:
             sources.append(case_sources.read_source(

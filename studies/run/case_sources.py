@@ -19,7 +19,7 @@ from gatetherm.checks import Range
 from gatetherm.solvers import elements
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.problem import Source
-from gatetherm.studies.run.tables import Table
+from gatetherm.studies.run.tables import MeshNames, Table
 
 log = logging.getLogger(__name__)
 
@@ -70,6 +70,12 @@ def element_loss(t: Table, names) -> Value:
 
     text, factor = kinds[kind].read(t, text), t.number("factor", FACTOR, 1.0)
     return Value.of(text if factor == 1.0 else f"{factor!r}*({text})", t.key("kind"), LOSS)
+
+
+def where(fm) -> MeshNames:
+    """What ``[sources.NAME]`` may name: a region, or a boundary (a surface source)."""
+    return MeshNames((*fm.regions, *(b for b in fm.boundaries if b not in fm.regions)), "region or boundary",
+                     "regions and boundaries")
 
 
 def warn_sizes(src: Table, extent: float) -> None:

@@ -19,7 +19,7 @@ from gatetherm.solvers.material import Material
 from gatetherm.solvers.problem import AXES, FixedTemperature, Fluid, Flux, Probe, Relative, Signals, Support
 from gatetherm.studies.run import case_films, case_mech
 from gatetherm.studies.run.case_mesh import numbers
-from gatetherm.studies.run.tables import Table
+from gatetherm.studies.run.tables import MeshNames, Table
 
 KEYS = {
     "materials.REGION": ("k", "rho", "c", "E", "nu", "alpha", "thickness"),
@@ -55,7 +55,7 @@ log = logging.getLogger(__name__)
 
 
 def materials(top: Table, fm: FrameMesh, need: set[str]) -> tuple[dict, dict]:
-    mats = top.sub("materials", tuple(fm.regions))
+    mats = top.sub("materials", MeshNames(fm.regions, "region", "regions"))
     missing = [r for r in fm.regions if r not in mats.data]
     if missing:
         mats.fail(missing[0], "region without a material", f"add [materials.{missing[0]}] (regions: "
@@ -89,7 +89,7 @@ def _plausible_thickness(t: Table, fm: FrameMesh, value: float) -> None:
 
 
 def boundary_conditions(top: Table, fm: FrameMesh, names) -> dict:
-    th = top.sub("thermal", tuple(fm.boundaries))
+    th = top.sub("thermal", MeshNames(fm.boundaries, "boundary", "boundaries"))
     out = {"films": [], "fixed": [], "fluxes": []}
     for b in th.data:
         t = th.sub(b, KEYS["thermal.BOUNDARY"])
@@ -136,7 +136,7 @@ def fluids(top: Table, fm: FrameMesh, names, thickness: dict) -> tuple:
 
 
 def supports(top: Table, fm: FrameMesh, names) -> tuple:
-    sup = top.sub("supports", case_mech.support_names(fm))
+    sup = top.sub("supports", MeshNames(case_mech.support_names(fm), "boundary or line", "boundaries and lines"))
     out = []
     for b in sup.data:
         t = sup.sub(b, KEYS["supports.BOUNDARY"])

@@ -47,7 +47,10 @@ def build_rom(case: Case, states: int = 30, cache: ScenarioCache | None = None) 
     t0 = time.perf_counter()
     model = prepare(case, cache=cache).model
     build = time.perf_counter() - t0
-    red = reduce(linear_heat_model(model, column), states)
+    try:
+        red = reduce(linear_heat_model(model, column), states)
+    except InputError as err:  # a film the reduced model cannot hold: named in the case file
+        raise err.at(case.source) if case.source else err
     red.seconds["model_build"] = build
     ambient = room(case.problem)
     text = ambient.text or repr(ambient.constant)

@@ -40,6 +40,16 @@ class Said(set):
         self.add(text)
 
 
+class MeshNames(tuple):
+    """The keys a table may have where they name parts of the mesh (``what``: "boundary", …; ``plural``):
+    an unknown one is "not a boundary of the mesh", not an unknown key."""
+
+    def __new__(cls, names, what: str, plural: str):
+        self = super().__new__(cls, names)
+        self.what, self.plural = what, plural
+        return self
+
+
 class Table:
     """One table of the case file; remembers where it is for the error messages, and what was said."""
 
@@ -51,6 +61,9 @@ class Table:
         self.data = data
         if known is not None:
             for key in data:
+                if key not in known and isinstance(known, MeshNames):
+                    raise InputError(f"{file}: {where}.{key}", f"'{key}' is not a {known.what} of the mesh",
+                                     f"{known.plural}: {', '.join(known) or 'none'}{alike(key, known, 'names')}")
                 if key not in known:
                     raise InputError(f"{file}: {where}.{key}", "unknown key", f"known keys: {', '.join(known)}")
 

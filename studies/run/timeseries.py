@@ -115,10 +115,10 @@ def rises(ts: TimeSeries, name: str) -> np.ndarray:
     return values - values[0]
 
 
-def alike(name: str, columns) -> str:
+def alike(name: str, columns, what: str = "columns") -> str:
     """``; columns alike: a, b`` for the ``columns`` that look like ``name`` (difflib), else ``""``."""
     close = difflib.get_close_matches(name, list(columns), n=3, cutoff=0.6)
-    return f"; columns alike: {', '.join(close)}" if close else ""
+    return f"; {what} alike: {', '.join(close)}" if close else ""
 
 
 def missing_column(name: str, columns, source: str = "", named_by: str = "") -> InputError:
