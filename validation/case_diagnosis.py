@@ -28,7 +28,7 @@ from pathlib import Path
 
 from gatetherm import InputError, write_text_atomic
 from gatetherm.studies.diagnosis.discrepancy import Settings, diagnose
-from gatetherm.studies.diagnosis.hypotheses import catalogue, configure
+from gatetherm.studies.diagnosis.hypotheses import catalogue, configure, parameter_pieces
 from gatetherm.studies.run.case import Case, load_case
 from gatetherm.studies.run.output import write_json
 from gatetherm.studies.run.scenario import run_scenario
@@ -63,25 +63,30 @@ COLUMNS = ("scenario", "mesh_factor", "order", "hidden", "verdict", "pieces", "a
 check on δ, in resolutions."""
 
 
-def lacking(case: Case, labels: dict) -> str:
-    """The first of ``labels`` that is not a hypothesis of ``case`` ('' if every one is)."""
-    pieces = {p.label for p in catalogue(case, OUTPUT_COLUMNS)}
+def _hypotheses(case: Case, labels: dict) -> tuple[dict, str]:
+    """The hypotheses of ``case`` by label, with the dimensions ``labels`` name, and the first of ``labels``
+    that is none of them ('' if every one is)."""
+    pieces = {p.label: p for p in catalogue(case, OUTPUT_COLUMNS)}
     for k in labels:
         if k.startswith("mesh."):
             try:
-                pieces |= {p.label for p in catalogue(case, OUTPUT_COLUMNS, [k])}
+                pieces.update({p.label: p for p in parameter_pieces(case, [k], [k])})
             except InputError:  # a dimension the case's geometry does not have
-                return k
-    return next((k for k in labels if k not in pieces), "")
+                return pieces, k
+    return pieces, next((k for k in labels if k not in pieces), "")
+
+
+def lacking(case: Case, labels: dict) -> str:
+    """The first of ``labels`` that is not a hypothesis of ``case`` ('' if every one is)."""
+    return _hypotheses(case, labels)[1]
 
 
 def hidden(case: Case, labels: dict) -> dict:
     """{Piece: value} of the labels (effects, the case's parameters, faults of the signal channels)."""
-    missing = lacking(case, labels)
+    pieces, missing = _hypotheses(case, labels)
     if missing:
         raise InputError(f"--case {case.path}", f"{missing} is not a hypothesis of this case",
                          "hide pieces it has (gatetherm diagnose --case CASE --list-effects)")
-    pieces = {p.label: p for p in catalogue(case, OUTPUT_COLUMNS, [k for k in labels if k.startswith("mesh.")])}
     return {pieces[k]: v for k, v in labels.items()}
 
 

@@ -50,7 +50,7 @@ def build_rom(case: Case, states: int = 30, cache: ScenarioCache | None = None) 
     try:
         red = reduce(linear_heat_model(model, column), states)
     except InputError as err:  # a film the reduced model cannot hold: named in the case file
-        raise err.at(case.source) if case.source else err
+        raise err.at(case.source) from None
     red.seconds["model_build"] = build
     ambient = room(case.problem)
     text = ambient.text or repr(ambient.constant)

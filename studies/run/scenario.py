@@ -202,7 +202,7 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
             return run_model(p.model, schedule.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver,
                              solve_at=solve_at, solve_first_peak=solve_first_peak)
         except InputError as err:  # a temperature out of range: the case's heat inputs, named with its file
-            raise err.at(case.source) if err.field == "temperature" and case.source else err
+            raise (err.at(case.source) if err.field == "temperature" else err) from None
 
     if cache is not None and U0 is None and not keep_times:
         key = (repr(target.problem), id(case.mesh), schedule.label, schedule.times.tobytes())
