@@ -171,3 +171,15 @@ class VaryingFilm:
         """The film's part beyond the matrix, on the left-hand side (solid unknowns)."""
         Ta = self.ambient(env)
         return (self.law(self.surface(U), Ta, env) - self.h_ref) * (self.A @ U[:len(self.a)] - self.a * Ta)
+
+
+def held_coefficient(t_s, h, excess) -> float:
+    """The one coefficient that stands for a film law over a run (a linear model holds it so): the
+    law's coefficients ``h`` (W/(m² K)) at the times ``t_s`` (s), averaged with the weights
+    ``|excess| dt``, ``excess`` the wall's mean temperature less the ambient (K), so that it is
+    right where the film carries heat; the plain time mean where the wall never leaves the ambient."""
+    t, h, w = (np.asarray(x, float) for x in (t_s, h, excess))
+    dt = np.diff(t)
+    dt = 0.5 * (np.r_[dt, 0.0] + np.r_[0.0, dt]) if t.size > 1 else np.ones(1)
+    w = np.abs(w) * dt
+    return float(h @ w / w.sum()) if w.sum() > 1e-12 * dt.sum() else float(h @ dt / dt.sum())

@@ -66,6 +66,8 @@ class ReducedModel:
     """Input columns a series may leave out, with the value they keep (the frame's room)."""
     room: int | None = None
     """Index of the input that is the room temperature (the films' ambient), if one is."""
+    notes: tuple[str, ...] = ()
+    """What a user of the model should know (films held at constants, and what that costs)."""
 
     @property
     def states(self) -> int:
@@ -97,6 +99,9 @@ class Reduction:
     static_gain_error: dict[str, float]
     """Per mode: largest |static gain of the first key output, reduced − full| per input unit."""
     seconds: dict[str, float]
+    held: dict[str, float] = field(default_factory=dict)
+    """Films that follow the temperature, held at one coefficient each, W/(m² K), by boundary
+    (what that costs: ``rom.notes``)."""
 
 
 def _weights(names) -> np.ndarray:

@@ -326,18 +326,6 @@ def test_a_zoo_cell_ends_quietly_on_the_commands_signal():
     assert cell["text"] == f"{signal.SIG_DFL} {signal.SIG_DFL}"
 
 
-def test_a_correlation_film_refused_by_the_reduction_names_its_equivalent(tmp_path):
-    """A reduced model is linear: a film that follows the temperature is refused, naming the case file,
-    and the message names a number to give instead (the law's reference coefficient)."""
-    case = gt.load_case(spindle(tmp_path, "reference = 40.0", "reference = 40.0"))
-    with pytest.raises(InputError) as info:
-        gt.reduce(case)
-    assert str(info.value).startswith(f"{case.source}: film of 'nose': follows the temperature (a correlation or "
-                                      "radiation)")
-    assert "give each such film as a number to reduce the case (at the law's reference: nose 40 W/(m² K)" \
-        in str(info.value)
-
-
 @pytest.mark.parametrize("old, new, needle", [
     ("[probes.mount_point]", '[probes."mount,point"]',
      "probes.mount,point: cannot name a probe's columns (it holds a comma"),
@@ -462,3 +450,15 @@ def test_a_run_that_leaves_the_temperature_range_names_the_case_file(tmp_path):
     case = gt.load_case(spindle(tmp_path, "dm = 0.0825", "dm = 82.5"))
     with pytest.raises(InputError, match=r"^.*spindle/case.toml: temperature: the solution reaches .* °C at t = "):
         gt.run(case, keep=())
+
+
+def test_a_case_without_the_signals_is_refused_compensation_with_the_error_model_offered():
+    """The spindle maps no θ_A, θ_B, θ_C: its own run cannot be compensated by θ; the message says what
+    would do it (the zoo's paper, mlr and rom cells give the same line)."""
+    case = gt.load_case(EXAMPLES / "spindle_unit" / "case.toml")
+    with pytest.raises(InputError) as info:
+        gt.compensate_run(case=case, method="rom")
+    assert str(info.value) == (f"{case.source}: signals: a compensated case needs [time] and [signals] with theta_A, "
+                               "theta_B, theta_C and delta; map them to its probes and a relative displacement, or "
+                               "compensate its δ with an error model of its temperatures (gatetherm errormodel fit, "
+                               "then compensate --model)")

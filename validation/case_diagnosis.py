@@ -32,7 +32,8 @@ from gatetherm.studies.diagnosis.hypotheses import catalogue, configure, paramet
 from gatetherm.studies.run.case import Case, load_case
 from gatetherm.studies.run.output import write_json
 from gatetherm.studies.run.scenario import run_scenario
-from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS, write_timeseries
+from gatetherm.studies.run.simulate import signal_columns
+from gatetherm.studies.run.timeseries import write_timeseries
 from gatetherm.validation.hidden_effects import diagnosis_row, fmt
 from gatetherm.validation.scoring import row_groups, score
 from gatetherm.validation.truth import recorded
@@ -66,7 +67,7 @@ check on δ, in resolutions."""
 def _hypotheses(case: Case, labels: dict) -> tuple[dict, str]:
     """The hypotheses of ``case`` by label, with the dimensions ``labels`` name, and the first of ``labels``
     that is none of them ('' if every one is)."""
-    pieces = {p.label: p for p in catalogue(case, OUTPUT_COLUMNS)}
+    pieces = {p.label: p for p in catalogue(case, signal_columns(case.problem))}
     for k in labels:
         if k.startswith("mesh."):
             try:
@@ -94,8 +95,8 @@ def measured_run(case: Case, values: dict, seed: int, name: str):
     """The rig's record of ``case`` with the hidden pieces ``values``, run with P2 elements."""
     truth = configure(case.with_order(2), values)
     schedule = case.schedule
-    cols = run_scenario(truth, schedule).columns
-    return recorded(cols, ("time_s", *schedule.drive.columns, *OUTPUT_COLUMNS), OUTPUT_COLUMNS, seed,
+    cols, channels = run_scenario(truth, schedule).columns, signal_columns(case.problem)
+    return recorded(cols, ("time_s", *schedule.drive.columns, *channels), channels, seed,
                     {"source": f"case-diagnosis study, scenario {name} (P2 truth of {case.path.name})"})
 
 

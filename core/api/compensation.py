@@ -235,12 +235,10 @@ def _own_run(case: Case, condition: int | None, on_progress) -> tuple:
     progress steps (the run's samples and the compensation)."""
     from gatetherm.api.case import condition as paper_condition
     from gatetherm.api.run import run
+    from gatetherm.studies.control.methods import compensated_case
     from gatetherm.studies.run.timeseries import FORMAT
 
-    if not case.problem.signals.complete or case.time is None:
-        raise InputError(f"{case.source}: signals", "a compensated case needs [time] and [signals] with "
-                         "theta_A, theta_B, theta_C and delta", "map them to its probes and a relative "
-                         "displacement")
+    compensated_case(case)
     schedule = paper_condition(condition, case) if condition is not None else case.schedule
     res = run(case, schedule, keep=(), on_step=on_progress and (lambda i, n: on_progress(i, n + 1)))
     meta = {"format": FORMAT, "source": "gatetherm compensate", "schedule": schedule.label,

@@ -77,10 +77,10 @@ def diagnosis_hypotheses(model: Case, uncertain: Sequence[str] = (), as_json: bo
     """
     from gatetherm.studies.diagnosis.hypotheses import catalogue
     from gatetherm.studies.diagnosis.progress import FIRST_RUNS
-    from gatetherm.studies.run.timeseries import OUTPUT_COLUMNS
+    from gatetherm.studies.run.simulate import signal_columns
 
     argument("model", model, Case, "a Case", "make one with gt.load_case(path) or gt.gate_frame()")
-    pieces = catalogue(model, OUTPUT_COLUMNS, tuple(uncertain))
+    pieces = catalogue(model, signal_columns(model.problem), tuple(uncertain))
     if as_json:
         return json.dumps([p.describe() for p in pieces], indent=2)
     rows = [f"{'kind':<10} {'name':<34} {'parameter':<12} {'plausible range':<23} {'unit':<9}"]

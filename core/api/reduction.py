@@ -32,6 +32,9 @@ def reduce(case: Case, states: int = 30):
     Reduction
         ``.rom`` the :class:`~gatetherm.solvers.rom.ReducedModel` (``gatetherm.studies.run.reduce.write_rom``
         keeps it as ``rom.npz``), with the error bounds, Hankel singular values and timings of its making.
+        Where a film follows the temperature (a correlation, radiation), ``.held`` is the constant it is
+        held at (the law's mean over the case's own run) and ``.rom.notes`` what that costs on that run
+        (also logged).
     """
     from gatetherm.studies.run.reduce import build_rom
 
@@ -111,7 +114,7 @@ def write_reduction(out: str | os.PathLike, red: Reduction, checks: Sequence, ca
     Returns
     -------
     dict
-        The summary: states, bounds (µm), the static-gain error, timings and checks.
+        The summary: states, bounds (µm), the static-gain error, timings, checks and ``notes``.
     """
     from gatetherm.studies.run.output import write_json
     from gatetherm.solvers.rom import Reduction
@@ -126,7 +129,7 @@ def write_reduction(out: str | os.PathLike, red: Reduction, checks: Sequence, ca
                "modes": list(red.rom.modes), "error_bound_bt": red.error_bound,
                "static_gain_error": red.static_gain_error, "hankel_singular_values": red.hankel,
                "reduction_seconds": round(seconds, 2), "seconds": {k: round(v, 2) for k, v in red.seconds.items()},
-               "checks": {c.schedule: dataclasses.asdict(c) for c in checks}}
+               "checks": {c.schedule: dataclasses.asdict(c) for c in checks}, "notes": list(red.rom.notes)}
     if checks:
         summary["max_delta_error_um"] = max(c.max_delta_error_um for c in checks)
     write_json(out / "summary.json", summary)

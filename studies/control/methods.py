@@ -103,6 +103,17 @@ class Compensation:
     extra: dict = field(default_factory=dict)
 
 
+def compensated_case(case: Case) -> Case:
+    """``case``, where its own run can be compensated by θ (``[time]`` and ``[signals]`` with θ_A, θ_B,
+    θ_C and δ), else InputError naming its file."""
+    if not case.problem.signals.complete or case.time is None:
+        raise InputError(f"{case.source}: signals", "a compensated case needs [time] and [signals] with theta_A, "
+                         "theta_B, theta_C and delta", "map them to its probes and a relative displacement, or "
+                         "compensate its δ with an error model of its temperatures (gatetherm errormodel fit, then "
+                         "compensate --model)")
+    return case
+
+
 def coefficients(case: Case | None, ts: TimeSeries, s: Settings, cache: ScenarioCache | None = None
                  ) -> tuple[float, float, str]:
     """K_i, K_C (um/K) and their source (``explicit`` or a :data:`K_SOURCES` entry)."""

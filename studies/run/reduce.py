@@ -10,8 +10,9 @@ go through :func:`~gatetherm.studies.run.scenario.run_scenario`.
 schedule column or expression each input is) and ``offsets`` (subtracted from each input's
 value); ``outputs``; ``modes`` and ``pumps`` (the pump expression of every fluid: a mode is
 ``on``/``off`` per fluid, joined by ``_``); ``T0``; ``default_inputs``/``default_values``
-(inputs a series may leave out); ``room`` (the index of the room input, −1: none). ``ẋ = A x + B (u − offsets)``, ``y = C x + D (u − offsets) + y0``,
-x = 0 at the start (every unknown at T0).
+(inputs a series may leave out); ``room`` (the index of the room input, −1: none); ``notes`` (what
+a user of the model should know: films held at constants). ``ẋ = A x + B (u − offsets)``,
+``y = C x + D (u − offsets) + y0``, x = 0 at the start (every unknown at T0).
 """
 from __future__ import annotations
 
@@ -27,12 +28,13 @@ import numpy as np
 
 from gatetherm import InputError, __version__, atomic_path, write_text_atomic
 from gatetherm.checks import CELSIUS, check_linear_system
+from gatetherm.solvers.convection import held_coefficient
 from gatetherm.solvers.effects import room
 from gatetherm.solvers.expr import Value
 from gatetherm.solvers.rom import Input, Reduction, ReducedModel, linear_heat_model, mode_name, reduce
 from gatetherm.solvers.rom_time import discretise, march_rom, outputs
 from gatetherm.studies.run.case import Case
-from gatetherm.studies.run.scenario import ScenarioCache, prepare, run_scenario
+from gatetherm.studies.run.scenario import ScenarioCache, assembled, effective, prepare, run_scenario
 from gatetherm.studies.run.simulate import column
 
 log = logging.getLogger(__name__)
@@ -45,17 +47,58 @@ def build_rom(case: Case, states: int = 30, cache: ScenarioCache | None = None) 
         raise InputError("case", f"{case.name} has no transient heat solve (steady or prescribed temperatures): "
                          "nothing to reduce", "give a case with [time] settings")
     t0 = time.perf_counter()
-    model = prepare(case, cache=cache).model
+    prepared = prepare(case, cache=cache)
+    model, fe, held = prepared.model, None, {}
+    if model.heat.varying:  # linear: each film that follows the temperature held at its run's mean
+        model, fe, held = _held_films(case, prepared, cache)
     build = time.perf_counter() - t0
-    try:
-        red = reduce(linear_heat_model(model, column), states)
-    except InputError as err:  # a film the reduced model cannot hold: named in the case file
-        raise err.at(case.source) from None
+    red = reduce(linear_heat_model(model, column), states)
     red.seconds["model_build"] = build
     ambient = room(case.problem)
     text = ambient.text or repr(ambient.constant)
     at = next((j for j, u in enumerate(red.rom.inputs) if u.text == text), None)
-    return dataclasses.replace(red, rom=dataclasses.replace(red.rom, defaults=dict(case.defaults), room=at))
+    red = dataclasses.replace(red, rom=dataclasses.replace(red.rom, defaults=dict(case.defaults), room=at))
+    if fe is None:
+        return red
+    notes = (_held_note(case, red.rom, fe, held),)
+    log.warning("%s", notes[0])
+    return dataclasses.replace(red, rom=dataclasses.replace(red.rom, notes=notes),
+                               held={b: h[0] for b, h in held.items()})
+
+
+def _held_films(case: Case, prepared, cache):
+    """The case's own run on the full model, the model with each film whose coefficient follows the
+    temperature held at :func:`~gatetherm.solvers.convection.held_coefficient` of that run, and per
+    film (held, least, largest) coefficient, W/(m² K)."""
+    varying, samples = prepared.model.heat.varying, []
+
+    def seen(t, U, env):
+        samples.append([(t, v.h(U, env), v.surface(U) - v.ambient(env)) for v in varying])
+    fe = run_scenario(case, cache=cache, on_state=seen)
+    s = np.array(samples)  # samples × films × (t, h, excess)
+    held = {v.boundary: (held_coefficient(s[:, j, 0], s[:, j, 1], s[:, j, 2]), s[:, j, 1].min(), s[:, j, 1].max())
+            for j, v in enumerate(varying)}
+    target = effective(case, prepared.effects)
+    films = tuple(dataclasses.replace(f, h=held[f.boundary][0], law=None) if f.law is not None else f
+                  for f in target.problem.films)
+    model, _ = assembled(dataclasses.replace(target, problem=dataclasses.replace(target.problem, films=films)), cache)
+    return model, fe, held
+
+
+def _held_note(case: Case, rom: ReducedModel, fe, held: dict) -> str:
+    """What holding the films costs, on the case's own run: the largest error of δ (else of the
+    displacement output, else the temperature, it is largest for) against the full model."""
+    err = check_run(rom, case.schedule.label, fe.result.columns).errors
+    unit = "um" if any(k.endswith("_um") for k in err) else "degC"
+    worst = "delta_um" if "delta_um" in err else max((k for k in err if k.endswith(f"_{unit}")), key=err.get)
+    size = float(np.max(np.abs(fe.result.columns[worst])))
+    films = "; ".join(f"{b} {h:.3g} W/(m² K) (the law {lo:.3g} … {hi:.3g} over the run)"
+                      for b, (h, lo, hi) in held.items())
+    unit = "µm" if unit == "um" else "K"
+    return (f"{case.source or case.name}: the reduced model is linear: it holds each film that follows the temperature "
+            f"at its mean over the case's own run, weighted by the wall's excess over the ambient: {films}; on that run "
+            f"{worst} is off the full model's by up to {err[worst]:.3g} {unit} (of {size:.3g} {unit}); another run "
+            "can be further off: check it against the full model (gatetherm reduce --check)")
 
 
 def rom_key(case: Case, states: int) -> str:
@@ -77,7 +120,7 @@ def write_rom(rom: ReducedModel, path) -> None:
                  inputs=names(u.text for u in rom.inputs), offsets=np.array([u.offset for u in rom.inputs], float),
                  outputs=names(rom.outputs), modes=names(rom.modes), pumps=names(rom.pumps),
                  default_inputs=names(rom.defaults), default_values=np.array(list(rom.defaults.values()), float),
-                 room=np.int64(-1 if rom.room is None else rom.room))
+                 room=np.int64(-1 if rom.room is None else rom.room), notes=names(rom.notes))
 
 
 def load_rom(path) -> ReducedModel:
@@ -96,9 +139,10 @@ def load_rom(path) -> ReducedModel:
             inputs = tuple(Input(str(t), float(o)) for t, o in zip(d["inputs"], d["offsets"], strict=True))
             defaults = dict(zip(map(str, d["default_inputs"]), map(float, d["default_values"]), strict=True))
             room = int(d["room"])
+            notes = tuple(map(str, d["notes"])) if "notes" in d.files else ()
             rom = ReducedModel(A, B, np.array(d["C"], float), np.array(d["D"], float), np.array(d["y0"], float),
                                inputs, tuple(map(str, d["outputs"])), tuple(map(str, d["pumps"])), float(d["T0"]),
-                               defaults, None if room < 0 else room)
+                               defaults, None if room < 0 else room, notes)
     except (KeyError, ValueError, TypeError, OSError, EOFError, zipfile.BadZipFile) as err:
         raise InputError(str(path), f"not a reduced model ({type(err).__name__}: {err})", fix) from None
     CELSIUS.check(f"{path}: T0", rom.T0, fix)
@@ -127,6 +171,8 @@ def cached_rom(case: Case, states: int, directory: Path, cache: ScenarioCache | 
         try:
             rom = load_rom(path)
             log.info("reusing %s", path)
+            for note in rom.notes:  # said again: a later command acts on it too
+                log.warning("%s", note)
             return rom
         except InputError as err:
             log.warning("%s; building the reduced model again", err)

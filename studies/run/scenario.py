@@ -127,9 +127,14 @@ class Prepared:
 def prepare(case: Case, effects: Mapping[str, float] | None = None, *, cache: ScenarioCache | None = None) -> Prepared:
     """Apply the effects of ``case`` and ``effects`` (these win) and build or reuse the model."""
     eff = active(case, effects)
-    target = effective(case, eff)
-    model, solver = _build(target) if cache is None else cache.model(target)
+    model, solver = assembled(effective(case, eff), cache)
     return Prepared(model, solver, eff)
+
+
+def assembled(target: Case, cache: ScenarioCache | None = None) -> tuple[Model, HeatSolver | None]:
+    """The model of ``target`` (its effects already in its problem: :func:`effective`) and its heat
+    solver, from ``cache`` where it holds them."""
+    return _build(target) if cache is None else cache.model(target)
 
 
 def _build(case: Case) -> tuple[Model, HeatSolver | None]:
@@ -184,12 +189,13 @@ class ScenarioRun:
 
 def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[str, float] | None = None, *,
                  cache: ScenarioCache | None = None, keep_times=(), on_step: Callable[[int, int], None] | None = None,
-                 U0: np.ndarray | None = None, solve_at=(), solve_first_peak: bool = False) -> ScenarioRun:
+                 U0: np.ndarray | None = None, solve_at=(), solve_first_peak: bool = False,
+                 on_state: Callable | None = None) -> ScenarioRun:
     """Run ``case`` (its effects, plus ``effects``) through ``schedule`` (default: its own); keep
     full states at ``keep_times`` (their displacement fields at ``solve_at``, and with
     ``solve_first_peak`` δ's first peak's, solved during the march where it can:
-    :func:`~gatetherm.studies.run.simulate.run_model`). With a ``cache`` the model, its factorisations and (for a plain
-    run from the initial state) the run itself are reused."""
+    :func:`~gatetherm.studies.run.simulate.run_model`; ``on_state`` as there). With a ``cache`` the model, its
+    factorisations and (for a plain run from the initial state, no ``on_state``) the run itself are reused."""
     t0 = time.perf_counter()
     schedule = case.schedule if schedule is None else schedule
     eff = active(case, effects)
@@ -200,11 +206,11 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
             if p.model.heat is None or len(schedule.times) == 1:
                 return _once(p, schedule)
             return run_model(p.model, schedule.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver,
-                             solve_at=solve_at, solve_first_peak=solve_first_peak)
+                             solve_at=solve_at, solve_first_peak=solve_first_peak, on_state=on_state)
         except InputError as err:  # a temperature out of range: the case's heat inputs, named with its file
             raise (err.at(case.source) if err.field == "temperature" else err) from None
 
-    if cache is not None and U0 is None and not keep_times:
+    if cache is not None and U0 is None and not keep_times and on_state is None:
         key = (repr(target.problem), id(case.mesh), schedule.label, schedule.times.tobytes())
 
         def make() -> tuple[RunResult, Model]:
@@ -213,7 +219,7 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
 
         result, model = cache.result(key, make)  # a kept run is observed again without building the model
     else:
-        model, solver = _build(target) if cache is None else cache.model(target)
+        model, solver = assembled(target, cache)
         result = run(Prepared(model, solver, eff))
     cols = apply_faults(eff.observe(result.columns, target.problem), case.sensors)
     if schedule.every > 1:  # every output interval, and the end of the run
@@ -222,5 +228,5 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
     return ScenarioRun(cols, result, model, eff, schedule, time.perf_counter() - t0)
 
 
-__all__ = ["STEADY", "Prepared", "ScenarioCache", "ScenarioRun", "Schedule", "active", "effective",
+__all__ = ["STEADY", "Prepared", "ScenarioCache", "ScenarioRun", "Schedule", "active", "assembled", "effective",
            "file_schedule", "measured_schedule", "prepare", "run_scenario", "span_note"]

@@ -62,6 +62,14 @@ def column(problem: Problem, key) -> tuple[str, float]:
     return f"T_{name}_degC", 1.0
 
 
+def signal_columns(problem: Problem) -> tuple[str, ...]:
+    """The data format's θ_A, θ_B, θ_C and δ columns (in that order) that the problem's runs have:
+    those its signals map."""
+    s = problem.signals
+    return tuple(c for c, on in zip(("theta_A_degC", "theta_B_degC", "theta_C_degC", "delta_um"),
+                                    (s.theta_A, s.theta_B, s.theta_C, s.delta)) if on)
+
+
 def output_columns(problem: Problem, keys, Y: np.ndarray) -> dict[str, np.ndarray]:
     """Data-format columns of the outputs ``Y`` (samples × ``keys``, SI units), by
     :func:`column`: the signals θ_A, θ_B, θ_C (the mean of its probes) and δ first, then
@@ -133,7 +141,7 @@ def check_temperatures(U: np.ndarray, t: float) -> None:
 def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
               on_step: Callable[[int, int], None] | None = None, scheme: TimeScheme | None = None,
               U0: np.ndarray | None = None, solver: HeatSolver | None = None, solve_at=(),
-              solve_first_peak: bool = False) -> RunResult:
+              solve_first_peak: bool = False, on_state: Callable | None = None) -> RunResult:
     """March ``model`` over ``times`` (s) under ``drive`` from ``U0`` (default: uniform T0)
     with ``scheme`` (default: the problem's); keep full states at ``keep_times``. A
     ``solver`` of ``model.heat`` carries its factorisations over from earlier runs. Where the
@@ -141,7 +149,8 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     are in (the states kept till then), and the displacement fields of the kept states at
     ``solve_at`` but the last are solved there during the march (:attr:`RunResult.solved`);
     so is, with ``solve_first_peak``, the kept state of δ's first peak (the deformed
-    picture's) as soon as the samples settle it (:func:`settled_first_peak`).
+    picture's) as soon as the samples settle it (:func:`settled_first_peak`). ``on_state(t, U, env)``
+    sees every sample's state (not to be kept: it may be overwritten).
     Columns: ``time_s``, the drive's inputs, then :func:`output_columns`."""
     keep = {float(t) for t in keep_times}
     inputs, Y, states, envs, waiting, solved = [], [], [], {}, [], {}
@@ -161,6 +170,8 @@ def run_model(model: Model, drive: Drive, times: np.ndarray, keep_times=(),
     for i, (t, U) in enumerate(steps):
         env = environment(drive, t)
         check_temperatures(U, t)
+        if on_state:
+            on_state(t, U, env)
         inputs.append({"time_s": t, **drive(t)})
         if t in keep:
             U = U.copy()

@@ -95,6 +95,8 @@ MACHINES = {
                                ("mesh.parameters.head_height", (0.9, 1.3)), "source_head", 1.3, ("spindle",)),
     "rotary_table": Machine("rotary_table", "rotary table, axisymmetric",
                             ("thermal.free.film", (6.0, 12.0)), "source_stator", 1.3, ("table",)),
+    "spindle_unit": Machine("spindle_unit", "motor spindle, bearing losses, a rotating nose's film, axisymmetric",
+                            ("thermal.jacket.film", (300.0, 600.0)), "source_front_bearing", 1.3, ("shaft",)),
 }
 
 CAPABILITIES = ("run", "reduce", "paper", "mlr", "rom", "errormodel comp", "sweep", "sensors", "diagnose",

@@ -49,9 +49,10 @@ def _compensated(ctx: Context, comp):
 
 def _cell_method(method: str):
     def cell(ctx: Context):
-        from gatetherm.studies.control.methods import Settings, compensate
+        from gatetherm.studies.control.methods import Settings, compensate, compensated_case
 
-        return _compensated(ctx, compensate(ctx.series, ctx.case, Settings(method=method), ctx.case.actuator))
+        return _compensated(ctx, compensate(ctx.series, compensated_case(ctx.case), Settings(method=method),
+                                            ctx.case.actuator))
     cell.__name__ = f"cell_{method}"
     return cell
 
