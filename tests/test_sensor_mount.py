@@ -122,3 +122,18 @@ def test_placement_puts_no_sensor_on_the_spindle_and_says_so(headstock, tmp_path
     assert "# none on spindle (63 candidate nodes), feet_fixed (7 candidate nodes), feet_sliding (7 candidate nodes) " \
         "(cannot carry a sensor: [sensors] exclude, or a face a support holds)" in (tmp_path / "s" / "sensors.toml"
                                                                                   ).read_text()
+
+
+def test_the_axis_of_an_axisymmetric_section_is_no_surface():
+    """The rotary table's section: its outline's facets on r = 0 lie inside the solid of revolution;
+    the axis nodes that stay are on an end face."""
+    from gatetherm.studies.sensors.candidates import outer_facets, surface_facets
+
+    case = gt.load_case(Path(__file__).resolve().parents[1] / "validation" / "examples" / "rotary_table" / "case.toml")
+    mesh = case.mesh
+    plain = candidates(mesh, unmountable=case.unmountable)
+    axis = candidates(mesh, unmountable=case.unmountable, axisymmetric=True)
+    on_axis = np.abs(axis.xyz[:, 0]) < 1e-12
+    assert (len(plain.nodes), len(axis.nodes), int(on_axis.sum())) == (55, 52, 2)
+    assert len(outer_facets(mesh.cells)) - len(surface_facets(mesh, True)) == 7  # the axis' facets (table, bed)
+    assert not np.any(np.all(np.abs(mesh.points[surface_facets(mesh, True), 0]) < 1e-12, axis=1))

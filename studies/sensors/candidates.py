@@ -3,7 +3,8 @@ to a spacing, minus boxes that are not allowed and the parts that cannot carry o
 ``[sensors] exclude``: regions and boundaries that rotate or move).
 
 The outer surface is every facet that belongs to one cell only (in a 2-D section: its outline;
-interfaces between regions are inside). Each candidate carries the name of the boundary it lies
+interfaces between regions are inside), but for the facets on the axis r = 0 of an axisymmetric
+section, which lie inside the solid of revolution (a node of the axis on an end face stays). Each candidate carries the name of the boundary it lies
 on: the first named boundary of the mesh whose facets are all outer that holds the node; else, for
 a node of the outer surface, ``surface`` (an unnamed part of the outline, where an interface may
 end); else the first named boundary that holds it.
@@ -74,6 +75,15 @@ def outer_facets(cells: np.ndarray) -> np.ndarray:
     faces = np.sort(np.vstack([cells[:, list(c)] for c in combinations(range(d + 1), d)]), axis=1)
     uniq, count = np.unique(faces, axis=0, return_counts=True)
     return uniq[count == 1]
+
+
+def surface_facets(mesh, axisymmetric: bool = False) -> np.ndarray:
+    """:func:`outer_facets` of the mesh, less those on the axis x = 0 of an ``axisymmetric`` section."""
+    facets = outer_facets(mesh.cells)
+    if not axisymmetric:
+        return facets
+    tol = 1e-9 * (float(np.ptp(mesh.points, axis=0).max()) or 1.0)
+    return facets[~np.all(np.abs(mesh.points[facets, 0]) <= tol, axis=1)]
 
 
 def boundary_names(mesh, nodes: np.ndarray, skip=()) -> tuple[str, ...]:
@@ -148,7 +158,7 @@ def seated_nodes(mesh, names) -> dict[str, np.ndarray]:
 
 
 def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: str = "--candidates",
-               unmountable=()) -> Candidates:
+               unmountable=(), axisymmetric: bool = False) -> Candidates:
     """The candidate nodes of ``mesh``.
 
     Parameters
@@ -164,6 +174,8 @@ def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: s
     unmountable : sequence of str
         Regions and boundaries whose nodes are not candidates (:func:`unmountable_nodes`; a case's
         ``[sensors] exclude``).
+    axisymmetric : bool
+        An axisymmetric section: the axis is no surface (:func:`surface_facets`).
 
     Returns
     -------
@@ -176,7 +188,7 @@ def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: s
                              f"boundaries: {', '.join(mesh.boundaries)}")
         nodes = np.unique(np.concatenate([np.ravel(mesh.boundaries[b]) for b in boundaries]))
     else:
-        nodes = np.unique(outer_facets(mesh.cells))
+        nodes = np.unique(surface_facets(mesh, axisymmetric))
     for box in exclude:
         if len(box.lo) != mesh.dim or len(box.hi) != mesh.dim:
             raise InputError("--exclude", f"a box of {len(box.lo)}-D corners on a {mesh.dim}-D mesh",

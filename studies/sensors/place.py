@@ -185,7 +185,8 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
     if not targets:
         raise InputError(case.source or case.name, "has no relative displacement to predict",
                          "add a [relative] table (the tool against the workpiece)")
-    cand = find_candidates(case.mesh, s.boundaries, s.spacing_m, s.exclude, unmountable=case.unmountable)
+    cand = find_candidates(case.mesh, s.boundaries, s.spacing_m, s.exclude, unmountable=case.unmountable,
+                           axisymmetric=p.plane == "axisymmetric")
     if case.unmountable:
         log.info("no sensor on %s ([sensors] exclude): %s candidate nodes left out", ", ".join(case.unmountable),
                  cand.excluded)
