@@ -222,6 +222,8 @@ def test_drift_report_command(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "Test duration 20.0 min, 21 samples, sampling interval 60 s" in out
     assert "Largest drift over the whole test, displacement: 3 µm (delta_um, at 10 min)" in out
+    assert out.index("δ (delta_um, the tool against the workpiece): largest drift 3 µm at 10 min, drift at the end "
+                     "1 µm, range 3 µm.") < out.index("Largest drift")
     assert static_check(tmp_path / "D/index.html").problems == []
     assert "ISO 230-3" in (tmp_path / "D/index.html").read_text()
 
