@@ -137,3 +137,17 @@ def test_the_axis_of_an_axisymmetric_section_is_no_surface():
     assert (len(plain.nodes), len(axis.nodes), int(on_axis.sum())) == (55, 52, 2)
     assert len(outer_facets(mesh.cells)) - len(surface_facets(mesh, True)) == 7  # the axis' facets (table, bed)
     assert not np.any(np.all(np.abs(mesh.points[surface_facets(mesh, True), 0]) < 1e-12, axis=1))
+
+
+def test_a_sensor_on_a_part_a_rotating_film_bounds_is_noted(tmp_path):
+    """The spindle unit without its [sensors] exclude: the placement notes the sensors on its shaft."""
+    src = Path(__file__).resolve().parents[1] / "validation" / "examples" / "spindle_unit"
+    shutil.copytree(src, tmp_path / "s")
+    text = (tmp_path / "s" / "case.toml").read_text()
+    (tmp_path / "s" / "case.toml").write_text(text.replace('exclude = ["shaft"]', "exclude = []"))
+    placed = gt.place_sensors(gt.load_case(tmp_path / "s" / "case.toml"), count=3)
+    shaft = [n for n in placed.notes if "lies on region 'shaft'" in n]
+    assert [n.split()[0] for n in shaft] == ["S1", "S3"]
+    assert shaft[0] == ("S1 lies on region 'shaft', which the rotating_cylinder film of 'nose' bounds: if it rotates, "
+                        "no thermocouple can go there; name it in [sensors] exclude")
+    assert not any("lies on region" in n for n in gt.place_sensors(gt.load_case(src / "case.toml"), count=3).notes)

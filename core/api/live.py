@@ -95,6 +95,8 @@ def twin(case: Case | str | Path, endpoint: str, speed: float = 1.0, *,
         raise InputError(f"{case.source}: [actuator]", "the case has none", "add one, or apply the ideal offset")
     sched = _schedule(case, schedule)
     rom = rom or build_rom(case, states).rom
+    for note in rom.notes:  # the twin's machine is that reduced model
+        log.warning("%s", note)
     published = tuple(n for n in SENSORS if n in rom.outputs)
     return asyncio.run(serve(rom, sched, endpoint, params, published, stopped, case.actuator if actuator else None))
 

@@ -33,8 +33,7 @@ def reduce(case: Case, states: int = 30):
         ``.rom`` the :class:`~gatetherm.solvers.rom.ReducedModel` (``gatetherm.studies.run.reduce.write_rom``
         keeps it as ``rom.npz``), with the error bounds, Hankel singular values and timings of its making.
         Where a film follows the temperature (a correlation, radiation), ``.held`` is the constant it is
-        held at (the law's mean over the case's own run) and ``.rom.notes`` what that costs on that run
-        (also logged).
+        held at (the law's mean over the case's own run) and ``.rom.notes`` what that costs on that run.
     """
     from gatetherm.studies.run.reduce import build_rom
 
@@ -180,6 +179,7 @@ class ReductionRun:
         lines = [f"wrote {self.folder}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} "
                  f"unknowns in {self.seconds:.1f} s; BT bound "
                  + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items())]
+        lines += [f"warning: {note}" for note in red.rom.notes]
         for c in self.checks:
             theta = "" if math.isnan(c.max_theta_error_K) else f", θ {c.max_theta_error_K:.3f} K"  # a case without θ
             lines.append(f"{c.schedule.split(':')[0]}: max |δ_rom − δ_FE| = {c.max_delta_error_um:.3f} µm{theta}; "

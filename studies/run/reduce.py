@@ -60,8 +60,7 @@ def build_rom(case: Case, states: int = 30, cache: ScenarioCache | None = None) 
     red = dataclasses.replace(red, rom=dataclasses.replace(red.rom, defaults=dict(case.defaults), room=at))
     if fe is None:
         return red
-    notes = (_held_note(case, red.rom, fe, held),)
-    log.warning("%s", notes[0])
+    notes = (_held_note(case, red.rom, fe, held),)  # said by what uses the model (rom.notes)
     return dataclasses.replace(red, rom=dataclasses.replace(red.rom, notes=notes),
                                held={b: h[0] for b, h in held.items()})
 
@@ -171,8 +170,6 @@ def cached_rom(case: Case, states: int, directory: Path, cache: ScenarioCache | 
         try:
             rom = load_rom(path)
             log.info("reusing %s", path)
-            for note in rom.notes:  # said again: a later command acts on it too
-                log.warning("%s", note)
             return rom
         except InputError as err:
             log.warning("%s; building the reduced model again", err)

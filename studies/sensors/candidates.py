@@ -204,3 +204,29 @@ def candidates(mesh, boundaries=(), spacing_m: float = 0.0, exclude=(), where: s
         raise InputError(where, "no candidate location is left", "name other boundaries, or fewer --exclude boxes"
                          + (" or [sensors] exclude names" if unmountable else ""))
     return Candidates(nodes, mesh.points[nodes].copy(), boundary_names(mesh, nodes), excluded)
+
+
+ROTATING = ("rotating_cylinder", "rotating_disc")
+"""The film correlations of a part that rotates."""
+
+
+def on_rotating(case, sensors) -> list[str]:
+    """One line per sensor of ``sensors`` (``.name``, ``.node``) on a region that a film of
+    :data:`ROTATING` bounds and the case's ``[sensors] exclude`` does not name: a part that likely
+    rotates, where no thermocouple can go."""
+    mesh, out = case.mesh, []
+    for film in case.problem.films:
+        if getattr(film.law, "correlation", "") not in ROTATING or film.boundary not in mesh.boundaries:
+            continue
+        facets = {tuple(f) for f in np.sort(np.asarray(mesh.boundaries[film.boundary]), axis=1)}
+        for region, cells in mesh.regions.items():
+            if region in case.unmountable:
+                continue
+            nodes = np.unique(mesh.cells[np.asarray(cells, int)])
+            if not any(set(f) <= set(nodes.tolist()) for f in facets):
+                continue
+            out += [f"{x.name} lies on region '{region}', which the {film.law.correlation} film of '{film.boundary}' "
+                    "bounds: if it rotates, no thermocouple can go there; name it in [sensors] exclude"
+                    for x in sensors if x.node in nodes]
+    return out
+

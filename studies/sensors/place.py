@@ -32,7 +32,8 @@ from gatetherm.studies.run.reduce import build_rom
 from gatetherm.studies.run.scenario import ScenarioCache, prepare
 from gatetherm.studies.run.simulate import column
 from gatetherm.studies.sensors import greedy
-from gatetherm.studies.sensors.candidates import Box, boundary_names, candidates as find_candidates, seated_nodes
+from gatetherm.studies.sensors.candidates import Box, boundary_names, candidates as find_candidates, on_rotating, \
+    seated_nodes
 from gatetherm.studies.sensors.loads import duty_cycles, input_ranges
 from gatetherm.studies.sensors.models import error_model, held_out_mae, lag_columns, lag_terms, settings_of
 from gatetherm.studies.sensors.reduced import candidate_rows, simulate
@@ -260,7 +261,7 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
         if len(final.sensors) > 1:
             rest = greedy.fixed_set(design, final.sensors[:i] + final.sensors[i + 1:], final.form, fit)
             failed[sensor.name] = scored(rest)[2]
-    notes = greedy.rising(curve)
+    notes = (*rom.notes, *greedy.rising(curve), *on_rotating(case, sens))
     signals = _signals(case, rom, design, tr, ho, terms, targets, truth, fit, s, span, source)
     idx = [sl[i] for i in final.sensors]
     held_T = {x.label: p.T0 + x.states @ rows[idx].T for x in ho}

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import logging
 from pathlib import Path
 
 from gatetherm import InputError
 from gatetherm.studies.control.method import Batch, Job, Method, Setup
+
+log = logging.getLogger(__name__)
 
 
 def batch(job: Job) -> Batch:
@@ -16,7 +19,7 @@ def batch(job: Job) -> Batch:
 
     validate_complete(job.ts, NEEDED)
     loop, extra, label = _rom_loop(job)
-    notes = (extra.pop("budget_warning"),) if extra.get("budget_warning") else ()
+    notes = (*extra.pop("rom_notes"), *((extra.pop("budget_warning"),) if extra.get("budget_warning") else ()))
     return Batch(loop, extra, label, f"rom ({label})",
                  (loop, "as applied (the reduced model and its causal Kalman filter fit nothing on the record)"),
                  notes=notes, model="the reduced model")
@@ -64,7 +67,7 @@ def _rom_loop(job: Job):
     loop = close_loop(ts, pr, s.params, actuator)
     extra = {"rom": where, "rom_states": rom.states, "sensors": list(s.sensors), "threshold_um": cmds.threshold_um,
              "predictive": dataclasses.asdict(control), "observer": dataclasses.asdict(s.observer),
-             "budget_exhausted_s": None}
+             "budget_exhausted_s": None, "rom_notes": rom.notes}
     if cmds.exhausted_at is not None:
         extra["budget_exhausted_s"] = float(pr.t_s[cmds.exhausted_at])
         extra["budget_warning"] = budget_warning(loop.t_s, loop.delta_comp_um, extra["budget_exhausted_s"],
@@ -85,6 +88,8 @@ def stepper(setup: Setup):
 
     params, sched = setup.params, setup.schedule
     rom = cached_rom(setup.case, setup.states, setup.out)
+    for note in rom.notes:  # a service: its log is what it says
+        log.warning("%s", note)
     end = float(sched.times[-1])
     t = params.sample_interval_s * np.arange(int(np.floor(end / params.sample_interval_s + 1e-9)) + 1)
     rows = [dict(sched.drive(float(x))) for x in t]
