@@ -117,10 +117,10 @@ def compensated_case(case: Case) -> Case:
 def coefficients(case: Case | None, ts: TimeSeries, s: Settings, cache: ScenarioCache | None = None
                  ) -> tuple[float, float, str]:
     """K_i, K_C (um/K) and their source (``explicit`` or a :data:`K_SOURCES` entry)."""
-    return _coefficients(case, ts, s, cache)[:3]
+    return coefficients_noted(case, ts, s, cache)[:3]
 
 
-def _coefficients(case, ts, s: Settings, cache) -> tuple[float, float, str, str]:
+def coefficients_noted(case, ts, s: Settings, cache) -> tuple[float, float, str, str]:
     """:func:`coefficients` and the fit's warning ('' unless fitted and something was dropped or bounded)."""
     if s.Ki is not None or s.Kc is not None:
         if s.Ki is None or s.Kc is None or s.k_source:

@@ -15,13 +15,13 @@ def batch(job: Job) -> Batch:
     held-out span where K is fitted on the record."""
     from gatetherm.studies.control import benefit as held
     from gatetherm.studies.control.compensator import NEEDED, compensate as paper_loop
-    from gatetherm.studies.control.methods import _coefficients, refitted
+    from gatetherm.studies.control.methods import coefficients_noted, refitted
     from gatetherm.studies.control.regression import fit_coefficients_noted, prediction_noise_um
     from gatetherm.studies.run.timeseries import validate_complete
 
     ts, s, params, actuator = job.ts, job.settings, job.settings.params, job.actuator
     validate_complete(ts, NEEDED)
-    ki, kc, source, note = _coefficients(job.case, ts, s, job.cache)
+    ki, kc, source, note = coefficients_noted(job.case, ts, s, job.cache)
     loop = paper_loop(ts, ki, kc, params, actuator)
     if source == "fit":
         before = held.before(ts, s.held_out)
@@ -43,11 +43,11 @@ def batch(job: Job) -> Batch:
 def stepper(setup: Setup):
     """K_i, K_C as the batch form chooses them by default, on the case's own run; the label says what
     the fit left out (a difference spanning under ten resolutions gets no weight)."""
-    from gatetherm.studies.control.methods import Settings, _coefficients
+    from gatetherm.studies.control.methods import Settings, coefficients_noted
     from gatetherm.studies.control.stepwise import PaperStepper
     from gatetherm.studies.run.scenario import run_scenario
 
-    ki, kc, source, note = _coefficients(setup.case, run_scenario(setup.case).series({}), Settings(), None)
+    ki, kc, source, note = coefficients_noted(setup.case, run_scenario(setup.case).series({}), Settings(), None)
     if note:
         log.warning("%s (on the case's own run)", note)
     return PaperStepper(ki, kc, setup.params), f"paper (K_i {ki:.4g}, K_C {kc:.4g} um/K, {source})" + \
