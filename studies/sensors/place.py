@@ -188,9 +188,6 @@ def place_sensors(case, settings: PlacementSettings = PlacementSettings(), sched
                          "add a [relative] table (the tool against the workpiece)")
     cand = find_candidates(case.mesh, s.boundaries, s.spacing_m, s.exclude, unmountable=case.unmountable,
                            axisymmetric=p.plane == "axisymmetric")
-    if case.unmountable:
-        log.info("no sensor on %s ([sensors] exclude): %s candidate nodes left out", ", ".join(case.unmountable),
-                 cand.excluded)
     train, held, ranges = _loads(case, s, schedules, held_out)
     tick = _ticker(on_progress, len(train) + len(held) + 2)
     t0 = time.perf_counter()
