@@ -86,11 +86,12 @@ def _held_films(case: Case, prepared, cache):
 
 def _held_note(case: Case, rom: ReducedModel, fe, held: dict) -> str:
     """What holding the films costs, on the case's own run: the largest error of δ (else of the
-    displacement output, else the temperature, it is largest for) against the full model."""
+    displacement output, else the temperature, it is largest for) against the full model, beside
+    that output's largest size (a temperature's rise)."""
     err = check_run(rom, case.schedule.label, fe.result.columns).errors
     unit = "um" if any(k.endswith("_um") for k in err) else "degC"
     worst = "delta_um" if "delta_um" in err else max((k for k in err if k.endswith(f"_{unit}")), key=err.get)
-    size = float(np.max(np.abs(fe.result.columns[worst])))
+    size = float(np.max(np.abs(fe.result.columns[worst] - (0.0 if unit == "um" else case.problem.T0))))  # a rise
     films = "; ".join(f"{b} {h:.3g} W/(m² K) (the law {lo:.3g} … {hi:.3g} over the run)"
                       for b, (h, lo, hi) in held.items())
     unit = "µm" if unit == "um" else "K"
