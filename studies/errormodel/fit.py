@@ -94,13 +94,47 @@ def fit_error_model(series, targets, candidates=None, inputs=(), params: FitPara
         (first valid sample in the span, degC; none for several runs) and the span; see
         :mod:`gatetherm.studies.errormodel.model`.
     """
+    model = _fit(series, targets, candidates, inputs, params, span, source)
+    if isinstance(series, (list, tuple)) and len(series) >= 3:  # how sure: each run as a new one
+        model = _run_intervals(model, list(series), targets, candidates, inputs, params, span)
+    return model
+
+
+def _run_intervals(model: ErrorModel, runs, targets, candidates, inputs, params: FitParams, span) -> ErrorModel:
+    """``model`` with each target's 90 % interval calibrated on every run predicted by the whole fit
+    (terms, form, time constants; the readings unsmoothed, as the model's) made on the other runs
+    alone, as a run it never saw (:func:`~gatetherm.studies.errormodel.trust.calibrate`: the runs' own
+    90 % quantiles, conformal over runs)."""
+    from gatetherm.studies.errormodel.model import predict
+
+    spans, params = span if isinstance(span, list) else [span] * len(runs), dataclasses.replace(params, smooth_grid_s=())
+    res: dict[str, list] = {m.target: [] for m in model.targets}
+    for i, run in enumerate(runs):
+        rest = [r for j, r in enumerate(runs) if j != i]
+        inner = _fit(rest, targets, candidates, inputs, params, [s for j, s in enumerate(spans) if j != i])
+        p, t = predict(inner, run), np.asarray(run["time_s"], float)
+        keep = (t >= spans[i][0]) & (t <= spans[i][1]) if spans[i] is not None else np.ones(t.size, bool)
+        for m in model.targets:
+            y = np.asarray(run[m.target], float)
+            ok = keep & np.isfinite(y) & np.isfinite(p[m.target])
+            res[m.target].append(p[m.target][ok] - (y[ok] - y[ok][0]) if ok.any() else np.zeros(0))
+    out = []
+    for m in model.targets:
+        edges = np.cumsum([0] + [r.size for r in res[m.target]])
+        out.append(dataclasses.replace(m, interval={**calibrate(res[m.target], list(zip(edges[:-1], edges[1:])),
+                                                                chain=False), "calibration": "runs"}))
+    return dataclasses.replace(model, targets=tuple(out))
+
+
+def _fit(series, targets, candidates, inputs, params: FitParams, span, source: str = "") -> ErrorModel:
+    """:func:`fit_error_model`, its intervals from the chosen model's held-out residuals."""
     several = isinstance(series, (list, tuple)) and len(series) >= 3
     if params.smooth_grid_s and several:  # left to the readings as they are: docs/errormodel.md, "Several runs"
         log.info("three or more runs: the readings are not smoothed (smooth_grid_s is tried within one or two runs)")
         params = dataclasses.replace(params, smooth_grid_s=())
     if params.smooth_grid_s:
-        fits = {float(v): fit_error_model(series, targets, candidates, inputs,
-                                          dataclasses.replace(params, smooth_s=float(v), smooth_grid_s=()), span, source)
+        fits = {float(v): _fit(series, targets, candidates, inputs,
+                               dataclasses.replace(params, smooth_s=float(v), smooth_grid_s=()), span, source)
                 for v in dict.fromkeys((params.smooth_s, *params.smooth_grid_s))}
         held = {v: float(sum(m.held_out_mae_um for m in f.targets)) for v, f in fits.items()}
         best = min(held, key=held.get)  # ties: the first listed, smooth_s
@@ -229,7 +263,7 @@ def _fit_target(y_all, name, data: Runs, base, B, params: FitParams) -> TargetMo
     c = select.noisy_least_squares(X[rows], y_all[rows], var)
     if data.blocks(rows) is None:  # one or two runs: calibrated as a control uses it, on the latest blocks
         final = held_out(X[rows], y_all[rows], data, rows, dataclasses.replace(params, cv="chain"), var)
-        interval = calibrate_forward(final.residuals(np.eye(X.shape[1])), final.blocks, data.time[rows])
+        interval = calibrate_forward(final.residuals(np.eye(X.shape[1])), final.blocks, data.clock[rows])
     else:
         final = held_out(X[rows], y_all[rows], data, rows, params, var)
         interval = calibrate(final.residuals(np.eye(X.shape[1])), final.blocks, chain=False)

@@ -62,6 +62,16 @@ class Runs:
         return np.concatenate(self.t)
 
     @property
+    def clock(self) -> np.ndarray:
+        """All runs' sample times on one clock, s: each run after the one before it, its first sample
+        one :attr:`step_s` after that run's last (a forward chaining's horizons across runs)."""
+        out, end = [], None
+        for t in self.t:
+            out.append(t if end is None else t - t[0] + end + self.step_s)
+            end = out[-1][-1] if t.size else end
+        return np.concatenate(out)
+
+    @property
     def ok(self) -> np.ndarray:
         """Rows inside the fitting spans and outside long gaps, concatenated."""
         return np.concatenate(self.rows)

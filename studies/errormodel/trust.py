@@ -44,15 +44,15 @@ def calibrate(residuals: list[np.ndarray], blocks: list[tuple[int, int]], chain:
     if not residuals:
         return {}
     a = [np.abs(r) for r in residuals]
-    half = float(np.quantile(np.concatenate(a), LEVEL))
+    q = [float(np.quantile(x, LEVEL)) for x in a]
+    half = block_quantile(q)
     inside, n = 0, 0
     for i, (lo, hi) in enumerate(blocks):
-        others = [a[j] for j, (l2, h2) in enumerate(blocks)
+        others = [q[j] for j, (l2, h2) in enumerate(blocks)
                   if j != i and (h2 <= lo if chain else (h2 <= lo or l2 >= hi))]
         if not others:
             continue
-        q = np.quantile(np.concatenate(others), LEVEL)
-        inside += int((a[i] <= q).sum())
+        inside += int((a[i] <= block_quantile(others)).sum())
         n += a[i].size
     return {"half_width_um": half, "coverage": inside / n if n else None, "samples": n, "level": LEVEL}
 
