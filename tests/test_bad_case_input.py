@@ -115,6 +115,9 @@ SCHEDULE = "# format: gatetherm-timeseries/1\ntime_s,T\n"
      "materials.bar.thickness: got 1e+30, must be a number in [1e-06, 1000] m"),
     ("", "", 'schedule = "s.csv"\n', "0,0\n20,0\n",
      "time.schedule: '{d}/s.csv' spans 20 s, less than the run (end = 32 s)"),
+    ("", "", '[relative.d]\na = "p"\nb = "q"\naxis = "x"\n', None,  # a run crashed on δ = None
+     "relative: a relative displacement needs [supports] (without them the body is not solved for displacements); "
+     "hold the body with [supports.BOUNDARY] tables"),
     (HOT, 'temperature = "T"', 'schedule = "s.csv"\n', "0,0\n32,2000\n40,0\n",
      "thermal.hot_end.temperature: 'T' is 2000 at t = 32 s, T = 2000, must be a number in (-273.15, 1000] °C"),
 ])

@@ -505,3 +505,31 @@ def test_report_section_puts_the_frame_answer_next_to_A_B_C(tmp_path):
     assert [r[0] for r in curve.rows] == ["1", "2", "its TF, TB, TS"]
     assert any(n.startswith("FE check") and "of the reduced model's" in n for n in res.notes)
     assert all((tmp_path / f.file).stat().st_size > 1e4 for f in res.figures)
+
+
+def test_a_pump_state_keeps_the_range_given():
+    """``--range pump=1:1``: every generated load keeps the pump on (it was ignored: a cooled machine
+    was trained with its coolant off half the time); 0.5 is no pump state."""
+    from gatetherm.studies.sensors.loads import duty_cycles, input_ranges
+
+    case = gt.gate_frame(2)
+    on = input_ranges(case, [case.schedule], {"pump": (1.0, 1.0)})
+    pump = next(r for r in on if r.name == "pump")
+    assert (pump.lo, pump.hi, pump.rest, pump.held) == (1.0, 1.0, 1.0, True)
+    loads = duty_cycles(on, 6, 3600.0, 60.0)
+    assert all(load.drive(float(t))["pump"] == 1.0 for load in loads for t in load.times)
+    free = next(r for r in input_ranges(case, [case.schedule]) if r.name == "pump")
+    assert (free.lo, free.hi, free.rest) == (0.0, 1.0, 0.0)
+    with pytest.raises(InputError, match="a pump state is 0 .off. or 1 .on."):
+        input_ranges(case, [case.schedule], {"pump": (0.5, 1.0)})
+
+
+def test_an_fe_check_far_off_the_placement_is_warned_of():
+    from gatetherm.studies.sensors.check import FECheck
+
+    def check(fe_um):
+        return FECheck({"delta_um": fe_um}, {"delta_um": 0.446}, 2.2, 25, 18.0)
+    assert check(0.55).warning == ""  # 1.23 ×
+    assert check(0.708).warning.startswith("the FE check's held-out MAE of delta_um is 1.59 × the placement's (0.708 "
+                                           "against 0.446 um; the sensors' temperatures up to 2.2 K off FE)")
+    assert check(0.708).summary()["warning"] == check(0.708).warning

@@ -290,4 +290,5 @@ class SensorStudy:
                          + ", ".join(f"{k} {v:.3g} um ({check.ratio[k]:.3f} of the reduced model's)"
                                      for k, v in check.held_out_mae_um.items())
                          + f"; sensor temperatures within {check.temperature_error_K:.2g} K of FE")
+            lines += [f"warning: {check.warning}"] if check.warning else []
         return "\n".join(lines)

@@ -24,6 +24,10 @@ from gatetherm.studies.sensors.models import held_out_mae
 from gatetherm.studies.sensors.screen import load_key, noise
 
 
+WORSE = 1.25
+"""An FE-checked error beyond this multiple of the placement's own is warned of."""
+
+
 @dataclass(frozen=True)
 class FECheck:
     """The placement's model refitted on FE runs and scored on FE runs of the held-out loads."""
@@ -42,8 +46,22 @@ class FECheck:
         """Per target, FE-checked over the placement's held-out error."""
         return {k: v / self.placement_mae_um[k] for k, v in self.held_out_mae_um.items()}
 
+    @property
+    def warning(self) -> str:
+        """One line where the FE-checked error exceeds the placement's by more than :data:`WORSE`
+        (the points were chosen on a reduced model that does not hold), else ''."""
+        off = {k: r for k, r in self.ratio.items() if r > WORSE}
+        if not off:
+            return ""
+        k = max(off, key=off.get)
+        return (f"the FE check's held-out MAE of {k} is {off[k]:.2f} × the placement's ({self.held_out_mae_um[k]:.3g} "
+                f"against {self.placement_mae_um[k]:.3g} um; the sensors' temperatures up to "
+                f"{self.temperature_error_K:.2g} K off FE): the points were chosen on a reduced model that does not "
+                "hold for these loads (too few states, films held at constants, a pump switching modes); place with "
+                "more --states or with the loads the machine sees (--range, e.g. pump=1:1 for a pump that never stops)")
+
     def summary(self) -> dict:
-        return {**dataclasses.asdict(self), "ratio": self.ratio}
+        return {**dataclasses.asdict(self), "ratio": self.ratio, "warning": self.warning}
 
 
 def with_probes(case, sensors):

@@ -4,7 +4,8 @@ The inputs are the case's schedule columns (:meth:`~gatetherm.studies.run.case.C
 varies within a stated range ``[lo, hi]`` (by default the range it spans over the schedules the
 case knows) from a rest value: a temperature column (``*_degC``) rests at the case's initial
 temperature T0 (clipped into its range: a machine at rest is at one temperature), any other input
-at ``lo``; a pump state (held) is on (1) or off (0).
+at ``lo``; a pump state (held) is on (1) or off (0), resting off, between 0 and 1 unless stated
+(``1:1``: always on, ``0:0``: always off).
 
 A generated family (:func:`duty_cycles`) cycles through three kinds, every input at once, with
 times and levels drawn from a seeded generator (the same seed and label give the same loads):
@@ -71,6 +72,10 @@ def input_ranges(case, schedules, given=None) -> tuple[InputRange, ...]:
             raise InputError(f"--range {k}", "is not an input of the case", f"inputs: {', '.join(names) or 'none'}")
         if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi):
             raise InputError(f"--range {k}", f"{lo:g}:{hi:g} is not LO:HI with LO <= HI", f"e.g. --range {k}=0:200")
+    for k, (lo, hi) in given.items():
+        if k in case.held() and not {lo, hi} <= {0.0, 1.0}:
+            raise InputError(f"--range {k}", f"{lo:g}:{hi:g}: a pump state is 0 (off) or 1 (on)",
+                             f"give {k}=1:1 (always on), {k}=0:0 or {k}=0:1")
     todo = [n for n in names if n not in given and n not in case.held()]
     if todo and not schedules:
         raise InputError(f"--range {todo[0]}", "not given, and the case has no schedule to take it from",
@@ -79,7 +84,7 @@ def input_ranges(case, schedules, given=None) -> tuple[InputRange, ...]:
     out = []
     for n in names:
         held = n in case.held()
-        lo, hi = (0.0, 1.0) if held else given[n] if n in given else \
+        lo, hi = given[n] if n in given else (0.0, 1.0) if held else \
             (min(float(c[n].min()) for c in seen), max(float(c[n].max()) for c in seen))
         rest = float(np.clip(case.problem.T0, lo, hi)) if n.endswith("_degC") and not held else lo
         out.append(InputRange(n, float(lo), float(hi), rest, held))
@@ -87,8 +92,8 @@ def input_ranges(case, schedules, given=None) -> tuple[InputRange, ...]:
 
 
 def _level(r: InputRange, rng, upper: bool = False) -> float:
-    if r.held:
-        return 1.0 if upper else float(rng.integers(0, 2))
+    if r.held:  # within its stated states
+        return r.hi if upper else float(rng.integers(int(r.lo), int(r.hi) + 1))
     return float(rng.uniform(r.lo + 0.5 * (r.hi - r.lo) if upper else r.lo, r.hi))
 
 
