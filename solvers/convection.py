@@ -122,6 +122,8 @@ class FilmLaw:
     """Emissivity of the surface for radiation to the ambient (0: none)."""
     minimum: float = 0.0
     """Lower bound of the convective part, W/(m² K) (a rotating part at rest)."""
+    factor: float = 1.0
+    """Multiplies the correlation's convective part (before :attr:`minimum`): its uncertainty, 1."""
 
     def convective(self, Ts, Ta, env) -> float:
         dT, Tf, L, c = Ts - Ta, 0.5 * (Ts + Ta), self.length, self.correlation
@@ -137,7 +139,7 @@ class FilmLaw:
             h = rotating_disc(self.speed(env), L, Tf)
         else:
             h = flat_plate(self.speed(env), L, Tf)
-        return max(float(h), self.minimum)
+        return max(float(h) * self.factor, self.minimum)
 
     def __call__(self, Ts: float, Ta: float, env) -> float:
         """The film coefficient at surface temperature ``Ts`` and ambient ``Ta`` (°C), W/(m² K)."""

@@ -452,6 +452,18 @@ def test_a_run_that_leaves_the_temperature_range_names_the_case_file(tmp_path):
         gt.run(case, keep=())
 
 
+def test_a_film_that_does_not_settle_names_the_case_file(tmp_path):
+    """A bearing's mean diameter in dm (8.25 for 0.0825 m) heats a naturally cooled nose until its
+    film's iterations do not settle: the refusal names the case file (a new user's read only "film of")."""
+    nose = 'film = { correlation = "rotating_cylinder", length = 0.065, speed = "n_spindle", reference = 40.0, minimum = 5.0 }'
+    path = spindle(tmp_path, nose, 'film = { correlation = "vertical_plate", length = 0.065, reference = 1.0 }\nemissivity = 0.9')
+    text = path.read_text()
+    path.write_text(text.replace("dm = 0.0825", "dm = 8.25", 1))
+    with pytest.raises(InputError, match=r"^.*spindle/case.toml: film of 'nose': the coefficient's Picard iterations did "
+                                         "not settle"), np.errstate(all="ignore"):
+        gt.run(gt.load_case(path), keep=())
+
+
 def test_a_case_without_the_signals_is_refused_compensation_with_the_error_model_offered():
     """The spindle maps no θ_A, θ_B, θ_C: its own run cannot be compensated by θ; the message says what
     would do it (the zoo's paper, mlr and rom cells give the same line)."""

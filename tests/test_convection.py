@@ -162,3 +162,22 @@ def test_correlation_film_is_refused_by_the_reduced_model_and_bad_tables_are_one
                                          'correlation = "rotating_disc", length = 0.2, speed = "n"')
     with pytest.raises(InputError, match="thermal.free.film"):
         _case(tmp_path, bad)
+
+
+def test_a_correlations_factor_scales_its_convective_part_and_is_a_diagnosis_parameter(tmp_path):
+    """``factor`` multiplies the correlation before its floor; a diagnosis offers ``film_BOUNDARY`` as
+    that factor, its reference scaled with it (a new user's nose film had no hypothesis)."""
+    law = cv.FilmLaw("vertical_plate", length=1.0, emissivity=0.5, minimum=1.0)
+    twice = cv.FilmLaw("vertical_plate", length=1.0, emissivity=0.5, minimum=1.0, factor=2.0)
+    rad = float(cv.radiation(0.5, 60.0, 20.0))
+    assert twice(60.0, 20.0, {}) - rad == pytest.approx(2 * (law(60.0, 20.0, {}) - rad), rel=1e-14)
+    assert cv.FilmLaw("vertical_plate", length=1.0, minimum=50.0, factor=2.0)(60.0, 20.0, {}) == 50.0
+    from gatetherm.studies.run.parameters import case_parameters
+
+    case = _case(tmp_path, STEADY.format(time="").replace('length = 1.0 }', 'length = 1.0, factor = 1.5 }', 1))
+    p = next(p for p in case_parameters(case) if p.name == "film_free")
+    assert (p.param, p.value, p.lo, p.hi) == ("factor", 1.5, pytest.approx(0.6), pytest.approx(3.75))
+    ref = next(f.h for f in case.problem.films if f.boundary == "free")
+    moved = case.with_overrides(p.overrides(3.0))
+    film = next(f for f in moved.problem.films if f.boundary == "free")
+    assert film.law.factor == 3.0 and film.h == pytest.approx(2 * ref, rel=1e-12)

@@ -10,7 +10,7 @@ from gatetherm.solvers.expr import Value
 from gatetherm.solvers.problem import Film
 from gatetherm.studies.run.tables import Table
 
-KEYS = {"thermal.BOUNDARY.film": ("correlation", "length", "speed", "reference", "minimum")}
+KEYS = {"thermal.BOUNDARY.film": ("correlation", "length", "speed", "reference", "minimum", "factor")}
 """The keys of a film table (as :data:`gatetherm.studies.run.case.KEYS`)."""
 FILM = Range(0.0, unit="W/(m² K)")
 REFERENCE_POINT = (40.0, 20.0)
@@ -34,7 +34,7 @@ def film(t: Table, boundary: str, names) -> Film:
         f.fail("speed", f"goes with a rotating part or a flow, not {name}", "remove it")
     speed = f.value("speed", names, unit=unit) if unit else Value(0.0)
     law = FilmLaw(name, 0.0, f.number("length", Range(0.0, lo_open=True, unit="m")), speed, eps,
-                  f.number("minimum", FILM, 0.0))
+                  f.number("minimum", FILM, 0.0), f.number("factor", Range(0.1, 10.0, unit="1"), 1.0))
     if "reference" not in f.data and not speed.is_constant:
         f.fail("reference", "missing: the coefficient follows the schedule's speed",
                "give the coefficient (W/(m² K)) near the largest the run reaches")

@@ -106,9 +106,17 @@ def case_parameters(case) -> tuple[Parameter, ...]:
     as uncertain (:func:`marked`)."""
     doc, pr, out = case.origin.document, case.problem, []
     for f in pr.films:
-        if f.h > 0 and f.law is None:  # a correlation's film is not a number to scale
-            out.append(factor(f"film_{f.boundary}", "h", "W/(m2 K)", f.h, FILM, f"film coefficient of boundary "
-                              f"'{f.boundary}'", lambda v, b=f.boundary: {f"thermal.{b}.film": v}, f.boundary))
+        law = f.law
+        if law is not None and law.correlation:  # a correlation: a factor on its convective part
+            out.append(factor(f"film_{f.boundary}", "factor", "1", law.factor, FILM, f"factor on the {law.correlation} "
+                              f"film of boundary '{f.boundary}' (its convective part)",
+                              lambda v, b=f.boundary, r=f.h / law.factor: {f"thermal.{b}.film.factor": v,
+                                                                           f"thermal.{b}.film.reference": r * v},
+                              f.boundary))  # the reference scaled with it: the iterations settle below 2 × it
+        elif (law.h if law is not None else f.h) > 0:  # a number (with radiation: its convective part)
+            out.append(factor(f"film_{f.boundary}", "h", "W/(m2 K)", law.h if law is not None else f.h, FILM,
+                              f"film coefficient of boundary '{f.boundary}'",
+                              lambda v, b=f.boundary: {f"thermal.{b}.film": v}, f.boundary))
     if pr.faces is not None and pr.faces.h > 0:
         out.append(factor("faces_film", "h", "W/(m2 K)", pr.faces.h, FILM, "film coefficient of the section's "
                           "front and back faces", lambda v: {"faces.film": v}))

@@ -207,8 +207,9 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
                 return _once(p, schedule)
             return run_model(p.model, schedule.drive, schedule.times, keep_times, on_step, U0=U0, solver=p.solver,
                              solve_at=solve_at, solve_first_peak=solve_first_peak, on_state=on_state)
-        except InputError as err:  # a temperature out of range: the case's heat inputs, named with its file
-            raise (err.at(case.source) if err.field == "temperature" else err) from None
+        except InputError as err:  # a temperature out of range, a film that does not settle: named with the file
+            raise (err.at(case.source) if err.field == "temperature" or err.field.startswith("film of ") else err) \
+                from None
 
     if cache is not None and U0 is None and not keep_times and on_state is None:
         key = (repr(target.problem), id(case.mesh), schedule.label, schedule.times.tobytes())
