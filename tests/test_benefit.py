@@ -251,6 +251,12 @@ def test_a_record_in_minutes_is_said_to_be(machine):
     assert not any("time_s" in w for w in compensate(measured, case, Settings("mlr")).summary["warnings"])
     ms = measured.with_columns(time_s=measured.time_s * 1000.0)
     assert "a record in milliseconds?" in compensate(ms, case, Settings("mlr")).summary["warnings"][-1]
+    # without the case's time scale (paper, K fitted on the record): fewer than three updates of the
+    # actuator, said; where the correction is refused, the refusal says it (a fourth new user's spindle)
+    s = Settings("paper", k_source="fit", force=True)
+    [line] = [w for w in compensate(minutes, None, s).summary["warnings"] if "time_s" in w]
+    assert line == ("--data: time_s spans 480 s, less than three of the actuator's 5-min update intervals: a record "
+                    "in minutes? give time_s in seconds (minutes × 60)")
 
 
 def test_commands_beyond_the_actuators_reach_are_said_once(machine, caplog):

@@ -178,6 +178,10 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
             held.benefit(check_loop, s.held_out, basis)
     model = f"{out.model} of case {case.name!r}" if out.model and case is not None else ""
     span = span_note(case, ts, source) if model else ""  # the case's time scale matters to what it predicts
+    length, every = float(ts.time_s[-1] - ts.time_s[0]), s.params.update_interval_s
+    if not span and length < 3 * every:  # a thermal record holds hours; a few updates are no benefit to judge
+        span = (f"{source}: time_s spans {length:g} s, less than three of the actuator's {every / 60:g}-min update "
+                "intervals: a record in minutes? give time_s in seconds (minutes × 60)")
     return _checked(ts, out.loop, b, s, actuator, out.extra, out.label, out.head, (*out.notes, *filter(None, [span])),
                     model)
 
@@ -197,6 +201,8 @@ def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, hea
     name = registry.get(s.method).title or s.method
     b = held.as_applied(b, loop)
     better = _better(ts, s, actuator) if b.verdict == "worse" and not s.force else ""
+    scale = [n for n in notes if "a record in minutes?" in n]  # a record in other units: the likelier cause
+    better = f"{better} ({scale[0]})" if better and scale else better
     b, warning = held.guard(b, name, s.force, better)
     early = held.over_record(loop, s.params.settle_s, name, model)
     notes = (*notes, early) if early else notes

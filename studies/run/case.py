@@ -347,10 +347,9 @@ def case_from_document(data: dict, path: Path, mesh_factor: float = 1.0, mesh: F
         if both:
             top.fail(f"loads.{both[1]}", f"shares facets with loads.{both[0]}: the loads would add up unseen",
                      "give every part of the boundary one load table")
-    elif {"gravity", "loads", "relative"} & set(data):  # displacements need a held body
-        key = next(k for k in ("gravity", "loads", "relative") if k in data)
-        top.fail(key, f"a {'relative displacement' if key == 'relative' else 'mechanical load'} needs [supports] "
-                 "(without them the body is not solved for displacements)", "hold the body with [supports.BOUNDARY] tables")
+    elif key := next((k for k in ("gravity", "loads", "relative") if k in data), None):  # needs a held body
+        top.fail(key, f"a {'relative displacement' if key == 'relative' else 'mechanical load'} needs [supports] (without "
+                 "them the body is not solved for displacements)", "hold the body with [supports.BOUNDARY] tables")
     kw["contacts"] = case_mech.read_contacts(top, fm, not (prescribed or mechanical), elastic)
     quantities = ("T",) * (not mechanical) + (("u", "sigma") if elastic else ())
     probes = case_tables.probes(top, fm, quantities)
