@@ -210,3 +210,21 @@ def test_alpha_or_a_delta_gain_hidden_with_another_piece_is_one_group(coarse, i)
     assert fitted == pytest.approx(ALPHA_GAIN_NAMED[i], rel=1e-3)
     hidden = a[1] * (1.05e-05 if a[0].startswith("sensor:") else 1.0)  # α that makes the same δ
     assert fitted["parameter:expansion"] == pytest.approx(hidden, rel=0.04)  # band; achieved 0.32–0.43 %
+
+
+def test_a_pumped_fluids_phases_are_cut_where_another_input_steps():
+    """A cooled spindle (a pump and its supply, and a speed that steps): the phases follow the speed
+    too (a new user's 8-h run had 3 phases, all named by the coolant, none by the speed)."""
+    import gatetherm as gt
+    from gatetherm.studies.diagnosis.locate import case_phases
+
+    t = np.arange(0.0, 4 * 3600.0 + 1, 60.0)
+    cols = {"oil_degC": np.full(t.size, 40.0), "pump": np.where((t >= 7200) & (t < 9000), 0.0, 1.0),
+            "n_spindle": np.where(t < 3600, 4000.0, 8000.0)}
+    got = [(p.label, p.span()) for p in case_phases(gt.gate_frame(2), t, cols)]
+    assert got == [("pump on, oil steady (40 °C), n_spindle 4e+03", "0:00–1:00"),
+                   ("pump on, oil steady (40 °C), n_spindle 8e+03", "1:00–2:00"),
+                   ("pump off, n_spindle 8e+03", "2:00–2:30"),
+                   ("pump on, oil steady (40 °C), n_spindle 8e+03", "2:30–4:00")]
+    frame = case_phases(gt.gate_frame(2), t, {k: v for k, v in cols.items() if k != "n_spindle"})
+    assert [p.label for p in frame] == ["pump on, oil steady (40 °C)", "pump off", "pump on, oil steady (40 °C)"]

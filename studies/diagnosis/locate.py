@@ -55,21 +55,35 @@ def clock(seconds: float) -> str:
     return f"{m // 60}:{m % 60:02d}"
 
 
-def phases(t: np.ndarray, oil: np.ndarray, pump: np.ndarray) -> list[Phase]:
+def phases(t: np.ndarray, oil: np.ndarray, pump: np.ndarray, others: dict | None = None) -> list[Phase]:
     """Phases of a run from its (gap-free) inputs: "pump off", "heating",
-    "forced cooling", "pump on, oil steady (N °C oil)"."""
+    "forced cooling", "pump on, oil steady (N °C oil)"; each cut again where one of ``others``
+    (the other inputs) steps, named by their values as :func:`input_phases` names them."""
     n = len(t)
     rate = np.append(np.diff(oil) / np.diff(t), 0.0) * 3600.0 if n > 1 else np.zeros(n)
     if n > 1:  # the trend over the interval after each sample, like the pump state
         rate[-1] = rate[-2]
     kinds = np.where(pump < 0.5, "pump off", np.where(rate > OIL_RATE_K_PER_H, "heating",
                      np.where(rate < -OIL_RATE_K_PER_H, "forced cooling", "pump on, oil steady")))
+    stepping, ids = _steps(others or {})
     out = []
-    for kind, a, b in _merged(t, kinds):
+    for kind, a, b in _merged(t, [f"{k}|{i}" for k, i in zip(kinds, ids)] if stepping else kinds):
+        kind = kind.split("|")[0]
         if kind == "pump on, oil steady":
             kind = f"pump on, oil steady ({np.mean(oil[a:b]):.0f} °C)"
+        kind = ", ".join([kind, *(f"{k} {np.median(others[k][a:b]):.3g}" for k in stepping)])
         out.append(Phase(str(kind), float(t[a]), float(t[b] if b < n else t[-1]), closed=b >= n))
     return out
+
+
+def _steps(columns: dict) -> tuple[list[str], np.ndarray]:
+    """The inputs of ``columns`` that step (change between two samples by more than
+    :data:`STEP_FRACTION` of their range) and per sample the count of steps before it."""
+    jumps = {k: np.abs(np.diff(v)) > STEP_FRACTION * np.ptp(v) for k, v in columns.items() if np.ptp(v) > 0}
+    stepping = [k for k, j in jumps.items() if j.any()]
+    n = len(next(iter(columns.values()))) if columns else 0
+    ids = np.concatenate([[0], np.cumsum(np.any([jumps[k] for k in stepping], axis=0))]) if stepping else np.zeros(n)
+    return stepping, ids
 
 
 def input_phases(t: np.ndarray, columns: dict[str, np.ndarray]) -> list[Phase]:
@@ -77,11 +91,9 @@ def input_phases(t: np.ndarray, columns: dict[str, np.ndarray]) -> list[Phase]:
     between two samples by more than :data:`STEP_FRACTION` of its range), each named by the median
     values of the stepping inputs ("spindle_W 120"); one phase, "whole run", if none steps."""
     n = len(t)
-    jumps = {k: np.abs(np.diff(v)) > STEP_FRACTION * np.ptp(v) for k, v in columns.items() if np.ptp(v) > 0}
-    stepping = [k for k, j in jumps.items() if j.any()]
+    stepping, ids = _steps(columns)
     if not stepping or n < 2:
         return [Phase("whole run", float(t[0]), float(t[-1]), closed=True)]
-    ids = np.concatenate([[0], np.cumsum(np.any([jumps[k] for k in stepping], axis=0))])
     out = []
     for _, a, b in _merged(t, ids):
         name = ", ".join(f"{k} {np.median(columns[k][a:b]):.3g}" for k in stepping)
@@ -196,10 +208,12 @@ def locate(t: np.ndarray, res: dict[str, np.ndarray], run_phases: list[Phase]) -
 
 def case_phases(case, t: np.ndarray, columns: dict) -> list[Phase]:
     """Phases of a run: a pumped fluid's (pump off, heating, forced cooling, supply steady) where
-    the case has one whose supply and pump are columns, else where an input steps."""
+    the case has one whose supply and pump are columns, cut again where another input steps; else
+    where an input steps."""
     fluid = next((f for f in case.problem.fluids if len(f.supply.names()) == 1 and len(f.pump.names()) == 1
                   and f.supply.text in columns and f.pump.text in columns), None)
     if fluid is None:
         return input_phases(t, columns)
-    return phases(t, columns[fluid.supply.text], columns[fluid.pump.text])
+    others = {k: v for k, v in columns.items() if k not in (fluid.supply.text, fluid.pump.text)}
+    return phases(t, columns[fluid.supply.text], columns[fluid.pump.text], others)
 
