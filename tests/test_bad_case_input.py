@@ -304,3 +304,12 @@ def test_equations_no_solver_can_solve_are_one_line(tmp_path, capsys, monkeypatc
         raise SolverError("the matrix cannot be factorised (PARDISO phase 22 failed: zero pivot)")
     monkeypatch.setattr(gatetherm.api, "run_case", fail)
     refused(capsys, 2, ["run", "c.toml", "--out", tmp_path / "o"], "error: the matrix cannot be factorised")
+
+
+def test_a_run_length_in_hours_is_said_to_be(tmp_path):
+    """``end = 8.0`` meant 8 h: the output interval is refused as longer than the run, and the fix names
+    the end in hours."""
+    case = t3(tmp_path, "end = 32.0", "end = 0.25")
+    with pytest.raises(InputError) as got:
+        load_case(case)
+    assert str(got.value) == f"{case}: time.output: got 1, must be a number in (0, 0.25] s; or end in s: 0.25 h is end = 900"

@@ -1,17 +1,14 @@
 """Case files: a user's frame described in the names of its mesh's physical groups.
 
-A TOML case names a mesh (``.msh`` of any gmsh version, or a ``.geo``/CAD file meshed
-through gmsh) and gives materials per region, thermal conditions per boundary (film to
-an ambient, fixed temperature, heat flux; adiabatic where nothing is said), sources,
-lumped fluid volumes, supports, probes, relative displacements and the time settings.
-Every key is checked where it is read: an unknown key, a name that is not a group of
-the mesh, a region without a material or a boundary with two conditions is one
-:class:`~gatetherm.InputError` line naming the file and the key and listing what is
-valid. ``docs/case-file.md`` is the reference of every key. The tables are read by
-:mod:`~gatetherm.studies.run.case_mesh` (``[mesh]``), :mod:`~gatetherm.studies.run.case_tables`
-(materials, thermal conditions, fluids, supports, probes, signals, actuator) and
-:mod:`~gatetherm.studies.run.case_mech` (loads, contacts); this module reads the rest and
-puts the case together.
+A TOML case names a mesh (``.msh`` of any gmsh version, or a ``.geo``/CAD file meshed through gmsh) and gives
+materials per region, thermal conditions per boundary (film to an ambient, fixed temperature, heat flux; adiabatic
+where nothing is said), sources, lumped fluid volumes, supports, probes, relative displacements and the time
+settings. Every key is checked where it is read: an unknown key, a name that is not a group of the mesh, a region
+without a material or a boundary with two conditions is one :class:`~gatetherm.InputError` line naming the file
+and the key and listing what is valid. ``docs/case-file.md`` is the reference of every key. The tables are read by
+:mod:`~gatetherm.studies.run.case_mesh` (``[mesh]``), :mod:`~gatetherm.studies.run.case_tables` (materials,
+thermal conditions, fluids, supports, probes, signals, actuator) and :mod:`~gatetherm.studies.run.case_mech`
+(loads, contacts); this module reads the rest and puts the case together.
 """
 from __future__ import annotations
 
@@ -211,8 +208,11 @@ def _time(top: Table, base: Path):
     t = top.sub("time", KEYS["time"])
     end = t.number("end", SECONDS)
     within = Range(0.0, end, lo_open=True, unit="s")  # an interval longer than the run is refused
-    output = t.number("output", within, min(60.0, end))
-    step = t.number("step", within, output)
+    try:
+        output = t.number("output", within, min(60.0, end))
+        step = t.number("step", within, output)
+    except InputError as err:  # or the run's end in hours
+        raise InputError(err.field, err.problem, f"{err.fix}; or end in s: {end:g} h is end = {end * 3600:g}".lstrip("; "))
     check_steps(end, step, t.key("step"))
     if abs(output / step - round(output / step)) > 1e-9:
         t.fail("output", f"{output:g} s is not a whole multiple of the step {step:g} s", "change output or step")
