@@ -49,7 +49,8 @@ class Effect:
 KINDS: dict[str, Effect] = {e.name: e for e in (
     Effect("ambient_drift", "rate", "K/h", -1.0, 1.0, "model", "room",
            "the room temperature drifts linearly from its initial value (heating, sun, "
-           "neighbouring machines): every film's ambient; no effect when the file records the room temperature"),
+           "neighbouring machines): every film's ambient; where the file records the room, added to it (the room "
+           "the machine sees drifts away from the thermometer's)"),
     Effect("joint_resistance", "conductance", "W/(m2 K)", 150.0, 2000.0, "model", "joint",
            "thermal contact conductance of a joint (bolted, painted or lightly loaded faces) in series "
            "with its layers"),

@@ -177,7 +177,7 @@ class ReductionRun:
         """The lines ``gatetherm reduce`` prints (no final newline)."""
         red, b = self.reduction, self.reduction.error_bound
         lines = [f"wrote {self.folder}/rom.npz, summary.json: {red.rom.states} states from {red.basis.shape[0]} "
-                 f"unknowns in {self.seconds:.1f} s; BT bound "
+                 f"unknowns in {self.seconds:.1f} s; BT bound (µm; 0.1 K) "
                  + ", ".join(f"{m} {v:.3g}".strip() for m, v in b.items())]
         lines += [f"warning: {note}" for note in red.rom.notes]
         for c in self.checks:
