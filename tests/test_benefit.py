@@ -274,3 +274,17 @@ def test_commands_beyond_the_actuators_reach_are_said_once(machine, caplog):
     assert line == f"{s['piezo_saturated_updates']} of {s['updates']} piezo commands outside the reachable " \
         "-2 .. 1 um; clipped" and s["piezo_saturated_updates"] > 0
     assert "piezo" not in caplog.text
+
+
+def test_a_record_compensated_without_its_case_names_the_borrowed_piezo(machine, tmp_path):
+    """Without --case the loop has the paper frame's piezo: its clipped commands say so (a new user's
+    spindle record lost 3.8 µm to a stroke it does not have)."""
+    case, own, measured = machine
+    big = measured.with_columns(**{n: measured[n] * 8.0 for n in measured.names if n != "time_s"})  # δ to 70 µm
+    write_timeseries(tmp_path / "big.csv", TimeSeries(dict(big.columns), {"format": FORMAT}))
+    done = gt.compensate_run(tmp_path / "big.csv", method="mlr", force=True)
+    [line] = [w for w in done.record["warnings"] if "piezo" in w]
+    assert line.endswith("clipped: the paper frame's piezo (no --case); give the machine's case for its actuator, "
+                         "or --ideal")
+    mine = gt.compensate_run(tmp_path / "big.csv", case, method="mlr", force=True)
+    assert not any("paper frame's piezo" in w for w in mine.record["warnings"])

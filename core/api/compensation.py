@@ -208,6 +208,10 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
             log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
         comp = run_methods(ts, model_case, s, actuator, rom=load_rom(rom) if rom else None,
                            rom_dir=None if out is None else Path(out), source=what, rom_source=rom)
+        if case is None and condition is None and actuator is not None:  # a record of the user's machine
+            comp.summary["warnings"] = [f"{w}: the paper frame's piezo (no --case); give the machine's case for its "
+                                        "actuator, or --ideal" if "piezo commands outside" in w else w
+                                        for w in comp.summary["warnings"]]
         if on_progress is not None:
             on_progress(steps, steps)
         record = {**comp.summary, "data": _name(data), "case": _name(case), "condition": condition,
