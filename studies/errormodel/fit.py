@@ -107,7 +107,8 @@ def _run_intervals(model: ErrorModel, runs, targets, candidates, inputs, params:
     90 % quantiles, conformal over runs)."""
     from gatetherm.studies.errormodel.model import predict
 
-    spans, params = span if isinstance(span, list) else [span] * len(runs), dataclasses.replace(params, smooth_grid_s=())
+    spans = span if isinstance(span, list) else [span] * len(runs)
+    params = dataclasses.replace(params, smooth_grid_s=())
     res: dict[str, list] = {m.target: [] for m in model.targets}
     for i, run in enumerate(runs):
         rest = [r for j, r in enumerate(runs) if j != i]

@@ -95,8 +95,9 @@ def _held_note(case: Case, rom: ReducedModel, fe, held: dict) -> str:
     films = "; ".join(f"{b} {h:.3g} W/(m² K) (the law {lo:.3g} … {hi:.3g} over the run)"
                       for b, (h, lo, hi) in held.items())
     unit = "µm" if unit == "um" else "K"
-    return (f"{case.source or case.name}: the reduced model is linear: it holds each film that follows the temperature "
-            f"at its mean over the case's own run, weighted by the wall's excess over the ambient: {films}; on that run "
+    return (f"{case.source or case.name}: the reduced model is linear: it holds each film that follows the "
+            f"temperature at its mean over the case's own run, weighted by the wall's excess over the ambient: {films}; "
+            "on that run "
             f"{worst} is off the full model's by up to {err[worst]:.3g} {unit} (of {size:.3g} {unit}); another run "
             "can be further off: check it against the full model (gatetherm reduce --check)")
 

@@ -4,8 +4,8 @@ to a spacing, minus boxes that are not allowed and the parts that cannot carry o
 
 The outer surface is every facet that belongs to one cell only (in a 2-D section: its outline;
 interfaces between regions are inside), but for the facets on the axis r = 0 of an axisymmetric
-section, which lie inside the solid of revolution (a node of the axis on an end face stays). Each candidate carries the name of the boundary it lies
-on: the first named boundary of the mesh whose facets are all outer that holds the node; else, for
+section, which lie inside the solid of revolution (a node of the axis on an end face stays). Each
+candidate carries the name of the boundary it lies on: the first named boundary of the mesh whose facets are all outer that holds the node; else, for
 a node of the outer surface, ``surface`` (an unnamed part of the outline, where an interface may
 end); else the first named boundary that holds it.
 """
@@ -130,7 +130,6 @@ def unmountable_nodes(mesh, names) -> dict[str, np.ndarray]:
                              f"names: {', '.join((*mesh.regions, *mesh.boundaries))}")
     return out
 
-
 def part_at(mesh, names, xyz, tol: float = 1e-9) -> str | None:
     """The first of ``names`` (regions, boundaries) that the point ``xyz`` (m) lies in or on (a
     region: inside one of its elements, faces included; a boundary: on one of its facets), else None."""
@@ -229,4 +228,3 @@ def on_rotating(case, sensors) -> list[str]:
                     "bounds: if it rotates, no thermocouple can go there; name it in [sensors] exclude"
                     for x in sensors if x.node in nodes]
     return out
-

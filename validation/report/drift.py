@@ -144,7 +144,8 @@ def compute(ts: TimeSeries, work, name: str):
              f"{s['interval_s']:g} s (from {s['interval_min_s']:g} to {s['interval_max_s']:g} s)."]
     d = next((r for r in rows["µm"] if r["channel"] == "delta_um"), None)  # δ first: what a compensation acts on
     notes += [f"δ (delta_um, the tool against the workpiece): largest drift {d['max |drift|']:.4g} µm at "
-              f"{d['at [min]']:.4g} min, drift at the end {d['drift at end']:.4g} µm, range {d['range']:.4g} µm."] if d else []
+              f"{d['at [min]']:.4g} min, drift at the end {d['drift at end']:.4g} µm, range {d['range']:.4g} µm."
+              ] if d else []
     notes += [f"Largest drift over the whole test, {'displacement' if u == 'µm' else 'temperature'}: "
               f"{r['max |drift|']:.4g} {'µm' if u == 'µm' else 'K'} ({r['channel']}, at {r['at [min]']:.4g} min); "
               f"largest range {max(x['range'] for x in rows[u]):.4g} {'µm' if u == 'µm' else 'K'}."
