@@ -92,8 +92,9 @@ def _held_note(case: Case, rom: ReducedModel, fe, held: dict) -> str:
     unit = "um" if any(k.endswith("_um") for k in err) else "degC"
     worst = "delta_um" if "delta_um" in err else max((k for k in err if k.endswith(f"_{unit}")), key=err.get)
     size = float(np.max(np.abs(fe.result.columns[worst] - (0.0 if unit == "um" else case.problem.T0))))  # a rise
-    films = "; ".join(f"{b} {h:.3g} W/(m² K) (the law {lo:.3g} … {hi:.3g} over the run)"
-                      for b, (h, lo, hi) in held.items())
+    radiating = {f.boundary for f in case.problem.films if getattr(f.law, "emissivity", 0.0)}
+    films = "; ".join(f"{b} {h:.3g} W/(m² K) (the law{' with its radiation' * (b in radiating)} {lo:.3g} … {hi:.3g} "
+                      "over the run)" for b, (h, lo, hi) in held.items())
     unit = "µm" if unit == "um" else "K"
     return (f"{case.source or case.name}: the reduced model is linear: it holds each film that follows the "
             f"temperature at its mean over the case's own run, weighted by the wall's excess over the ambient: {films}; "
