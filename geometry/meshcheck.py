@@ -42,21 +42,25 @@ def snap_points(points: np.ndarray, cells: np.ndarray, sensors: dict[str, int]) 
                              "put the point on the meshed body (embed it in gmsh)")
         out[name] = near
         notes.append(f"mesh point {name} at ({where}) is not a node of the mesh's elements: read at the nearest "
-                     f"node, {dist.min():.3g} m away (embed the point in gmsh to read it exactly)" if _inside(
+                     f"node, {dist.min():.3g} m away (embed the point in gmsh to read it exactly)" if in_simplices(
                          points, cells, points[node]) else f"mesh point {name} at ({where}) lies outside the meshed "
                      f"body: read at its nearest node, {dist.min():.3g} m away; move the point onto the body")
     return out, notes
 
 
-def _inside(points: np.ndarray, cells: np.ndarray, x: np.ndarray, tol: float = 1e-9) -> bool:
-    """Whether ``x`` lies in one of the elements ``cells`` (faces included, to ``tol`` of their size)."""
-    v = points[cells]  # (E, dim+1, dim)
-    near = np.flatnonzero(((v.min(axis=1) <= x + tol) & (v.max(axis=1) >= x - tol)).all(axis=1))
-    if not near.size:
+def in_simplices(points: np.ndarray, simplices: np.ndarray, x, tol: float = 1e-9) -> bool:
+    """Whether the point ``x`` lies in one of ``simplices`` (node lists: elements, or facets of a lower
+    dimension), their faces included, to ``tol`` of the mesh's size."""
+    x = np.asarray(x, float)
+    eps = tol * (float(np.ptp(points, axis=0).max()) or 1.0)
+    v = points[np.asarray(simplices)]  # (S, k+1, dim)
+    v = v[((v.min(axis=1) <= x + eps) & (v.max(axis=1) >= x - eps)).all(axis=1)]  # those whose box holds it
+    if not len(v):
         return False
-    v = v[near]
-    lam = np.einsum("skd,sd->sk", np.linalg.pinv(np.swapaxes(v[:, 1:] - v[:, :1], 1, 2)), x - v[:, 0])
-    return bool(((lam >= -tol) & (lam.sum(axis=1, keepdims=True) <= 1 + tol)).all(axis=1).any())
+    E = np.swapaxes(v[:, 1:] - v[:, :1], 1, 2)  # (S, dim, k): the edges from the first vertex
+    lam = np.einsum("skd,sd->sk", np.linalg.pinv(E), x - v[:, 0])
+    gap = np.linalg.norm(np.einsum("sdk,sk->sd", E, lam) - (x - v[:, 0]), axis=1)  # off a facet's plane
+    return bool(((lam >= -tol).all(axis=1) & (lam.sum(axis=1) <= 1 + tol) & (gap <= eps)).any())
 
 
 CHUNK = 1 << 15

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from gatetherm import InputError
+from gatetherm.geometry.meshcheck import in_simplices
 
 UNNAMED = "surface"
 """The boundary name of an outer node that no named boundary holds."""
@@ -133,19 +134,8 @@ def unmountable_nodes(mesh, names) -> dict[str, np.ndarray]:
 def part_at(mesh, names, xyz, tol: float = 1e-9) -> str | None:
     """The first of ``names`` (regions, boundaries) that the point ``xyz`` (m) lies in or on (a
     region: inside one of its elements, faces included; a boundary: on one of its facets), else None."""
-    x = np.asarray(xyz, float)
-    size = float(np.ptp(mesh.points, axis=0).max()) or 1.0
-    for n in names:
-        simplices = (mesh.cells[np.asarray(mesh.regions[n], int)] if n in mesh.regions
-                     else np.asarray(mesh.boundaries[n]))
-        v = mesh.points[simplices]  # (S, k+1, dim)
-        E = np.swapaxes(v[:, 1:] - v[:, :1], 1, 2)  # (S, dim, k): the edges from the first vertex
-        lam = np.einsum("skd,sd->sk", np.linalg.pinv(E), x - v[:, 0])
-        gap = np.linalg.norm(np.einsum("sdk,sk->sd", E, lam) - (x - v[:, 0]), axis=1)
-        inside = (lam >= -tol).all(axis=1) & (lam.sum(axis=1) <= 1 + tol) & (gap <= tol * size)
-        if inside.any():
-            return n
-    return None
+    return next((n for n in names if in_simplices(mesh.points, mesh.cells[np.asarray(mesh.regions[n], int)]
+                                                  if n in mesh.regions else mesh.boundaries[n], xyz, tol)), None)
 
 
 def seated_nodes(mesh, names) -> dict[str, np.ndarray]:
