@@ -206,12 +206,10 @@ def compensate_run(data: str | os.PathLike | None = None, case: str | os.PathLik
         replaced = [name for name in WRITTEN if name in ts]
         if replaced:
             log.warning("%s: the existing columns %s are replaced", what, ", ".join(replaced))
+        borrowed = "the paper frame's piezo (no --case); give the machine's case for its actuator, or --ideal" \
+            if case is None and condition is None else ""  # a record of the user's machine on the frame's actuator
         comp = run_methods(ts, model_case, s, actuator, rom=load_rom(rom) if rom else None,
-                           rom_dir=None if out is None else Path(out), source=what, rom_source=rom)
-        if case is None and condition is None and actuator is not None:  # a record of the user's machine
-            comp.summary["warnings"] = [f"{w}: the paper frame's piezo (no --case); give the machine's case for its "
-                                        "actuator, or --ideal" if "piezo commands outside" in w else w
-                                        for w in comp.summary["warnings"]]
+                           rom_dir=None if out is None else Path(out), source=what, rom_source=rom, borrowed=borrowed)
         if on_progress is not None:
             on_progress(steps, steps)
         record = {**comp.summary, "data": _name(data), "case": _name(case), "condition": condition,

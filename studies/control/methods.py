@@ -143,8 +143,8 @@ def coefficients_noted(case, ts, s: Settings, cache) -> tuple[float, float, str,
 
 def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Settings(),
                actuator: ActuatorParams | None = None, *, rom=None, rom_dir: Path | None = None,
-               cache: ScenarioCache | None = None, source: str = "--data", rom_source: str | None = None
-               ) -> Compensation:
+               cache: ScenarioCache | None = None, source: str = "--data", rom_source: str | None = None,
+               borrowed: str = "") -> Compensation:
     """Compensate the series ``ts`` (δ the uncompensated thermal displacement).
 
     Parameters
@@ -162,6 +162,8 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
         (kept in ``rom_dir``).
     source : str
         What the series is, for messages (a file name).
+    borrowed : str
+        Where ``actuator`` is not the machine's own: what it is, said with the commands it clips.
 
     Returns
     -------
@@ -182,8 +184,7 @@ def compensate(ts: TimeSeries, case: Case | None = None, settings: Settings = Se
     if not span and length < 3 * every:  # a thermal record holds hours; a few updates are no benefit to judge
         span = (f"{source}: time_s spans {length:g} s, less than three of the actuator's {every / 60:g}-min update "
                 "intervals: a record in minutes? give time_s in seconds (minutes × 60)")
-    return _checked(ts, out.loop, b, s, actuator, out.extra, out.label, out.head, (*out.notes, *filter(None, [span])),
-                    model)
+    return _checked(ts, out.loop, b, s, actuator, out.extra, out.label, out.head, out.notes, model, span, borrowed)
 
 
 def refitted(make, basis: str):
@@ -194,21 +195,22 @@ def refitted(make, basis: str):
         return None, f"{basis} failed: {err}"
 
 
-def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head, notes=(), model: str = ""
-             ) -> Compensation:
+def _checked(ts, loop, b: held.Benefit, s: Settings, actuator, extra, label, head, notes=(), model: str = "",
+             scale: str = "", borrowed: str = "") -> Compensation:
     """The compensation with its held-out benefit, refused (InputError) where it would make δ worse
-    unless forced (:func:`.benefit.guard`)."""
+    unless forced (:func:`.benefit.guard`); ``scale``: a record's time scale in doubt (said, and the
+    likelier cause of a refusal); ``borrowed``: what the actuator is where not the machine's."""
     name = registry.get(s.method).title or s.method
     b = held.as_applied(b, loop)
     better = _better(ts, s, actuator) if b.verdict == "worse" and not s.force else ""
-    scale = [n for n in notes if "a record in minutes?" in n]  # a record in other units: the likelier cause
-    better = f"{better} ({scale[0]})" if better and scale else better
+    better = f"{better} ({scale})" if better and scale else better
+    notes = (*notes, scale) if scale else notes
     b, warning = held.guard(b, name, s.force, better)
     early = held.over_record(loop, s.params.settle_s, name, model)
     notes = (*notes, early) if early else notes
     if loop.saturated_updates:  # the correction applied (a separate check's loop clips its own)
         notes = (*notes, f"{loop.saturated_updates} of {loop.update_t_s.size} piezo commands outside the reachable "
-                 "{:.3g} .. {:.3g} um; clipped".format(*stroke_range(actuator)))
+                 "{:.3g} .. {:.3g} um; clipped".format(*stroke_range(actuator)) + (f": {borrowed}" if borrowed else ""))
     summary = {**summarize(loop, s.params.settle_s), "method": s.method, **extra,
                "resampled": loop.prediction.resampled, "compensator": dataclasses.asdict(s.params),
                "actuator": dataclasses.asdict(actuator) if actuator else None, "benefit": b.as_dict(),
