@@ -74,3 +74,16 @@ def test_the_note_is_kept_with_the_model_and_said_by_what_uses_it(tmp_path):
     assert f"warning: {first.notes[0]}" in done.summary().splitlines()
     placed = gt.place_sensors(case, count=1)
     assert placed.notes[0] == first.notes[0]
+
+
+def test_the_full_run_the_films_are_held_on_serves_the_check(tmp_path):
+    """The case's own run, made to hold the films, is kept: checking the reduced model on that schedule
+    runs the full model no second time."""
+    from gatetherm.studies.run.reduce import build_rom, check
+    from gatetherm.studies.run.scenario import ScenarioCache
+
+    case, cache = spindle(tmp_path), ScenarioCache()
+    rom = build_rom(case, 30, cache).rom
+    assert cache.runs == 1
+    [own] = check(case, rom, [case.schedule], cache)
+    assert cache.runs == 1 and own.max_delta_error_um == pytest.approx(8.12, abs=0.02)

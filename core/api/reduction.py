@@ -225,7 +225,7 @@ def reduce_case(case: Case | str | os.PathLike | None = None, *, dim: int = 2, c
     from gatetherm.api.case import PATH, gate_frame, load_case, schedule_file
     from gatetherm.checks import argument
     from gatetherm.outdir import output_dir
-    from gatetherm.studies.run.reduce import check as check_one
+    from gatetherm.studies.run.reduce import build_rom, check as check_one
     from gatetherm.studies.run.scenario import ScenarioCache
 
     states = whole_argument("states", states, STATES, "e.g. 30")
@@ -241,11 +241,10 @@ def reduce_case(case: Case | str | os.PathLike | None = None, *, dim: int = 2, c
     progress = on_progress or (lambda i, n: None)
 
     def made() -> ReductionRun:
-        t0 = time.perf_counter()
-        red = reduce(case, states)
+        t0, cache, checks = time.perf_counter(), ScenarioCache(), []
+        red = build_rom(case, states, cache)  # its model, and a full run it made, serve the checks
         seconds = time.perf_counter() - t0
         progress(1, 1 + len(schedules))
-        cache, checks = ScenarioCache(), []
         for i, s in enumerate(schedules):
             checks += check_one(case, red.rom, [s], cache)
             progress(2 + i, 1 + len(schedules))

@@ -107,10 +107,14 @@ class ScenarioCache:
     def model(self, case: Case) -> tuple[Model, HeatSolver | None]:
         return self._lru(self._models, (repr(case.problem), id(case.mesh)), lambda: _build(case))
 
-    def result(self, key, make: Callable[[], tuple[RunResult, Model]]) -> tuple[RunResult, Model]:
+    def result(self, key, make: Callable[[], tuple[RunResult, Model]], fresh: bool = False
+               ) -> tuple[RunResult, Model]:
+        """The run of ``key``, made where not kept (``fresh``: made in any case, and kept)."""
         def counted():
             self.runs += 1
             return make()
+        if fresh:
+            self._results.pop(key, None)
         return self._lru(self._results, key, counted)
 
 
@@ -195,7 +199,8 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
     full states at ``keep_times`` (their displacement fields at ``solve_at``, and with
     ``solve_first_peak`` δ's first peak's, solved during the march where it can:
     :func:`~gatetherm.studies.run.simulate.run_model`; ``on_state`` as there). With a ``cache`` the model, its
-    factorisations and (for a plain run from the initial state, no ``on_state``) the run itself are reused."""
+    factorisations and (for a plain run from the initial state) the run itself are reused; with ``on_state``
+    the run is made (its states are wanted) and kept."""
     t0 = time.perf_counter()
     schedule = case.schedule if schedule is None else schedule
     eff = active(case, effects)
@@ -211,14 +216,14 @@ def run_scenario(case: Case, schedule: Schedule | None = None, effects: Mapping[
             raise (err.at(case.source) if err.field == "temperature" or err.field.startswith("film of ") else err) \
                 from None
 
-    if cache is not None and U0 is None and not keep_times and on_state is None:
+    if cache is not None and U0 is None and not keep_times:
         key = (repr(target.problem), id(case.mesh), schedule.label, schedule.times.tobytes())
 
         def make() -> tuple[RunResult, Model]:
             model, solver = cache.model(target)
             return run(Prepared(model, solver, eff)), model
 
-        result, model = cache.result(key, make)  # a kept run is observed again without building the model
+        result, model = cache.result(key, make, fresh=on_state is not None)  # a kept run: observed again
     else:
         model, solver = assembled(target, cache)
         result = run(Prepared(model, solver, eff))
