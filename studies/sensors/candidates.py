@@ -211,8 +211,8 @@ def on_rotating(case, sensors) -> list[str]:
         for region, cells in mesh.regions.items():
             if region in case.unmountable:
                 continue
-            nodes = np.unique(mesh.cells[np.asarray(cells, int)])
-            if not any(set(f) <= set(nodes.tolist()) for f in facets):
+            nodes = set(np.unique(mesh.cells[np.asarray(cells, int)]).tolist())
+            if not any(set(f) <= nodes for f in facets):
                 continue
             out += [f"{x.name} lies on region '{region}', which the {film.law.correlation} film of '{film.boundary}' "
                     "bounds: if it rotates, no thermocouple can go there; name it in [sensors] exclude"
