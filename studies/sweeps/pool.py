@@ -55,7 +55,8 @@ class _Pool(ProcessPoolExecutor):
 def worker_pool(workers: int, mp_context=None):
     """A :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes as above;
     on an exception (Ctrl-C included) its workers are killed at once (SIGKILL: a worker still
-    starting has SIGTERM blocked; workers write no files, the parent does), not awaited."""
+    starting has SIGTERM blocked; workers write no files, the parent does), then its manager thread
+    is awaited (a signal's grace timer ends a command that hangs here)."""
     ctx = mp_context or multiprocessing.get_context()
     parent = os.getpid() if ctx.get_start_method() in ("fork", "spawn") else None  # else a server forks them
     pool = _Pool(workers, mp_context=ctx, initializer=_die_with, initargs=(parent,))
@@ -67,7 +68,9 @@ def worker_pool(workers: int, mp_context=None):
             proc.kill()
         for proc in procs:  # gone before the caller cleans up after them
             proc.join(timeout=2)
-        pool.shutdown(wait=False, cancel_futures=True)
+        # its manager thread ends now, its workers gone: left running, it raced the interpreter's exit
+        # (closing its wake-up pipe while the exit wrote to it: "Exception ignored … Bad file descriptor")
+        pool.shutdown(wait=True, cancel_futures=True)
         raise
     pool.shutdown(wait=True)
 

@@ -34,8 +34,8 @@ from gatetherm.validation.live.nodes import OBJECT, WRITTEN, machine_namespace
 log = logging.getLogger(__name__)
 
 LAST_WAIT_S = 10.0
-"""With ``wait``: how long (wall s) the last sample stays readable for the service's correction for it,
-at most (a loaded machine answers late; without an answer the twin stops after one step)."""
+"""With ``wait``: how long (wall s) the first and the last sample stay readable for the service's correction
+for them, at most (a loaded machine answers late: the first sample was overwritten before the service read it)."""
 
 
 @dataclass(frozen=True)
@@ -250,10 +250,10 @@ class _Plant:
         machine, nodes = self.machine, self.nodes
         delta = published.index("delta_um")
         temps = [i for i, n in enumerate(published) if n.endswith("_degC")]
-        late = 600.0 + params.start_s
+        late, first, shift = 600.0 + params.start_s, True, 0.0
         while True:
             t = self.t = float(machine.times[machine.k])
-            due = t_wall0 + (t - t_mach0) / params.speed
+            due = t_wall0 + shift + (t - t_mach0) / params.speed
             await asyncio.sleep(max(0.0, due - time.monotonic()))
             offset = float(await nodes["offset_um"].read_value())
             y = machine.outputs()
@@ -267,7 +267,7 @@ class _Plant:
                 if lo <= t <= hi:
                     values[name] = math.nan
             last = t >= until - 1e-9 or machine.k >= len(machine.times) - 1
-            if last and params.wait:  # the service's correction for the last sample is awaited below
+            if (first or last) and params.wait:  # the service's correction for it is awaited below
                 await nodes["offset_um"].write_value(math.nan)
             await nodes["time_s"].write_value(math.nan)
             for name, value in values.items():
@@ -280,11 +280,21 @@ class _Plant:
                 self.worst = max(self.worst, abs(comp))
             if stopped is not None and stopped():
                 break
+            if first and params.wait and not last:  # the clock runs on once the first sample is answered
+                t0 = time.monotonic()
+                await self._answered(t0 + LAST_WAIT_S, stopped)
+                shift += time.monotonic() - t0
+            first = False
             if last:  # the last sample stays readable for a step, and with a service waited for until it answers
                 end = time.monotonic() + max(params.step_s / params.speed, LAST_WAIT_S if params.wait else 0.0)
                 await asyncio.sleep(params.step_s / params.speed)
-                while params.wait and time.monotonic() < end and not math.isfinite(
-                        await nodes["offset_um"].read_value()) and not (stopped is not None and stopped()):
-                    await asyncio.sleep(0.05)
+                if params.wait:
+                    await self._answered(end, stopped)
                 break
             machine.advance()
+
+    async def _answered(self, end: float, stopped) -> None:
+        """Until the service has written its correction (``offset_um`` finite again), at most to wall ``end``."""
+        while time.monotonic() < end and not math.isfinite(await self.nodes["offset_um"].read_value()) \
+                and not (stopped is not None and stopped()):
+            await asyncio.sleep(0.05)
